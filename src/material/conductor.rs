@@ -1,0 +1,99 @@
+//! Conductor microfacets.
+
+use super::{Material, PhaseSample, g2_reflection, reflect};
+use crate::fresnel::{ComplexIor, fresnel_conductor};
+use crate::rng::uniform;
+use crate::slope::MicrosurfaceSlope;
+use glam::Vec3;
+use rand::Rng;
+
+/// Conductor microfacets: specular reflection weighted by a Fresnel term
+/// (Heitz et al. 2016, supplement §3.2).
+///
+/// [`Conductor::perfect`] has F = 1 (the supplement's non-absorptive validation baseline);
+/// [`Conductor::new`] uses the exact Fresnel term of a complex IOR per RGB channel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Conductor {
+    ior: Option<ComplexIor>,
+}
+
+impl Conductor {
+    /// A perfect mirror facet, F = 1.
+    pub fn perfect() -> Self {
+        Self { ior: None }
+    }
+
+    /// A conductor with the given complex IOR.
+    pub fn new(ior: ComplexIor) -> Self {
+        Self { ior: Some(ior) }
+    }
+
+    /// The Fresnel term for the cosine between ωi and the facet normal.
+    #[inline(always)]
+    pub fn fresnel(&self, cos_theta: f32) -> Vec3 {
+        match &self.ior {
+            None => Vec3::ONE,
+            Some(ior) => fresnel_conductor(cos_theta, ior),
+        }
+    }
+}
+
+impl Material for Conductor {
+    const TRANSMITS: bool = false;
+
+    /// p(ωi, ωo) = F(ωi·ωh) D_ωi(ωh) / (4 ωi·ωh) = F D(ωh) / (4 A(ωi)), with ωh the normalized
+    /// ωi + ωo and A the projected area (supplement §3.2).
+    #[inline]
+    fn eval_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
+        if !(wi_outside && wo_outside) {
+            return Vec3::ZERO;
+        }
+        let wh = (wi + wo).normalize_or_zero();
+        let cos_ih = wi.dot(wh);
+        if wh.z <= 0.0 || cos_ih <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let value = 0.25 * slope.d_wi(wi, wh) / cos_ih;
+        self.fresnel(cos_ih) * value
+    }
+
+    /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm).
+    #[inline]
+    fn sample_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        let wo = reflect(wi, wm).normalize_or(wm);
+        PhaseSample { wo, weight: self.fresnel(wi.dot(wm)), outside: true }
+    }
+
+    /// F(ωi·ωh) D(ωh) G2(ωi, ωo) / (4 cos θi) (the Cook–Torrance BRDF times cos θo).
+    #[inline]
+    fn eval_single_scattering<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
+        let g2 = g2_reflection(slope, wi, wo);
+        if g2 == 0.0 {
+            return Vec3::ZERO;
+        }
+        let wh = (wi + wo).normalize_or_zero();
+        let value = slope.d(wh) * g2 / (4.0 * wi.z);
+        self.fresnel(wi.dot(wh)) * value
+    }
+}

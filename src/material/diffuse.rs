@@ -1,0 +1,101 @@
+//! Diffuse (Lambertian) microfacets.
+
+use super::{Material, PhaseSample, g2_reflection};
+use crate::error::Error;
+use crate::frame::{orthonormal_basis, sample_cosine_hemisphere};
+use crate::rng::uniform;
+use crate::slope::MicrosurfaceSlope;
+use core::f32::consts::FRAC_1_PI;
+use glam::Vec3;
+use rand::Rng;
+
+/// Lambertian microfacets with an RGB albedo (Heitz et al. 2016, supplement §3.3).
+///
+/// [`Diffuse::white`] has albedo 1 (the supplement's non-absorptive validation baseline).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Diffuse {
+    albedo: Vec3,
+}
+
+impl Diffuse {
+    /// Diffuse facets with the given albedo per channel.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if a component of `albedo` is NaN or outside [0, 1].
+    pub fn new(albedo: Vec3) -> Result<Self, Error> {
+        for a in albedo.to_array() {
+            Error::check_unit_interval("albedo", a)?;
+        }
+        Ok(Self { albedo })
+    }
+
+    /// Non-absorptive facets, albedo 1.
+    pub fn white() -> Self {
+        Self { albedo: Vec3::ONE }
+    }
+
+    /// The albedo per channel.
+    #[inline]
+    pub fn albedo(&self) -> Vec3 {
+        self.albedo
+    }
+}
+
+impl Material for Diffuse {
+    const TRANSMITS: bool = false;
+
+    /// p(ωi, ωo) = (a/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm, estimated with one ωm drawn from D_ωi
+    /// (supplement §3.3, Algorithm 5): unbiased, stochastic.
+    #[inline]
+    fn eval_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
+        if !(wi_outside && wo_outside) {
+            return Vec3::ZERO;
+        }
+        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0))
+    }
+
+    /// ωm from D_ωi, then ωo cosine-distributed about ωm; weight a.
+    #[inline]
+    fn sample_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        let local = sample_cosine_hemisphere(uniform(rng), uniform(rng));
+        let (t, b) = orthonormal_basis(wm);
+        let wo = (local.x * t + local.y * b + local.z * wm).normalize_or(wm);
+        PhaseSample { wo, weight: self.albedo, outside: true }
+    }
+
+    /// (a/π) ⟨ωo, ωm⟩ (1 + Λ(ωi))/(1 + Λ(ωi) + Λ(ωo)) with ωm drawn from D_ωi: the
+    /// single-scattering BSDF times cos θo, estimated without bias (Heitz and Dupuy 2015,
+    /// supplement §3.3).
+    #[inline]
+    fn eval_single_scattering<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
+        let g2 = g2_reflection(slope, wi, wo);
+        if g2 == 0.0 {
+            return Vec3::ZERO;
+        }
+        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        let g2_given_g1 = (1.0 + slope.lambda(wi)) * g2;
+        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * g2_given_g1)
+    }
+}

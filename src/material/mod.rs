@@ -1,0 +1,87 @@
+//! Materials of the microfacets: their phase functions and single-scattering BSDFs
+//! (Heitz et al. 2016, supplement §3.2–3.4).
+
+mod conductor;
+mod dielectric;
+mod diffuse;
+
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
+pub use diffuse::Diffuse;
+
+use crate::slope::MicrosurfaceSlope;
+use glam::Vec3;
+use rand::Rng;
+
+/// An outgoing direction sampled from a phase function.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseSample {
+    /// The outgoing direction ωo (unit).
+    pub wo: Vec3,
+    /// The sample weight p/pdf per RGB channel: the Fresnel term of a conductor, the albedo of
+    /// a diffuse facet, 1 for a dielectric (whose Fresnel term chooses the event instead).
+    pub weight: Vec3,
+    /// Whether ωo leaves on the outside of the interface (always true for opaque materials;
+    /// false after a refraction).
+    pub outside: bool,
+}
+
+/// The material of the microfacets: a phase function and the single-scattering BSDF.
+///
+/// Directions follow the supplement's convention: `wi` points away from the scattering point
+/// towards where light comes from, `wo` towards where it goes. `wi_outside` and `wo_outside`
+/// tell on which side of the interface each direction lies; a material that does not
+/// transmit is only evaluated with both true. Phase functions are flipped vertically inside a
+/// dielectric (supplement §3.4), so every method is written for `wi_outside = true` and
+/// inside configurations are mapped to it.
+pub trait Material: Copy + core::fmt::Debug + Send + Sync {
+    /// Whether light can cross the interface (dielectrics).
+    const TRANSMITS: bool;
+
+    /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
+    /// given sides. Stochastic (unbiased) for the diffuse material, exact otherwise.
+    fn eval_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3;
+
+    /// Samples ωo from the phase function p(ωi, ·) for a ray arriving on side `wi_outside`.
+    fn sample_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample;
+
+    /// The single-scattering BSDF times |cos θo|, for ωi above the surface. Stochastic
+    /// (unbiased) for the diffuse material, exact otherwise.
+    fn eval_single_scattering<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        rng: &mut impl Rng,
+    ) -> Vec3;
+}
+
+/// The reflection of `wi` about the unit normal `wm`: 2(ωi·ωm)ωm − ωi.
+#[inline(always)]
+pub(crate) fn reflect(wi: Vec3, wm: Vec3) -> Vec3 {
+    2.0 * wi.dot(wm) * wm - wi
+}
+
+/// The Smith masking-shadowing G2 = 1/(1 + Λ(ωi) + Λ(ωo)) for ωi and ωo above the surface
+/// (supplement §3.2), 0 if either is at or below the horizon.
+#[inline(always)]
+pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
+    if wi.z <= 0.0 || wo.z <= 0.0 {
+        return 0.0;
+    }
+    1.0 / (1.0 + slope.lambda(wi) + slope.lambda(wo))
+}

@@ -1,0 +1,112 @@
+//! Material-independent geometry of the microsurface: masking and the height of the next
+//! intersection (Heitz et al. 2016, supplement §3.1).
+
+use crate::height::MicrosurfaceHeight;
+use crate::slope::MicrosurfaceSlope;
+use glam::Vec3;
+
+/// Where a ray leaving a point of the microsurface goes next (supplement §3.1, Algorithm 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HeightSample {
+    /// The ray intersects the microsurface again, at this height.
+    Hit(f32),
+    /// The ray leaves the microsurface without further intersection.
+    Escape,
+}
+
+/// A microsurface without a material: a height distribution and a slope distribution.
+///
+/// It answers the geometric questions of the Smith model: masking G1, masking at a height,
+/// and the height of the next intersection along a ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MicrosurfaceGeometry<H, S> {
+    height: H,
+    slope: S,
+}
+
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
+    /// Combines a height and a slope distribution.
+    pub fn new(height: H, slope: S) -> Self {
+        Self { height, slope }
+    }
+
+    /// The height distribution.
+    #[inline]
+    pub fn height(&self) -> &H {
+        &self.height
+    }
+
+    /// The slope distribution.
+    #[inline]
+    pub fn slope(&self) -> &S {
+        &self.slope
+    }
+
+    /// The masking function averaged over heights, G1(ω) = 1/(1 + Λ(ω)) for ω.z > 0 and 0 for
+    /// ω.z ≤ 0 (supplement §3.1). In [0, 1]; 1 at the zenith, 0 at the horizon.
+    #[inline]
+    pub fn g1(&self, w: Vec3) -> f32 {
+        if w.z <= 0.0 {
+            return 0.0;
+        }
+        1.0 / (1.0 + self.slope.lambda(w))
+    }
+
+    /// The masking function at height h, G1(ω, h) = C¹(h)^Λ(ω) for ω.z > 0 and 0 for ω.z ≤ 0
+    /// (supplement §3.1): the probability that a ray leaving height h in direction ω escapes.
+    /// `h` may be +∞ (above the surface: 1).
+    #[inline]
+    pub fn g1_at(&self, w: Vec3, h: f32) -> f32 {
+        if w.z <= 0.0 {
+            return 0.0;
+        }
+        escape_probability(self.height.c1(h), self.slope.lambda(w))
+    }
+
+    /// Samples the height of the next intersection of a ray leaving height `h0` in direction
+    /// `w`, from one uniform `u` ∈ [0, 1) (supplement §3.1, Algorithm 1).
+    ///
+    /// The ray escapes with probability G1(ω, h0); otherwise the next height is
+    /// C⁻¹(C¹(h0) / (1 − u)^{1/Λ(ω)}). `h0` may be +∞ (a ray arriving from above the surface).
+    /// Special cases: a ray straight up (Λ = 0) always escapes; a downward ray always hits
+    /// (below h0; straight down, uniformly in C¹ below h0); a horizontal ray hits at h0
+    /// itself, or escapes if h0 = +∞.
+    #[inline]
+    pub fn sample_height(&self, w: Vec3, h0: f32, u: f32) -> HeightSample {
+        if w.z == 0.0 {
+            return if h0 == f32::INFINITY { HeightSample::Escape } else { HeightSample::Hit(h0) };
+        }
+        match next_c1(w.z, self.slope.lambda(w), self.height.c1(h0), u) {
+            Some(c) => HeightSample::Hit(self.height.inv_c1(c)),
+            None => HeightSample::Escape,
+        }
+    }
+}
+
+/// C¹(h)^Λ for Λ ≥ 0: the probability of escaping from a point whose height has CDF value
+/// `c1`. 0^0 = 1 (a ray straight up from the bottom escapes).
+#[inline(always)]
+pub(crate) fn escape_probability(c1: f32, lambda: f32) -> f32 {
+    c1.powf(lambda)
+}
+
+/// Algorithm 1 of the supplement in C¹ space: the CDF value of the next intersection's
+/// height, or `None` if the ray escapes. `lambda` is Λ(ω) for the ray direction with
+/// z-component `z`.
+///
+/// Computed in log space: the ray escapes iff ln(1 − u) ≤ Λ ln c1, and otherwise
+/// c1' = exp(ln c1 − ln(1 − u)/Λ) (in this form c1 = 0 gives 0, not 0·∞), which lies in
+/// [0, c1] below the horizon and in [c1, 1) above it.
+#[inline(always)]
+pub(crate) fn next_c1(z: f32, lambda: f32, c1: f32, u: f32) -> Option<f32> {
+    let ln_1mu = (-u).ln_1p();
+    if z > 0.0 {
+        if c1 >= 1.0 || lambda == 0.0 || ln_1mu <= lambda * c1.ln() {
+            return None;
+        }
+        Some((c1.ln() - ln_1mu / lambda).exp().min(1.0))
+    } else {
+        // Λ ≤ −1 below the horizon; Λ = −1 − Λ(−ω) saturates at −f32::MAX at the horizon
+        Some(c1 * (ln_1mu / -lambda).exp())
+    }
+}

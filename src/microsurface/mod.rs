@@ -1,0 +1,84 @@
+//! The microsurface: geometry (heights and slopes) plus a material, with the random-walk
+//! multiple-scattering BSDF (Heitz et al. 2016, supplement §3).
+
+mod geometry;
+mod walk;
+
+pub use geometry::{HeightSample, MicrosurfaceGeometry};
+pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
+
+use crate::height::MicrosurfaceHeight;
+use crate::material::{Material, PhaseSample};
+use crate::slope::MicrosurfaceSlope;
+use glam::Vec3;
+use rand::Rng;
+
+/// A microsurface with height distribution `H`, slope distribution `S` and material `M`
+/// (`Microsurface` in Heitz et al. 2016, supplement §3.1), statically dispatched.
+///
+/// Directions are unit vectors in the local frame (z up, the macrosurface normal), both
+/// pointing away from the surface: `wi` towards the light, `wo` towards the viewer.
+/// Evaluations return the BSDF **times |cos θo|**, per RGB channel, like the supplement's
+/// `eval()`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Microsurface<H, S, M> {
+    geometry: MicrosurfaceGeometry<H, S>,
+    material: M,
+}
+
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S, M> {
+    /// Combines a height distribution, a slope distribution and a material.
+    pub fn new(height: H, slope: S, material: M) -> Self {
+        Self { geometry: MicrosurfaceGeometry::new(height, slope), material }
+    }
+
+    /// The material-independent geometry (masking, height sampling).
+    #[inline]
+    pub fn geometry(&self) -> &MicrosurfaceGeometry<H, S> {
+        &self.geometry
+    }
+
+    /// The slope distribution.
+    #[inline]
+    pub fn slope(&self) -> &S {
+        self.geometry.slope()
+    }
+
+    /// The material.
+    #[inline]
+    pub fn material(&self) -> &M {
+        &self.material
+    }
+
+    /// The phase function p(ωi, ωo) (times the material's weight) of a ray arriving from
+    /// outside, summed over both sides of the interface for a dielectric (reflection and
+    /// transmission), as the supplement's wrapper does. Integrates to 1 over the sphere for
+    /// non-absorptive materials (test 4.3.1). Stochastic for the diffuse material.
+    #[inline]
+    pub fn eval_phase(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        let slope = self.geometry.slope();
+        let reflected = self.material.eval_phase(slope, wi, wo, true, true, rng);
+        if M::TRANSMITS {
+            reflected + self.material.eval_phase(slope, wi, wo, true, false, rng)
+        } else {
+            reflected
+        }
+    }
+
+    /// Samples the phase function p(ωi, ·) of a ray arriving from outside.
+    #[inline]
+    pub fn sample_phase(&self, wi: Vec3, rng: &mut impl Rng) -> PhaseSample {
+        self.material.sample_phase(self.geometry.slope(), wi, true, rng)
+    }
+
+    /// The single-scattering BSDF times |cos θo| (what `eval` with
+    /// [`ScatteringOrder::Only`]`(1)` estimates). Zero for ωi at or below the horizon, except
+    /// for a dielectric, which is evaluated from inside.
+    #[inline]
+    pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        if !M::TRANSMITS && (wi.z <= 0.0 || wo.z <= 0.0) {
+            return Vec3::ZERO;
+        }
+        self.material.eval_single_scattering(self.geometry.slope(), wi, wo, rng)
+    }
+}

@@ -1,0 +1,248 @@
+//! The Beckmann slope distribution.
+
+use super::{MicrosurfaceSlope, check_roughness, projected_roughness_sq};
+use crate::error::Error;
+use crate::special::{erfc64, erfcx64, erfinv_from_both_ends};
+use glam::{Vec2, Vec3};
+
+/// √π.
+const SQRT_PI: f64 = 1.772_453_850_905_516;
+/// 1/√π.
+const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
+/// 1/π.
+const INV_PI: f64 = core::f64::consts::FRAC_1_PI;
+/// Uniforms are kept at least this far from 0 and 1 before they are inverted through a
+/// Gaussian tail: the quantile of 1e-30 is finite (|x̃| ≈ 8.3 at α = 1) and the probability
+/// mass left out is 1e-30.
+const MIN_TAIL_PROBABILITY: f64 = 1e-30;
+/// From this u = −x̃ on, 1 − m√π erfcx(u) is evaluated by its asymptotic series (which is free
+/// of the cancellation the direct form suffers for large u).
+const PSI_SERIES_FROM: f64 = 8.0;
+/// Newton stops once its step is below this fraction of 1 + |x̃| (the error after the last
+/// step is about the square of it).
+const NEWTON_TOLERANCE: f64 = 1e-7;
+/// A hard cap on Newton–bisection iterations (never reached in the tests: typically 3–5).
+const MAX_ITERATIONS: usize = 64;
+
+/// The anisotropic Beckmann slope distribution (Heitz et al. 2016, supplement §2.2):
+///
+/// P²²(x̃, ỹ) = exp(−x̃²/αx² − ỹ²/αy²) / (π αx αy),
+/// Λ(ω) = (erf(a) − 1)/2 + exp(−a²)/(2a√π) with a = 1/(αᵢ tan θ).
+///
+/// Λ, D, D_ωi and the projected area are evaluated in double precision with forms that
+/// avoid the cancellation of erf(a) − 1 (they use erfc). Visible normals are sampled
+/// exactly by inverting the visible-slope CDF (Jakob 2014, extended to θ ∈ [0, π]) with a
+/// safeguarded Newton iteration on the log-CDF, without the supplement's truncation of the
+/// tail (`erf_min = −0.9999`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Beckmann {
+    alpha_x: f32,
+    alpha_y: f32,
+}
+
+impl Beckmann {
+    /// An anisotropic Beckmann distribution.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if `alpha_x` or `alpha_y` is NaN, infinite or ≤ 0.
+    pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self, Error> {
+        let (alpha_x, alpha_y) = check_roughness(alpha_x, alpha_y)?;
+        Ok(Self { alpha_x, alpha_y })
+    }
+
+    /// An isotropic Beckmann distribution, α = αx = αy.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if `alpha` is NaN, infinite or ≤ 0.
+    pub fn isotropic(alpha: f32) -> Result<Self, Error> {
+        Self::new(alpha, alpha)
+    }
+
+    /// D(ωm) in double precision (0 for ωm.z ≤ 0).
+    #[inline]
+    fn d64(&self, wm: Vec3) -> f64 {
+        if wm.z <= 0.0 {
+            return 0.0;
+        }
+        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
+        let (x, y, z) = (f64::from(wm.x) / ax, f64::from(wm.y) / ay, f64::from(wm.z));
+        let z2 = z * z;
+        (-(x * x + y * y) / z2).exp() * INV_PI / (ax * ay * z2 * z2)
+    }
+
+    /// The projected area in double precision.
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        let q = f64::from(projected_roughness_sq(self.alpha_x, self.alpha_y, w));
+        let root_q = q.sqrt();
+        let z = f64::from(w.z);
+        if z >= 0.0 {
+            // ((1 + erf a)/2) cos θ + αᵢ sin θ exp(−a²)/(2√π), a = cos θ/(αᵢ sin θ)
+            let a = z / root_q;
+            0.5 * z * erfc64(-a) + 0.5 * INV_SQRT_PI * root_q * (-a * a).exp()
+        } else {
+            // Λ(−ω)|cos θ|
+            let a = -z / root_q;
+            0.5 * INV_SQRT_PI * root_q * (-a * a).exp() - 0.5 * (-z) * erfc64(a)
+        }
+    }
+}
+
+/// Λ for the upper hemisphere in double precision, a = cot θ / αᵢ ≥ 0:
+/// exp(−a²)/(2a√π) − erfc(a)/2. The cancellation of the two terms for large a costs about
+/// 2a² ulps, at most 1.5e-13 relative before exp(−a²) underflows (a ≈ 27).
+#[inline(always)]
+fn lambda_up64(a: f64) -> f64 {
+    0.5 * INV_SQRT_PI * (-a * a).exp() / a - 0.5 * erfc64(a)
+}
+
+impl MicrosurfaceSlope for Beckmann {
+    #[inline]
+    fn alpha_x(&self) -> f32 {
+        self.alpha_x
+    }
+
+    #[inline]
+    fn alpha_y(&self) -> f32 {
+        self.alpha_y
+    }
+
+    #[inline]
+    fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
+        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
+        let (x, y) = (f64::from(slope_x) / ax, f64::from(slope_y) / ay);
+        ((-(x * x) - y * y).exp() * INV_PI / (ax * ay)) as f32
+    }
+
+    /// exp(−(m.x²/αx² + m.y²/αy²)/m.z²) / (π αx αy m.z⁴), in double precision so that m.z⁴
+    /// does not underflow before the exponential does.
+    #[inline]
+    fn d(&self, wm: Vec3) -> f32 {
+        self.d64(wm) as f32
+    }
+
+    #[inline]
+    fn lambda(&self, w: Vec3) -> f32 {
+        let q = f64::from(projected_roughness_sq(self.alpha_x, self.alpha_y, w));
+        let a = f64::from(w.z.abs()) / q.sqrt();
+        let up = lambda_up64(a);
+        let value = if w.z >= 0.0 { up } else { -1.0 - up };
+        (value as f32).clamp(-f32::MAX, f32::MAX)
+    }
+
+    #[inline]
+    fn projected_area(&self, w: Vec3) -> f32 {
+        self.projected_area64(w) as f32
+    }
+
+    /// Evaluated in double precision, so that neither the projected area nor D underflow
+    /// alone when ωi is far below the horizon.
+    #[inline]
+    fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
+        let cos_im = wi.dot(wm);
+        if cos_im <= 0.0 || wm.z <= 0.0 {
+            return 0.0;
+        }
+        let area = self.projected_area64(wi);
+        if area <= 0.0 {
+            return 0.0;
+        }
+        (f64::from(cos_im) * self.d64(wm) / area) as f32
+    }
+
+    /// Exact inversion of the visible-slope CDF (see [`visible_slope_x`]); ỹ is Gaussian and
+    /// independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
+    /// visible, returns the zero slope.
+    #[inline]
+    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        let (c, s) = (f64::from(cos_theta), f64::from(sin_theta));
+        let slope_x = if s > 0.0 {
+            visible_slope_x(c / s, f64::from(u1))
+        } else if c > 0.0 {
+            gaussian_slope(f64::from(u1))
+        } else {
+            return Vec2::ZERO;
+        };
+        Vec2::new(slope_x as f32, gaussian_slope(f64::from(u2)) as f32)
+    }
+}
+
+/// The quantile of the slope density exp(−x²)/√π: erf⁻¹(2u − 1), evaluated from the nearer
+/// end of [0, 1].
+#[inline]
+fn gaussian_slope(u: f64) -> f64 {
+    let tail = u.min(1.0 - u).max(MIN_TAIL_PROBABILITY);
+    let x = erfinv_from_both_ends(1.0 - 2.0 * tail, 2.0 * tail);
+    if u < 0.5 { -x } else { x }
+}
+
+/// ln S(x) and its derivative, where S(x) = ∫₋∞ˣ (κ − t) e^{−t²} dt is (up to a constant
+/// factor) the unnormalized CDF of the visible slopes, x < κ.
+///
+/// S(x) = κ(√π/2) erfc(−x) + e^{−x²}/2. For x < 0 it is written e^{−u²} ψ(u)/2 with u = −x
+/// and ψ(u) = 1 + κ√π erfcx(u), so that the Gaussian factor is carried as a logarithm and
+/// never underflows. For κ < 0 (ωi below the horizon) ψ is a small difference; beyond
+/// `PSI_SERIES_FROM` it is evaluated as ((u + κ) + (−κ) r(u))/u with
+/// r(u) = 1 − √π u erfcx(u) from its asymptotic series, free of cancellation.
+#[inline]
+fn ln_s(kappa: f64, x: f64) -> (f64, f64) {
+    if x >= 0.0 {
+        let s = kappa * 0.5 * SQRT_PI * (2.0 - erfc64(x)) + 0.5 * (-x * x).exp();
+        return (s.ln(), (kappa - x) * (-x * x).exp() / s);
+    }
+    let u = -x;
+    let psi = if kappa >= 0.0 || u < PSI_SERIES_FROM {
+        1.0 + kappa * SQRT_PI * erfcx64(u)
+    } else {
+        let r2 = 1.0 / (2.0 * u * u);
+        // r(u) = r2 − 3r2² + 15r2³ − 105r2⁴ + 945r2⁵ − 10395r2⁶ (terms < 1e-16 beyond, u ≥ 8)
+        let r = r2 * (1.0 - r2 * (3.0 - r2 * (15.0 - r2 * (105.0 - r2 * (945.0 - r2 * 10395.0)))));
+        ((kappa - x) - kappa * r) / u
+    };
+    (-u * u + (0.5 * psi).ln(), 2.0 * (kappa - x) / psi)
+}
+
+/// Samples x̃ < κ from the density ∝ (κ − x̃) e^{−x̃²}: the visible slopes at α = 1 seen from
+/// cot θ = κ (any sign), by solving ln S(x̃) − ln S(κ) = ln u.
+///
+/// ln S is concave (S is the integral of a log-concave density), so Newton's method from the
+/// left of the root climbs to it monotonically; steps that leave the current bracket are
+/// replaced by bisection, or by a doubling step to the left while no lower bound is known.
+#[inline]
+fn visible_slope_x(kappa: f64, u: f64) -> f64 {
+    let u = u.clamp(MIN_TAIL_PROBABILITY, 1.0);
+    let ln_u = u.ln();
+    let target = ln_s(kappa, kappa).0 + ln_u;
+    // initial guess from the model survival e^{−(2m t + t²)} with t = κ − x̃ and m = max(−κ, 0),
+    // corrected for the linear factor t; exact at κ = 0
+    let big_l = -ln_u + (-ln_u).ln_1p();
+    let m = (-kappa).max(0.0);
+    let t0 = if kappa >= 0.0 {
+        // above the horizon the Gaussian quantile is an upper bound of the root
+        let x_gauss = gaussian_slope(u);
+        (kappa - x_gauss).max(big_l / (m + (m * m + big_l).sqrt()))
+    } else {
+        big_l / (m + (m * m + big_l).sqrt())
+    };
+    let mut x = kappa - t0.max(f64::MIN_POSITIVE);
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, kappa);
+    for _ in 0..MAX_ITERATIONS {
+        let (value, derivative) = ln_s(kappa, x);
+        let g = value - target;
+        if g > 0.0 {
+            hi = x;
+        } else {
+            lo = x;
+        }
+        let mut next = x - g / derivative;
+        if !(next > lo && next < hi) {
+            next = if lo.is_finite() { 0.5 * (lo + hi) } else { x - 2.0 * (hi - x) - 1.0 };
+        }
+        let step = next - x;
+        x = next;
+        if step.abs() <= NEWTON_TOLERANCE * (1.0 + x.abs()) {
+            break;
+        }
+    }
+    x.min(kappa)
+}

@@ -1,0 +1,131 @@
+//! The GGX (Trowbridge–Reitz) slope distribution.
+
+use super::{MicrosurfaceSlope, check_roughness, projected_roughness_sq};
+use crate::error::Error;
+use core::f32::consts::{FRAC_1_PI, TAU};
+use glam::{Vec2, Vec3};
+
+/// Smallest cos θm kept when a sampled normal is turned into slopes (only
+/// [`Ggx::sample_p22_11`]; the sampled normals themselves are exact).
+const MIN_SLOPE_COS: f32 = f32::MIN_POSITIVE;
+
+/// The anisotropic GGX slope distribution (Heitz et al. 2016, supplement §2.3):
+///
+/// P²²(x̃, ỹ) = 1 / (π αx αy (1 + x̃²/αx² + ỹ²/αy²)²),
+/// Λ(ω) = (−1 + sign(a) √(1 + 1/a²))/2 with a = 1/(αᵢ tan θ).
+///
+/// Visible normals are sampled exactly on the whole sphere with the spherical-cap method of
+/// Dupuy and Benyoub 2023 (“Sampling Visible GGX Normals with Spherical Caps”), which also
+/// holds for incident directions below the horizon.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ggx {
+    alpha_x: f32,
+    alpha_y: f32,
+}
+
+impl Ggx {
+    /// An anisotropic GGX distribution.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if `alpha_x` or `alpha_y` is NaN, infinite or ≤ 0.
+    pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self, Error> {
+        let (alpha_x, alpha_y) = check_roughness(alpha_x, alpha_y)?;
+        Ok(Self { alpha_x, alpha_y })
+    }
+
+    /// An isotropic GGX distribution, α = αx = αy.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if `alpha` is NaN, infinite or ≤ 0.
+    pub fn isotropic(alpha: f32) -> Result<Self, Error> {
+        Self::new(alpha, alpha)
+    }
+}
+
+/// Λ for the upper hemisphere from q = (αᵢ sin θ)² and z = cos θ ≥ 0, in the
+/// cancellation-free form q / (2z(z + √(z² + q))); saturates to `f32::MAX` at z = 0.
+#[inline(always)]
+fn lambda_up(q: f32, z: f32) -> f32 {
+    (q / (2.0 * z * (z + (z * z + q).sqrt()))).min(f32::MAX)
+}
+
+impl MicrosurfaceSlope for Ggx {
+    #[inline]
+    fn alpha_x(&self) -> f32 {
+        self.alpha_x
+    }
+
+    #[inline]
+    fn alpha_y(&self) -> f32 {
+        self.alpha_y
+    }
+
+    #[inline]
+    fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
+        let (x, y) = (slope_x / self.alpha_x, slope_y / self.alpha_y);
+        let t = 1.0 + x * x + y * y;
+        FRAC_1_PI / (self.alpha_x * self.alpha_y * t * t)
+    }
+
+    /// D(ωm) = 1 / (π αx αy (m.x²/αx² + m.y²/αy² + m.z²)²) for m.z > 0: the slope form
+    /// multiplied through by cos⁴θm, finite down to m.z = 0.
+    #[inline]
+    fn d(&self, wm: Vec3) -> f32 {
+        if wm.z <= 0.0 {
+            return 0.0;
+        }
+        let (x, y) = (wm.x / self.alpha_x, wm.y / self.alpha_y);
+        let t = x * x + y * y + wm.z * wm.z;
+        FRAC_1_PI / (self.alpha_x * self.alpha_y * t * t)
+    }
+
+    #[inline]
+    fn lambda(&self, w: Vec3) -> f32 {
+        let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
+        if w.z >= 0.0 { lambda_up(q, w.z) } else { -1.0 - lambda_up(q, -w.z) }
+    }
+
+    /// ½(cos θ + √(cos²θ + αᵢ² sin²θ)) above the horizon (supplement §2.3) and the
+    /// equivalent αᵢ² sin²θ / (2(√(cos²θ + αᵢ² sin²θ) − cos θ)) below it, which has no
+    /// cancellation there.
+    #[inline]
+    fn projected_area(&self, w: Vec3) -> f32 {
+        let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
+        let root = (w.z * w.z + q).sqrt();
+        if w.z >= 0.0 { 0.5 * (w.z + root) } else { q / (2.0 * (root - w.z)) }
+    }
+
+    /// Visible slopes at α = 1 from the spherical-cap sampler. Slopes of normals that round
+    /// to cos θm = 0 are computed with cos θm = `f32::MIN_POSITIVE` (finite, probability 0).
+    #[inline]
+    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), u1, u2);
+        let z = m.z.max(MIN_SLOPE_COS);
+        Vec2::new(-m.x / z, -m.y / z)
+    }
+
+    /// Exact for every ωi: stretch ωi to α = 1, sample the visible hemisphere with the
+    /// spherical cap, unstretch (Dupuy and Benyoub 2023, with the cap z > −ωi.z, which is
+    /// also valid for ωi.z < 0).
+    #[inline]
+    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        let v = Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z).normalize_or(Vec3::Z);
+        let h = sample_visible_hemisphere(v, u1, u2);
+        Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z).normalize_or(Vec3::Z)
+    }
+}
+
+/// Samples the normals of the unit upper hemisphere visible from the unit direction `v`, with
+/// density ∝ max(0, v·m) on m.z ≥ 0.
+///
+/// normalize(v + c) has density max(0, v·m)/π when c is uniform on the sphere (the map
+/// c = reflect(v, m) has Jacobian 4 v·m); restricting m.z ≥ 0 restricts c to the cap
+/// c.z ≥ −v.z, sampled uniformly by a uniform c.z. Returns +z when v = −z (empty cap).
+#[inline(always)]
+fn sample_visible_hemisphere(v: Vec3, u1: f32, u2: f32) -> Vec3 {
+    let z = (1.0 - u1) * (1.0 + v.z) - v.z;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
+    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (z + v.z).max(0.0));
+    h.normalize_or(Vec3::Z)
+}

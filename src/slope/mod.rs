@@ -1,0 +1,117 @@
+//! Slope distributions of the microsurface (Heitz et al. 2016, supplement §2).
+//!
+//! Every function here is valid on the whole sphere of directions (θ ∈ [0, π]), because the
+//! random walks query directions below the horizon. Directions are unit vectors in the local
+//! frame (z up). Λ is the signed Smith function, with Λ(−ω) = −1 − Λ(ω).
+
+mod beckmann;
+mod ggx;
+
+pub use beckmann::Beckmann;
+pub use ggx::Ggx;
+
+use crate::error::Error;
+use glam::{Vec2, Vec3};
+
+/// A slope distribution P²²(x̃, ỹ) with roughness (αx, αy) and everything derived from it
+/// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
+///
+/// Implementors provide the primitives `p22`, `d`, `lambda`, `projected_area` and
+/// `sample_p22_11`; `alpha_i`, `d_wi` and `sample_d_wi` are derived (and may be overridden
+/// with faster or more accurate forms).
+pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
+    /// Roughness along x.
+    fn alpha_x(&self) -> f32;
+
+    /// Roughness along y.
+    fn alpha_y(&self) -> f32;
+
+    /// The slope density P²²(x̃, ỹ), with slopes x̃ = −m.x/m.z and ỹ = −m.y/m.z.
+    fn p22(&self, slope_x: f32, slope_y: f32) -> f32;
+
+    /// The distribution of normals D(ωm) = P²²(x̃m, ỹm)/cos⁴θm for ωm.z > 0, and 0 otherwise
+    /// (supplement §2.1). Implemented in a form that stays finite as ωm.z → 0.
+    fn d(&self, wm: Vec3) -> f32;
+
+    /// Smith's Λ(ω) on the whole sphere (supplement §2.2–2.3, with the sign of a kept).
+    ///
+    /// Λ ≥ 0 for ω.z > 0 (0 at the zenith), Λ(−ω) = −1 − Λ(ω) below the horizon (−1 at the
+    /// nadir). At exactly grazing ω.z = ±0 the exact value is +∞; the result saturates to
+    /// `f32::MAX` there (and to −`f32::MAX`−1 below), never leaving the finite numbers.
+    fn lambda(&self, w: Vec3) -> f32;
+
+    /// The projected area ∫⟨ω, ωm⟩ D(ωm) dωm = (1 + Λ(ω)) cos θ ≥ 0, for every ω
+    /// (supplement §2.2–2.3), evaluated without forming 1 + Λ. It is cos θ at the zenith,
+    /// 0 at the nadir and ½ αᵢ sin θ at the horizon.
+    fn projected_area(&self, w: Vec3) -> f32;
+
+    /// Samples visible slopes of the distribution stretched to α = 1, seen from the direction
+    /// (sin θ, 0, cos θ), θ ∈ [0, π] (supplement §2.1, `sampleP22_11`).
+    ///
+    /// Takes cos θ and sin θ ≥ 0 rather than θ, and two uniforms in [0, 1).
+    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2;
+
+    /// The projected roughness αᵢ = √(cos²φ αx² + sin²φ αy²) in the azimuth of ω
+    /// (supplement §2.1). At ω = ±z, where φ is undefined, returns αx.
+    #[inline]
+    fn alpha_i(&self, w: Vec3) -> f32 {
+        let sin2 = w.x * w.x + w.y * w.y;
+        if sin2 == 0.0 {
+            return self.alpha_x();
+        }
+        (projected_roughness_sq(self.alpha_x(), self.alpha_y(), w) / sin2).sqrt()
+    }
+
+    /// The distribution of visible normals D_ωi(ωm) = ⟨ωi, ωm⟩ D(ωm) / projected_area(ωi)
+    /// (supplement §2.1), for any ωi. Zero where ωi sees no microsurface (projected area 0,
+    /// i.e. ωi = −z).
+    #[inline]
+    fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
+        let cos_im = wi.dot(wm);
+        if cos_im <= 0.0 || wm.z <= 0.0 {
+            return 0.0;
+        }
+        let area = self.projected_area(wi);
+        if area <= 0.0 {
+            return 0.0;
+        }
+        cos_im * self.d(wm) / area
+    }
+
+    /// Samples a normal ωm from D_ωi exactly, for any ωi on the sphere, from two uniforms in
+    /// [0, 1) (supplement §2.1: stretch to α = 1, sample slopes, rotate, unstretch).
+    ///
+    /// Always returns a unit vector with ωm.z ≥ 0. For ωi = −z, which sees no microsurface,
+    /// returns +z.
+    #[inline]
+    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        let (ax, ay) = (self.alpha_x(), self.alpha_y());
+        let stretched = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
+        let sin_theta = (stretched.x * stretched.x + stretched.y * stretched.y).sqrt();
+        let (cos_phi, sin_phi) =
+            if sin_theta > 0.0 { (stretched.x / sin_theta, stretched.y / sin_theta) } else { (1.0, 0.0) };
+        let s = self.sample_p22_11(stretched.z, sin_theta, u1, u2);
+        let slope_x = ax * (cos_phi * s.x - sin_phi * s.y);
+        let slope_y = ay * (sin_phi * s.x + cos_phi * s.y);
+        normal_from_slopes(slope_x, slope_y)
+    }
+}
+
+/// q = αx² ω.x² + αy² ω.y² = (αᵢ sin θ)², the squared stretched horizontal extent of ω.
+#[inline(always)]
+pub(crate) fn projected_roughness_sq(alpha_x: f32, alpha_y: f32, w: Vec3) -> f32 {
+    let (x, y) = (alpha_x * w.x, alpha_y * w.y);
+    x * x + y * y
+}
+
+/// The unit normal (−x̃, −ỹ, 1)/‖·‖ of the slopes (x̃, ỹ), without overflow for huge slopes.
+#[inline(always)]
+pub(crate) fn normal_from_slopes(slope_x: f32, slope_y: f32) -> Vec3 {
+    let scale = slope_x.abs().max(slope_y.abs()).max(1.0);
+    Vec3::new(-slope_x / scale, -slope_y / scale, 1.0 / scale).normalize()
+}
+
+/// Validates a roughness pair: both finite and > 0.
+pub(crate) fn check_roughness(alpha_x: f32, alpha_y: f32) -> Result<(f32, f32), Error> {
+    Ok((Error::check_positive("alpha_x", alpha_x)?, Error::check_positive("alpha_y", alpha_y)?))
+}

@@ -1,0 +1,14 @@
+//! Special functions used at run time: the error function, its inverse, log-gamma and beta.
+//!
+//! Each public function states its maximum error over its whole domain, measured against
+//! `statrs` in `tests/special_functions.rs`.
+
+mod erf;
+mod erfinv;
+mod gamma;
+
+pub use erf::{erf, erfc};
+pub(crate) use erf::{erfc64, erfcx64};
+pub use erfinv::erfinv;
+pub(crate) use erfinv::erfinv_from_both_ends;
+pub use gamma::{beta, ln_beta, ln_gamma};

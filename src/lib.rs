@@ -48,3 +48,8 @@ pub use microsurface::{
 };
 pub use slope::{Beckmann, Ggx, MicrosurfaceSlope};
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma};
+
+/// The README's code blocks, compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -34,6 +34,7 @@ mod fresnel;
 mod height;
 mod material;
 mod microsurface;
+mod position_free;
 mod rng;
 mod slope;
 mod special;
@@ -46,6 +47,7 @@ pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
 pub use microsurface::{
     HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
 };
+pub use position_free::{Estimator, PositionFree, Shadowing};
 pub use slope::{Beckmann, Ggx, MicrosurfaceSlope};
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma};
 

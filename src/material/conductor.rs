@@ -1,6 +1,6 @@
 //! Conductor microfacets.
 
-use super::{Material, PhaseSample, g2_reflection, reflect};
+use super::{Material, PhaseSample, g2_reflection, reflect, reflection_half_vector};
 use crate::fresnel::{ComplexIor, fresnel_conductor};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
@@ -53,16 +53,47 @@ impl Material for Conductor {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        if !(wi_outside && wo_outside) {
+        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
-        }
-        let wh = (wi + wo).normalize_or_zero();
+        };
         let cos_ih = wi.dot(wh);
-        if wh.z <= 0.0 || cos_ih <= 0.0 {
+        self.fresnel(cos_ih) * (0.25 * slope.d_wi(wi, wh) / cos_ih)
+    }
+
+    const EXACT_PHASE_PDF: bool = true;
+
+    /// D_ωi(ωh)/(4 ωi·ωh): the phase function without F.
+    #[inline]
+    fn pdf_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
+        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
+            return 0.0;
+        };
+        0.25 * slope.d_wi(wi, wh) / wi.dot(wh)
+    }
+
+    /// F(ωi·ωh) D(ωh) / (4 |cos θi|) (Wang et al. 2022, eq. 2).
+    #[inline]
+    fn vertex<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
+        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside && wi.z != 0.0)
+        else {
             return Vec3::ZERO;
-        }
-        let value = 0.25 * slope.d_wi(wi, wh) / cos_ih;
-        self.fresnel(cos_ih) * value
+        };
+        self.fresnel(wi.dot(wh)) * (slope.d(wh) / (4.0 * wi.z.abs()))
     }
 
     /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm).

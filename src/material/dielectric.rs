@@ -1,6 +1,6 @@
 //! Dielectric microfacets.
 
-use super::{Material, PhaseSample, g2_reflection, reflect};
+use super::{Material, PhaseSample, g2_reflection, reflect, reflection_half_vector};
 use crate::error::Error;
 use crate::fresnel::fresnel_dielectric;
 use crate::rng::uniform;
@@ -62,11 +62,8 @@ impl Dielectric {
         wo_outside: bool,
     ) -> f32 {
         if wo_outside {
-            let wh = (wi + wo).normalize_or_zero();
+            let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
             let cos_ih = wi.dot(wh);
-            if wh.z <= 0.0 || cos_ih <= 0.0 {
-                return 0.0;
-            }
             fresnel_dielectric(cos_ih, self.eta) * 0.25 * slope.d_wi(wi, wh) / cos_ih
         } else {
             let Some(wh) = self.refraction_half_vector(wi, wo) else { return 0.0 };
@@ -78,6 +75,29 @@ impl Dielectric {
                 * slope.d_wi(wi, wh)
                 * (-cos_oh)
                 / (denom * denom)
+        }
+    }
+
+    /// The vertex term for ωi outside (Wang et al. 2022, eqs. 2–3).
+    #[inline(always)]
+    fn vertex_outside<S: MicrosurfaceSlope>(&self, slope: &S, wi: Vec3, wo: Vec3, wo_outside: bool) -> f32 {
+        if wi.z == 0.0 {
+            return 0.0;
+        }
+        if wo_outside {
+            let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
+            fresnel_dielectric(wi.dot(wh), self.eta) * slope.d(wh) / (4.0 * wi.z.abs())
+        } else {
+            let Some(wh) = self.refraction_half_vector(wi, wo) else { return 0.0 };
+            let (cos_ih, cos_oh) = (wi.dot(wh), wo.dot(wh));
+            let denom = cos_ih + self.eta * cos_oh;
+            cos_ih
+                * (-cos_oh)
+                * self.eta
+                * self.eta
+                * (1.0 - fresnel_dielectric(cos_ih, self.eta))
+                * slope.d(wh)
+                / (wi.z.abs() * denom * denom)
         }
     }
 
@@ -111,6 +131,56 @@ impl Material for Dielectric {
             self.eval_phase_outside(slope, wi, wo, wo_outside)
         } else {
             self.flipped().eval_phase_outside(slope, -wi, -wo, !wo_outside)
+        };
+        Vec3::splat(value)
+    }
+
+    const EXACT_PHASE_PDF: bool = true;
+
+    #[inline]
+    fn relative_eta_sq(&self, wi_outside: bool, wo_outside: bool) -> f32 {
+        match (wi_outside, wo_outside) {
+            (true, false) => self.eta * self.eta,
+            (false, true) => 1.0 / (self.eta * self.eta),
+            _ => 1.0,
+        }
+    }
+
+    /// The phase function itself (the sample weight is 1).
+    #[inline]
+    fn pdf_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
+        if wi_outside {
+            self.eval_phase_outside(slope, wi, wo, wo_outside)
+        } else {
+            self.flipped().eval_phase_outside(slope, -wi, -wo, !wo_outside)
+        }
+    }
+
+    /// Reflection F D/(4|cos θi|); transmission
+    /// |ωi·ωh| |ωo·ωh| η² (1 − F) D / (|cos θi| (ωi·ωh + η ωo·ωh)²) (Wang et al. 2022, eqs. 2–3,
+    /// without the released code's extra rejection of refractions back into the incident
+    /// hemisphere); the inside configuration is flipped.
+    #[inline]
+    fn vertex<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
+        let value = if wi_outside {
+            self.vertex_outside(slope, wi, wo, wo_outside)
+        } else {
+            self.flipped().vertex_outside(slope, -wi, -wo, !wo_outside)
         };
         Vec3::splat(value)
     }

@@ -5,7 +5,7 @@ use crate::error::Error;
 use crate::frame::{orthonormal_basis, sample_cosine_hemisphere};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
-use core::f32::consts::FRAC_1_PI;
+use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
 use rand::Rng;
 
@@ -61,6 +61,45 @@ impl Material for Diffuse {
         }
         let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
         self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0))
+    }
+
+    const EXACT_PHASE_PDF: bool = false;
+
+    /// An approximation, 1/(8π) + max(0, cos θo)/(2π) for two outside directions: the exact
+    /// density (1/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm has no closed form. Positive on the whole
+    /// sphere, so that MIS weights built on it never exclude a path.
+    #[inline]
+    fn pdf_phase<S: MicrosurfaceSlope>(
+        &self,
+        _slope: &S,
+        _wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
+        if !(wi_outside && wo_outside) {
+            return 0.0;
+        }
+        0.125 / PI + 0.5 * FRAC_1_PI * wo.z.max(0.0)
+    }
+
+    /// (a/π) ⟨ωo, ωm⟩ A(ωi)/|cos θi| with ωm drawn from D_ωi: an unbiased estimate of the
+    /// vertex term (1/|cos θi|) ∫ (a/π) ⟨ωi, ωm⟩⟨ωo, ωm⟩ D(ωm) dωm.
+    #[inline]
+    fn vertex<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
+        if !(wi_outside && wo_outside) || wi.z == 0.0 {
+            return Vec3::ZERO;
+        }
+        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * slope.projected_area(wi) / wi.z.abs())
     }
 
     /// ωm from D_ωi, then ωo cosine-distributed about ωm; weight a.

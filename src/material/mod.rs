@@ -59,6 +59,48 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         rng: &mut impl Rng,
     ) -> PhaseSample;
 
+    /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
+    const EXACT_PHASE_PDF: bool;
+
+    /// The solid-angle density with which [`Material::sample_phase`] draws ωo on side
+    /// `wo_outside` from ωi on side `wi_outside`: the phase function without the per-channel
+    /// weight. Exact for conductors and dielectrics; for diffuse facets, whose density has no
+    /// closed form, a documented deterministic approximation (used only for MIS weights,
+    /// never to divide a contribution).
+    fn pdf_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32;
+
+    /// The vertex term of the position-free path integral (Wang et al. 2022, eqs. 2–3): the
+    /// local BSDF of one bounce without any shadowing, F D(ωh)/(4|cos θi|) for a reflection
+    /// and Walter's BTDF without G for a transmission. It equals the phase function divided
+    /// by the full-spherical masking G1(ωi) = |cos θi|/A(ωi) of the incident direction (A is
+    /// the projected area). Per channel; stochastic (unbiased) for diffuse facets.
+    fn vertex<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3;
+
+    /// (ηo/ηi)², the squared ratio of the indices on the two sides of an event from side
+    /// `wi_outside` to side `wo_outside`: η² for a transmission into a dielectric, 1/η² out of
+    /// it, 1 otherwise. It is the factor by which radiance transport differs from importance
+    /// transport across the interface.
+    #[inline]
+    fn relative_eta_sq(&self, wi_outside: bool, wo_outside: bool) -> f32 {
+        let _ = (wi_outside, wo_outside);
+        1.0
+    }
+
     /// The single-scattering BSDF times |cos θo|, for ωi above the surface. Stochastic
     /// (unbiased) for the diffuse material, exact otherwise.
     fn eval_single_scattering<S: MicrosurfaceSlope>(
@@ -68,6 +110,14 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         wo: Vec3,
         rng: &mut impl Rng,
     ) -> Vec3;
+}
+
+/// The normalized half vector of a reflection ωi → ωo, if it is a valid microfacet normal
+/// for the pair (ωh.z > 0 and ωi·ωh > 0).
+#[inline(always)]
+pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<Vec3> {
+    let wh = (wi + wo).normalize_or_zero();
+    (wh.z > 0.0 && wi.dot(wh) > 0.0).then_some(wh)
 }
 
 /// The reflection of `wi` about the unit normal `wm`: 2(ωi·ωm)ωm − ωi.

@@ -43,7 +43,7 @@ impl ScatteringOrder {
 
     /// The last bounce the walk needs to simulate.
     #[inline(always)]
-    fn last(self) -> u32 {
+    pub(crate) fn last(self) -> u32 {
         match self {
             Self::All => MAX_BOUNCES,
             Self::Only(n) | Self::UpTo(n) => n.get().min(MAX_BOUNCES),
@@ -52,7 +52,7 @@ impl ScatteringOrder {
 
     /// Whether bounce `k` contributes.
     #[inline(always)]
-    fn includes(self, k: u32) -> bool {
+    pub(crate) fn includes(self, k: u32) -> bool {
         match self {
             Self::All => true,
             Self::Only(n) => k == n.get(),

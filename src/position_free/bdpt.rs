@@ -1,0 +1,251 @@
+//! The bidirectional estimator (Wang et al. 2022, §4.2, eqs. 27–29), with the exact
+//! per-strategy path densities and the balance heuristic.
+
+use super::segment::{in_side_frame, inv_g1};
+use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE};
+use crate::material::Material;
+use crate::microsurface::ScatteringOrder;
+use crate::rng::uniform;
+use crate::slope::MicrosurfaceSlope;
+use glam::{DVec3, Vec3};
+use rand::Rng;
+
+/// The longest sub-path: paths of up to 2 × 48 + 1 vertices are built. Longer paths carry a
+/// negligible share of the energy (`tests/position_free.rs` bounds it below 1e-4).
+pub const BDPT_MAX_SUBPATH: usize = 48;
+
+/// A vertex of the camera sub-path, after the direction x_j was sampled at path vertex j.
+#[derive(Debug, Clone, Copy)]
+struct CameraVertex {
+    /// The incident state at vertex j + 1: −x_j and its side.
+    next: Incident,
+    /// Product of the throughput ratios of vertices 1..=j (Russian roulette included).
+    throughput: DVec3,
+    /// Density of x_j given the incident direction at vertex j.
+    pdf_forward: f64,
+    /// Density of the incident direction at vertex j given x_j (the reverse density of x_{j−1}).
+    pdf_reverse_prev: f64,
+}
+
+/// A vertex of the light sub-path, after its incident direction was sampled from its outgoing
+/// one.
+#[derive(Debug, Clone, Copy)]
+struct LightVertex {
+    /// The sampled incident direction (towards the previous vertex) and its side.
+    incident: Incident,
+    /// Product of the forward contributions / reverse densities of the light vertices so far.
+    throughput: DVec3,
+    /// Density of the incident direction given the outgoing one (how it was sampled).
+    pdf_reverse: f64,
+    /// Density of the outgoing direction given the incident one (0 for the vertex at ωo,
+    /// whose outgoing direction is fixed).
+    pdf_forward_out: f64,
+}
+
+const EMPTY_CAMERA: CameraVertex = CameraVertex {
+    next: Incident { w: Vec3::Z, outside: true },
+    throughput: DVec3::ZERO,
+    pdf_forward: 0.0,
+    pdf_reverse_prev: 0.0,
+};
+const EMPTY_LIGHT: LightVertex = LightVertex {
+    incident: Incident { w: Vec3::Z, outside: true },
+    throughput: DVec3::ZERO,
+    pdf_reverse: 0.0,
+    pdf_forward_out: 0.0,
+};
+
+impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
+    /// Evaluates f·|cos θo| by bidirectional path tracing (Wang et al. 2022, eqs. 27–29).
+    /// Unbiased and stochastic.
+    ///
+    /// A camera sub-path is sampled from ωi and a light sub-path from ωo (each with the
+    /// phase-function sampler; the light sub-path samples incident directions from outgoing
+    /// ones). Every pair of prefixes is joined through one connection vertex, and each path is
+    /// weighted by the balance heuristic over all the ways of building a path of its length,
+    /// P_s / Σ_t P_t with P_t = Π_{j≤t} p→(x_j) Π_{j>t} p←(x_j). Contributions are always
+    /// evaluated from ωi to ωo, which keeps the non-reciprocal correlated model consistent.
+    /// The densities are exact for conductors and dielectrics; for diffuse facets the MIS
+    /// weights use [`Material::pdf_phase`]'s deterministic approximation, which keeps the
+    /// estimator unbiased (the weights still sum to one).
+    pub fn eval_bdpt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+            return Vec3::ZERO;
+        };
+        let last = order.last() as usize;
+        let max_sub = (last - 1).min(BDPT_MAX_SUBPATH);
+        let mut camera = [EMPTY_CAMERA; BDPT_MAX_SUBPATH];
+        let mut light = [EMPTY_LIGHT; BDPT_MAX_SUBPATH];
+        let n_camera = self.camera_subpath(start, max_sub, &mut camera, rng);
+        let n_light = self.light_subpath(wo, wo_outside, max_sub, &mut light, rng);
+
+        let mut pdf_forward = [0.0f64; 2 * BDPT_MAX_SUBPATH + 1];
+        let mut pdf_reverse = [0.0f64; 2 * BDPT_MAX_SUBPATH + 1];
+        let mut sum = DVec3::ZERO;
+        for s in 0..=n_camera {
+            let (at, cam_throughput) =
+                if s == 0 { (start, DVec3::ONE) } else { (camera[s - 1].next, camera[s - 1].throughput) };
+            for t in 0..=n_light {
+                let n = s + t + 1;
+                if n > last || !order.includes(n as u32) {
+                    continue;
+                }
+                let (out, out_outside, light_throughput) = if t == 0 {
+                    (wo, wo_outside, DVec3::ONE)
+                } else {
+                    let l = &light[t - 1];
+                    (-l.incident.w, l.incident.outside, l.throughput)
+                };
+                let throughput = cam_throughput * light_throughput;
+                if throughput == DVec3::ZERO {
+                    continue;
+                }
+                let contribution = self.connect(at, out, out_outside, t == 0, rng);
+                if contribution == DVec3::ZERO {
+                    continue;
+                }
+                // densities of the directions x_1 … x_{n−1} of this path (index j − 1)
+                for j in 1..=s {
+                    pdf_forward[j - 1] = camera[j - 1].pdf_forward;
+                    if j < s {
+                        pdf_reverse[j - 1] = camera[j].pdf_reverse_prev;
+                    }
+                }
+                if s >= 1 {
+                    pdf_reverse[s - 1] =
+                        f64::from(self.material.pdf_phase(&self.slope, out, at.w, out_outside, at.outside));
+                }
+                if t >= 1 {
+                    pdf_forward[s] =
+                        f64::from(self.material.pdf_phase(&self.slope, at.w, out, at.outside, out_outside));
+                    for j in (s + 1)..n {
+                        let i = n - j; // light vertex whose sampled incident direction is −x_j
+                        pdf_reverse[j - 1] = light[i - 1].pdf_reverse;
+                        if j > s + 1 {
+                            pdf_forward[j - 1] = light[i].pdf_forward_out;
+                        }
+                    }
+                }
+                let weight = balance_weight(&pdf_forward[..n - 1], &pdf_reverse[..n - 1], s);
+                sum += throughput * contribution * weight;
+            }
+        }
+        sum.as_vec3()
+    }
+
+    /// Samples up to `max` directions from ωi; returns how many were stored.
+    fn camera_subpath(
+        &self,
+        start: Incident,
+        max: usize,
+        out: &mut [CameraVertex; BDPT_MAX_SUBPATH],
+        rng: &mut impl Rng,
+    ) -> usize {
+        let mut at = start;
+        let mut throughput = DVec3::ONE;
+        for j in 0..max {
+            let Some((next, ratio)) = self.extend(at, rng) else { return j };
+            throughput *= ratio;
+            if throughput == DVec3::ZERO {
+                return j;
+            }
+            let x = -next.w;
+            let pdf_forward =
+                f64::from(self.material.pdf_phase(&self.slope, at.w, x, at.outside, next.outside));
+            let pdf_reverse_prev =
+                f64::from(self.material.pdf_phase(&self.slope, x, at.w, next.outside, at.outside));
+            if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
+                let q = throughput.max_element().min(1.0);
+                if f64::from(uniform(rng)) >= q {
+                    return j;
+                }
+                throughput /= q;
+            }
+            out[j] = CameraVertex { next, throughput, pdf_forward, pdf_reverse_prev };
+            at = next;
+        }
+        max
+    }
+
+    /// Samples up to `max` incident directions backwards from ωo; returns how many were
+    /// stored. Each vertex contributes v(ωin, ωout)·S / p←(ωin | ωout), where
+    /// v/p← = w·(ηo/ηi)²·A(ωout)/|cos θin| (w: the sample weight, A: the projected area of
+    /// ωout in its side frame).
+    fn light_subpath(
+        &self,
+        wo: Vec3,
+        wo_outside: bool,
+        max: usize,
+        out: &mut [LightVertex; BDPT_MAX_SUBPATH],
+        rng: &mut impl Rng,
+    ) -> usize {
+        let (mut b, mut b_outside) = (wo, wo_outside);
+        let mut throughput = DVec3::ONE;
+        for i in 0..max {
+            let s = self.material.sample_phase(&self.slope, b, b_outside, rng);
+            let a = Incident { w: s.wo, outside: s.outside };
+            let k_in = inv_g1(&self.slope, in_side_frame(a.w, a.outside));
+            if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
+                return i;
+            }
+            let factor = self.shadowing_factor(k_in, b, b_outside, a.outside == b_outside, i == 0)
+                * f64::from(self.material.relative_eta_sq(a.outside, b_outside))
+                * f64::from(self.slope.projected_area(in_side_frame(b, b_outside)))
+                / f64::from(a.w.z.abs());
+            throughput *= s.weight.as_dvec3() * factor;
+            if throughput == DVec3::ZERO || !throughput.is_finite() {
+                return i;
+            }
+            let pdf_reverse = f64::from(self.material.pdf_phase(&self.slope, b, a.w, b_outside, a.outside));
+            let pdf_forward_out = if i == 0 {
+                0.0
+            } else {
+                f64::from(self.material.pdf_phase(&self.slope, a.w, b, a.outside, b_outside))
+            };
+            if i as u32 + 1 >= ROULETTE_FROM_BOUNCE {
+                let q = throughput.max_element().min(1.0);
+                if f64::from(uniform(rng)) >= q {
+                    return i;
+                }
+                throughput /= q;
+            }
+            out[i] = LightVertex { incident: a, throughput, pdf_reverse, pdf_forward_out };
+            b = -a.w;
+            b_outside = a.outside;
+        }
+        max
+    }
+}
+
+/// The balance-heuristic weight P_s / Σ_t P_t of the strategy that sampled s directions
+/// from the camera side, for a path whose directions x_1 … x_{n−1} have forward densities
+/// `forward[j−1]` and reverse densities `reverse[j−1]` (P_t = Π_{j≤t} p→_j Π_{j>t} p←_j).
+/// Computed from the ratios P_t/P_s, whose factors are sampled densities (> 0).
+#[inline]
+fn balance_weight(forward: &[f64], reverse: &[f64], s: usize) -> f64 {
+    let mut total = 1.0;
+    let mut r = 1.0;
+    for j in (s + 1)..=forward.len() {
+        r *= forward[j - 1] / reverse[j - 1];
+        total += r;
+    }
+    r = 1.0;
+    for j in (1..=s).rev() {
+        r *= reverse[j - 1] / forward[j - 1];
+        total += r;
+    }
+    if total.is_finite() { 1.0 / total } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::balance_weight;
+
+    #[test]
+    fn balance_weights_of_all_strategies_sum_to_one() {
+        let forward = [0.3, 2.0, 0.7, 1.1];
+        let reverse = [0.9, 0.4, 1.5, 0.2];
+        let total: f64 = (0..=forward.len()).map(|s| balance_weight(&forward, &reverse, s)).sum();
+        assert!((total - 1.0).abs() < 1e-12, "{total}");
+    }
+}

@@ -1,0 +1,221 @@
+//! Position-free multiple-bounce microfacet BSDFs (Wang, Jin, Fan, Yang, Holzschuch and Yan
+//! 2022, “Position-free Multiple-bounce Computations for Smith Microfacet BSDFs”).
+//!
+//! A light path inside the microsurface is a sequence of directions; every vertex has the
+//! same statistics, so no heights are traced. The path contribution is a product of vertex
+//! terms (the local BSDF of one bounce without shadowing, [`Material::vertex`]) and
+//! shadowing factors ([`Shadowing`]). The BSDF is estimated by path tracing with next-event
+//! estimation ([`PositionFree::eval_pt`]) or by bidirectional path tracing with the balance
+//! heuristic ([`PositionFree::eval_bdpt`]).
+
+mod bdpt;
+mod pt;
+mod segment;
+
+pub use segment::Shadowing;
+
+use crate::material::Material;
+use crate::microsurface::WalkSample;
+use crate::rng::uniform;
+use crate::slope::MicrosurfaceSlope;
+use core::f32::consts::FRAC_1_PI;
+use glam::{DVec3, Vec3};
+use rand::Rng;
+use segment::{in_side_frame, inv_g1};
+
+/// Russian roulette starts after this many sampled bounces (it is unbiased at any depth).
+const ROULETTE_FROM_BOUNCE: u32 = 3;
+/// Share of the cosine lobe in the approximate MIS density [`PositionFree::pdf`].
+const PDF_COSINE_SHARE: f32 = 0.2;
+
+/// Which estimator evaluates the position-free BSDF.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Estimator {
+    /// Unidirectional path tracing with next-event estimation (Wang et al. 2022, eqs. 24–26).
+    Pt,
+    /// Bidirectional path tracing, all connection strategies, balance heuristic
+    /// (Wang et al. 2022, eqs. 27–29).
+    #[default]
+    Bdpt,
+}
+
+/// A position-free multiple-bounce BSDF: slope distribution `S`, material `M`, and a
+/// [`Shadowing`] model. No height distribution is needed.
+///
+/// Directions follow the crate's conventions (local frame, both pointing away from the
+/// surface); evaluations return f·|cos θo| per RGB channel. A dielectric is evaluated from
+/// inside for ωi.z < 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PositionFree<S, M> {
+    slope: S,
+    material: M,
+    shadowing: Shadowing,
+}
+
+/// The incident state at a vertex: the direction towards the previous vertex and its side.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Incident {
+    pub(crate) w: Vec3,
+    pub(crate) outside: bool,
+}
+
+impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
+    /// A position-free BSDF with the given slope distribution, material and shadowing model.
+    pub fn new(slope: S, material: M, shadowing: Shadowing) -> Self {
+        Self { slope, material, shadowing }
+    }
+
+    /// The slope distribution.
+    #[inline]
+    pub fn slope(&self) -> &S {
+        &self.slope
+    }
+
+    /// The material.
+    #[inline]
+    pub fn material(&self) -> &M {
+        &self.material
+    }
+
+    /// The shadowing model.
+    #[inline]
+    pub fn shadowing(&self) -> Shadowing {
+        self.shadowing
+    }
+
+    /// Evaluates f·|cos θo| with the chosen estimator and orders; unbiased and stochastic.
+    pub fn eval(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        estimator: Estimator,
+        order: crate::ScatteringOrder,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
+        match estimator {
+            Estimator::Pt => self.eval_pt(wi, wo, order, rng),
+            Estimator::Bdpt => self.eval_bdpt(wi, wo, order, rng),
+        }
+    }
+
+    /// The single-bounce term v(ωi, ωo)·S_last (the path of one vertex): the microfacet BSDF
+    /// times |cos θo| with this model's masking-shadowing — G1(ωi)G1(ωo) uncorrelated,
+    /// 1/(1 + Λ(ωi) + Λ(ωo)) or B(1 + Λ(ωi), 1 + Λ(−ωo)) correlated. Exact, except for diffuse
+    /// facets (unbiased estimate).
+    pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+            return Vec3::ZERO;
+        };
+        self.connect(start, wo, wo_outside, true, rng).as_vec3()
+    }
+
+    /// Samples an outgoing direction with the position-free random walk (Wang et al. 2022,
+    /// §4.3): each bounce draws a visible normal (exact full-spherical VNDF sampling) and an
+    /// event; a direction that can leave the surface does so with the probability the
+    /// shadowing model gives (G1(ωo) uncorrelated; G2/G1(ωin) correlated).
+    ///
+    /// The weight is f·|cos θo|/pdf exactly: the product of the sample weights (Fresnel for
+    /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
+    /// the material, or the walk reached [`crate::MAX_BOUNCES`].
+    pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
+        let mut at = Self::incident(wi)?;
+        let mut weight = Vec3::ONE;
+        for bounces in 1..=crate::MAX_BOUNCES {
+            let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+            weight *= s.weight;
+            if weight == Vec3::ZERO {
+                return None;
+            }
+            let exit = in_side_frame(s.wo, s.outside);
+            if exit.z > 0.0 {
+                let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+                let lambda_out = f64::from(self.slope.lambda(exit));
+                let v = self.shadowing.vertex(k_in, true, lambda_out, at.outside == s.outside);
+                // P(exit) = S_last/(S_last + S_middle) = S_last/G1(ωin)
+                if f64::from(uniform(rng)) < v.last * k_in {
+                    return Some(WalkSample { wo: s.wo, weight, bounces });
+                }
+            }
+            at = Incident { w: -s.wo, outside: s.outside };
+        }
+        None
+    }
+
+    /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
+    /// in a renderer: 0.8 × the single-bounce sampling density of ωo plus 0.2 × a cosine lobe
+    /// on ωo's side (divided between both sides for a dielectric). Like the papers' `pdf()`,
+    /// it is **not** the density of what `sample` draws (which has no closed form); the
+    /// weights of `sample` never use it.
+    pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+            return 0.0;
+        };
+        let single = self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside);
+        let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
+        (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
+    }
+
+    /// The incident state for the macro direction ωi, or `None` if the material cannot be lit
+    /// from there (on the horizon, or below it for an opaque material).
+    #[inline(always)]
+    pub(crate) fn incident(wi: Vec3) -> Option<Incident> {
+        if wi.z > 0.0 {
+            Some(Incident { w: wi, outside: true })
+        } else if M::TRANSMITS && wi.z < 0.0 {
+            Some(Incident { w: wi, outside: false })
+        } else {
+            None
+        }
+    }
+
+    /// The side of the macro direction ωo, or `None` if light cannot leave there.
+    #[inline(always)]
+    pub(crate) fn exit_side(wo: Vec3) -> Option<bool> {
+        if wo.z > 0.0 {
+            Some(true)
+        } else if M::TRANSMITS && wo.z < 0.0 {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    /// The forward contribution of one vertex, v(ωin, ωout)·S, where S is the last-vertex
+    /// factor if `last` and the continuing factor otherwise.
+    #[inline]
+    pub(crate) fn connect(
+        &self,
+        at: Incident,
+        wo: Vec3,
+        wo_outside: bool,
+        last: bool,
+        rng: &mut impl Rng,
+    ) -> DVec3 {
+        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+        if k_in == 0.0 {
+            return DVec3::ZERO;
+        }
+        let factor = self.shadowing_factor(k_in, wo, wo_outside, at.outside == wo_outside, last);
+        if factor == 0.0 {
+            return DVec3::ZERO;
+        }
+        self.material.vertex(&self.slope, at.w, wo, at.outside, wo_outside, rng).as_dvec3() * factor
+    }
+
+    /// The last or continuing shadowing factor of a vertex with incident 1 + L̃ = `k_in`.
+    #[inline(always)]
+    pub(crate) fn shadowing_factor(
+        &self,
+        k_in: f64,
+        wo: Vec3,
+        wo_outside: bool,
+        reflect: bool,
+        last: bool,
+    ) -> f64 {
+        let exit = in_side_frame(wo, wo_outside);
+        let can_exit = exit.z > 0.0;
+        let lambda_out = if can_exit { f64::from(self.slope.lambda(exit)) } else { 0.0 };
+        let v = self.shadowing.vertex(k_in, can_exit, lambda_out, reflect);
+        if last { v.last } else { v.middle }
+    }
+}

@@ -1,0 +1,69 @@
+//! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
+
+use super::segment::{in_side_frame, inv_g1};
+use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE};
+use crate::material::Material;
+use crate::microsurface::ScatteringOrder;
+use crate::rng::uniform;
+use crate::slope::MicrosurfaceSlope;
+use glam::{DVec3, Vec3};
+use rand::Rng;
+
+impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
+    /// Evaluates f·|cos θo| by path tracing with next-event estimation towards ωo at every
+    /// vertex (Wang et al. 2022, eqs. 24–26). Unbiased and stochastic.
+    ///
+    /// A path is extended by sampling the phase function (exact full-spherical VNDF
+    /// sampling): the vertex term and the sampling density cancel up to w/G1(ωin), so the
+    /// throughput of a bounce is w·S_middle/G1(ωin) (w: the sample weight). Russian roulette
+    /// with survival probability min(1, max throughput) from the fourth vertex on keeps it
+    /// unbiased; the throughput is carried in f64. `order` selects all orders (no
+    /// truncation; [`crate::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
+    pub fn eval_pt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        let (Some(mut at), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+            return Vec3::ZERO;
+        };
+        let last = order.last();
+        let mut throughput = DVec3::ONE;
+        let mut sum = DVec3::ZERO;
+        for bounce in 1..=last {
+            if order.includes(bounce) {
+                sum += throughput * self.connect(at, wo, wo_outside, true, rng);
+            }
+            if bounce == last {
+                break;
+            }
+            match self.extend(at, rng) {
+                Some((next, ratio)) => {
+                    throughput *= ratio;
+                    at = next;
+                }
+                None => break,
+            }
+            if throughput == DVec3::ZERO {
+                break;
+            }
+            if bounce >= ROULETTE_FROM_BOUNCE {
+                let q = throughput.max_element().min(1.0);
+                if f64::from(uniform(rng)) >= q {
+                    break;
+                }
+                throughput /= q;
+            }
+        }
+        sum.as_vec3()
+    }
+
+    /// Samples the next direction from the incident state `at` and returns the next incident
+    /// state with the throughput ratio w·S_middle/G1(ωin) = w·k_in·S_middle.
+    #[inline]
+    pub(crate) fn extend(&self, at: Incident, rng: &mut impl Rng) -> Option<(Incident, DVec3)> {
+        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+        if k_in == 0.0 || !k_in.is_finite() {
+            return None;
+        }
+        let middle = self.shadowing_factor(k_in, s.wo, s.outside, at.outside == s.outside, false);
+        Some((Incident { w: -s.wo, outside: s.outside }, s.weight.as_dvec3() * (k_in * middle)))
+    }
+}

@@ -38,6 +38,7 @@ mod position_free;
 mod rng;
 mod slope;
 mod special;
+mod vndf;
 
 pub use error::Error;
 pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
@@ -50,6 +51,10 @@ pub use microsurface::{
 pub use position_free::{Estimator, PositionFree, Shadowing};
 pub use slope::{Beckmann, Ggx, MicrosurfaceSlope};
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma};
+pub use vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
+    smith_normalization,
+};
 
 /// The README's code blocks, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

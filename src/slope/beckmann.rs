@@ -170,7 +170,7 @@ impl MicrosurfaceSlope for Beckmann {
 /// The quantile of the slope density exp(−x²)/√π: erf⁻¹(2u − 1), evaluated from the nearer
 /// end of [0, 1].
 #[inline]
-fn gaussian_slope(u: f64) -> f64 {
+pub(crate) fn gaussian_slope(u: f64) -> f64 {
     let tail = u.min(1.0 - u).max(MIN_TAIL_PROBABILITY);
     let x = erfinv_from_both_ends(1.0 - 2.0 * tail, 2.0 * tail);
     if u < 0.5 { -x } else { x }
@@ -210,9 +210,23 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64) {
 /// replaced by bisection, or by a doubling step to the left while no lower bound is known.
 #[inline]
 fn visible_slope_x(kappa: f64, u: f64) -> f64 {
+    visible_slope_x_above(kappa, f64::NEG_INFINITY, u)
+}
+
+/// Like [`visible_slope_x`], restricted to x̃ ∈ [`lower`, κ) (`lower` may be −∞): solves
+/// S(x̃) = S(lower) + u (S(κ) − S(lower)) in log space. Used by the V-cavity sampler, whose
+/// unmasked part is the Smith VNDF limited to slopes above 3 cot θ (Tokuyoshi, listing 5).
+#[inline]
+pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
     let u = u.clamp(MIN_TAIL_PROBABILITY, 1.0);
     let ln_u = u.ln();
-    let target = ln_s(kappa, kappa).0 + ln_u;
+    let ln_s_kappa = ln_s(kappa, kappa).0;
+    let (target, mut lo) = if lower > f64::NEG_INFINITY && lower < kappa {
+        let r = (ln_s(kappa, lower).0 - ln_s_kappa).exp();
+        (ln_s_kappa + (r + u * (1.0 - r)).ln(), lower)
+    } else {
+        (ln_s_kappa + ln_u, f64::NEG_INFINITY)
+    };
     // initial guess from the model survival e^{−(2m t + t²)} with t = κ − x̃ and m = max(−κ, 0),
     // corrected for the linear factor t; exact at κ = 0
     let big_l = -ln_u + (-ln_u).ln_1p();
@@ -224,8 +238,11 @@ fn visible_slope_x(kappa: f64, u: f64) -> f64 {
     } else {
         big_l / (m + (m * m + big_l).sqrt())
     };
+    let mut hi = kappa;
     let mut x = kappa - t0.max(f64::MIN_POSITIVE);
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, kappa);
+    if x <= lo {
+        x = 0.5 * (lo + hi);
+    }
     for _ in 0..MAX_ITERATIONS {
         let (value, derivative) = ln_s(kappa, x);
         let g = value - target;

@@ -8,7 +8,7 @@ mod erfinv;
 mod gamma;
 
 pub use erf::{erf, erfc};
-pub(crate) use erf::{erfc64, erfcx64};
+pub(crate) use erf::{erf64, erfc64, erfcx64};
 pub use erfinv::erfinv;
-pub(crate) use erfinv::erfinv_from_both_ends;
+pub(crate) use erfinv::{erfinv_from_both_ends, erfinv64};
 pub use gamma::{beta, ln_beta, ln_gamma};

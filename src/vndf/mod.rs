@@ -1,0 +1,43 @@
+//! Visible-normal samplers, each with its exact density, and the V-cavity masking model
+//! (Tokuyoshi, “Unbiased VNDF Sampling for Backfacing Shading Normals”, supplement).
+//!
+//! Every sampler here is valid on the whole sphere of incident directions, including
+//! directions below the (shading-normal) horizon, and `pdf` integrates to one for each of
+//! them. A renderer picks one by type.
+
+mod disk;
+mod smith;
+mod vcavity;
+
+pub use smith::{BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf};
+pub use vcavity::{VCavity, VCavitySlope};
+
+use crate::slope::MicrosurfaceSlope;
+use glam::Vec3;
+
+/// A sampler of microfacet normals visible from an incident direction, with its density.
+pub trait VisibleNormalSampler: Copy + core::fmt::Debug + Send + Sync {
+    /// A normal ωm (unit, ωm.z ≥ 0) visible from ωi, from uniforms in [0, 1). Smith samplers
+    /// use `u[0]` and `u[1]`; V-cavity samplers also `u[2]`.
+    fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3;
+
+    /// The solid-angle density of [`VisibleNormalSampler::sample`] at ωm.
+    fn pdf(&self, wi: Vec3, wm: Vec3) -> f32;
+}
+
+/// The Smith normalization factor G(i, m)/H(i) = |i·n| / ∫ D(ω) max(i·ω, 0) dω · χ⁺(i·m)
+/// (Tokuyoshi, supplement §1, eq. 1), for any incident direction i.
+///
+/// With it, D_i(m) = G(i, m)/H(i) · ⟨i, m⟩ D(m)/|i·n| integrates to one also for backfacing
+/// i. The integral is the slope's projected area: GGX (i_z + √(αx² i_x² + αy² i_y² + i_z²))/2,
+/// Beckmann (i_z erfc(−i_z/√B) + √(B/π) exp(−i_z²/B))/2 with B = αx² i_x² + αy² i_y²,
+/// evaluated in their cancellation-free forms for i_z < 0. It equals the full-spherical
+/// masking 1/|1 + Λ(i)| of Wang et al. 2022 (eq. 10). Zero where i sees no microsurface.
+#[inline]
+pub fn smith_normalization<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: Vec3) -> f32 {
+    if wi.dot(wm) <= 0.0 {
+        return 0.0;
+    }
+    let area = slope.projected_area(wi);
+    if area <= 0.0 { 0.0 } else { wi.z.abs() / area }
+}

@@ -143,7 +143,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     ) -> usize {
         let mut at = start;
         let mut throughput = DVec3::ONE;
-        for j in 0..max {
+        for (j, slot) in out.iter_mut().enumerate().take(max) {
             let Some((next, ratio)) = self.extend(at, rng) else { return j };
             throughput *= ratio;
             if throughput == DVec3::ZERO {
@@ -161,7 +161,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 }
                 throughput /= q;
             }
-            out[j] = CameraVertex { next, throughput, pdf_forward, pdf_reverse_prev };
+            *slot = CameraVertex { next, throughput, pdf_forward, pdf_reverse_prev };
             at = next;
         }
         max
@@ -181,7 +181,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     ) -> usize {
         let (mut b, mut b_outside) = (wo, wo_outside);
         let mut throughput = DVec3::ONE;
-        for i in 0..max {
+        for (i, slot) in out.iter_mut().enumerate().take(max) {
             let s = self.material.sample_phase(&self.slope, b, b_outside, rng);
             let a = Incident { w: s.wo, outside: s.outside };
             let k_in = inv_g1(&self.slope, in_side_frame(a.w, a.outside));
@@ -209,7 +209,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 }
                 throughput /= q;
             }
-            out[i] = LightVertex { incident: a, throughput, pdf_reverse, pdf_forward_out };
+            *slot = LightVertex { incident: a, throughput, pdf_reverse, pdf_forward_out };
             b = -a.w;
             b_outside = a.outside;
         }

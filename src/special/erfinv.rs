@@ -3,7 +3,7 @@
 use super::erf::{erf64, erfc64};
 
 /// 2/√π: erf'(0).
-const TWO_OVER_SQRT_PI: f64 = 1.128_379_167_095_512_6;
+const TWO_OVER_SQRT_PI: f64 = core::f64::consts::FRAC_2_SQRT_PI;
 /// Winitzki's constant `a` of the closed-form initial guess (relative error < 2e-3).
 const WINITZKI_A: f64 = 0.147;
 /// Above this |y| the residual is formed from erfc, which keeps the tail's relative accuracy.

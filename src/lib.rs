@@ -28,6 +28,7 @@
 
 #![warn(missing_docs)]
 
+mod bsdf;
 mod error;
 mod frame;
 mod fresnel;
@@ -40,9 +41,13 @@ mod slope;
 mod special;
 mod vndf;
 
+pub use bsdf::{
+    Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder, MicrofacetBsdf,
+    SampleFlags, ShadingFrame, Technique, Transport,
+};
 pub use error::Error;
 pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
-pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric};
+pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
 pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
 pub use microsurface::{

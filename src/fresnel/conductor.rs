@@ -6,8 +6,8 @@ use glam::Vec3;
 /// A complex index of refraction η + i k per RGB channel, relative to the outside medium.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ComplexIor {
-    eta: Vec3,
-    k: Vec3,
+    pub(super) eta: Vec3,
+    pub(super) k: Vec3,
 }
 
 impl ComplexIor {

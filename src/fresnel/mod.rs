@@ -2,6 +2,9 @@
 
 mod conductor;
 mod dielectric;
+mod presets;
+mod schlick;
 
 pub use conductor::{ComplexIor, fresnel_conductor};
 pub use dielectric::fresnel_dielectric;
+pub use schlick::fresnel_schlick;

@@ -141,6 +141,28 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         None
     }
 
+    /// Samples the single-bounce term: ωo from the phase function (exact full-spherical VNDF
+    /// sampling and the material's event choice), weighted by w·S_last/G1(ωi) so that the
+    /// weight is v·S_last·|cos θo|/pdf exactly. Returns (ωo, weight); `None` if ωi cannot light
+    /// the material or the sampled direction cannot leave the surface.
+    pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
+        let at = Self::incident(wi)?;
+        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+        let last = self.shadowing_factor(k_in, s.wo, s.outside, at.outside == s.outside, true) * k_in;
+        let weight = s.weight * last as f32;
+        (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
+    }
+
+    /// The density of [`PositionFree::sample_single`]: the phase function's sampling density
+    /// (exact for conductors and dielectrics).
+    pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+            return 0.0;
+        };
+        self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside)
+    }
+
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
     /// in a renderer: 0.8 × the single-bounce sampling density of ωo plus 0.2 × a cosine lobe
     /// on ωo's side (divided between both sides for a dielectric). Like the papers' `pdf()`,

@@ -1,0 +1,200 @@
+//! The classic renderer BRDF of the CS500 project: a Lambertian lobe plus a single-scattering
+//! microfacet lobe with Phong, Beckmann or GGX normals, Smith masking and Schlick's Fresnel.
+
+use super::{Bsdf, BsdfSample, BsdfValue, SampleFlags, is_direction};
+use crate::error::Error;
+use crate::frame::sample_cosine_hemisphere;
+use crate::fresnel::fresnel_schlick;
+use crate::rng::uniform;
+use crate::special::erfc64;
+use core::f32::consts::{FRAC_1_PI, TAU};
+use glam::Vec3;
+use rand::Rng;
+
+/// Above this `a` = 1/(α tan θ) the CS500 rational approximation of the Beckmann G1 is 1.
+const RATIONAL_G1_CUTOFF: f32 = 1.6;
+
+/// The normal distribution of the classic BRDF's specular lobe (CS500, "D factor").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ClassicNdf {
+    /// D = (αp + 2)/(2π) cos^αp θm, αp ≥ 0 (larger is smoother).
+    Phong(f32),
+    /// D = exp(−tan²θm/αb²)/(π αb² cos⁴θm).
+    Beckmann(f32),
+    /// D = αg²/(π cos⁴θm (αg² + tan²θm)²).
+    Ggx(f32),
+}
+
+/// The Smith masking term of the classic BRDF, G = G1(ωi) G1(ωo).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ClassicMasking {
+    /// Exact Smith G1 = 1/(1 + Λ) (for Phong, the Beckmann Λ with αb = √(2/(αp + 2))).
+    #[default]
+    Exact,
+    /// The CS500 rational approximation for Beckmann and Phong,
+    /// (3.535a + 2.181a²)/(1 + 2.276a + 2.577a²) for a < 1.6, else 1 (a = 1/(αb tan θ), or
+    /// √(αp/2 + 1)/tan θ for Phong); GGX keeps its exact G1. Relative error below 0.5 %
+    /// (Walter et al. 2007).
+    Rational,
+}
+
+/// The CS500 BRDF: K_d/π + D G F/(4 |cos θi| |cos θo|), with Schlick's F (F0 = K_s), sampled
+/// by choosing the diffuse lobe with probability ‖K_d‖/(‖K_d‖ + ‖K_s‖) (cosine sampling) and
+/// the specular lobe otherwise (sampling D(m) cos θm and reflecting); the pdf is the mixture of
+/// both lobes' densities, so `sample`'s weight is exactly f·cos θi/pdf. Reflection only, in
+/// the upper hemisphere of the shading frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClassicBrdf {
+    kd: Vec3,
+    ks: Vec3,
+    ndf: ClassicNdf,
+    masking: ClassicMasking,
+    p_diffuse: f32,
+}
+
+impl ClassicBrdf {
+    /// A classic BRDF with diffuse albedo `kd` and specular color `ks` (both per channel in
+    /// [0, 1]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a component of `kd` or `ks` outside [0, 1] (or NaN),
+    /// both zero, a Phong exponent that is negative or not finite, or a Beckmann/GGX α that is
+    /// not finite and > 0.
+    pub fn new(kd: Vec3, ks: Vec3, ndf: ClassicNdf, masking: ClassicMasking) -> Result<Self, Error> {
+        for c in kd.to_array() {
+            Error::check_unit_interval("kd", c)?;
+        }
+        for c in ks.to_array() {
+            Error::check_unit_interval("ks", c)?;
+        }
+        match ndf {
+            ClassicNdf::Phong(e) => Error::check_non_negative("phong_exponent", e).map(|_| ())?,
+            ClassicNdf::Beckmann(a) | ClassicNdf::Ggx(a) => Error::check_positive("alpha", a).map(|_| ())?,
+        }
+        let total = kd.length() + ks.length();
+        if total == 0.0 {
+            return Err(Error::InvalidParameter { name: "kd + ks", value: 0.0, expected: "not both zero" });
+        }
+        Ok(Self { kd, ks, ndf, masking, p_diffuse: kd.length() / total })
+    }
+
+    /// D(m) for a unit normal in the shading frame.
+    pub fn d(&self, m: Vec3) -> f32 {
+        let c = m.z;
+        if c <= 0.0 {
+            return 0.0;
+        }
+        let c2 = c * c;
+        let tan2 = (1.0 - c2).max(0.0) / c2;
+        match self.ndf {
+            ClassicNdf::Phong(e) => (e + 2.0) / TAU * c.powf(e),
+            ClassicNdf::Beckmann(a) => (-tan2 / (a * a)).exp() * FRAC_1_PI / (a * a * c2 * c2),
+            ClassicNdf::Ggx(a) => {
+                let t = a * a + tan2;
+                a * a * FRAC_1_PI / (c2 * c2 * t * t)
+            }
+        }
+    }
+
+    /// G1(v) for a direction v above the horizon (0 at or below it).
+    pub fn g1(&self, v: Vec3) -> f32 {
+        if v.z <= 0.0 {
+            return 0.0;
+        }
+        if v.z >= 1.0 {
+            return 1.0;
+        }
+        let tan = (1.0 - v.z * v.z).sqrt() / v.z;
+        if tan == 0.0 {
+            return 1.0;
+        }
+        let beckmann_alpha = match self.ndf {
+            ClassicNdf::Ggx(a) => {
+                let t = a * tan;
+                return 2.0 / (1.0 + (1.0 + t * t).sqrt());
+            }
+            ClassicNdf::Beckmann(a) => a,
+            ClassicNdf::Phong(e) => (2.0 / (e + 2.0)).sqrt(),
+        };
+        let a = 1.0 / (beckmann_alpha * tan);
+        match self.masking {
+            ClassicMasking::Rational if a < RATIONAL_G1_CUTOFF => {
+                (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a)
+            }
+            ClassicMasking::Rational => 1.0,
+            ClassicMasking::Exact => {
+                let a = f64::from(a);
+                let lambda = 0.5 * (-a * a).exp() / (a * core::f64::consts::PI.sqrt()) - 0.5 * erfc64(a);
+                (1.0 / (1.0 + lambda)) as f32
+            }
+        }
+    }
+
+    /// cos θm of a normal sampled from D(m) cos θm (CS500, "Sampling a BRDF").
+    fn sample_cos_theta_m(&self, u: f32) -> f32 {
+        match self.ndf {
+            ClassicNdf::Phong(e) => u.powf(1.0 / (e + 1.0)),
+            ClassicNdf::Beckmann(a) => 1.0 / (1.0 - a * a * (-u).ln_1p()).sqrt(),
+            ClassicNdf::Ggx(a) => {
+                let tan2 = a * a * u / (1.0 - u).max(f32::MIN_POSITIVE);
+                1.0 / (1.0 + tan2).sqrt()
+            }
+        }
+    }
+
+    fn pdf_specular(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let m = (wo + wi).normalize_or_zero();
+        let cos_im = wi.dot(m);
+        if m.z <= 0.0 || cos_im <= 0.0 { 0.0 } else { self.d(m) * m.z / (4.0 * cos_im) }
+    }
+}
+
+impl Bsdf for ClassicBrdf {
+    fn eval(&self, wo: Vec3, wi: Vec3, _rng: &mut impl Rng) -> BsdfValue {
+        if !is_direction(wo) || !is_direction(wi) || wo.z <= 0.0 || wi.z <= 0.0 {
+            return BsdfValue { f: Vec3::ZERO, exact: true };
+        }
+        let m = (wo + wi).normalize();
+        let specular = self.d(m) * self.g1(wi) * self.g1(wo) / (4.0 * wi.z * wo.z);
+        let f = self.kd * FRAC_1_PI + fresnel_schlick(wi.dot(m), self.ks) * specular;
+        BsdfValue { f: if f.is_finite() { f } else { Vec3::ZERO }, exact: true }
+    }
+
+    fn sample(&self, wo: Vec3, rng: &mut impl Rng) -> Option<BsdfSample> {
+        if !is_direction(wo) || wo.z <= 0.0 {
+            return None;
+        }
+        let (u0, u1, u2) = (uniform(rng), uniform(rng), uniform(rng));
+        let wi = if u0 < self.p_diffuse {
+            sample_cosine_hemisphere(u1, u2)
+        } else {
+            let cos_m = self.sample_cos_theta_m(u1);
+            let sin_m = (1.0 - cos_m * cos_m).max(0.0).sqrt();
+            let (s, c) = (TAU * u2).sin_cos();
+            let m = Vec3::new(sin_m * c, sin_m * s, cos_m);
+            // a normal facing away from ωo reflects nothing (the CS500 listing's |ωo·m| would
+            // produce directions whose density is not the one `pdf` returns)
+            let cos_om = wo.dot(m);
+            if cos_om <= 0.0 {
+                return None;
+            }
+            2.0 * cos_om * m - wo
+        };
+        let pdf = self.pdf(wo, wi);
+        if wi.z <= 0.0 || pdf <= 0.0 {
+            return None;
+        }
+        let f = self.eval(wo, wi, rng).f;
+        let weight = f * (wi.z / pdf);
+        let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
+        weight.is_finite().then_some(BsdfSample { wi, weight, pdf, flags })
+    }
+
+    /// p_d cos θi/π + p_r D(m) cos θm/(4 |ωi·m|).
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !is_direction(wo) || !is_direction(wi) || wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        self.p_diffuse * wi.z * FRAC_1_PI + (1.0 - self.p_diffuse) * self.pdf_specular(wo, wi)
+    }
+}

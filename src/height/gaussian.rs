@@ -22,7 +22,8 @@ pub struct GaussianHeight;
 
 impl GaussianHeight {
     /// The height returned for u = 1 (and its negative for u = 0): C¹(16) = 1 and C¹(−16) = 0
-    /// in f32, while every u strictly inside (0, 1) maps to |h| < 14.1.
+    /// in f32, while every u strictly inside (0, 1) maps to |h| < 14.13
+    /// (inv_c1(2⁻¹⁴⁹) = −14.1214).
     pub const H_MAX: f32 = 16.0;
 }
 

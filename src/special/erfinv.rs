@@ -17,9 +17,9 @@ const HALLEY_STEPS: usize = 2;
 /// result saturates instead of leaving the finite numbers). NaN input gives NaN.
 ///
 /// Accuracy: computed in double precision (Winitzki's closed form refined by two Halley
-/// steps on erf, on erfc in the tails) and rounded once. Measured against `statrs` over the
-/// whole of (−1, 1), including the f32 neighbours of ±1, in `tests/special_functions.rs`:
-/// within 1 ulp.
+/// steps on erf, on erfc in the tails) and rounded once. Measured over the whole of (−1, 1),
+/// including the 2¹⁶ f32 neighbours of ±1, in `tests/special_functions.rs` against `statrs`'
+/// `erf_inv` refined by one Newton step: within 1 ulp (0.501 ulp against the f64 value).
 #[inline]
 pub fn erfinv(y: f32) -> f32 {
     if y.abs() >= 1.0 {

@@ -1,0 +1,246 @@
+//! Benchmarks of the random walks: the stochastic evaluation (`eval`, all orders) and the
+//! sampling (`sample`) of the multiple-scattering BSDF per material, slope, roughness and
+//! incident angle, on uniform heights, and the closed-form single scattering of the conductor.
+//!
+//! One call per iteration. ωi is fixed per configuration (azimuth 0, the slopes are
+//! isotropic); the ωo of `eval` are pre-generated from a fixed seed, uniform on the upper
+//! hemisphere for the opaque materials and on the whole sphere for the dielectric, and rotated
+//! through with a wrapping counter behind `std::hint::black_box`. The walk's own random
+//! numbers come from a seeded `Pcg64Mcg` that runs on across iterations.
+//!
+//! Before each configuration's benchmarks the mean number of bounces of `sample` over
+//! `BOUNCE_WALKS` walks is printed to stderr (outside the timed loops): the walk's cost is
+//! about that many times the cost of one bounce.
+//!
+//! Benchmark ids: `{material}/{slope}/{eval|sample|single}/a{α}/t{θi}` (θi in radians).
+
+use core::f32::consts::TAU;
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::Vec3;
+use microsurface::{
+    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope,
+    ScatteringOrder, UniformHeight,
+};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+use std::hint::black_box;
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+/// The number of pre-generated outgoing directions per benchmark (a power of two).
+const N: usize = 1024;
+/// The number of walks the mean bounce count is estimated from.
+const BOUNCE_WALKS: usize = 100_000;
+/// (α, θi) configurations: the 3 × 3 matrix, plus the reference configuration α = 0.5,
+/// θi = 0.5 rad.
+const CONFIGS: [(f32, f32); 10] = [
+    (0.1, 0.0),
+    (0.1, 1.0),
+    (0.1, 1.5),
+    (0.5, 0.0),
+    (0.5, 0.5),
+    (0.5, 1.0),
+    (0.5, 1.5),
+    (1.0, 0.0),
+    (1.0, 1.0),
+    (1.0, 1.5),
+];
+
+/// The next index of the rotation through the `N` inputs.
+#[inline(always)]
+fn next(i: &mut usize) -> usize {
+    let k = *i & (N - 1);
+    *i = i.wrapping_add(1);
+    k
+}
+
+/// `N` outgoing directions, uniform on the upper hemisphere (or the whole sphere when
+/// `transmits`), never exactly horizontal.
+fn outgoing_directions(transmits: bool, seed: u64) -> Vec<Vec3> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    (0..N)
+        .map(|_| {
+            // z in (0, 1], or (−1, 1] \ {0}
+            let u = 1.0 - rng.random::<f32>();
+            let z = if transmits {
+                if u > 0.5 { 2.0 * u - 1.0 } else { 2.0 * u - 1.0 - f32::EPSILON }
+            } else {
+                u
+            };
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = TAU * rng.random::<f32>();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        })
+        .collect()
+}
+
+fn bench_material<S: MicrosurfaceSlope, M: Material>(
+    c: &mut Criterion<Clock>,
+    material_name: &str,
+    material: M,
+    slope_name: &str,
+    make_slope: impl Fn(f32) -> S,
+    single_scattering: bool,
+) {
+    for (k, &(alpha, theta)) in CONFIGS.iter().enumerate() {
+        let surface = Microsurface::new(UniformHeight, make_slope(alpha), material);
+        let wi = Vec3::new(theta.sin(), 0.0, theta.cos());
+        let wo = outgoing_directions(M::TRANSMITS, 3000 + k as u64);
+        let id = format!("a{alpha:?}/t{theta:?}");
+
+        let mut rng = Pcg64Mcg::seed_from_u64(4000 + k as u64);
+        let (mut bounces, mut exits) = (0u64, 0u64);
+        for _ in 0..BOUNCE_WALKS {
+            if let Some(s) = surface.sample(wi, &mut rng) {
+                bounces += u64::from(s.bounces);
+                exits += 1;
+            }
+        }
+        eprintln!(
+            "{material_name}/{slope_name}/{id}: mean bounces of sample = {:.4} ({exits}/{BOUNCE_WALKS} walks exited)",
+            bounces as f64 / exits.max(1) as f64
+        );
+
+        let mut rng = Pcg64Mcg::seed_from_u64(5000 + k as u64);
+        c.benchmark_group(format!("{material_name}/{slope_name}/eval")).bench_function(&id, |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&surface).eval(black_box(wi), black_box(wo[k]), ScatteringOrder::All, &mut rng)
+            })
+        });
+        c.benchmark_group(format!("{material_name}/{slope_name}/sample"))
+            .bench_function(&id, |b| b.iter(|| black_box(&surface).sample(black_box(wi), &mut rng)));
+        if single_scattering {
+            c.benchmark_group(format!("{material_name}/{slope_name}/single")).bench_function(&id, |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    black_box(&surface).eval_single_scattering(black_box(wi), black_box(wo[k]), &mut rng)
+                })
+            });
+        }
+    }
+}
+
+fn walks(c: &mut Criterion<Clock>) {
+    let ggx = |a| Ggx::isotropic(a).expect("valid roughness");
+    let beckmann = |a| Beckmann::isotropic(a).expect("valid roughness");
+    let dielectric = Dielectric::new(1.5).expect("valid index");
+    bench_material(c, "conductor", Conductor::perfect(), "ggx", ggx, true);
+    bench_material(c, "conductor", Conductor::perfect(), "beckmann", beckmann, true);
+    bench_material(c, "dielectric", dielectric, "ggx", ggx, false);
+    bench_material(c, "dielectric", dielectric, "beckmann", beckmann, false);
+    bench_material(c, "diffuse", Diffuse::white(), "ggx", ggx, false);
+    bench_material(c, "diffuse", Diffuse::white(), "beckmann", beckmann, false);
+}
+
+/// The clock of the measurements: wall time by default, or with `MICROSURFACE_BENCH_CLOCK=cpu`
+/// the CPU time of the benchmarking thread (Linux), which leaves out the time the thread
+/// spends preempted when other processes compete for the cores. Reported as durations either
+/// way.
+#[derive(Debug, Clone, Copy)]
+enum Clock {
+    Wall,
+    #[cfg(target_os = "linux")]
+    ThreadCpu,
+}
+
+#[cfg(target_os = "linux")]
+mod thread_cpu {
+    use std::time::Duration;
+
+    /// `struct timespec` on Linux (`time_t` and `long` are the pointer width).
+    #[repr(C)]
+    struct Timespec {
+        tv_sec: isize,
+        tv_nsec: isize,
+    }
+
+    /// `CLOCK_THREAD_CPUTIME_ID` on Linux.
+    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+
+    unsafe extern "C" {
+        fn clock_gettime(clock_id: i32, tp: *mut Timespec) -> i32;
+    }
+
+    /// The CPU time consumed by the calling thread.
+    pub fn now() -> Duration {
+        let mut t = Timespec { tv_sec: 0, tv_nsec: 0 };
+        // SAFETY: `t` is a valid `struct timespec` to write to; the clock id is supported
+        // by every Linux since 2.6.12.
+        let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut t) };
+        assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
+        Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
+    }
+}
+
+impl Clock {
+    fn from_env() -> Self {
+        match std::env::var("MICROSURFACE_BENCH_CLOCK").as_deref() {
+            #[cfg(target_os = "linux")]
+            Ok("cpu") => Self::ThreadCpu,
+            Ok("wall") | Err(_) => Self::Wall,
+            Ok(other) => panic!("MICROSURFACE_BENCH_CLOCK={other}: expected `wall` or `cpu`"),
+        }
+    }
+
+    /// The time since an arbitrary fixed origin.
+    fn now(self) -> Duration {
+        static ORIGIN: OnceLock<Instant> = OnceLock::new();
+        match self {
+            Self::Wall => ORIGIN.get_or_init(Instant::now).elapsed(),
+            #[cfg(target_os = "linux")]
+            Self::ThreadCpu => thread_cpu::now(),
+        }
+    }
+}
+
+impl Measurement for Clock {
+    type Intermediate = Duration;
+    type Value = Duration;
+
+    fn start(&self) -> Duration {
+        self.now()
+    }
+
+    fn end(&self, start: Duration) -> Duration {
+        self.now().saturating_sub(start)
+    }
+
+    fn add(&self, v1: &Duration, v2: &Duration) -> Duration {
+        *v1 + *v2
+    }
+
+    fn zero(&self) -> Duration {
+        Duration::ZERO
+    }
+
+    fn to_f64(&self, value: &Duration) -> f64 {
+        value.as_nanos() as f64
+    }
+
+    fn formatter(&self) -> &dyn ValueFormatter {
+        static WALL: WallTime = WallTime;
+        WALL.formatter()
+    }
+}
+
+/// Short runs: the matrix is large, and the whole suite should finish in a few minutes.
+fn config() -> Criterion<Clock> {
+    Criterion::default()
+        .with_measurement(Clock::from_env())
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(1))
+        .sample_size(20)
+        .nresamples(20_000)
+        .without_plots()
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = walks
+}
+criterion_main!(benches);

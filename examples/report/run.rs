@@ -1,0 +1,801 @@
+//! The computations of the report: error against run time, lobes per scattering order,
+//! energy per order and cost. Shared by `main.rs` and `tests/report.rs`.
+
+use super::plot::{Canvas, PALETTE, Series, loglog_chart, polar_chart};
+use glam::Vec3;
+use microsurface::{
+    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
+    ScatteringOrder, Shadowing, UniformHeight,
+};
+use rand::SeedableRng;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+type Rng = rand_pcg::Pcg64Mcg;
+
+/// What to compute and where to write it.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// A small run for CI (seconds instead of a minute).
+    pub quick: bool,
+    /// Output directory.
+    pub out_dir: PathBuf,
+    /// Worker threads.
+    pub threads: usize,
+    /// Print a progress bar on stderr.
+    pub progress: bool,
+}
+
+/// Sample counts of one run.
+#[derive(Debug, Clone, Copy)]
+struct Budget {
+    /// Evaluations per estimator and configuration.
+    samples: usize,
+    /// Evaluations of the converged reference, as a multiple of `samples`.
+    reference_factor: usize,
+    lobe_angles: usize,
+    lobe_samples: usize,
+    energy_walks: usize,
+    furnace_samples: usize,
+    cost_calls: usize,
+}
+
+impl Budget {
+    fn new(quick: bool) -> Self {
+        if quick {
+            Self {
+                samples: 1 << 10,
+                reference_factor: 4,
+                lobe_angles: 13,
+                lobe_samples: 96,
+                energy_walks: 1 << 10,
+                furnace_samples: 1 << 10,
+                cost_calls: 2_000,
+            }
+        } else {
+            Self {
+                samples: 1 << 15,
+                reference_factor: 4,
+                lobe_angles: 61,
+                lobe_samples: 2048,
+                energy_walks: 1 << 15,
+                furnace_samples: 1 << 15,
+                cost_calls: 100_000,
+            }
+        }
+    }
+}
+
+/// The estimators compared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Est {
+    Single,
+    Walk,
+    PtUncorrelated,
+    PtCorrelated,
+    BdptUncorrelated,
+    BdptCorrelated,
+}
+
+impl Est {
+    pub const ALL: [Est; 6] = [
+        Est::Single,
+        Est::Walk,
+        Est::PtUncorrelated,
+        Est::PtCorrelated,
+        Est::BdptUncorrelated,
+        Est::BdptCorrelated,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Est::Single => "single",
+            Est::Walk => "heitz-walk",
+            Est::PtUncorrelated => "pt-uncorr",
+            Est::PtCorrelated => "pt-corr",
+            Est::BdptUncorrelated => "bdpt-uncorr",
+            Est::BdptCorrelated => "bdpt-corr",
+        }
+    }
+
+    /// The estimator that computes the converged reference of this estimator's model.
+    fn reference(self) -> Est {
+        match self {
+            Est::PtUncorrelated => Est::BdptUncorrelated,
+            Est::PtCorrelated => Est::BdptCorrelated,
+            other => other,
+        }
+    }
+}
+
+/// The configurations of the error study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Config {
+    ConductorGgx1,
+    ConductorGgx01,
+    DielectricGgx1,
+    DiffuseGgx1,
+    ConductorBeckmann05,
+}
+
+impl Config {
+    pub const ALL: [Config; 5] = [
+        Config::ConductorGgx1,
+        Config::ConductorGgx01,
+        Config::DielectricGgx1,
+        Config::DiffuseGgx1,
+        Config::ConductorBeckmann05,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Config::ConductorGgx1 => "conductor-ggx-a1.0",
+            Config::ConductorGgx01 => "conductor-ggx-a0.1",
+            Config::DielectricGgx1 => "dielectric-ggx-a1.0",
+            Config::DiffuseGgx1 => "diffuse-ggx-a1.0",
+            Config::ConductorBeckmann05 => "conductor-beckmann-a0.5",
+        }
+    }
+}
+
+/// The three models behind the estimators, over one slope and material.
+struct Models<S, M> {
+    walk: Microsurface<UniformHeight, S, M>,
+    uncorrelated: PositionFree<S, M>,
+    correlated: PositionFree<S, M>,
+}
+
+impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
+    fn new(slope: S, material: M) -> Self {
+        Self {
+            walk: Microsurface::new(UniformHeight, slope, material),
+            uncorrelated: PositionFree::new(slope, material, Shadowing::Uncorrelated),
+            correlated: PositionFree::new(slope, material, Shadowing::Correlated),
+        }
+    }
+
+    /// One estimate of f·|cos θo| (mean over RGB).
+    #[inline]
+    fn eval(&self, est: Est, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut Rng) -> f64 {
+        let v = match est {
+            Est::Single => self.walk.eval_single_scattering(wi, wo, rng),
+            Est::Walk => self.walk.eval(wi, wo, order, rng),
+            Est::PtUncorrelated => self.uncorrelated.eval_pt(wi, wo, order, rng),
+            Est::PtCorrelated => self.correlated.eval_pt(wi, wo, order, rng),
+            Est::BdptUncorrelated => self.uncorrelated.eval_bdpt(wi, wo, order, rng),
+            Est::BdptCorrelated => self.correlated.eval_bdpt(wi, wo, order, rng),
+        };
+        f64::from(v.element_sum()) / 3.0
+    }
+}
+
+fn dir(theta: f64, phi: f64) -> Vec3 {
+    Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32)
+}
+
+/// The incident angles of the error study and energy table.
+pub const THETAS: [f64; 3] = [0.0, 1.0, 1.5];
+
+/// The outgoing directions of the error study for θi: the mirror direction, the normal
+/// (or a 0.6 rad tilt at normal incidence) and, for the dielectric, the transmission through
+/// the macrosurface; otherwise a side-scattering direction.
+fn outgoing(config: Config, theta_i: f64) -> [(&'static str, Vec3); 3] {
+    let third = if config == Config::DielectricGgx1 {
+        ("transmission", dir(std::f64::consts::PI - 0.6 * theta_i.max(0.3), std::f64::consts::PI))
+    } else {
+        ("side", dir(1.2, std::f64::consts::FRAC_PI_2))
+    };
+    [
+        ("mirror", dir(theta_i.max(0.15), std::f64::consts::PI)),
+        ("normal", if theta_i == 0.0 { dir(0.6, 0.0) } else { Vec3::Z }),
+        third,
+    ]
+}
+
+/// Per-sample values of one estimator in one configuration, with its timing.
+struct Run {
+    config: Config,
+    theta_i: f64,
+    wo_label: &'static str,
+    est: Est,
+    values: Vec<f32>,
+    ns_per_sample: f64,
+}
+
+/// Runs `n` evaluations single-threaded and times them.
+fn run_estimator(config: Config, est: Est, wi: Vec3, wo: Vec3, n: usize, seed: u64) -> (Vec<f32>, f64) {
+    fn go<S: MicrosurfaceSlope, M: Material>(
+        m: Models<S, M>,
+        est: Est,
+        wi: Vec3,
+        wo: Vec3,
+        n: usize,
+        seed: u64,
+    ) -> (Vec<f32>, f64) {
+        let mut rng = Rng::seed_from_u64(seed);
+        let start = Instant::now();
+        let values: Vec<f32> =
+            (0..n).map(|_| m.eval(est, wi, wo, ScatteringOrder::All, &mut rng) as f32).collect();
+        (values, start.elapsed().as_secs_f64() * 1e9 / n as f64)
+    }
+    let ggx = |a| Ggx::isotropic(a).expect("valid α");
+    match config {
+        Config::ConductorGgx1 => go(Models::new(ggx(1.0), Conductor::perfect()), est, wi, wo, n, seed),
+        Config::ConductorGgx01 => go(Models::new(ggx(0.1), Conductor::perfect()), est, wi, wo, n, seed),
+        Config::DielectricGgx1 => {
+            go(Models::new(ggx(1.0), Dielectric::new(1.5).expect("valid η")), est, wi, wo, n, seed)
+        }
+        Config::DiffuseGgx1 => go(Models::new(ggx(1.0), Diffuse::white()), est, wi, wo, n, seed),
+        Config::ConductorBeckmann05 => go(
+            Models::new(Beckmann::isotropic(0.5).expect("valid α"), Conductor::perfect()),
+            est,
+            wi,
+            wo,
+            n,
+            seed,
+        ),
+    }
+}
+
+/// Runs `jobs` on `threads` workers, reporting progress on stderr.
+fn parallel<T: Send, R: Send>(
+    label: &str,
+    jobs: Vec<T>,
+    opts: &Options,
+    work: impl Fn(T) -> R + Sync,
+) -> Vec<R> {
+    let total = jobs.len();
+    let queue = Mutex::new(jobs.into_iter().enumerate().collect::<Vec<_>>());
+    let done = AtomicUsize::new(0);
+    let results = Mutex::new(Vec::with_capacity(total));
+    std::thread::scope(|s| {
+        for _ in 0..opts.threads.max(1) {
+            s.spawn(|| {
+                loop {
+                    let Some((i, job)) = queue.lock().expect("queue").pop() else { break };
+                    let r = work(job);
+                    results.lock().expect("results").push((i, r));
+                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if opts.progress {
+                        let bar = 30 * d / total.max(1);
+                        eprint!("\r{label:<22} [{}{}] {d}/{total}", "=".repeat(bar), " ".repeat(30 - bar));
+                    }
+                }
+            });
+        }
+    });
+    if opts.progress {
+        eprintln!();
+    }
+    let mut results = results.into_inner().expect("results");
+    results.sort_by_key(|(i, _)| *i);
+    results.into_iter().map(|(_, r)| r).collect()
+}
+
+fn mean_and_variance(values: &[f32]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
+    let var = values.iter().map(|&v| (f64::from(v) - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    (mean, var)
+}
+
+/// One row of the efficiency table (all fields are read by `tests/report.rs`).
+#[allow(dead_code)]
+#[derive(Debug, Clone)]
+pub struct EfficiencyRow {
+    pub config: Config,
+    pub theta_i: f64,
+    pub wo: &'static str,
+    pub est: Est,
+    pub mean: f64,
+    pub std: f64,
+    pub ns_per_sample: f64,
+    pub reference: f64,
+    pub reference_se: f64,
+    /// 1/(relative variance × seconds per sample).
+    pub efficiency: f64,
+    /// (samples, seconds, relative RMSE) measured on batches.
+    pub curve: Vec<(usize, f64, f64)>,
+}
+
+/// What the report found, for the summary and the tests.
+#[derive(Debug, Clone, Default)]
+pub struct Summary {
+    pub efficiency: Vec<EfficiencyRow>,
+    /// (config, ratio of PT-corr to walk efficiency, ratio of BDPT-corr to PT-corr), geometric
+    /// means over θi and ωo.
+    pub ratios: Vec<(Config, f64, f64)>,
+    /// (label, θi, R, T, per order [1, 2, 3, 4+], mean bounces, furnace ∫eval, its SE).
+    pub energy: Vec<(String, f64, f64, f64, [f64; 4], f64, f64, f64)>,
+    /// (model, ns per eval, ns per sample, mean bounces).
+    pub cost: Vec<(String, f64, f64, f64)>,
+    pub files: Vec<PathBuf>,
+    pub markdown: String,
+}
+
+fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Result<()> {
+    let mut jobs = Vec::new();
+    for config in Config::ALL {
+        for theta_i in THETAS {
+            for (label, wo) in outgoing(config, theta_i) {
+                for est in Est::ALL {
+                    jobs.push((config, theta_i, label, wo, est, budget.samples, false));
+                }
+                for est in [Est::Walk, Est::BdptUncorrelated, Est::BdptCorrelated] {
+                    jobs.push((
+                        config,
+                        theta_i,
+                        label,
+                        wo,
+                        est,
+                        budget.samples * budget.reference_factor,
+                        true,
+                    ));
+                }
+            }
+        }
+    }
+    let seed_of = |i: usize| 0x5EED_0000 + i as u64;
+    let jobs: Vec<_> = jobs.into_iter().enumerate().collect();
+    let runs = parallel("error vs time", jobs, opts, |(i, (config, theta_i, label, wo, est, n, is_ref))| {
+        let wi = dir(theta_i, 0.0);
+        let (values, ns) = run_estimator(config, est, wi, wo, n, seed_of(i));
+        (is_ref, Run { config, theta_i, wo_label: label, est, values, ns_per_sample: ns })
+    });
+    let (refs, runs): (Vec<_>, Vec<_>) = runs.into_iter().partition(|(is_ref, _)| *is_ref);
+    let mut csv = String::from("config,theta_i,wo,estimator,samples,time_s,rmse,rel_rmse\n");
+    let mut eff_csv = String::from(
+        "config,theta_i,wo,estimator,mean,std,ns_per_sample,reference,reference_se,efficiency_per_s\n",
+    );
+    for (_, run) in &runs {
+        let (mean, var) = mean_and_variance(&run.values);
+        let (reference, reference_se) = if run.est == Est::Single && run.config != Config::DiffuseGgx1 {
+            (mean, 0.0)
+        } else {
+            let r = refs
+                .iter()
+                .map(|(_, r)| r)
+                .find(|r| {
+                    r.config == run.config
+                        && r.theta_i == run.theta_i
+                        && r.wo_label == run.wo_label
+                        && r.est == run.est.reference()
+                })
+                .map(|r| {
+                    let (m, v) = mean_and_variance(&r.values);
+                    (m, (v / r.values.len() as f64).sqrt())
+                });
+            r.unwrap_or((mean, (var / run.values.len() as f64).sqrt()))
+        };
+        let scale = if reference.abs() > 0.0 { reference.abs() } else { 1.0 };
+        let mut curve = Vec::new();
+        let mut batch = 1;
+        while batch * 16 <= run.values.len() {
+            let batches = run.values.len() / batch;
+            let mse = run
+                .values
+                .chunks_exact(batch)
+                .map(|c| (c.iter().map(|&v| f64::from(v)).sum::<f64>() / batch as f64 - reference).powi(2))
+                .sum::<f64>()
+                / batches as f64;
+            let seconds = batch as f64 * run.ns_per_sample * 1e-9;
+            curve.push((batch, seconds, mse.sqrt() / scale));
+            let _ = writeln!(
+                csv,
+                "{},{},{},{},{batch},{seconds:.3e},{:.4e},{:.4e}",
+                run.config.name(),
+                run.theta_i,
+                run.wo_label,
+                run.est.name(),
+                mse.sqrt(),
+                mse.sqrt() / scale
+            );
+            batch *= 2;
+        }
+        let rel_var = var / (scale * scale);
+        let efficiency =
+            if rel_var > 0.0 { 1.0 / (rel_var * run.ns_per_sample * 1e-9) } else { f64::INFINITY };
+        let _ = writeln!(
+            eff_csv,
+            "{},{},{},{},{mean:.6e},{:.4e},{:.1},{reference:.6e},{reference_se:.2e},{efficiency:.4e}",
+            run.config.name(),
+            run.theta_i,
+            run.wo_label,
+            run.est.name(),
+            var.sqrt(),
+            run.ns_per_sample
+        );
+        summary.efficiency.push(EfficiencyRow {
+            config: run.config,
+            theta_i: run.theta_i,
+            wo: run.wo_label,
+            est: run.est,
+            mean,
+            std: var.sqrt(),
+            ns_per_sample: run.ns_per_sample,
+            reference,
+            reference_se,
+            efficiency,
+            curve,
+        });
+    }
+    write(opts, "errors.csv", &csv, summary)?;
+    write(opts, "efficiency.csv", &eff_csv, summary)?;
+
+    // efficiency ratios (geometric means over θi and ωo where both are finite)
+    for config in Config::ALL {
+        let ratio = |a: Est, b: Est| {
+            let logs: Vec<f64> = summary
+                .efficiency
+                .iter()
+                .filter(|r| r.config == config && r.est == a)
+                .filter_map(|ra| {
+                    let rb = summary.efficiency.iter().find(|r| {
+                        r.config == config && r.est == b && r.theta_i == ra.theta_i && r.wo == ra.wo
+                    })?;
+                    let q = ra.efficiency / rb.efficiency;
+                    (q.is_finite() && q > 0.0).then(|| q.ln())
+                })
+                .collect();
+            if logs.is_empty() { f64::NAN } else { (logs.iter().sum::<f64>() / logs.len() as f64).exp() }
+        };
+        summary.ratios.push((
+            config,
+            ratio(Est::PtCorrelated, Est::Walk),
+            ratio(Est::BdptCorrelated, Est::PtCorrelated),
+        ));
+    }
+
+    // plots: θi = 1.0, mirror direction
+    for config in Config::ALL {
+        let series: Vec<Series> = Est::ALL
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &est)| {
+                let row = summary
+                    .efficiency
+                    .iter()
+                    .find(|r| r.config == config && r.est == est && r.theta_i == 1.0 && r.wo == "mirror")?;
+                let points: Vec<(f64, f64)> = row.curve.iter().map(|&(_, t, e)| (t, e)).collect();
+                (!points.is_empty() && points.iter().any(|p| p.1 > 0.0)).then(|| Series {
+                    label: est.name().into(),
+                    points,
+                    color: PALETTE[k],
+                })
+            })
+            .collect();
+        let mut canvas = Canvas::new(520, 340);
+        loglog_chart(
+            &mut canvas,
+            &format!("{}  theta_i = 1.0, mirror: relative RMSE vs time", config.name()),
+            "seconds",
+            "rel. RMSE",
+            &series,
+        );
+        save(opts, &format!("error_vs_time_{}.png", config.name()), &canvas, summary)?;
+    }
+    Ok(())
+}
+
+fn write(opts: &Options, name: &str, content: &str, summary: &mut Summary) -> std::io::Result<()> {
+    let path = opts.out_dir.join(name);
+    std::fs::write(&path, content)?;
+    summary.files.push(path);
+    Ok(())
+}
+
+fn save(opts: &Options, name: &str, canvas: &Canvas, summary: &mut Summary) -> std::io::Result<()> {
+    let path = opts.out_dir.join(name);
+    canvas.save(&path)?;
+    summary.files.push(path);
+    Ok(())
+}
+
+/// The lobe materials: conductor, dielectric and diffuse on GGX α = 1.
+fn lobes(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Result<()> {
+    let materials = ["conductor", "dielectric", "diffuse"];
+    let n = budget.lobe_angles;
+    let mut jobs = Vec::new();
+    for (m, &name) in materials.iter().enumerate() {
+        let angles: Vec<f64> = if name == "dielectric" {
+            (0..2 * n)
+                .map(|k| -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / (n - 1) as f64)
+                .collect()
+        } else {
+            (0..n)
+                .map(|k| -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / (n - 1) as f64)
+                .collect()
+        };
+        for theta_i in THETAS {
+            for &t in &angles {
+                jobs.push((m, theta_i, t));
+            }
+        }
+    }
+    let samples = budget.lobe_samples;
+    let ggx = Ggx::isotropic(1.0).expect("valid α");
+    let values = parallel("lobes per order", jobs.clone(), opts, |(m, theta_i, t)| {
+        let wi = dir(theta_i, 0.0);
+        // θo measured from the normal towards −x (the mirror side); beyond π/2 below
+        let wo = Vec3::new(-(t.sin()) as f32, 0.0, t.cos() as f32);
+        let mut rng = Rng::seed_from_u64(((m as u64) << 32) ^ (theta_i * 1e3) as u64 ^ (t * 1e6) as u64);
+        let mut go = |order: ScatteringOrder| -> f64 {
+            let eval = |rng: &mut Rng| -> f64 {
+                let v = match m {
+                    0 => Microsurface::new(UniformHeight, ggx, Conductor::perfect()).eval(wi, wo, order, rng),
+                    1 => Microsurface::new(UniformHeight, ggx, Dielectric::new(1.5).expect("valid η"))
+                        .eval(wi, wo, order, rng),
+                    _ => Microsurface::new(UniformHeight, ggx, Diffuse::white()).eval(wi, wo, order, rng),
+                };
+                f64::from(v.x)
+            };
+            (0..samples).map(|_| eval(&mut rng)).sum::<f64>() / samples as f64
+        };
+        let o1 = go(ScatteringOrder::only(1).expect("n > 0"));
+        let o2 = go(ScatteringOrder::only(2).expect("n > 0"));
+        let all = go(ScatteringOrder::All);
+        (o1, o2, all)
+    });
+    let mut csv = String::from("material,theta_i,theta_o,order1,order2,order3plus,total\n");
+    for (&(m, theta_i, t), &(o1, o2, all)) in jobs.iter().zip(&values) {
+        let _ = writeln!(
+            csv,
+            "{},{theta_i},{t:.4},{o1:.5e},{o2:.5e},{:.5e},{all:.5e}",
+            materials[m],
+            all - o1 - o2
+        );
+    }
+    write(opts, "lobes.csv", &csv, summary)?;
+    for (m, &name) in materials.iter().enumerate() {
+        let (pw, ph) = (300u32, if name == "dielectric" { 300 } else { 220 });
+        let mut canvas = Canvas::new(3 * pw, ph);
+        for (k, theta_i) in THETAS.into_iter().enumerate() {
+            let rows: Vec<(f64, f64, f64, f64)> = jobs
+                .iter()
+                .zip(&values)
+                .filter(|((mm, ti, _), _)| *mm == m && *ti == theta_i)
+                .map(|(&(_, _, t), &(o1, o2, all))| (t, o1, o2, all))
+                .collect();
+            let pick = |f: fn(&(f64, f64, f64, f64)) -> f64| {
+                rows.iter().map(|r| (r.0, f(r).max(0.0))).collect::<Vec<_>>()
+            };
+            let series = vec![
+                Series { label: "order 1".into(), points: pick(|r| r.1), color: PALETTE[0] },
+                Series { label: "order 2".into(), points: pick(|r| r.2), color: PALETTE[1] },
+                Series { label: "order 3+".into(), points: pick(|r| r.3 - r.1 - r.2), color: PALETTE[2] },
+                Series { label: "total".into(), points: pick(|r| r.3), color: PALETTE[3] },
+            ];
+            let energy = summary
+                .energy
+                .iter()
+                .find(|e| e.0 == format!("{name} ggx a1.0") && e.1 == theta_i)
+                .map(|e| format!("E 1/2/3+: {:.3}/{:.3}/{:.3}", e.4[0], e.4[1], e.4[2] + e.4[3]))
+                .unwrap_or_default();
+            let mut panel = Canvas::new(pw, ph);
+            polar_chart(&mut panel, &format!("{name}, theta_i = {theta_i}"), &[energy], &series, -theta_i);
+            canvas.blit(&panel, (k as u32 * pw) as i32, 0);
+        }
+        save(opts, &format!("lobes_{name}.png"), &canvas, summary)?;
+    }
+    Ok(())
+}
+
+/// Albedo per order from sampled walks, and the white furnace ∫eval dωo by uniform-sphere MC.
+fn energy(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Result<()> {
+    let mut jobs = Vec::new();
+    for material in ["conductor", "dielectric", "diffuse"] {
+        for slope in ["ggx", "beckmann"] {
+            for alpha in [0.1f32, 0.5, 1.0] {
+                for theta_i in THETAS {
+                    jobs.push((material, slope, alpha, theta_i));
+                }
+            }
+        }
+    }
+    fn go<S: MicrosurfaceSlope, M: Material>(
+        walk: Microsurface<UniformHeight, S, M>,
+        theta_i: f64,
+        walks: usize,
+        furnace: usize,
+        seed: u64,
+    ) -> (f64, f64, [f64; 4], f64, f64, f64) {
+        let mut rng = Rng::seed_from_u64(seed);
+        let wi = dir(theta_i, 0.0);
+        let (mut r, mut t, mut orders, mut bounces) = (0.0, 0.0, [0.0; 4], 0.0);
+        for _ in 0..walks {
+            if let Some(s) = walk.sample(wi, &mut rng) {
+                let w = f64::from(s.weight.x) / walks as f64;
+                if s.wo.z > 0.0 {
+                    r += w
+                } else {
+                    t += w
+                }
+                orders[(s.bounces as usize - 1).min(3)] += w;
+                bounces += f64::from(s.bounces) / walks as f64;
+            }
+        }
+        let (mut sum, mut sum2) = (0.0, 0.0);
+        for _ in 0..furnace {
+            let u1: f64 = rand::RngExt::random(&mut rng);
+            let u2: f64 = rand::RngExt::random(&mut rng);
+            let wo = dir((1.0 - 2.0 * u1).acos(), std::f64::consts::TAU * u2);
+            let v =
+                f64::from(walk.eval(wi, wo, ScatteringOrder::All, &mut rng).x) * 4.0 * std::f64::consts::PI;
+            sum += v;
+            sum2 += v * v;
+        }
+        let mean = sum / furnace as f64;
+        let se = ((sum2 / furnace as f64 - mean * mean).max(0.0) / furnace as f64).sqrt();
+        (r, t, orders, bounces, mean, se)
+    }
+    let results = parallel("energy per order", jobs.clone(), opts, |(material, slope, alpha, theta_i)| {
+        let seed = (alpha * 1e3) as u64
+            ^ ((theta_i * 1e3) as u64) << 16
+            ^ (material.len() as u64) << 32
+            ^ (slope.len() as u64) << 40;
+        let (w, f) = (budget.energy_walks, budget.furnace_samples);
+        macro_rules! with_slope {
+            ($m:expr) => {
+                if slope == "ggx" {
+                    go(
+                        Microsurface::new(UniformHeight, Ggx::isotropic(alpha).expect("valid α"), $m),
+                        theta_i,
+                        w,
+                        f,
+                        seed,
+                    )
+                } else {
+                    go(
+                        Microsurface::new(UniformHeight, Beckmann::isotropic(alpha).expect("valid α"), $m),
+                        theta_i,
+                        w,
+                        f,
+                        seed,
+                    )
+                }
+            };
+        }
+        match material {
+            "conductor" => with_slope!(Conductor::perfect()),
+            "dielectric" => with_slope!(Dielectric::new(1.5).expect("valid η")),
+            _ => with_slope!(Diffuse::white()),
+        }
+    });
+    let mut csv = String::from(
+        "material,slope,alpha,theta_i,reflected,transmitted,order1,order2,order3,order4plus,mean_bounces,furnace,furnace_se\n",
+    );
+    for (&(material, slope, alpha, theta_i), &(r, t, o, b, f, fse)) in jobs.iter().zip(&results) {
+        let _ = writeln!(
+            csv,
+            "{material},{slope},{alpha},{theta_i},{r:.5},{t:.5},{:.5},{:.5},{:.5},{:.5},{b:.3},{f:.5},{fse:.5}",
+            o[0], o[1], o[2], o[3]
+        );
+        summary.energy.push((format!("{material} {slope} a{alpha:.1}"), theta_i, r, t, o, b, f, fse));
+    }
+    write(opts, "energy.csv", &csv, summary)
+}
+
+/// Single-threaded cost per call.
+fn cost(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Result<()> {
+    let wi = dir(0.5, 0.0);
+    let wo = dir(0.7, 2.5);
+    let n = budget.cost_calls;
+    fn time<S: MicrosurfaceSlope, M: Material>(
+        name: &str,
+        m: Models<S, M>,
+        wi: Vec3,
+        wo: Vec3,
+        n: usize,
+        out: &mut Vec<(String, f64, f64, f64)>,
+    ) {
+        let mut rng = Rng::seed_from_u64(99);
+        for est in Est::ALL {
+            let start = Instant::now();
+            let mut acc = 0.0;
+            for _ in 0..n {
+                acc += m.eval(est, wi, wo, ScatteringOrder::All, &mut rng);
+            }
+            let eval_ns = start.elapsed().as_secs_f64() * 1e9 / n as f64;
+            std::hint::black_box(acc);
+            let start = Instant::now();
+            let mut bounces = 0.0;
+            for _ in 0..n {
+                let s = match est {
+                    Est::Single => None,
+                    Est::Walk => m.walk.sample(wi, &mut rng),
+                    Est::PtUncorrelated | Est::BdptUncorrelated => m.uncorrelated.sample(wi, &mut rng),
+                    Est::PtCorrelated | Est::BdptCorrelated => m.correlated.sample(wi, &mut rng),
+                };
+                bounces += s.map_or(0.0, |s| f64::from(s.bounces));
+            }
+            let sample_ns =
+                if est == Est::Single { f64::NAN } else { start.elapsed().as_secs_f64() * 1e9 / n as f64 };
+            out.push((format!("{name} {}", est.name()), eval_ns, sample_ns, bounces / n as f64));
+        }
+    }
+    let ggx = Ggx::isotropic(0.5).expect("valid α");
+    let beckmann = Beckmann::isotropic(0.5).expect("valid α");
+    let mut rows = Vec::new();
+    time("conductor ggx a0.5", Models::new(ggx, Conductor::perfect()), wi, wo, n, &mut rows);
+    time("conductor beckmann a0.5", Models::new(beckmann, Conductor::perfect()), wi, wo, n, &mut rows);
+    time(
+        "dielectric ggx a0.5",
+        Models::new(ggx, Dielectric::new(1.5).expect("valid η")),
+        wi,
+        wo,
+        n,
+        &mut rows,
+    );
+    time("diffuse ggx a0.5", Models::new(ggx, Diffuse::white()), wi, wo, n, &mut rows);
+    let mut csv = String::from("model,ns_per_eval,ns_per_sample,mean_bounces_of_sample\n");
+    for (name, e, s, b) in &rows {
+        let _ = writeln!(csv, "{name},{e:.1},{s:.1},{b:.3}");
+    }
+    summary.cost = rows;
+    write(opts, "cost.csv", &csv, summary)
+}
+
+fn markdown(summary: &Summary) -> String {
+    let mut md = String::from(
+        "# microsurface report\n\n## Efficiency ratios (geometric means over θi ∈ {0, 1, 1.5} and three ωo)\n\n",
+    );
+    md.push_str("| configuration | PT-corr / Heitz walk | BDPT-corr / PT-corr |\n|---|---|---|\n");
+    for (c, a, b) in &summary.ratios {
+        let _ = writeln!(md, "| {} | {a:.2} | {b:.2} |", c.name());
+    }
+    md.push_str("\nEfficiency = 1 / (relative variance × seconds per sample); a ratio above 1 means the first estimator reaches a given error sooner.\n");
+    md.push_str("\n## Efficiency per estimator at θi = 1.0, mirror direction (1/s)\n\n| configuration |");
+    for est in Est::ALL {
+        let _ = write!(md, " {} |", est.name());
+    }
+    md.push_str("\n|---|---|---|---|---|---|---|\n");
+    for config in Config::ALL {
+        let _ = write!(md, "| {} |", config.name());
+        for est in Est::ALL {
+            let e = summary
+                .efficiency
+                .iter()
+                .find(|r| r.config == config && r.est == est && r.theta_i == 1.0 && r.wo == "mirror")
+                .map_or(f64::NAN, |r| r.efficiency);
+            let _ = write!(md, " {e:.2e} |");
+        }
+        md.push('\n');
+    }
+    md.push_str("\n## Energy per scattering order (Heitz walk; white furnace ∫f cos dωo ± SE)\n\n");
+    md.push_str("| model | θi | R | T | order 1 | order 2 | order 3 | order 4+ | bounces | furnace |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    for (label, t, r, tr, o, b, f, fse) in &summary.energy {
+        let _ = writeln!(
+            md,
+            "| {label} | {t} | {r:.4} | {tr:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {b:.2} | {f:.3} ± {fse:.3} |",
+            o[0], o[1], o[2], o[3]
+        );
+    }
+    md.push_str("\n## Cost (single thread, θi = 0.5, α = 0.5)\n\n| model | ns / eval | ns / sample | mean bounces |\n|---|---|---|---|\n");
+    for (name, e, s, b) in &summary.cost {
+        let _ = writeln!(md, "| {name} | {e:.0} | {s:.0} | {b:.2} |");
+    }
+    md
+}
+
+/// Runs the whole report and writes its files into `opts.out_dir`.
+pub fn run(opts: &Options) -> std::io::Result<Summary> {
+    std::fs::create_dir_all(&opts.out_dir)?;
+    let budget = Budget::new(opts.quick);
+    let mut summary = Summary::default();
+    error_study(opts, budget, &mut summary)?;
+    energy(opts, budget, &mut summary)?;
+    lobes(opts, budget, &mut summary)?;
+    cost(opts, budget, &mut summary)?;
+    summary.markdown = markdown(&summary);
+    let md = summary.markdown.clone();
+    write(opts, "summary.md", &md, &mut summary)?;
+    Ok(summary)
+}
+
+/// The default output directory.
+pub fn default_out_dir() -> PathBuf {
+    Path::new("target").join("report")
+}

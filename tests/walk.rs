@@ -1,0 +1,802 @@
+//! The multiple-scattering BSDF of the random walk (Heitz et al. 2016, supplement §4.4):
+//! white furnace (4.4.1), reciprocity (4.4.2), single scattering (4.4.3), importance sampling
+//! (4.4.4), independence of the height distribution, absorptive materials and scattering
+//! orders, over materials × heights × slopes × roughness × incident angles.
+//!
+//! The full matrix (3 materials plus the dielectric lit from inside, 2 heights, 2 slopes,
+//! α ∈ {0.5, 1.5, (1.0, 0.3)}) is run for the furnace test with one incident angle per cell,
+//! rotated deterministically so that every material meets every angle in {0, 0.8, 1.2, 1.5};
+//! the more expensive tests use fixed subsets that cover every factor.
+//!
+//! Statistics: every Monte Carlo assertion is |mean − expected| ≤ z·SE (or a two-sample
+//! |m1 − m2| ≤ z·√(SE1² + SE2²)) with z = `family_z(0.01, m)` for the m assertions of its test
+//! function, and asserts an upper bound on SE. `eval` is stochastic, so the chi-square test
+//! of `sample` estimates each cell's expected probability by Monte Carlo (`stochastic_chi2`):
+//! uniform directions in the cell, one independent `eval` each, refined until the variance
+//! of the estimate is at most a tenth of the multinomial variance, and that variance is
+//! still included in the statistic (with moment-matched degrees of freedom).
+mod common;
+
+use common::{Stats, TestRng};
+use glam::{DVec3, Vec3};
+use microsurface::{
+    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, Material, Microsurface,
+    MicrosurfaceHeight, MicrosurfaceSlope, PhaseSample, ScatteringOrder, UniformHeight, WalkSample,
+};
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
+use std::f64::consts::{PI, TAU};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+const ALPHAS: [(f32, f32); 3] = [(0.5, 0.5), (1.5, 1.5), (1.0, 0.3)];
+const THETAS: [f64; 4] = [0.0, 0.8, 1.2, 1.5];
+const ETA: f32 = 1.5;
+const PHI_I: f64 = 0.7;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Height {
+    Uniform,
+    Gaussian,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Slope {
+    Ggx,
+    Beckmann,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Mat {
+    /// F = 1.
+    Conductor,
+    /// Gold-like complex IOR.
+    Gold,
+    /// Diffuse with a grey albedo.
+    Diffuse(f32),
+    /// η = 1.5.
+    Dielectric,
+}
+
+/// A microsurface, type-erased over height, slope and material.
+trait Bsdf: Sync {
+    fn name(&self) -> &str;
+    fn transmits(&self) -> bool;
+    fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut TestRng) -> Vec3;
+    fn sample(&self, wi: Vec3, rng: &mut TestRng) -> Option<WalkSample>;
+    fn single(&self, wi: Vec3, wo: Vec3, rng: &mut TestRng) -> Vec3;
+    fn sample_phase(&self, wi: Vec3, rng: &mut TestRng) -> PhaseSample;
+    /// Whether the phase function is an exact, normalized density (F = 1 conductor,
+    /// dielectric): then `phase_sample`/`phase_pdf` can importance-sample the albedo.
+    fn exact_phase(&self) -> bool;
+    /// A direction from the phase function of ωi on ωi's side of the interface.
+    fn phase_sample(&self, wi: Vec3, rng: &mut TestRng) -> Vec3;
+    /// Its density (both sides of ωo summed).
+    fn phase_pdf(&self, wi: Vec3, wo: Vec3, rng: &mut TestRng) -> f64;
+}
+
+struct Surf<H, S, M> {
+    name: String,
+    surface: Microsurface<H, S, M>,
+    exact_phase: bool,
+}
+
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Bsdf for Surf<H, S, M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn transmits(&self) -> bool {
+        M::TRANSMITS
+    }
+    fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut TestRng) -> Vec3 {
+        self.surface.eval(wi, wo, order, rng)
+    }
+    fn sample(&self, wi: Vec3, rng: &mut TestRng) -> Option<WalkSample> {
+        self.surface.sample(wi, rng)
+    }
+    fn single(&self, wi: Vec3, wo: Vec3, rng: &mut TestRng) -> Vec3 {
+        self.surface.eval_single_scattering(wi, wo, rng)
+    }
+    fn sample_phase(&self, wi: Vec3, rng: &mut TestRng) -> PhaseSample {
+        self.surface.sample_phase(wi, rng)
+    }
+    fn exact_phase(&self) -> bool {
+        self.exact_phase
+    }
+    fn phase_sample(&self, wi: Vec3, rng: &mut TestRng) -> Vec3 {
+        self.surface.material().sample_phase(self.surface.slope(), wi, wi.z > 0.0, rng).wo
+    }
+    fn phase_pdf(&self, wi: Vec3, wo: Vec3, rng: &mut TestRng) -> f64 {
+        let (m, s, side) = (self.surface.material(), self.surface.slope(), wi.z > 0.0);
+        let mut p = m.eval_phase(s, wi, wo, side, true, rng).x;
+        if M::TRANSMITS {
+            p += m.eval_phase(s, wi, wo, side, false, rng).x;
+        }
+        f64::from(p)
+    }
+}
+
+fn gold() -> Conductor {
+    Conductor::new(ComplexIor::new(Vec3::new(0.18, 0.42, 1.37), Vec3::new(3.42, 2.35, 1.77)).unwrap())
+}
+
+fn with_hs<M: Material + 'static>(
+    h: Height,
+    s: Slope,
+    (ax, ay): (f32, f32),
+    m: Mat,
+    mat: M,
+) -> Box<dyn Bsdf> {
+    let name = format!("{m:?} {h:?} {s:?}(αx = {ax}, αy = {ay})");
+    let exact_phase = matches!(m, Mat::Conductor | Mat::Dielectric);
+    match (h, s) {
+        (Height::Uniform, Slope::Ggx) => Box::new(Surf {
+            name,
+            exact_phase,
+            surface: Microsurface::new(UniformHeight, Ggx::new(ax, ay).unwrap(), mat),
+        }),
+        (Height::Uniform, Slope::Beckmann) => Box::new(Surf {
+            name,
+            exact_phase,
+            surface: Microsurface::new(UniformHeight, Beckmann::new(ax, ay).unwrap(), mat),
+        }),
+        (Height::Gaussian, Slope::Ggx) => Box::new(Surf {
+            name,
+            exact_phase,
+            surface: Microsurface::new(GaussianHeight, Ggx::new(ax, ay).unwrap(), mat),
+        }),
+        (Height::Gaussian, Slope::Beckmann) => Box::new(Surf {
+            name,
+            exact_phase,
+            surface: Microsurface::new(GaussianHeight, Beckmann::new(ax, ay).unwrap(), mat),
+        }),
+    }
+}
+
+fn build(h: Height, s: Slope, alpha: (f32, f32), m: Mat) -> Box<dyn Bsdf> {
+    match m {
+        Mat::Conductor => with_hs(h, s, alpha, m, Conductor::perfect()),
+        Mat::Gold => with_hs(h, s, alpha, m, gold()),
+        Mat::Diffuse(a) => with_hs(h, s, alpha, m, Diffuse::new(Vec3::splat(a)).unwrap()),
+        Mat::Dielectric => with_hs(h, s, alpha, m, Dielectric::new(ETA).unwrap()),
+    }
+}
+
+/// Maps `f` over `items` on two threads (results in order); a panic in `f` fails the test.
+fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> Vec<R> {
+    let next = AtomicUsize::new(0);
+    let results = Mutex::new(Vec::with_capacity(items.len()));
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= items.len() {
+                        break;
+                    }
+                    let r = f(i, &items[i]);
+                    results.lock().unwrap().push((i, r));
+                }
+            });
+        }
+    });
+    let mut results = results.into_inner().unwrap();
+    results.sort_by_key(|(i, _)| *i);
+    results.into_iter().map(|(_, r)| r).collect()
+}
+
+/// A uniform direction with cos θ ∈ [z_lo, 1].
+fn uniform_dir(z_lo: f64, rng: &mut TestRng) -> Vec3 {
+    let z = z_lo + (1.0 - z_lo) * common::uniform64(rng);
+    let phi = TAU * common::uniform64(rng);
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()
+}
+
+/// The albedo ∫ eval(ωi, ωo) dωo per channel by Monte Carlo over ωo on the sphere
+/// (transmitting materials) or the upper hemisphere (`upper_only`, or opaque materials).
+///
+/// ωo is uniform, or — for the F = 1 conductor and the dielectric, whose sharp lobes make the
+/// uniform estimator noisy — drawn from the defensive mixture q = ½ uniform + ½ phase function
+/// of ωi (an exact density validated by tests/phase_functions.rs; independent of `sample`),
+/// with the estimator eval/q.
+fn albedo(bsdf: &dyn Bsdf, wi: Vec3, upper_only: bool, n: usize, rng: &mut TestRng) -> [Stats; 3] {
+    let z_lo = if bsdf.transmits() && !upper_only { -1.0 } else { 0.0 };
+    let area = TAU * (1.0 - z_lo);
+    let mixture = bsdf.exact_phase() && !upper_only;
+    let mut stats = [Stats::default(); 3];
+    for _ in 0..n {
+        let wo = if mixture && common::uniform64(rng) < 0.5 {
+            bsdf.phase_sample(wi, rng)
+        } else {
+            uniform_dir(z_lo, rng)
+        };
+        let q = if mixture {
+            let uniform = if f64::from(wo.z) >= z_lo { 0.5 / area } else { 0.0 };
+            uniform + 0.5 * bsdf.phase_pdf(wi, wo, rng)
+        } else {
+            1.0 / area
+        };
+        let v = bsdf.eval(wi, wo, ScatteringOrder::All, rng);
+        for (c, s) in stats.iter_mut().enumerate() {
+            s.push(if v[c] == 0.0 { 0.0 } else { f64::from(v[c]) / q });
+        }
+    }
+    stats
+}
+
+fn worst_z(values: &[(f64, f64)]) -> f64 {
+    values.iter().map(|(d, se)| (d / se).abs()).fold(0.0, f64::max)
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4.4.1 white furnace
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn white_furnace() {
+    const N: usize = 120_000;
+    // (material, height, slope, α index, θi, lit from inside)
+    let mut cases = Vec::new();
+    for m in [Mat::Conductor, Mat::Diffuse(1.0), Mat::Dielectric] {
+        for (hi, h) in [Height::Uniform, Height::Gaussian].into_iter().enumerate() {
+            for (si, s) in [Slope::Ggx, Slope::Beckmann].into_iter().enumerate() {
+                for a in 0..ALPHAS.len() {
+                    let theta = THETAS[(hi + 2 * si + a) % THETAS.len()];
+                    cases.push((m, h, s, a, theta, false));
+                    if m == Mat::Dielectric {
+                        cases.push((m, h, s, a, PI - THETAS[(hi + 2 * si + a + 1) % THETAS.len()], true));
+                    }
+                }
+            }
+        }
+    }
+    let z = common::family_z(0.01, cases.len());
+    let out = par_map(&cases, |i, &(m, h, s, a, theta, inside)| {
+        let bsdf = build(h, s, ALPHAS[a], m);
+        let wi = common::dir(theta, PHI_I);
+        let mut rng = common::rng(100 + i as u64);
+        // the dielectric's eval is the noisiest (σ̂ ≈ 3.3 against ≈ 2.4): twice the walks
+        let n = if m == Mat::Dielectric { 2 * N } else { N };
+        let [stats, _, _] = albedo(bsdf.as_ref(), wi, false, n, &mut rng);
+        let label = format!("{}: white furnace θi = {theta:.3} (lit from inside: {inside})", bsdf.name());
+        // at grazing incidence the dielectric's σ̂ reaches 4.8: SE ≤ 1e-2 there, 8e-3 otherwise
+        let max_se = if m == Mat::Dielectric { 1e-2 } else { 8e-3 };
+        common::assert_mean(&label, &stats, 1.0, z, max_se, 0.0);
+        (stats.mean() - 1.0, stats.se())
+    });
+    for (case, (d, se)) in cases.iter().zip(&out) {
+        println!(
+            "furnace {:?} {:?} {:?} α{:?} θ={:.2}: 1{d:+.4} ± {se:.4}",
+            case.0, case.1, case.2, ALPHAS[case.3], case.4
+        );
+    }
+    let max_se = out.iter().map(|o| o.1).fold(0.0, f64::max);
+    println!(
+        "white furnace: {} cases, N = {N} (dielectric {}), worst |albedo − 1|/SE = {:.2} (z = {z:.2}), largest SE = {max_se:.4}",
+        cases.len(),
+        2 * N,
+        worst_z(&out)
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4.4.2 reciprocity
+// ---------------------------------------------------------------------------------------------
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pair {
+    /// Both directions above (conductor, diffuse, dielectric reflection).
+    Above,
+    /// ωi above, ωo below (dielectric transmission).
+    Through,
+    /// Both below (dielectric, reflection inside).
+    Below,
+}
+
+#[test]
+fn reciprocity() {
+    const N: usize = 100_000;
+    let pairs = [(0.3, 0.0, 1.1, 2.6), (1.2, 0.5, 0.6, 3.7), (1.5, 1.0, 0.9, 4.4)];
+    let mut cases = Vec::new();
+    let mut k = 0;
+    for h in [Height::Uniform, Height::Gaussian] {
+        for s in [Slope::Ggx, Slope::Beckmann] {
+            for (m, pair) in [
+                (Mat::Conductor, Pair::Above),
+                (Mat::Diffuse(1.0), Pair::Above),
+                (Mat::Dielectric, Pair::Above),
+                (Mat::Dielectric, Pair::Through),
+                (Mat::Dielectric, Pair::Below),
+            ] {
+                cases.push((m, h, s, k % ALPHAS.len(), pairs[k % pairs.len()], pair));
+                k += 1;
+            }
+        }
+    }
+    let z = common::family_z(0.01, cases.len());
+    let out = par_map(&cases, |i, &(m, h, s, a, (ti, pi, to, po), pair)| {
+        let bsdf = build(h, s, ALPHAS[a], m);
+        let (mut wi, mut wo) = (common::dir(ti, pi), common::dir(to, po));
+        // generalized reciprocity f(ωi, ωo)/ηo² = f(ωo, ωi)/ηi²: only crossing pairs differ
+        let mut scale_a = 1.0;
+        match pair {
+            Pair::Above => {}
+            Pair::Through => {
+                // forward transmission, inside the lobe: ωo's azimuth opposite to ωi's and
+                // half the polar angle (off-lobe values are too noisy to test)
+                wo = -common::dir(0.5 * to, pi);
+                scale_a = 1.0 / f64::from(ETA * ETA);
+            }
+            Pair::Below => {
+                wi = -wi;
+                wo = -wo;
+            }
+        }
+        let mut rng = common::rng(200 + i as u64);
+        let (mut fa, mut fb) = (Stats::default(), Stats::default());
+        for _ in 0..N {
+            fa.push(
+                scale_a * f64::from(bsdf.eval(wi, wo, ScatteringOrder::All, &mut rng).x)
+                    / f64::from(wo.z.abs()),
+            );
+            fb.push(f64::from(bsdf.eval(wo, wi, ScatteringOrder::All, &mut rng).x) / f64::from(wi.z.abs()));
+        }
+        let label = format!("{}: reciprocity {pair:?} θi = {ti}, θo = {to}", bsdf.name());
+        let scale = fa.mean().max(fb.mean());
+        assert!(scale > 1e-3, "{label}: vanishing BSDF {scale:e}: the test would be vacuous");
+        common::assert_two_sample(&label, &fa, &fb, z, 0.04 * scale);
+        (fa.mean() - fb.mean(), fa.se().hypot(fb.se()))
+    });
+    println!(
+        "BSDF reciprocity: {} cases, N = {N} per side, worst |Δ|/SE = {:.2} (z = {z:.2})",
+        cases.len(),
+        worst_z(&out)
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4.4.3 single scattering
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn first_order_equals_single_scattering() {
+    const N: usize = 100_000;
+    let only1 = ScatteringOrder::only(1).unwrap();
+    // (θi, θo) with signs: the dielectric is also lit from inside
+    let configs: [(Mat, f64, f64); 6] = [
+        (Mat::Conductor, 0.7, 1.2),
+        (Mat::Diffuse(1.0), 1.4, 0.5),
+        (Mat::Dielectric, 0.4, 1.0),
+        (Mat::Dielectric, 1.1, PI - 0.5),
+        (Mat::Dielectric, PI - 0.6, PI - 1.0),
+        (Mat::Dielectric, PI - 0.3, 0.9),
+    ];
+    let mut cases = Vec::new();
+    for (hi, h) in [Height::Uniform, Height::Gaussian].into_iter().enumerate() {
+        for (si, s) in [Slope::Ggx, Slope::Beckmann].into_iter().enumerate() {
+            for (c, &(m, ti, to)) in configs.iter().enumerate() {
+                cases.push((m, h, s, (hi + si + c) % ALPHAS.len(), ti, to));
+            }
+        }
+    }
+    let z = common::family_z(0.01, cases.len());
+    let out = par_map(&cases, |i, &(m, h, s, a, ti, to)| {
+        let bsdf = build(h, s, ALPHAS[a], m);
+        let (wi, wo) = (common::dir(ti, PHI_I), common::dir(to, PHI_I + PI));
+        let mut rng = common::rng(300 + i as u64);
+        let (mut walk, mut single) = (Stats::default(), Stats::default());
+        for _ in 0..N {
+            walk.push(f64::from(bsdf.eval(wi, wo, only1, &mut rng).x));
+            single.push(f64::from(bsdf.single(wi, wo, &mut rng).x));
+        }
+        let label =
+            format!("{}: eval(only(1)) vs eval_single_scattering, θi = {ti:.3}, θo = {to:.3}", bsdf.name());
+        let scale = walk.mean().max(single.mean());
+        assert!(scale > 1e-3, "{label}: vanishing value {scale:e}: the test would be vacuous");
+        if single.std() == 0.0 {
+            // exact single scattering (conductor, dielectric): one-sample test, f32 tolerance
+            common::assert_mean(&label, &walk, single.mean(), z, 0.01 * scale, 1e-5 * scale);
+            (walk.mean() - single.mean(), walk.se())
+        } else {
+            common::assert_two_sample(&label, &walk, &single, z, 0.01 * scale);
+            (walk.mean() - single.mean(), walk.se().hypot(single.se()))
+        }
+    });
+    println!(
+        "single scattering: {} cases, N = {N}, worst |Δ|/SE = {:.2} (z = {z:.2})",
+        cases.len(),
+        worst_z(&out)
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4.4.4 importance sampling
+// ---------------------------------------------------------------------------------------------
+
+const CHI2_N: usize = 30_000;
+
+#[test]
+fn sampling_chi2() {
+    // (material, height, slope, α index, θi): every material, height, slope, roughness,
+    // grazing incidence and the dielectric lit from inside
+    let cases = [
+        (Mat::Conductor, Height::Uniform, Slope::Ggx, 0, 0.8),
+        (Mat::Conductor, Height::Gaussian, Slope::Beckmann, 2, 1.5),
+        (Mat::Conductor, Height::Uniform, Slope::Beckmann, 1, 0.0),
+        (Mat::Diffuse(1.0), Height::Gaussian, Slope::Ggx, 1, 1.5),
+        (Mat::Diffuse(1.0), Height::Uniform, Slope::Beckmann, 0, 0.8),
+        (Mat::Diffuse(1.0), Height::Gaussian, Slope::Ggx, 2, 1.2),
+        (Mat::Dielectric, Height::Uniform, Slope::Ggx, 1, 0.8),
+        (Mat::Dielectric, Height::Gaussian, Slope::Beckmann, 0, 1.5),
+        (Mat::Dielectric, Height::Uniform, Slope::Ggx, 2, 1.2),
+        (Mat::Dielectric, Height::Gaussian, Slope::Ggx, 0, PI - 0.8),
+        (Mat::Dielectric, Height::Uniform, Slope::Beckmann, 1, PI - 1.5),
+    ];
+    let alpha = common::sidak(0.01, cases.len());
+    let out = par_map(&cases, |i, &(m, h, s, a, theta)| {
+        let bsdf = build(h, s, ALPHAS[a], m);
+        let wi = common::dir(theta, PHI_I);
+        let label = format!("{}: sample, θi = {theta:.3}", bsdf.name());
+        let mut rng = common::rng(400 + i as u64);
+        let mut eval_rng = common::rng(500 + i as u64);
+        let mut bounces = Stats::default();
+        let z_lo = if bsdf.transmits() { -1.0 } else { 0.0 };
+        let (nz, nphi) = if bsdf.transmits() { (16, 16) } else { (8, 16) };
+        let result = stochastic_chi2(
+            &label,
+            z_lo,
+            nz,
+            nphi,
+            &mut |wo| f64::from(bsdf.eval(wi, wo, ScatteringOrder::All, &mut eval_rng).x),
+            &mut || {
+                let s = bsdf.sample(wi, &mut rng)?;
+                assert_eq!(s.weight, Vec3::ONE, "{label}: non-absorptive weight");
+                assert!(s.bounces >= 1, "{label}: a walk has at least one bounce");
+                bounces.push(f64::from(s.bounces));
+                Some(s.wo)
+            },
+            CHI2_N,
+            alpha,
+        );
+        println!(
+            "χ² {label}: p = {:.3e}, dof = {:.1}, Σm̂ = {:.4}, noise ratio ≤ {:.3}, mean bounces {:.3}",
+            result.p_value,
+            result.dof,
+            result.mass,
+            result.max_ratio,
+            bounces.mean()
+        );
+        result.p_value
+    });
+    let worst = out.iter().cloned().fold(1.0, f64::min);
+    println!(
+        "BSDF sampling χ²: {} tests, N = {CHI2_N}, worst p = {worst:.3e} (α = {alpha:.2e})",
+        cases.len()
+    );
+}
+
+struct Chi2Result {
+    p_value: f64,
+    dof: f64,
+    mass: f64,
+    max_ratio: f64,
+}
+
+/// Target of the adaptive refinement: N·Var(m̂)/m ≤ this in every cell.
+const NOISE_RATIO: f64 = 0.1;
+/// Evaluations per cell before refinement, and the cap.
+const CELL_START: usize = 1_000;
+const CELL_MAX: usize = 64_000;
+
+/// Chi-square test of `sample` against a density known only through an unbiased stochastic
+/// estimator `density`, over an equal-area `nz` × `nphi` grid of (cos θ, φ) on cos θ ≥ z_lo.
+///
+/// The expected probability m̂ of a cell is its area times the mean of `density` at uniform
+/// points of the cell, one independent evaluation each, doubled until N·Var(m̂)/m ≤
+/// `NOISE_RATIO` (or `CELL_MAX` points). Cells with N m̂ < 5 are pooled. The statistic
+/// Σ (O − N m̂)²/(N m̂ + N² Var m̂) has mean k − Σ m/(1 + N Var m̂/m) over the k cells used, and
+/// is compared with the chi-square distribution with that (fractional) number of degrees of
+/// freedom. Samples outside cos θ ≥ z_lo, or where every estimate is 0, fail the test.
+/// Failed samples (`None`) are allowed only for the mass the density leaves out.
+#[allow(clippy::too_many_arguments)]
+fn stochastic_chi2(
+    label: &str,
+    z_lo: f64,
+    nz: usize,
+    nphi: usize,
+    density: &mut dyn FnMut(Vec3) -> f64,
+    sample: &mut dyn FnMut() -> Option<Vec3>,
+    n: usize,
+    alpha: f64,
+) -> Chi2Result {
+    let mut point_rng = common::rng(0x5eed);
+    let nf = n as f64;
+    let cells = nz * nphi;
+    let (dz, dp) = ((1.0 - z_lo) / nz as f64, TAU / nphi as f64);
+    let (mut mass, mut var) = (vec![0.0; cells], vec![0.0; cells]);
+    for iz in 0..nz {
+        for ip in 0..nphi {
+            let (z0, p0) = (z_lo + dz * iz as f64, dp * ip as f64);
+            let mut stats = Stats::default();
+            let mut target = CELL_START;
+            loop {
+                while (stats.n as usize) < target {
+                    let z = z0 + dz * common::uniform64(&mut point_rng);
+                    let phi = p0 + dp * common::uniform64(&mut point_rng);
+                    let s = (1.0 - z * z).max(0.0).sqrt();
+                    stats.push(density(DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()));
+                }
+                let (m, v) = (dz * dp * stats.mean(), (dz * dp * stats.se()).powi(2));
+                if m == 0.0 || nf * v / m <= NOISE_RATIO || target >= CELL_MAX {
+                    break;
+                }
+                target *= 2;
+            }
+            mass[iz * nphi + ip] = dz * dp * stats.mean();
+            var[iz * nphi + ip] = (dz * dp * stats.se()).powi(2);
+        }
+    }
+    let mut observed = vec![0u64; cells];
+    let mut failures = 0usize;
+    for _ in 0..n {
+        let Some(w) = sample() else {
+            failures += 1;
+            continue;
+        };
+        assert!(w.is_finite() && w.is_normalized(), "{label}: sampled ωo = {w} is not a unit vector");
+        let w = w.as_dvec3();
+        assert!(w.z >= z_lo, "{label}: sampled ωo = {w} outside the support cos θ ≥ {z_lo}");
+        let iz = (((w.z - z_lo) / dz) as usize).min(nz - 1);
+        let ip = ((w.y.atan2(w.x).rem_euclid(TAU) / dp) as usize).min(nphi - 1);
+        observed[iz * nphi + ip] += 1;
+    }
+    let total: f64 = mass.iter().sum();
+    let missing = (1.0 - total).max(0.0) * nf;
+    assert!(
+        failures as f64 <= missing + 5.0 * missing.max(1.0).sqrt() + 1.0,
+        "{label}: {failures} failed samples out of {n}, expected about {missing:.1}"
+    );
+    let (mut stat, mut dof, mut max_ratio) = (0.0, 0.0, 0.0f64);
+    let mut add = |m: f64, v: f64, o: f64| {
+        let ratio = nf * v / m;
+        stat += (o - nf * m).powi(2) / (nf * m * (1.0 + ratio));
+        dof += 1.0 - m / (1.0 + ratio);
+        max_ratio = max_ratio.max(ratio);
+    };
+    let (mut pool_m, mut pool_v, mut pool_o) = (0.0, 0.0, 0.0);
+    for c in 0..cells {
+        if nf * mass[c] < 5.0 {
+            pool_m += mass[c];
+            pool_v += var[c];
+            pool_o += observed[c] as f64;
+        } else {
+            add(mass[c], var[c], observed[c] as f64);
+        }
+    }
+    if pool_m > 0.0 {
+        add(pool_m, pool_v, pool_o);
+    } else {
+        assert!(pool_o == 0.0, "{label}: {pool_o} samples fell where the density is zero");
+    }
+    let p_value = 1.0 - ChiSquared::new(dof).unwrap().cdf(stat);
+    assert!(
+        max_ratio <= 4.0 * NOISE_RATIO,
+        "{label}: the expectation stayed too noisy (N·Var(m̂)/m = {max_ratio:.3}): the test would lose its power"
+    );
+    assert!(
+        p_value >= alpha,
+        "{label}: chi-square rejects the sampler: χ² = {stat:.2}, dof = {dof:.2}, p = {p_value:.3e} < α = {alpha:.3e} \
+         (N = {n}, Σm̂ = {total:.5}, failures = {failures}, largest N·Var(m̂)/m = {max_ratio:.3})"
+    );
+    Chi2Result { p_value, dof, mass: total, max_ratio }
+}
+
+// ---------------------------------------------------------------------------------------------
+// heights: the BSDF does not depend on the height distribution
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn uniform_and_gaussian_heights_agree() {
+    const N: usize = 150_000;
+    // absorptive or partial quantities, so that the albedo comparison is not trivially 1 = 1:
+    // gold, grey diffuse, and the dielectric's reflected albedo (upper hemisphere only)
+    let mats = [Mat::Gold, Mat::Diffuse(0.5), Mat::Dielectric];
+    let slopes = [(Slope::Ggx, 1), (Slope::Beckmann, 2)];
+    let cases: Vec<(Mat, Slope, usize)> =
+        mats.iter().flat_map(|&m| slopes.iter().map(move |&(s, a)| (m, s, a))).collect();
+    let z = common::family_z(0.01, 2 * cases.len());
+    let (wi, wo) = (common::dir(1.0, PHI_I), common::dir(0.6, 3.5));
+    let out = par_map(&cases, |i, &(m, s, a)| {
+        let uniform = build(Height::Uniform, s, ALPHAS[a], m);
+        let gaussian = build(Height::Gaussian, s, ALPHAS[a], m);
+        let mut rng = common::rng(600 + i as u64);
+        let [au, _, _] = albedo(uniform.as_ref(), wi, true, N, &mut rng);
+        let [ag, _, _] = albedo(gaussian.as_ref(), wi, true, N, &mut rng);
+        let label = format!("{}: albedo, uniform vs Gaussian heights", uniform.name());
+        common::assert_two_sample(&label, &au, &ag, z, 0.01);
+        let (mut eu, mut eg) = (Stats::default(), Stats::default());
+        for _ in 0..N {
+            eu.push(f64::from(uniform.eval(wi, wo, ScatteringOrder::All, &mut rng).x));
+            eg.push(f64::from(gaussian.eval(wi, wo, ScatteringOrder::All, &mut rng).x));
+        }
+        let label = format!("{}: eval, uniform vs Gaussian heights", uniform.name());
+        let scale = eu.mean().max(eg.mean());
+        assert!(scale > 1e-3, "{label}: vanishing value {scale:e}");
+        common::assert_two_sample(&label, &eu, &eg, z, 0.01 * scale);
+        println!(
+            "heights {:?} {s:?}: albedo {:.4} ± {:.4} vs {:.4} ± {:.4}; eval {:.4} ± {:.4} vs {:.4} ± {:.4}",
+            m,
+            au.mean(),
+            au.se(),
+            ag.mean(),
+            ag.se(),
+            eu.mean(),
+            eu.se(),
+            eg.mean(),
+            eg.se()
+        );
+        [(au.mean() - ag.mean(), au.se().hypot(ag.se())), (eu.mean() - eg.mean(), eu.se().hypot(eg.se()))]
+    });
+    let flat: Vec<(f64, f64)> = out.into_iter().flatten().collect();
+    println!("heights: {} comparisons, worst |Δ|/SE = {:.2} (z = {z:.2})", flat.len(), worst_z(&flat));
+}
+
+// ---------------------------------------------------------------------------------------------
+// absorptive materials
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn gold_conductor_albedo() {
+    const N: usize = 200_000;
+    let cases = [(Height::Uniform, Slope::Ggx, 1, 0.8), (Height::Gaussian, Slope::Beckmann, 2, 1.3)];
+    // per case and channel: the two-sample equality and the one-sided upper bound
+    let z = common::family_z(0.01, 3 * cases.len());
+    let z_one_sided = Normal::new(0.0, 1.0).unwrap().inverse_cdf(1.0 - common::sidak(0.01, 3 * cases.len()));
+    let out = par_map(&cases, |i, &(h, s, a, theta)| {
+        let bsdf = build(h, s, ALPHAS[a], Mat::Gold);
+        let wi = common::dir(theta, PHI_I);
+        let mut rng = common::rng(700 + i as u64);
+        let by_eval = albedo(bsdf.as_ref(), wi, false, N, &mut rng);
+        let mut by_sample = [Stats::default(); 3];
+        let mut first_fresnel = [Stats::default(); 3];
+        for _ in 0..N {
+            let w = bsdf.sample(wi, &mut rng).map_or(Vec3::ZERO, |s| s.weight);
+            let f = bsdf.sample_phase(wi, &mut rng).weight;
+            for c in 0..3 {
+                by_sample[c].push(f64::from(w[c]));
+                first_fresnel[c].push(f64::from(f[c]));
+            }
+        }
+        let mut res = Vec::new();
+        for c in 0..3 {
+            let label = format!("{}: channel {c}, θi = {theta}", bsdf.name());
+            // every bounce multiplies by F ≤ 1: the albedo is at most the first bounce's mean
+            // Fresnel factor E[F(ωi·ωm)], ωm ~ D_ωi (which is itself at most max F = 1)
+            let (e, f) = (&by_eval[c], &first_fresnel[c]);
+            let se = e.se().hypot(f.se());
+            assert!(se <= 5e-3, "{label}: SE {se:.2e} too large");
+            assert!(
+                e.mean() <= f.mean() + z_one_sided * se,
+                "{label}: albedo {:.5} ± {:.5} exceeds the first-bounce Fresnel mean {:.5} ± {:.5} (z = {z_one_sided:.2})",
+                e.mean(),
+                e.se(),
+                f.mean(),
+                f.se()
+            );
+            common::assert_two_sample(
+                &format!("{label}: albedo by eval vs E[weight] of sample"),
+                e,
+                &by_sample[c],
+                z,
+                5e-3,
+            );
+            println!(
+                "gold {label}: ∫eval = {:.4} ± {:.4}, E[weight] = {:.4} ± {:.4}, E[F first] = {:.4} ± {:.4}",
+                e.mean(),
+                e.se(),
+                by_sample[c].mean(),
+                by_sample[c].se(),
+                f.mean(),
+                f.se()
+            );
+            res.push((e.mean() - by_sample[c].mean(), e.se().hypot(by_sample[c].se())));
+        }
+        // gold absorbs: the blue channel loses much more than the red one
+        assert!(by_eval[2].mean() < by_eval[0].mean() - 0.1, "gold must absorb blue more than red");
+        res
+    });
+    let flat: Vec<(f64, f64)> = out.into_iter().flatten().collect();
+    println!("gold: worst |∫eval − E[weight]|/SE = {:.2} (z = {z:.2})", worst_z(&flat));
+}
+
+#[test]
+fn grey_diffuse_sample_weight_matches_albedo() {
+    const N: usize = 200_000;
+    let cases = [(Height::Gaussian, Slope::Ggx, 1, 0.5), (Height::Uniform, Slope::Beckmann, 2, 1.4)];
+    let z = common::family_z(0.01, cases.len());
+    let out = par_map(&cases, |i, &(h, s, a, theta)| {
+        let bsdf = build(h, s, ALPHAS[a], Mat::Diffuse(0.5));
+        let wi = common::dir(theta, PHI_I);
+        let mut rng = common::rng(800 + i as u64);
+        let [by_eval, _, _] = albedo(bsdf.as_ref(), wi, false, N, &mut rng);
+        let mut by_sample = Stats::default();
+        for _ in 0..N {
+            by_sample.push(bsdf.sample(wi, &mut rng).map_or(0.0, |s| f64::from(s.weight.x)));
+        }
+        let label = format!("{}: albedo 0.5, θi = {theta}: ∫eval vs E[weight]", bsdf.name());
+        common::assert_two_sample(&label, &by_eval, &by_sample, z, 3e-3);
+        assert!(by_eval.mean() < 0.5, "{label}: the albedo must be below the facet albedo");
+        println!(
+            "{label}: {:.4} ± {:.4} vs {:.4} ± {:.4}",
+            by_eval.mean(),
+            by_eval.se(),
+            by_sample.mean(),
+            by_sample.se()
+        );
+        (by_eval.mean() - by_sample.mean(), by_eval.se().hypot(by_sample.se()))
+    });
+    println!("grey diffuse: worst |Δ|/SE = {:.2} (z = {z:.2})", worst_z(&out));
+}
+
+// ---------------------------------------------------------------------------------------------
+// scattering orders
+// ---------------------------------------------------------------------------------------------
+
+/// Orders summed: the mass beyond is negligible (tests/walk_cap.rs measures the fraction of
+/// walks longer than 64 bounces at α = 2: below 1e-4, and none at these α in its runs).
+const MAX_ORDER: u32 = 64;
+
+#[test]
+fn orders_sum_to_the_full_bsdf() {
+    const N: usize = 30_000;
+    let cases = [
+        (Mat::Conductor, Height::Uniform, Slope::Ggx, 1, 0.8, 1.1),
+        (Mat::Diffuse(1.0), Height::Gaussian, Slope::Beckmann, 1, 1.2, 0.4),
+        (Mat::Dielectric, Height::Gaussian, Slope::Ggx, 2, 0.5, PI - 0.7),
+    ];
+    let z = common::family_z(0.01, 2 * cases.len());
+    let out = par_map(&cases, |i, &(m, h, s, a, ti, to)| {
+        let bsdf = build(h, s, ALPHAS[a], m);
+        let (wi, wo) = (common::dir(ti, PHI_I), common::dir(to, PHI_I + PI));
+        let mut rng = common::rng(900 + i as u64);
+        let (mut sum, mut all, mut sum3, mut up3) =
+            (Stats::default(), Stats::default(), Stats::default(), Stats::default());
+        for _ in 0..N {
+            let mut s = 0.0;
+            for order in 1..=MAX_ORDER {
+                s += f64::from(bsdf.eval(wi, wo, ScatteringOrder::only(order).unwrap(), &mut rng).x);
+                if order == 3 {
+                    sum3.push(s);
+                }
+            }
+            sum.push(s);
+            all.push(f64::from(bsdf.eval(wi, wo, ScatteringOrder::All, &mut rng).x));
+            up3.push(f64::from(bsdf.eval(wi, wo, ScatteringOrder::up_to(3).unwrap(), &mut rng).x));
+        }
+        let label = format!("{}: θi = {ti}, θo = {to:.3}", bsdf.name());
+        let scale = all.mean();
+        assert!(scale > 1e-3, "{label}: vanishing BSDF {scale:e}");
+        common::assert_two_sample(&format!("{label}: Σ only(n) vs All"), &sum, &all, z, 0.02 * scale);
+        common::assert_two_sample(
+            &format!("{label}: Σ_{{n≤3}} only(n) vs up_to(3)"),
+            &sum3,
+            &up3,
+            z,
+            0.02 * scale,
+        );
+        println!(
+            "orders {label}: Σ only(n) = {:.5} ± {:.5}, All = {:.5} ± {:.5}, only(1) share {:.3}",
+            sum.mean(),
+            sum.se(),
+            all.mean(),
+            all.se(),
+            1.0 - (all.mean() - sum3.mean()) / all.mean()
+        );
+        [
+            (sum.mean() - all.mean(), sum.se().hypot(all.se())),
+            (sum3.mean() - up3.mean(), sum3.se().hypot(up3.se())),
+        ]
+    });
+    let flat: Vec<(f64, f64)> = out.into_iter().flatten().collect();
+    println!("orders: worst |Δ|/SE = {:.2} (z = {z:.2})", worst_z(&flat));
+}

@@ -63,19 +63,16 @@ fn beckmann_g1() {
 }
 
 #[test]
-#[ignore = "library bug: Beckmann D in f32 up to the exponent E = 80 (uncommitted change) loses E·ε: 1e-5 relative at E ≈ 65"]
 fn beckmann_d() {
     check(|n| is(n, "Beckmann", &["d"]));
 }
 
 #[test]
-#[ignore = "library bug: Beckmann forms q = αx²x² + αy²y² in f32; Λ ~ exp(−a²) amplifies its rounding by 2a² (5e-6 relative)"]
 fn beckmann_lambda_area_and_d_wi() {
     check(|n| is(n, "Beckmann", &["lambda", "projected_area", "d_wi"]));
 }
 
 #[test]
-#[ignore = "library bug: alpha_i divides by x² + y², which underflows in f32 within 1e-19 of a pole (relative error 2.5)"]
 fn alpha_i() {
     check(|n| n.ends_with("alpha_i"));
 }
@@ -86,7 +83,6 @@ fn ggx_reflection_phase_functions_and_single_scattering() {
 }
 
 #[test]
-#[ignore = "library bug: Beckmann phase functions inherit the f32 q of Λ/A and the f32 D (1.7e-5); conductor D/(4A) underflows D first (uncommitted change)"]
 fn beckmann_phase_functions_and_single_scattering() {
     check(|n| {
         n.starts_with("Beckmann") && (n.contains("eval_phase") || n.contains("single")) && !transmission(n)
@@ -94,7 +90,6 @@ fn beckmann_phase_functions_and_single_scattering() {
 }
 
 #[test]
-#[ignore = "library bug: the f32 half vector −(ωi + ηωo) and its dots cancel (8e-5); near the critical angle 1 − F recomputes cos θt from the rounded cos θi (12%)"]
 fn dielectric_transmission() {
     check(transmission);
 }
@@ -105,7 +100,6 @@ fn fresnel_conductor() {
 }
 
 #[test]
-#[ignore = "library bug: fresnel_dielectric rounds (1 − c²)/η² to 1 near grazing: false total internal reflection at η = 1 (F = 1 instead of 0)"]
 fn fresnel_dielectric() {
     check(|n| n.starts_with("fresnel_dielectric"));
 }

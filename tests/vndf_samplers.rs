@@ -40,15 +40,18 @@ const THETAS: [f64; 7] = [0.0, 0.5, 1.2, 1.55, 1.8, 2.4, 2.9];
 /// every rotation of the samplers is exercised.
 const PHI: f64 = 0.7;
 /// Samples per chi-square test.
-const N_CHI2: usize = 200_000;
+const N_CHI2: usize = 500_000;
 /// Pilot samples (separate seed) that locate the lobe for the binning.
 const N_PILOT: usize = 4_000;
 /// The number of chi-square tests in the family: 7 samplers × roughnesses × directions.
 const CHI2_TESTS: usize = 7 * ALPHAS.len() * THETAS.len();
-/// Adaptive tolerance of the slope-space quadratures, relative to the integral.
+/// Adaptive tolerance of the slope-space quadratures, relative to the integral. The initial
+/// grid (8 cells per segment of x × 12 in y, 125 nodes each) already agrees with the refined
+/// result to ~1e-6; refinement stops after 3 levels, because deep in the backfacing tails the
+/// f32 densities carry ~1e-3 relative rounding noise per point (ωi·ωm cancels in f32), which
+/// no refinement can remove and which would otherwise drive it to exponential cost.
 const QUAD_REL_TOL: f64 = 1e-5;
-/// Tolerance of the assertions ∫pdf = 1 (quadrature tolerance 1e-7 plus the f32 rounding of
-/// the densities, ~1e-7 relative, with a wide margin).
+/// Tolerance of the assertions ∫pdf = 1: ten times the quadrature tolerance.
 const INTEGRAL_TOL: f64 = 1e-4;
 
 /// The samplers under test.
@@ -139,24 +142,11 @@ fn integrate_slopes(alpha: (f32, f32), gaussian: bool, wi: Vec3, mut f: impl FnM
     if coarse == 0.0 {
         return 0.0;
     }
-    let mut count = 0u64;
-    let t0 = std::time::Instant::now();
-    let r = integrate_slopes_tol(
-        alpha,
-        gaussian,
-        wi,
-        &mut |m| {
-            count += 1;
-            f(m)
-        },
-        Some(QUAD_REL_TOL * coarse.abs()),
-    );
-    eprintln!(
-        "DEBUG alpha={alpha:?} wi={wi} coarse={coarse:e} result={r:e} evals={count} t={:?}",
-        t0.elapsed()
-    );
-    r
+    integrate_slopes_tol(alpha, gaussian, wi, &mut f, Some(QUAD_REL_TOL * coarse.abs()))
 }
+
+/// x(s) and dx/ds of a segment parameterization of the stretched slope x̃.
+type SlopeMap = Box<dyn Fn(f64) -> (f64, f64)>;
 
 fn integrate_slopes_tol(
     (ax, ay): (f32, f32),
@@ -178,7 +168,7 @@ fn integrate_slopes_tol(
         f64::NEG_INFINITY
     };
     // x(s) and dx/ds on segments of s, with breakpoints at the kinks
-    let (x_of, segments): (Box<dyn Fn(f64) -> (f64, f64)>, Vec<f64>) = if kappa >= 0.0 {
+    let (x_of, segments): (SlopeMap, Vec<f64>) = if kappa >= 0.0 {
         // x = tan s on (−π/2, atan κ): the peak at x = 0, the mirror kink at x = −κ
         let hi = kappa.atan();
         let mut b = vec![-FRAC_PI_2, hi];
@@ -244,25 +234,59 @@ fn integrate_slopes_tol(
 // Chi-square family
 // ---------------------------------------------------------------------------------------
 
-/// The binning of a configuration: a cap around the lobe (mean of pilot samples, separate
-/// seed) of radius 2.5 × the 90% quantile of the pilot normals' angle to it, or the whole
-/// sphere if that radius exceeds 1.4 rad.
-fn grid_for(sampler: &dyn Sampler, wi: Vec3, seed: u64) -> (Chi2Grid, String) {
-    let mut r = rng(seed);
-    let pilot: Vec<DVec3> = (0..N_PILOT).map(|_| sampler.sample(wi, uniforms(&mut r)).as_dvec3()).collect();
-    let sum: DVec3 = pilot.iter().copied().filter(|m| m.is_finite()).sum();
-    let pole = sum.normalize_or(DVec3::Z);
-    let mut angles: Vec<f64> =
-        pilot.iter().filter(|m| m.is_finite()).map(|m| m.dot(pole).clamp(-1.0, 1.0).acos()).collect();
-    angles.sort_by(f64::total_cmp);
-    let q90 = angles.get(angles.len() * 9 / 10).copied().unwrap_or(PI);
-    let radius = 2.5 * q90;
-    if radius > 1.4 {
-        (Chi2Grid::sphere(16, 32), "sphere 16×32".to_string())
+/// Adaptive tolerance of the harness's per-cell quadrature (absolute, over the whole sphere)
+/// and its depth. The expected count of a cell is then exact to far below a count; deeper
+/// refinement only chases the f32 rounding noise of the densities in deep tails.
+const CHI2_QUAD_TOL: f64 = 1e-5;
+const CHI2_QUAD_DEPTH: u32 = 5;
+
+/// The binning of a configuration.
+///
+/// - ωi below the horizon: the whole sphere (16 × 32 cells) with its pole on the axis of the
+///   edge of the support along which the lobe lies as a thin sheet, so that this edge is the
+///   equator, a cell boundary: ωi for Beckmann (visible slopes pile up just below κ, at the
+///   edge ωi·ωm = 0), z for GGX (heavy tails: the visible normals hug the horizon ωm.z = 0).
+///   Across a cell, such a sheet can fall between all the nodes of the harness's quadrature
+///   (expected 0 or too low, observed > 0); the other edge, where the density vanishes
+///   linearly, is harmless.
+/// - ωi above it: a cap around the lobe (mean of `N_PILOT` pilot samples, separate seed) of
+///   radius 1.5 × the largest angle of a pilot normal to it, so that nearly no mass is left to
+///   the coarse outside cell; or, if that radius exceeds 1.4 rad, the whole sphere with its
+///   pole in the middle of the support {ωm.z > 0, ωi·ωm > 0}, normalize(z + ωi), as far as
+///   possible from both of its edges (a pole near an edge, e.g. z at grazing incidence, lets
+///   all the nodes of the cells around it miss their thin visible part).
+fn grid_for(sampler: &dyn Sampler, gaussian: bool, wi: Vec3, seed: u64) -> (Chi2Grid, String) {
+    let (mut grid, label) = if wi.z < 0.0 && gaussian {
+        (Chi2Grid { pole: wi.normalize(), ..Chi2Grid::sphere(16, 32) }, "sphere 16×32 around ωi".to_string())
+    } else if wi.z < 0.0 {
+        (Chi2Grid::sphere(16, 32), "sphere 16×32 around z".to_string())
     } else {
-        let pole = pole.as_vec3();
-        (Chi2Grid::cap(pole, radius, 10, 24), format!("cap 10×24 around {pole:.4} radius {radius:.4}"))
-    }
+        let mut r = rng(seed);
+        let pilot: Vec<DVec3> =
+            (0..N_PILOT).map(|_| sampler.sample(wi, uniforms(&mut r)).as_dvec3()).collect();
+        let sum: DVec3 = pilot.iter().copied().filter(|m| m.is_finite()).sum();
+        let pole = sum.normalize_or(DVec3::Z);
+        let max_angle = pilot
+            .iter()
+            .filter(|m| m.is_finite())
+            .map(|m| m.dot(pole).clamp(-1.0, 1.0).acos())
+            .fold(0.0, f64::max);
+        let radius = 1.5 * max_angle;
+        if radius > 1.4 {
+            let middle = (Vec3::Z + wi.normalize_or(Vec3::Z)).normalize_or(Vec3::Z);
+            (
+                Chi2Grid { pole: middle, ..Chi2Grid::sphere(16, 32) },
+                format!("sphere 16×32 around {middle:.4}"),
+            )
+        } else {
+            let grid = Chi2Grid::cap(pole.as_vec3(), radius, 10, 24);
+            let label = format!("cap 10×24 around {:.4} radius {radius:.4}", grid.pole);
+            (grid, label)
+        }
+    };
+    grid.quad_tol = CHI2_QUAD_TOL;
+    grid.max_depth = CHI2_QUAD_DEPTH;
+    (grid, label)
 }
 
 /// One chi-square test of a sampler at a configuration; also asserts that every sample is a
@@ -276,7 +300,7 @@ fn chi2_config(
 ) -> Result<Chi2Outcome, String> {
     let sampler = make(kind, alpha);
     let wi = dir(theta, PHI);
-    let (grid, grid_label) = grid_for(sampler.as_ref(), wi, seed ^ 0x9E37_79B9_7F4A_7C15);
+    let (grid, grid_label) = grid_for(sampler.as_ref(), kind.is_beckmann(), wi, seed ^ 0x9E37_79B9_7F4A_7C15);
     let label = format!(
         "{kind:?} α = {alpha:?}, θi = {theta}, φi = {PHI}, wi = {wi:.5}, N = {N_CHI2}, seed = {seed}, {grid_label}"
     );
@@ -386,7 +410,7 @@ fn chi2_negative_control() {
         let sampler = GgxDisk(Ggx::new(sampled, sampled).unwrap());
         let wrong = SmithVndf(Ggx::new(claimed, claimed).unwrap());
         let wi = dir(theta, PHI);
-        let (grid, grid_label) = grid_for(&sampler, wi, seed + 1000);
+        let (grid, grid_label) = grid_for(&sampler, false, wi, seed + 1000);
         let mut r = rng(seed);
         let result = catch_unwind(AssertUnwindSafe(|| {
             chi2_test(
@@ -422,7 +446,7 @@ fn chi2_negative_control() {
 
 /// ∫ pdf(ωi, ωm) dωm = 1 for every sampler, roughness and incident direction (also θi = 2.0,
 /// 3.1 and a direction 1e-3 below the horizon), by slope-space quadrature with relative
-/// tolerance 1e-7, asserted within 1e-4. Also checks that no density is put below the
+/// tolerance 1e-5, asserted within 1e-4. Also checks that no density is put below the
 /// horizon (ωm.z < 0), where the slope-space quadrature does not look.
 #[test]
 fn pdf_integrates_to_one() {
@@ -443,7 +467,7 @@ fn pdf_integrates_to_one() {
                 if err.is_nan() || err > worst.0 {
                     worst = (err, label.clone());
                 }
-                if !(err <= INTEGRAL_TOL) {
+                if err.is_nan() || err > INTEGRAL_TOL {
                     failures.push(format!("{label}: ∫pdf = {integral:.8}"));
                 }
                 for _ in 0..200 {
@@ -513,7 +537,7 @@ fn previous_normalization_loses_mass_below_the_horizon() {
             );
         }
     }
-    for (theta, assert_below) in [(2.9, true), (2.0, true), (1.8, true), (2.4, true), (1.2, false)] {
+    for (theta, assert_below) in [(2.0, true), (1.8, true), (2.4, true), (2.9, true), (1.2, false)] {
         check("GGX", Ggx::new(0.5, 0.5).unwrap(), false, theta, assert_below);
         check("Beckmann", Beckmann::new(0.5, 0.5).unwrap(), true, theta, assert_below);
     }
@@ -534,7 +558,8 @@ fn vcavity_g(i: DVec3, m: DVec3) -> f64 {
 
 /// ∫ G(i, m)⟨i, m⟩⁺D(m) dm / |i·n| = H(i) (closed form) for GGX and Beckmann, isotropic and
 /// anisotropic, i on both sides of the horizon; relative tolerance 1e-4 (the quadrature's is
-/// 1e-7), absolute 1e-12 for integrals that underflow.
+/// 1e-5), absolute 1e-12 for integrals that underflow. Relative, because the V-cavity density
+/// divides by H.
 #[test]
 fn vcavity_hit_probability_matches_quadrature() {
     fn check<S: microsurface::VCavitySlope>(
@@ -694,33 +719,4 @@ fn degenerate_inputs() {
         failures.len(),
         failures.join("\n")
     );
-}
-
-#[test]
-fn zz_debug() {
-    let alpha = (0.05f32, 0.05f32);
-    for theta in [2.4, 2.9, 3.1] {
-        let wi = dir(theta, PHI);
-        let s = Beckmann::new(alpha.0, alpha.1).unwrap();
-        let lib = integrate_slopes(alpha, true, wi, |m| f64::from(s.d_wi(wi, m)));
-        // exact f64 density from the f32 m, log space
-        let id = wi.as_dvec3();
-        let (ax, ay) = (0.05f64, 0.05f64);
-        let q = (ax * id.x).powi(2) + (ay * id.y).powi(2);
-        let a = -id.z / q.sqrt();
-        let r2 = 1.0 / (2.0 * a * a);
-        let r = r2 * (1.0 - r2 * (3.0 - r2 * (15.0 - r2 * (105.0 - r2 * (945.0 - r2 * 10395.0)))));
-        let ln_area = -a * a + (0.5 / PI.sqrt() * q.sqrt()).ln() + r.ln();
-        let exact = integrate_slopes(alpha, true, wi, |m| {
-            let md = m.as_dvec3();
-            let c = id.dot(md);
-            if c <= 0.0 {
-                return 0.0;
-            }
-            let ln_d = -((md.x / ax).powi(2) + (md.y / ay).powi(2)) / (md.z * md.z)
-                - (PI * ax * ay * md.z.powi(4)).ln();
-            c * (ln_d - ln_area).exp()
-        });
-        println!("θ = {theta}: a = {a}, library {lib:.8}, f64 {exact:.8}");
-    }
 }

@@ -51,6 +51,11 @@ const QUAD_EXACT_TOL: f64 = 1e-4;
 trait SlopeDyn: Send + Sync {
     fn alpha(&self) -> (f32, f32);
     fn d_wi(&self, wi: Vec3, m: Vec3) -> f32;
+    /// D_ωi at a normal given in double precision (no rounding of the normal to f32).
+    fn d_wi64(&self, wi: Vec3, m: glam::DVec3) -> f64;
+    /// Whether the slopes are Gaussian (Beckmann): the cross slope is then N(0, ½) whatever
+    /// the other, and binned through erf.
+    fn gaussian(&self) -> bool;
     fn sample(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
     fn visible_integral(&self, w: Vec3, g: &mut dyn FnMut(Vec3) -> f64) -> f64;
 }
@@ -61,6 +66,12 @@ impl<S: MicrosurfaceSlope> SlopeDyn for S {
     }
     fn d_wi(&self, wi: Vec3, m: Vec3) -> f32 {
         MicrosurfaceSlope::d_wi(self, wi, m)
+    }
+    fn d_wi64(&self, wi: Vec3, m: glam::DVec3) -> f64 {
+        MicrosurfaceSlope::d_wi64(self, wi, m)
+    }
+    fn gaussian(&self) -> bool {
+        std::any::type_name::<S>().contains("Beckmann")
     }
     fn sample(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         self.sample_d_wi(wi, u1, u2)
@@ -86,10 +97,13 @@ fn integrate_visible<S: MicrosurfaceSlope>(s: &S, w: Vec3, mut g: impl FnMut(Vec
         return 0.0;
     };
     let lo = -FRAC_PI_2;
+    let gaussian = std::any::type_name::<S>().contains("Beckmann");
     let mut f = |u: f64, v: f64| {
         let (x, dx) = (u.tan(), 1.0 / (u.cos() * u.cos()));
-        let sigma = (1.0 + x * x).sqrt();
-        let (y, dy) = (sigma * v.tan(), sigma / (v.cos() * v.cos()));
+        let (y, dy) = cross_y(x, v, gaussian);
+        if !y.is_finite() {
+            return 0.0;
+        }
         let sx = ax * (cos_phi * x - sin_phi * y);
         let sy = ay * (sin_phi * x + cos_phi * y);
         let norm = (1.0 + sx * sx + sy * sy).sqrt();
@@ -205,14 +219,32 @@ fn visible_frame(a: (f32, f32), w: Vec3) -> Option<(f64, f64, f64)> {
 
 /// The (u, v) coordinates of `integrate_visible` of a normal (u may exceed u_hi if ωm is not
 /// visible).
-fn uv_of(a: (f32, f32), frame: (f64, f64, f64), m: Vec3) -> (f64, f64) {
+fn uv_of(a: (f32, f32), frame: (f64, f64, f64), m: Vec3, gaussian: bool) -> (f64, f64) {
     let (cos_phi, sin_phi, _) = frame;
     let z = f64::from(m.z).max(1e-300);
     let sx = -f64::from(m.x) / z / f64::from(a.0);
     let sy = -f64::from(m.y) / z / f64::from(a.1);
     let x = cos_phi * sx + sin_phi * sy;
     let y = -sin_phi * sx + cos_phi * sy;
-    (x.atan(), (y / (1.0 + x * x).sqrt()).atan())
+    (x.atan(), cross_v(x, y, gaussian))
+}
+
+/// The cross coordinate v ∈ (−π/2, π/2) of the slopes (x, y): atan(y/√(1 + x²)) for GGX, whose
+/// conditional spreads with x, and (π/2) erf(y) for Beckmann, whose cross slope is N(0, ½)
+/// whatever x (so that thin lobes far from the origin stay resolved).
+fn cross_v(x: f64, y: f64, gaussian: bool) -> f64 {
+    if gaussian { FRAC_PI_2 * statrs::function::erf::erf(y) } else { (y / (1.0 + x * x).sqrt()).atan() }
+}
+
+/// The inverse of [`cross_v`] for a given x: (y, dy/dv).
+fn cross_y(x: f64, v: f64, gaussian: bool) -> (f64, f64) {
+    if gaussian {
+        let y = statrs::function::erf::erf_inv(v / FRAC_PI_2);
+        (y, (y * y).exp() * std::f64::consts::PI.sqrt() / std::f64::consts::PI)
+    } else {
+        let sigma = (1.0 + x * x).sqrt();
+        (sigma * v.tan(), sigma / (v.cos() * v.cos()))
+    }
 }
 
 /// A chi-square test with bins in the slope-space coordinates (u, v) of `integrate_visible`
@@ -235,32 +267,49 @@ fn slope_chi2(
     let (cos_phi, sin_phi, u_hi) = frame;
     let (ax, ay) = (f64::from(a.0), f64::from(a.1));
     let (wi, slope) = (c.wi, &c.slope);
+    let gaussian = c.slope.gaussian();
     let mut f = |u: f64, v: f64| {
         let (x, dx) = (u.tan(), 1.0 / (u.cos() * u.cos()));
-        let sigma = (1.0 + x * x).sqrt();
-        let (y, dy) = (sigma * v.tan(), sigma / (v.cos() * v.cos()));
+        let (y, dy) = cross_y(x, v, gaussian);
+        if !y.is_finite() {
+            return 0.0;
+        }
         let sx = ax * (cos_phi * x - sin_phi * y);
         let sy = ay * (sin_phi * x + cos_phi * y);
         let norm = (1.0 + sx * sx + sy * sy).sqrt();
-        let m = Vec3::new((-sx / norm) as f32, (-sy / norm) as f32, (1.0 / norm) as f32);
-        let value = f64::from(slope.d_wi(wi, m));
+        // the normal stays in f64: rounding it to f32 flips the visibility of normals near the
+        // boundary of thin lobes (Beckmann far below the horizon)
+        let m = glam::DVec3::new(-sx / norm, -sy / norm, 1.0 / norm);
+        let value = slope.d_wi64(wi, m);
         if value == 0.0 { 0.0 } else { value * ax * ay * dx * dy / (norm * norm * norm) }
     };
-    let lo = -FRAC_PI_2;
     let (vlo, vhi) = (-FRAC_PI_2, FRAC_PI_2);
     // marginal in u by strips
-    let mut cum = vec![0.0; STRIPS + 1];
-    for k in 0..STRIPS {
-        let u0 = lo + (u_hi - lo) * k as f64 / STRIPS as f64;
-        let u1 = lo + (u_hi - lo) * (k + 1) as f64 / STRIPS as f64;
-        let mut strip = 0.0;
-        for j in 0..8 {
-            let v0 = vlo + (vhi - vlo) * j as f64 / 8.0;
-            let v1 = vlo + (vhi - vlo) * (j + 1) as f64 / 8.0;
-            let rough = integrate(&mut f, u0, u1, v0, v1, 0.0, 0).abs();
-            strip += integrate(&mut f, u0, u1, v0, v1, (1e-9f64).max(REL_TOL * rough), 5);
+    let mut strips = |lo: f64, f: &mut dyn FnMut(f64, f64) -> f64| {
+        let mut cum = vec![0.0; STRIPS + 1];
+        for k in 0..STRIPS {
+            let u0 = lo + (u_hi - lo) * k as f64 / STRIPS as f64;
+            let u1 = lo + (u_hi - lo) * (k + 1) as f64 / STRIPS as f64;
+            let mut strip = 0.0;
+            for j in 0..8 {
+                let v0 = vlo + (vhi - vlo) * j as f64 / 8.0;
+                let v1 = vlo + (vhi - vlo) * (j + 1) as f64 / 8.0;
+                let mut g = |u: f64, v: f64| f(u, v);
+                let rough = integrate(&mut g, u0, u1, v0, v1, 0.0, 0).abs();
+                strip += integrate(&mut g, u0, u1, v0, v1, (1e-9f64).max(REL_TOL * rough), 5);
+            }
+            cum[k + 1] = cum[k] + strip;
         }
-        cum[k + 1] = cum[k] + strip;
+        cum
+    };
+    // a second pass zooms onto the support when the lobe spans only a few strips (the thin
+    // crescents of Beckmann far below the horizon): the mass left below `lo` is < 1e-12
+    let mut lo = -FRAC_PI_2;
+    let mut cum = strips(lo, &mut f);
+    let first = cum.iter().position(|&c| c > 1e-12 * cum[STRIPS]).unwrap_or(1).saturating_sub(1);
+    if first > 0 {
+        lo += (u_hi - lo) * first as f64 / STRIPS as f64;
+        cum = strips(lo, &mut f);
     }
     let total = cum[STRIPS];
     if (total - 1.0).abs() > 1e-3 {
@@ -292,7 +341,7 @@ fn slope_chi2(
     let mut observed = vec![0u64; NU * NV + 1];
     for _ in 0..n {
         let m = sample();
-        let (u, v) = uv_of(a, frame, m);
+        let (u, v) = uv_of(a, frame, m, gaussian);
         let cell = if !(u.is_finite() && v.is_finite()) || u > u_hi {
             NU * NV
         } else {

@@ -85,13 +85,22 @@ impl ClassicBrdf {
             return 0.0;
         }
         let c2 = c * c;
-        let tan2 = (1.0 - c2).max(0.0) / c2;
+        let s2 = (1.0 - c2).max(0.0);
         match self.ndf {
             ClassicNdf::Phong(e) => (e + 2.0) / TAU * c.powf(e),
-            ClassicNdf::Beckmann(a) => (-tan2 / (a * a)).exp() * FRAC_1_PI / (a * a * c2 * c2),
+            ClassicNdf::Beckmann(a) => {
+                // exp(−tan²θ/α²)/(π α² cos⁴θ) in f64: cos⁴θ underflows before the exponential
+                let (a, c2) = (f64::from(a), f64::from(c) * f64::from(c));
+                if c2 == 0.0 {
+                    return 0.0;
+                }
+                ((-(1.0 - c2).max(0.0) / (c2 * a * a)).exp() / (core::f64::consts::PI * a * a * c2 * c2))
+                    as f32
+            }
             ClassicNdf::Ggx(a) => {
-                let t = a * a + tan2;
-                a * a * FRAC_1_PI / (c2 * c2 * t * t)
+                // α²/(π cos⁴θ (α² + tan²θ)²) = α²/(π (α² cos²θ + sin²θ)²), finite at grazing
+                let t = a * a * c2 + s2;
+                a * a * FRAC_1_PI / (t * t)
             }
         }
     }
@@ -133,7 +142,9 @@ impl ClassicBrdf {
     /// cos θm of a normal sampled from D(m) cos θm (CS500, "Sampling a BRDF").
     fn sample_cos_theta_m(&self, u: f32) -> f32 {
         match self.ndf {
-            ClassicNdf::Phong(e) => u.powf(1.0 / (e + 1.0)),
+            // D(m) cos θm ∝ cos^(e+1) θm: cos θm = u^(1/(e+2)) (Walter et al. 2007, eq. 30; the
+            // CS500 handout's 1/(e+1) samples cos^e θm instead)
+            ClassicNdf::Phong(e) => u.powf(1.0 / (e + 2.0)),
             ClassicNdf::Beckmann(a) => 1.0 / (1.0 - a * a * (-u).ln_1p()).sqrt(),
             ClassicNdf::Ggx(a) => {
                 let tan2 = a * a * u / (1.0 - u).max(f32::MIN_POSITIVE);

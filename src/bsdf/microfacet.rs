@@ -131,7 +131,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> MicrofacetBsdf<H,
 
     /// The energy per scattering order for the view direction `wo`, from `walks` sampled
     /// walks of this BSDF's technique (single scattering uses the random walk): what a
-    /// truncation to n orders would leave out is [`EnergyByOrder::left_out`].
+    /// truncation to n orders would leave out is [`EnergyByOrder::left_out`]. The energies are
+    /// albedos (importance transport): the radiance factor (η_wo/η_wi)² of a dielectric is not
+    /// applied.
     pub fn energy_by_order(&self, wo: Vec3, walks: usize, rng: &mut impl Rng) -> EnergyByOrder {
         let mut table = EnergyByOrder { walks, ..EnergyByOrder::default() };
         for _ in 0..walks {
@@ -185,11 +187,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Bsdf for Microfac
                 (wi, weight, M::EXACT_PHASE_PDF)
             }
             Technique::RandomWalk => {
-                let s = self.surface.sample(wo, rng)?;
+                let s = self.surface.sample(wo, rng).filter(|s| self.order.includes(s.bounces))?;
                 (s.wo, s.weight, false)
             }
             Technique::PositionFree { shadowing, .. } => {
-                let s = self.position_free(shadowing).sample(wo, rng)?;
+                let s = self
+                    .position_free(shadowing)
+                    .sample(wo, rng)
+                    .filter(|s| self.order.includes(s.bounces))?;
                 (s.wo, s.weight, false)
             }
         };

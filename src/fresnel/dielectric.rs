@@ -10,13 +10,27 @@
 /// Rp = (η cos θi − cos θt)/(η cos θi + cos θt). F = 0 at η = 1; F = 1 at grazing incidence.
 #[inline]
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
-    let c = cos_theta_i.abs().min(1.0);
-    let sin2_t = (1.0 - c * c) / (eta * eta);
-    if sin2_t >= 1.0 {
+    let c = f64::from(cos_theta_i.abs().min(1.0));
+    let eta = f64::from(eta);
+    // η² cos²θt = c² + (η − 1)(η + 1): no rounding of (1 − c²)/η² to 1 near grazing
+    let eta2_cos2_t = c * c + (eta - 1.0) * (eta + 1.0);
+    if eta2_cos2_t <= 0.0 {
         return 1.0;
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let rs = (c - eta * cos_t) / (c + eta * cos_t);
-    let rp = (eta * c - cos_t) / (eta * c + cos_t);
-    0.5 * (rs * rs + rp * rp)
+    fresnel_dielectric_cosines(c, eta2_cos2_t.sqrt() / eta, eta) as f32
+}
+
+/// The unpolarized dielectric reflectance from both cosines, cos θi = `c` and cos θt = `t`
+/// (both ≥ 0), with relative index η = ηt/ηi, in double precision:
+/// Rs = (c − η t)/(c + η t), Rp = (η c − t)/(η c + t), F = (Rs² + Rp²)/2. Callers that know
+/// cos θt from the geometry (a refraction through a known facet) pass it directly instead of
+/// recomputing it from a rounded cos θi near the critical angle.
+#[inline]
+pub(crate) fn fresnel_dielectric_cosines(c: f64, t: f64, eta: f64) -> f64 {
+    let (num_s, den_s) = (c - eta * t, c + eta * t);
+    let (num_p, den_p) = (eta * c - t, eta * c + t);
+    if den_s <= 0.0 || den_p <= 0.0 {
+        return 1.0;
+    }
+    0.5 * ((num_s / den_s).powi(2) + (num_p / den_p).powi(2))
 }

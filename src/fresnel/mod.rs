@@ -7,4 +7,5 @@ mod schlick;
 
 pub use conductor::{ComplexIor, fresnel_conductor};
 pub use dielectric::fresnel_dielectric;
+pub(crate) use dielectric::fresnel_dielectric_cosines;
 pub use schlick::fresnel_schlick;

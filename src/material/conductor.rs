@@ -56,8 +56,8 @@ impl Material for Conductor {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
-        let cos_ih = wi.dot(wh);
-        self.fresnel(cos_ih) * (0.25 * slope.d_wi(wi, wh) / cos_ih)
+        let cos_ih = wi.as_dvec3().dot(wh);
+        self.fresnel(cos_ih as f32) * (0.25 * slope.d_wi64(wi, wh) / cos_ih) as f32
     }
 
     const EXACT_PHASE_PDF: bool = true;
@@ -75,7 +75,7 @@ impl Material for Conductor {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return 0.0;
         };
-        0.25 * slope.d_wi(wi, wh) / wi.dot(wh)
+        (0.25 * slope.d_wi64(wi, wh) / wi.as_dvec3().dot(wh)) as f32
     }
 
     /// F(ωi·ωh) D(ωh) / (4 |cos θi|) (Wang et al. 2022, eq. 2).
@@ -93,7 +93,7 @@ impl Material for Conductor {
         else {
             return Vec3::ZERO;
         };
-        self.fresnel(wi.dot(wh)) * (slope.d(wh) / (4.0 * wi.z.abs()))
+        self.fresnel(wi.as_dvec3().dot(wh) as f32) * (slope.d64(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
     }
 
     /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm).
@@ -123,8 +123,8 @@ impl Material for Conductor {
         if g2 == 0.0 {
             return Vec3::ZERO;
         }
-        let wh = (wi + wo).normalize_or_zero();
-        let value = slope.d(wh) * g2 / (4.0 * wi.z);
-        self.fresnel(wi.dot(wh)) * value
+        let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
+        let value = (slope.d64(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32;
+        self.fresnel(wi.as_dvec3().dot(wh) as f32) * value
     }
 }

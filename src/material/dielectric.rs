@@ -2,12 +2,28 @@
 
 use super::{Material, PhaseSample, g2_reflection, reflect, reflection_half_vector};
 use crate::error::Error;
-use crate::fresnel::fresnel_dielectric;
+use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_cosines};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use crate::special::beta;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rand::Rng;
+
+/// Below this |ωi + η ωo| (relative to max(1, η)) a transmission is treated as the Dirac of
+/// an η = 1 interface and has no density.
+const REFRACTION_DEGENERATE: f64 = 1e-6;
+
+/// A valid refraction ωi → ωo through the facet ωh, with its cosines in double precision.
+#[derive(Debug, Clone, Copy)]
+struct Refraction {
+    wh: DVec3,
+    cos_ih: f64,
+    cos_oh: f64,
+    /// (ωi·ωh + η ωo·ωh)², the Jacobian's denominator.
+    denom_sq: f64,
+    /// 1 − F from cos θi and the exact cos θt = −ωo·ωh.
+    transmittance: f64,
+}
 
 /// Dielectric microfacets separating an outside (z > 0) from an inside medium with relative
 /// index η = η_inside/η_outside (Heitz et al. 2016, supplement §3.4).
@@ -45,11 +61,28 @@ impl Dielectric {
     /// The refraction half vector −(ωi + η ωo), normalized and turned to the upper hemisphere,
     /// or `None` when it is undefined or the pair is not a valid refraction through it
     /// (ωi·ωh > 0 > ωo·ωh).
+    ///
+    /// Computed in double precision: −(ωi + η ωo) cancels strongly near η = 1 and near the
+    /// critical angle. Returns `None` when |ωi + η ωo| < `REFRACTION_DEGENERATE`·max(1, η): at
+    /// η = 1 and ωo = −ωi the transmission is a Dirac with no density to evaluate, and
+    /// elsewhere this leaves out about 1e-12 sr.
     #[inline(always)]
-    fn refraction_half_vector(&self, wi: Vec3, wo: Vec3) -> Option<Vec3> {
-        let wh = -(wi + self.eta * wo).normalize_or_zero();
-        let wh = if wh.z < 0.0 { -wh } else { wh };
-        (wh.z > 0.0 && wi.dot(wh) > 0.0 && wo.dot(wh) < 0.0).then_some(wh)
+    fn refraction(&self, wi: Vec3, wo: Vec3) -> Option<Refraction> {
+        let (i, o, eta) = (wi.as_dvec3(), wo.as_dvec3(), f64::from(self.eta));
+        let sum = i + eta * o;
+        let len = sum.length();
+        if !(len > REFRACTION_DEGENERATE * eta.max(1.0)) {
+            return None;
+        }
+        let h = if sum.z > 0.0 { sum / len } else { -sum / len };
+        let (cos_ih, cos_oh) = (i.dot(h), o.dot(h));
+        if !(h.z > 0.0 && cos_ih > 0.0 && cos_oh < 0.0) {
+            return None;
+        }
+        // cos θt = −ωo·ωh exactly for a valid refraction: no square root, no TIR branch
+        let transmittance = 1.0 - fresnel_dielectric_cosines(cos_ih, -cos_oh, eta);
+        // ωi·ωh + η ωo·ωh = (ωi + η ωo)·ωh = ±len
+        Some(Refraction { wh: h, cos_ih, cos_oh, denom_sq: len * len, transmittance })
     }
 
     /// The phase function for ωi outside.
@@ -63,18 +96,12 @@ impl Dielectric {
     ) -> f32 {
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            let cos_ih = wi.dot(wh);
-            fresnel_dielectric(cos_ih, self.eta) * 0.25 * slope.d_wi(wi, wh) / cos_ih
+            let cos_ih = wi.as_dvec3().dot(wh);
+            fresnel_dielectric(cos_ih as f32, self.eta) * (0.25 * slope.d_wi64(wi, wh) / cos_ih) as f32
         } else {
-            let Some(wh) = self.refraction_half_vector(wi, wo) else { return 0.0 };
-            let (cos_ih, cos_oh) = (wi.dot(wh), wo.dot(wh));
-            let denom = cos_ih + self.eta * cos_oh;
-            self.eta
-                * self.eta
-                * (1.0 - fresnel_dielectric(cos_ih, self.eta))
-                * slope.d_wi(wi, wh)
-                * (-cos_oh)
-                / (denom * denom)
+            let Some(r) = self.refraction(wi, wo) else { return 0.0 };
+            let eta = f64::from(self.eta);
+            (eta * eta * r.transmittance * slope.d_wi64(wi, r.wh) * (-r.cos_oh) / r.denom_sq) as f32
         }
     }
 
@@ -86,18 +113,13 @@ impl Dielectric {
         }
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            fresnel_dielectric(wi.dot(wh), self.eta) * slope.d(wh) / (4.0 * wi.z.abs())
+            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta)
+                * (slope.d64(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
         } else {
-            let Some(wh) = self.refraction_half_vector(wi, wo) else { return 0.0 };
-            let (cos_ih, cos_oh) = (wi.dot(wh), wo.dot(wh));
-            let denom = cos_ih + self.eta * cos_oh;
-            cos_ih
-                * (-cos_oh)
-                * self.eta
-                * self.eta
-                * (1.0 - fresnel_dielectric(cos_ih, self.eta))
-                * slope.d(wh)
-                / (wi.z.abs() * denom * denom)
+            let Some(r) = self.refraction(wi, wo) else { return 0.0 };
+            let eta = f64::from(self.eta);
+            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64(r.wh)
+                / (f64::from(wi.z.abs()) * r.denom_sq)) as f32
         }
     }
 
@@ -226,21 +248,15 @@ impl Material for Dielectric {
         }
         let value = if wo.z > 0.0 {
             let g2 = g2_reflection(slope, wi, wo);
-            let wh = (wi + wo).normalize_or_zero();
-            fresnel_dielectric(wi.dot(wh), self.eta) * slope.d(wh) * g2 / (4.0 * wi.z)
+            let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
+            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta)
+                * (slope.d64(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32
         } else {
-            let Some(wh) = self.refraction_half_vector(wi, wo) else { return Vec3::ZERO };
-            let (cos_ih, cos_oh) = (wi.dot(wh), wo.dot(wh));
-            let g2 = beta(1.0 + f64::from(slope.lambda(wi)), 1.0 + f64::from(slope.lambda(-wo))) as f32;
-            let denom = cos_ih + self.eta * cos_oh;
-            cos_ih
-                * (-cos_oh)
-                * self.eta
-                * self.eta
-                * (1.0 - fresnel_dielectric(cos_ih, self.eta))
-                * slope.d(wh)
-                * g2
-                / (wi.z * denom * denom)
+            let Some(r) = self.refraction(wi, wo) else { return Vec3::ZERO };
+            let g2 = beta(1.0 + f64::from(slope.lambda(wi)), 1.0 + f64::from(slope.lambda(-wo)));
+            let eta = f64::from(self.eta);
+            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64(r.wh) * g2
+                / (f64::from(wi.z) * r.denom_sq)) as f32
         };
         Vec3::splat(value)
     }

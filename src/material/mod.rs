@@ -10,7 +10,7 @@ pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 
 use crate::slope::MicrosurfaceSlope;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rand::Rng;
 
 /// An outgoing direction sampled from a phase function.
@@ -115,9 +115,10 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
 /// The normalized half vector of a reflection ωi → ωo, if it is a valid microfacet normal
 /// for the pair (ωh.z > 0 and ωi·ωh > 0).
 #[inline(always)]
-pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<Vec3> {
-    let wh = (wi + wo).normalize_or_zero();
-    (wh.z > 0.0 && wi.dot(wh) > 0.0).then_some(wh)
+pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<DVec3> {
+    // kept in f64: D in its tails and at small α amplifies the half vector's rounding
+    let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
+    (wh.z > 0.0 && wi.as_dvec3().dot(wh) > 0.0).then_some(wh)
 }
 
 /// The reflection of `wi` about the unit normal `wm`: 2(ωi·ωm)ωm − ωi.

@@ -115,7 +115,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             if order.includes(bounce) {
                 let phase = self.material.eval_phase(slope, -wr, wo, outside, wo_outside, rng);
                 let shadowing = escape_probability(height.c1(if wo_outside { h } else { -h }), lambda_o);
-                sum += throughput * phase * shadowing;
+                if shadowing > 0.0 {
+                    sum += throughput * phase * shadowing;
+                }
             }
             if bounce == last {
                 break;

@@ -103,7 +103,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// 1/(1 + Λ(ωi) + Λ(ωo)) or B(1 + Λ(ωi), 1 + Λ(−ωo)) correlated. Exact, except for diffuse
     /// facets (unbiased estimate).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
         self.connect(start, wo, wo_outside, true, rng).as_vec3()
@@ -146,7 +146,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// weight is v·S_last·|cos θo|/pdf exactly. Returns (ωo, weight); `None` if ωi cannot light
     /// the material or the sampled direction cannot leave the surface.
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
-        let at = Self::incident(wi)?;
+        let at = Self::incident_single(wi)?;
         let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
         let last = self.shadowing_factor(k_in, s.wo, s.outside, at.outside == s.outside, true) * k_in;
@@ -157,7 +157,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The density of [`PositionFree::sample_single`]: the phase function's sampling density
     /// (exact for conductors and dielectrics).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
         self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside)
@@ -188,6 +188,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         } else {
             None
         }
+    }
+
+    /// Like [`Self::incident`], but an opaque material also accepts ωi below the horizon: a
+    /// single bounce is well defined there (the full-spherical masking and VNDF handle it),
+    /// which is what a renderer meets when a shading normal makes the view backfacing
+    /// (Tokuyoshi; Wang et al. 2022 §3.5, normal mapping).
+    #[inline(always)]
+    pub(crate) fn incident_single(wi: Vec3) -> Option<Incident> {
+        if !M::TRANSMITS && wi.z < 0.0 { Some(Incident { w: wi, outside: true }) } else { Self::incident(wi) }
     }
 
     /// The side of the macro direction ωo, or `None` if light cannot leave there.

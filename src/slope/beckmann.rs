@@ -1,9 +1,9 @@
 //! The Beckmann slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, projected_roughness_sq};
+use super::{MicrosurfaceSlope, check_roughness};
 use crate::error::Error;
-use crate::special::{erfc64, erfcx64, erfinv_from_both_ends};
-use glam::{Vec2, Vec3};
+use crate::special::{erfc64, erfcx64, erfinv_from_both_ends_f32};
+use glam::{DVec3, Vec2, Vec3};
 
 /// √π.
 const SQRT_PI: f64 = 1.772_453_850_905_516;
@@ -18,9 +18,13 @@ const MIN_TAIL_PROBABILITY: f64 = 1e-30;
 /// From this u = −x̃ on, 1 − m√π erfcx(u) is evaluated by its asymptotic series (which is free
 /// of the cancellation the direct form suffers for large u).
 const PSI_SERIES_FROM: f64 = 8.0;
-/// Newton stops once its step is below this fraction of 1 + |x̃| (the error after the last
-/// step is about the square of it).
+/// Newton stops once its step is below this fraction of 1 + |x̃| (about the f32 resolution
+/// of x̃). Convergence is quadratic, so the error after that step is about C·step², where C,
+/// the inverse of the lobe's width, reaches |cot θ| far below the horizon: a looser stop
+/// (3e-5 was tried) biases those thin lobes measurably.
 const NEWTON_TOLERANCE: f64 = 1e-7;
+/// Below this projected area (a ≈ 26 from below) D_ωi is evaluated in log space.
+const AREA_LOG_SPACE_BELOW: f64 = 1e-280;
 /// A hard cap on Newton–bisection iterations (never reached in the tests: typically 3–5).
 const MAX_ITERATIONS: usize = 64;
 
@@ -60,12 +64,12 @@ impl Beckmann {
 
     /// D(ωm) in double precision (0 for ωm.z ≤ 0).
     #[inline]
-    fn d64(&self, wm: Vec3) -> f64 {
+    fn d_double(&self, wm: DVec3) -> f64 {
         if wm.z <= 0.0 {
             return 0.0;
         }
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
-        let (x, y, z) = (f64::from(wm.x) / ax, f64::from(wm.y) / ay, f64::from(wm.z));
+        let (x, y, z) = (wm.x / ax, wm.y / ay, wm.z);
         let z2 = z * z;
         (-(x * x + y * y) / z2).exp() * INV_PI / (ax * ay * z2 * z2)
     }
@@ -73,7 +77,7 @@ impl Beckmann {
     /// The projected area in double precision.
     #[inline]
     fn projected_area64(&self, w: Vec3) -> f64 {
-        let q = f64::from(projected_roughness_sq(self.alpha_x, self.alpha_y, w));
+        let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let root_q = q.sqrt();
         let z = f64::from(w.z);
         if z >= 0.0 {
@@ -86,6 +90,14 @@ impl Beckmann {
             0.5 * INV_SQRT_PI * root_q * (-a * a).exp() - 0.5 * (-z) * erfc64(a)
         }
     }
+}
+
+/// q = αx² ω.x² + αy² ω.y² in double precision: Λ and the projected area depend on it through
+/// exp(−z²/q), which amplifies an f32 rounding of q by 2a².
+#[inline(always)]
+fn projected_roughness_sq64(alpha_x: f32, alpha_y: f32, w: Vec3) -> f64 {
+    let (x, y) = (f64::from(alpha_x) * f64::from(w.x), f64::from(alpha_y) * f64::from(w.y));
+    x * x + y * y
 }
 
 /// Λ for the upper hemisphere in double precision, a = cot θ / αᵢ ≥ 0:
@@ -114,16 +126,21 @@ impl MicrosurfaceSlope for Beckmann {
         ((-(x * x) - y * y).exp() * INV_PI / (ax * ay)) as f32
     }
 
-    /// exp(−(m.x²/αx² + m.y²/αy²)/m.z²) / (π αx αy m.z⁴), in double precision so that m.z⁴
-    /// does not underflow before the exponential does.
+    /// exp(−(m.x²/αx² + m.y²/αy²)/m.z²) / (π αx αy m.z⁴), in double precision: the error of
+    /// an f32 exponent E grows as E·2⁻²⁴, and m.z⁴ would underflow before the exponential.
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
-        self.d64(wm) as f32
+        self.d_double(wm.as_dvec3()) as f32
+    }
+
+    #[inline]
+    fn d64(&self, wm: DVec3) -> f64 {
+        self.d_double(wm)
     }
 
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
-        let q = f64::from(projected_roughness_sq(self.alpha_x, self.alpha_y, w));
+        let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let a = f64::from(w.z.abs()) / q.sqrt();
         let up = lambda_up64(a);
         let value = if w.z >= 0.0 { up } else { -1.0 - up };
@@ -135,19 +152,34 @@ impl MicrosurfaceSlope for Beckmann {
         self.projected_area64(w) as f32
     }
 
-    /// Evaluated in double precision, so that neither the projected area nor D underflow
-    /// alone when ωi is far below the horizon.
+    /// Evaluated in double precision; when ωi is so far below the horizon that the
+    /// projected area underflows even there (a = |cot θ|/αᵢ beyond about 26), as the ratio of
+    /// logarithms ln D − ln A, with ln A = −a² + ln(αᵢ sin θ/(2√π)) + ln(1 − √π a erfcx(a)).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
-        let cos_im = wi.dot(wm);
+        self.d_wi64(wi, wm.as_dvec3()) as f32
+    }
+
+    #[inline]
+    fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
+        let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
         let area = self.projected_area64(wi);
-        if area <= 0.0 {
+        if area > AREA_LOG_SPACE_BELOW {
+            return cos_im * self.d_double(wm) / area;
+        }
+        let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, wi);
+        let a = -f64::from(wi.z) / q.sqrt();
+        if !(q > 0.0 && a >= PSI_SERIES_FROM) {
             return 0.0;
         }
-        (f64::from(cos_im) * self.d64(wm) / area) as f32
+        let ln_area = -a * a + (0.5 * INV_SQRT_PI * q.sqrt()).ln() + one_minus_scaled_erfcx(a).ln();
+        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
+        let (x, y, z) = (wm.x / ax, wm.y / ay, wm.z);
+        let ln_d = -(x * x + y * y) / (z * z) - (core::f64::consts::PI * ax * ay * z * z * z * z).ln();
+        cos_im * (ln_d - ln_area).exp()
     }
 
     /// Exact inversion of the visible-slope CDF (see [`visible_slope_x`]); ỹ is Gaussian and
@@ -172,8 +204,17 @@ impl MicrosurfaceSlope for Beckmann {
 #[inline]
 pub(crate) fn gaussian_slope(u: f64) -> f64 {
     let tail = u.min(1.0 - u).max(MIN_TAIL_PROBABILITY);
-    let x = erfinv_from_both_ends(1.0 - 2.0 * tail, 2.0 * tail);
+    let x = erfinv_from_both_ends_f32(1.0 - 2.0 * tail, 2.0 * tail);
     if u < 0.5 { -x } else { x }
+}
+
+/// r(u) = 1 − √π u erfcx(u) for u ≥ `PSI_SERIES_FROM`, from the asymptotic series
+/// r = r2 − 3r2² + 15r2³ − 105r2⁴ + 945r2⁵ − 10395r2⁶ with r2 = 1/(2u²) (the next term is
+/// below 1e-16 relative for u ≥ 8). Free of the cancellation of the direct form.
+#[inline(always)]
+fn one_minus_scaled_erfcx(u: f64) -> f64 {
+    let r2 = 1.0 / (2.0 * u * u);
+    r2 * (1.0 - r2 * (3.0 - r2 * (15.0 - r2 * (105.0 - r2 * (945.0 - r2 * 10395.0)))))
 }
 
 /// ln S(x) and its derivative, where S(x) = ∫₋∞ˣ (κ − t) e^{−t²} dt is (up to a constant
@@ -194,10 +235,7 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64) {
     let psi = if kappa >= 0.0 || u < PSI_SERIES_FROM {
         1.0 + kappa * SQRT_PI * erfcx64(u)
     } else {
-        let r2 = 1.0 / (2.0 * u * u);
-        // r(u) = r2 − 3r2² + 15r2³ − 105r2⁴ + 945r2⁵ − 10395r2⁶ (terms < 1e-16 beyond, u ≥ 8)
-        let r = r2 * (1.0 - r2 * (3.0 - r2 * (15.0 - r2 * (105.0 - r2 * (945.0 - r2 * 10395.0)))));
-        ((kappa - x) - kappa * r) / u
+        ((kappa - x) - kappa * one_minus_scaled_erfcx(u)) / u
     };
     (-u * u + (0.5 * psi).ln(), 2.0 * (kappa - x) / psi)
 }

@@ -1,9 +1,9 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, projected_roughness_sq};
+use super::{MicrosurfaceSlope, check_roughness, ensure_visible, normalize_scaled, projected_roughness_sq};
 use crate::error::Error;
 use core::f32::consts::{FRAC_1_PI, TAU};
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// Smallest cos θm kept when a sampled normal is turned into slopes (only
 /// [`Ggx::sample_p22_11`]; the sampled normals themselves are exact).
@@ -80,6 +80,17 @@ impl MicrosurfaceSlope for Ggx {
     }
 
     #[inline]
+    fn d64(&self, wm: DVec3) -> f64 {
+        if wm.z <= 0.0 {
+            return 0.0;
+        }
+        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
+        let (x, y) = (wm.x / ax, wm.y / ay);
+        let t = x * x + y * y + wm.z * wm.z;
+        core::f64::consts::FRAC_1_PI / (ax * ay * t * t)
+    }
+
+    #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         if w.z >= 0.0 { lambda_up(q, w.z) } else { -1.0 - lambda_up(q, -w.z) }
@@ -99,8 +110,9 @@ impl MicrosurfaceSlope for Ggx {
     /// to cos θm = 0 are computed with cos θm = `f32::MIN_POSITIVE` (finite, probability 0).
     #[inline]
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        // slopes are invariant under scaling, so the unnormalized normal serves
         let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), u1, u2);
-        let z = m.z.max(MIN_SLOPE_COS);
+        let z = m.z.max(MIN_SLOPE_COS * m.length());
         Vec2::new(-m.x / z, -m.y / z)
     }
 
@@ -111,21 +123,26 @@ impl MicrosurfaceSlope for Ggx {
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let v = Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z).normalize_or(Vec3::Z);
         let h = sample_visible_hemisphere(v, u1, u2);
-        Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z).normalize_or(Vec3::Z)
+        ensure_visible(wi, normalize_scaled(Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z), Vec3::Z))
     }
 }
 
 /// Samples the normals of the unit upper hemisphere visible from the unit direction `v`, with
-/// density ∝ max(0, v·m) on m.z ≥ 0.
+/// density ∝ max(0, v·m) on m.z ≥ 0; returns them **unnormalized** (v + c, of length in
+/// [0, 2]), since every caller rescales anyway.
 ///
 /// normalize(v + c) has density max(0, v·m)/π when c is uniform on the sphere (the map
 /// c = reflect(v, m) has Jacobian 4 v·m); restricting m.z ≥ 0 restricts c to the cap
-/// c.z ≥ −v.z, sampled uniformly by a uniform c.z. Returns +z when v = −z (empty cap).
+/// c.z ≥ −v.z, sampled uniformly by a uniform c.z. Returns 0 when v = −z (empty cap).
 #[inline(always)]
 fn sample_visible_hemisphere(v: Vec3, u1: f32, u2: f32) -> Vec3 {
     let z = (1.0 - u1) * (1.0 + v.z) - v.z;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
-    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (z + v.z).max(0.0));
-    h.normalize_or(Vec3::Z)
+    // z + v.z = (1 − u1)(1 + v.z), written without the cancellation
+    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (1.0 - u1) * (1.0 + v.z));
+    // v·h = 1 + v·c ≥ 0 exactly; near c = −v (measure zero) rounding can make it negative:
+    // then return a grazing visible normal
+    // (the horizontal normal along v's azimuth is visible and in the upper hemisphere)
+    if v.dot(h) < 0.0 { Vec3::new(v.x, v.y, 0.0) } else { h }
 }

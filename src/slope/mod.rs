@@ -12,7 +12,7 @@ pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
 pub use ggx::Ggx;
 
 use crate::error::Error;
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// A slope distribution P²²(x̃, ỹ) with roughness (αx, αy) and everything derived from it
 /// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
@@ -52,15 +52,39 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Takes cos θ and sin θ ≥ 0 rather than θ, and two uniforms in [0, 1).
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2;
 
+    /// D for a normal given in double precision, evaluated in double precision. The default
+    /// rounds the normal to f32; [`Ggx`] and [`Beckmann`] evaluate it in f64. The materials form
+    /// their half vectors in f64 and call this: D amplifies the rounding of its argument in its
+    /// tails and for small α (relative condition number up to 4(x̃/α)² for GGX, 2t for a
+    /// Beckmann exponent t).
+    #[inline]
+    fn d64(&self, wm: DVec3) -> f64 {
+        f64::from(self.d(wm.as_vec3()))
+    }
+
+    /// D_ωi(ωm) in double precision for ωm given in double precision (see [`Self::d64`]).
+    #[inline]
+    fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
+        let cos_im = wi.as_dvec3().dot(wm);
+        if cos_im <= 0.0 || wm.z <= 0.0 {
+            return 0.0;
+        }
+        let area = f64::from(self.projected_area(wi));
+        if area <= 0.0 { 0.0 } else { cos_im * self.d64(wm) / area }
+    }
+
     /// The projected roughness αᵢ = √(cos²φ αx² + sin²φ αy²) in the azimuth of ω
     /// (supplement §2.1). At ω = ±z, where φ is undefined, returns αx.
     #[inline]
     fn alpha_i(&self, w: Vec3) -> f32 {
-        let sin2 = w.x * w.x + w.y * w.y;
-        if sin2 == 0.0 {
+        // scaled by the larger horizontal component so that x² + y² cannot underflow
+        let scale = w.x.abs().max(w.y.abs());
+        if scale == 0.0 {
             return self.alpha_x();
         }
-        (projected_roughness_sq(self.alpha_x(), self.alpha_y(), w) / sin2).sqrt()
+        let (x, y) = (w.x / scale, w.y / scale);
+        let (ax, ay) = (self.alpha_x() * x, self.alpha_y() * y);
+        ((ax * ax + ay * ay) / (x * x + y * y)).sqrt()
     }
 
     /// The distribution of visible normals D_ωi(ωm) = ⟨ωi, ωm⟩ D(ωm) / projected_area(ωi)
@@ -94,8 +118,33 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         let s = self.sample_p22_11(stretched.z, sin_theta, u1, u2);
         let slope_x = ax * (cos_phi * s.x - sin_phi * s.y);
         let slope_y = ay * (sin_phi * s.x + cos_phi * s.y);
-        normal_from_slopes(slope_x, slope_y)
+        ensure_visible(wi, normal_from_slopes(slope_x, slope_y))
     }
+}
+
+/// Largest number of halvings tried by [`ensure_visible`].
+const VISIBILITY_NUDGES: i32 = 24;
+
+/// A sampled normal with ωi·ωm > 0 as evaluated in f64 from the f32 vectors (what `d_wi`
+/// tests). Exact sampling gives ωi·ωm > 0; rounding the normal to f32 can flip the sign for
+/// normals within about 1e-7 rad of the visibility boundary (grazing or backfacing ωi, low α).
+/// Those are moved towards ωi by the smallest power-of-two step that makes them visible (and
+/// kept in the upper hemisphere): a displacement of ~1e-7 rad of a mass of order 1e-5.
+#[inline(always)]
+pub(crate) fn ensure_visible(wi: Vec3, wm: Vec3) -> Vec3 {
+    if wi.as_dvec3().dot(wm.as_dvec3()) > 0.0 || wi.length_squared() == 0.0 {
+        return wm;
+    }
+    let w = wi.normalize();
+    let mut step = f32::EPSILON;
+    for _ in 0..VISIBILITY_NUDGES {
+        let m = (wm + step * w).normalize_or(wm);
+        if wi.as_dvec3().dot(m.as_dvec3()) > 0.0 && m.z >= 0.0 {
+            return m;
+        }
+        step *= 2.0;
+    }
+    wm
 }
 
 /// q = αx² ω.x² + αy² ω.y² = (αᵢ sin θ)², the squared stretched horizontal extent of ω.
@@ -105,11 +154,24 @@ pub(crate) fn projected_roughness_sq(alpha_x: f32, alpha_y: f32, w: Vec3) -> f32
     x * x + y * y
 }
 
-/// The unit normal (−x̃, −ỹ, 1)/‖·‖ of the slopes (x̃, ỹ), without overflow for huge slopes.
+/// The unit normal (−x̃, −ỹ, 1)/‖·‖ of the slopes (x̃, ỹ), without overflow for huge slopes
+/// (an infinite slope gives the horizontal normal).
 #[inline(always)]
 pub(crate) fn normal_from_slopes(slope_x: f32, slope_y: f32) -> Vec3 {
-    let scale = slope_x.abs().max(slope_y.abs()).max(1.0);
-    Vec3::new(-slope_x / scale, -slope_y / scale, 1.0 / scale).normalize()
+    let (sx, sy) = (slope_x.clamp(-f32::MAX, f32::MAX), slope_y.clamp(-f32::MAX, f32::MAX));
+    let scale = sx.abs().max(sy.abs()).max(1.0);
+    normalize_scaled(Vec3::new(-sx / scale, -sy / scale, 1.0 / scale), Vec3::Z)
+}
+
+/// `v` normalized after dividing by its largest component, so that tiny (even subnormal) and
+/// huge vectors come out unit; `fallback` for a zero or non-finite vector.
+#[inline(always)]
+pub(crate) fn normalize_scaled(v: Vec3, fallback: Vec3) -> Vec3 {
+    let scale = v.abs().max_element();
+    if !(scale > 0.0 && scale.is_finite()) {
+        return fallback;
+    }
+    (v / scale).normalize()
 }
 
 /// Validates a roughness pair: both finite and > 0.

@@ -46,6 +46,19 @@ pub(crate) fn erfinv64(y: f64) -> f64 {
 /// forming 1 − a from a would round to 0.
 #[inline]
 pub(crate) fn erfinv_from_both_ends(a: f64, one_minus_a: f64) -> f64 {
+    erfinv_refined(a, one_minus_a, HALLEY_STEPS)
+}
+
+/// Like [`erfinv_from_both_ends`] with a single Halley step: relative error below 1e-8 (the
+/// initial 2e-3 cubed, times a constant of order 1), enough for results rounded to f32 and
+/// about twice as fast.
+#[inline]
+pub(crate) fn erfinv_from_both_ends_f32(a: f64, one_minus_a: f64) -> f64 {
+    erfinv_refined(a, one_minus_a, 1)
+}
+
+#[inline(always)]
+fn erfinv_refined(a: f64, one_minus_a: f64, steps: usize) -> f64 {
     if a == 0.0 {
         return 0.0;
     }
@@ -56,7 +69,7 @@ pub(crate) fn erfinv_from_both_ends(a: f64, one_minus_a: f64) -> f64 {
     let ln_1ma2 = one_minus_a.ln() + a.ln_1p();
     let t = 2.0 / (core::f64::consts::PI * WINITZKI_A) + 0.5 * ln_1ma2;
     let mut x = ((t * t - ln_1ma2 / WINITZKI_A).sqrt() - t).sqrt();
-    for _ in 0..HALLEY_STEPS {
+    for _ in 0..steps {
         let residual = if a <= TAIL_FROM { erf64(x) - a } else { one_minus_a - erfc64(x) };
         let derivative = TWO_OVER_SQRT_PI * (-x * x).exp();
         let newton = residual / derivative;

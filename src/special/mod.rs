@@ -10,5 +10,5 @@ mod gamma;
 pub use erf::{erf, erfc};
 pub(crate) use erf::{erf64, erfc64, erfcx64};
 pub use erfinv::erfinv;
-pub(crate) use erfinv::{erfinv_from_both_ends, erfinv64};
+pub(crate) use erfinv::{erfinv_from_both_ends, erfinv_from_both_ends_f32, erfinv64};
 pub use gamma::{beta, ln_beta, ln_gamma};

@@ -32,12 +32,14 @@ pub trait VisibleNormalSampler: Copy + core::fmt::Debug + Send + Sync {
 /// i. The integral is the slope's projected area: GGX (i_z + √(αx² i_x² + αy² i_y² + i_z²))/2,
 /// Beckmann (i_z erfc(−i_z/√B) + √(B/π) exp(−i_z²/B))/2 with B = αx² i_x² + αy² i_y²,
 /// evaluated in their cancellation-free forms for i_z < 0. It equals the full-spherical
-/// masking 1/|1 + Λ(i)| of Wang et al. 2022 (eq. 10). Zero where i sees no microsurface.
+/// masking 1/|1 + Λ(i)| of Wang et al. 2022 (eq. 10). Zero where i sees no microsurface;
+/// saturates at `f32::MAX` near the nadir.
 #[inline]
 pub fn smith_normalization<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: Vec3) -> f32 {
     if wi.dot(wm) <= 0.0 {
         return 0.0;
     }
     let area = slope.projected_area(wi);
-    if area <= 0.0 { 0.0 } else { wi.z.abs() / area }
+    // saturates like Λ where the projected area is subnormal (near the nadir)
+    if area <= 0.0 { 0.0 } else { (wi.z.abs() / area).min(f32::MAX) }
 }

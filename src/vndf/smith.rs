@@ -8,6 +8,8 @@ use glam::Vec3;
 
 /// 1/√π.
 const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
+/// Uniforms are kept at least this far from 0 (as in the exact Beckmann sampler).
+const MIN_TAIL_PROBABILITY: f64 = 1e-30;
 /// Newton steps of [`BeckmannNewton`] stop once a step is below this (in the erf domain).
 const ERF_NEWTON_TOLERANCE: f64 = 1e-7;
 /// At most this many Newton steps in [`BeckmannNewton`].
@@ -125,8 +127,10 @@ fn erf_domain_slope(tan_theta: f64, u: f64) -> f64 {
     let slope_max = 1.0 / tan_theta;
     let e_max = erf64(slope_max);
     let c_max = e_max + INV_SQRT_PI * tan_theta * (-slope_max * slope_max).exp();
+    // u = 0 would put e on −1 (slope −∞): keep it in the exact sampler's tail floor
+    let u = u.clamp(MIN_TAIL_PROBABILITY, 1.0);
     let target = u * (c_max + 1.0) - 1.0;
-    let mut e = e_max - (1.0 + e_max) * erf64((-(u.max(f64::MIN_POSITIVE)).ln()).sqrt());
+    let mut e = e_max - (1.0 + e_max) * erf64((-u.ln()).sqrt());
     for _ in 0..ERF_NEWTON_MAX_STEPS {
         let x = erfinv64(e);
         let value = e + INV_SQRT_PI * tan_theta * (-x * x).exp() - target;
@@ -137,5 +141,5 @@ fn erf_domain_slope(tan_theta: f64, u: f64) -> f64 {
             break;
         }
     }
-    erfinv64(e).min(slope_max)
+    erfinv64(e.max(-1.0 + f64::EPSILON)).min(slope_max)
 }

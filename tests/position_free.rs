@@ -295,6 +295,7 @@ fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> 
 #[test]
 fn white_furnace() {
     const N_PT: usize = 60_000;
+    const N_PT_CONDUCTOR: usize = 250_000;
     const N_BDPT: usize = 24_000;
     const N_BDPT_CONDUCTOR: usize = 56_000;
     let thetas = [0.0, 0.8, 1.5];
@@ -324,6 +325,7 @@ fn white_furnace() {
         let wi = incident(theta, mat == 2);
         let mut rng = common::rng(0xf0_0000 + i as u64);
         let n = match (est, mat) {
+            (Estimator::Pt, 0) => N_PT_CONDUCTOR,
             (Estimator::Pt, _) => N_PT,
             (Estimator::Bdpt, 0) => N_BDPT_CONDUCTOR,
             (Estimator::Bdpt, _) => N_BDPT,

@@ -157,7 +157,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> MicrofacetBsdf<H,
     fn adjoint_eval(&self, wo: Vec3, wi: Vec3, rng: &mut impl Rng) -> Vec3 {
         match self.technique {
             Technique::SingleScattering => {
-                self.position_free(Shadowing::Correlated).eval_single_scattering(wo, wi, rng)
+                self.position_free(Shadowing::Correlated).eval_single_backfacing(wo, wi, rng)
             }
             Technique::RandomWalk => self.surface.eval(wo, wi, self.order, rng),
             Technique::PositionFree { estimator, shadowing } => {

@@ -103,6 +103,16 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// 1/(1 + Λ(ωi) + Λ(ωo)) or B(1 + Λ(ωi), 1 + Λ(−ωo)) correlated. Exact, except for diffuse
     /// facets (unbiased estimate).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+            return Vec3::ZERO;
+        };
+        self.connect(start, wo, wo_outside, true, rng).as_vec3()
+    }
+
+    /// [`PositionFree::eval_single_scattering`] that also accepts ωi below the horizon for an
+    /// opaque material (a backfacing view under normal mapping), like
+    /// [`PositionFree::sample_single`] and [`PositionFree::pdf_single`].
+    pub(crate) fn eval_single_backfacing(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
         let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };

@@ -285,7 +285,7 @@ fn slope_chi2(
     };
     let (vlo, vhi) = (-FRAC_PI_2, FRAC_PI_2);
     // marginal in u by strips
-    let mut strips = |lo: f64, f: &mut dyn FnMut(f64, f64) -> f64| {
+    let strips = |lo: f64, f: &mut dyn FnMut(f64, f64) -> f64| {
         let mut cum = vec![0.0; STRIPS + 1];
         for k in 0..STRIPS {
             let u0 = lo + (u_hi - lo) * k as f64 / STRIPS as f64;

@@ -157,10 +157,13 @@ impl Scene {
                 });
             }
         }
-        if let Some(l) = &self.light {
-            if let Some(t) = intersect_sphere(l.center, l.radius, o, d).filter(|&t| t < best_t) {
-                best = Some(Hit::Light { t });
-            }
+        if let Some(t) = self
+            .light
+            .as_ref()
+            .and_then(|l| intersect_sphere(l.center, l.radius, o, d))
+            .filter(|&t| t < best_t)
+        {
+            best = Some(Hit::Light { t });
         }
         best
     }

@@ -71,7 +71,7 @@ impl Dielectric {
         let (i, o, eta) = (wi.as_dvec3(), wo.as_dvec3(), f64::from(self.eta));
         let sum = i + eta * o;
         let len = sum.length();
-        if !(len > REFRACTION_DEGENERATE * eta.max(1.0)) {
+        if len.is_nan() || len <= REFRACTION_DEGENERATE * eta.max(1.0) {
             return None;
         }
         let h = if sum.z > 0.0 { sum / len } else { -sum / len };

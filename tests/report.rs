@@ -1,0 +1,99 @@
+//! The report example in its quick mode: every file is written, every number is finite, and
+//! the figures are consistent (errors fall with time for the unbiased estimators, the
+//! references and the furnace agree with one another).
+
+#[path = "../examples/report/plot.rs"]
+mod plot;
+#[path = "../examples/path_tracer/png.rs"]
+mod png;
+#[path = "../examples/report/run.rs"]
+mod run;
+
+use run::{Config, Est, Options};
+
+fn quick_report() -> run::Summary {
+    let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));
+    let opts = Options { quick: true, out_dir, threads: 2, progress: false };
+    run::run(&opts).expect("the report runs")
+}
+
+#[test]
+fn quick_report_is_complete_finite_and_consistent() {
+    let summary = quick_report();
+
+    // files
+    for name in ["errors.csv", "efficiency.csv", "energy.csv", "cost.csv", "lobes.csv", "summary.md"] {
+        assert!(summary.files.iter().any(|f| f.ends_with(name)), "{name} missing");
+    }
+    for config in Config::ALL {
+        let png = format!("error_vs_time_{}.png", config.name());
+        assert!(summary.files.iter().any(|f| f.ends_with(&png)), "{png} missing");
+    }
+    for f in &summary.files {
+        let len = std::fs::metadata(f).expect("written").len();
+        assert!(len > 0, "{} is empty", f.display());
+    }
+    for f in summary.files.iter().filter(|f| f.extension().is_some_and(|e| e == "csv")) {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (i, line) in text.lines().enumerate().skip(1) {
+            for field in line.split(',') {
+                if let Ok(v) = field.parse::<f64>() {
+                    // the single-scattering rows of the cost table carry NaN for "no sampler"
+                    let allowed_nan = f.ends_with("cost.csv") && line.contains(" single,");
+                    assert!(v.is_finite() || allowed_nan, "{}:{}: non-finite {field}", f.display(), i + 1);
+                }
+            }
+        }
+    }
+
+    // error falls with run time for every stochastic estimator: the RMSE at the largest batch
+    // is below the RMSE of single samples wherever the estimator has any variance
+    for row in &summary.efficiency {
+        if row.std == 0.0 || row.curve.len() < 3 {
+            continue;
+        }
+        let first = row.curve.first().unwrap().2;
+        let last = row.curve.last().unwrap().2;
+        assert!(
+            last < first,
+            "{} θi = {} {} {}: RMSE does not fall ({first:.3e} → {last:.3e})",
+            row.config.name(),
+            row.theta_i,
+            row.wo,
+            row.est.name()
+        );
+        assert!(row.ns_per_sample > 0.0 && row.efficiency > 0.0);
+    }
+
+    // PT and BDPT estimate the same model: their means agree with the shared reference within
+    // their combined standard errors (z = 5: many comparisons, quick sample sizes)
+    for row in summary.efficiency.iter().filter(|r| matches!(r.est, Est::PtCorrelated | Est::PtUncorrelated))
+    {
+        let se = (row.std * row.std / 1024.0 + row.reference_se * row.reference_se).sqrt();
+        assert!(
+            (row.mean - row.reference).abs() <= 5.0 * se + 1e-6,
+            "{} θi = {} {} {}: mean {:.5e} vs reference {:.5e} (SE {se:.2e})",
+            row.config.name(),
+            row.theta_i,
+            row.wo,
+            row.est.name(),
+            row.mean,
+            row.reference
+        );
+    }
+
+    // the white furnace of the non-absorptive walks: ∫eval = 1 within 5 SE, and the albedo
+    // by sampling (reflected + transmitted) is exactly 1 (weights are 1)
+    for (label, theta, r, t, orders, _, furnace, furnace_se) in &summary.energy {
+        assert!((r + t - 1.0).abs() < 1e-9, "{label} θi = {theta}: R + T = {}", r + t);
+        assert!((orders.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+        if *furnace_se > 0.0 {
+            assert!(
+                (furnace - 1.0).abs() <= 5.0 * furnace_se + 1e-3,
+                "{label} θi = {theta}: furnace {furnace} ± {furnace_se}"
+            );
+        }
+    }
+    assert!(!summary.cost.is_empty());
+    assert!(summary.markdown.contains("Efficiency ratios"));
+}

@@ -9,7 +9,7 @@ mod png;
 #[path = "../examples/report/run.rs"]
 mod run;
 
-use run::{Config, Est, Options};
+use run::{Config, Options};
 
 fn quick_report() -> run::Summary {
     let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));

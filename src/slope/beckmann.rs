@@ -205,7 +205,7 @@ impl MicrosurfaceSlope for Beckmann {
         ensure_visible(wi, normal_from_slopes(slope_x, slope_y))
     }
 
-    /// Exact inversion of the visible-slope CDF (see [`visible_slope_x`]); ỹ is Gaussian and
+    /// Exact inversion of the visible-slope CDF (a safeguarded Newton iteration on its logarithm); ỹ is Gaussian and
     /// independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
     /// visible, returns the zero slope.
     #[inline]

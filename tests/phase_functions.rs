@@ -15,6 +15,7 @@
 //! expectation, and its degrees of freedom are moment-matched, k − Σ m/(1 + N Var m̂/m)
 //! (k − 1 when the expectation is exact, k when its noise dominates). See `stochastic_chi2`.
 mod common;
+use common::par_map;
 
 use common::chi2::{Chi2Grid, chi2_test};
 use common::quadrature::integrate_sphere;
@@ -26,8 +27,6 @@ use microsurface::{
 };
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::{PI, TAU};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 const ALPHAS: [(f32, f32); 3] = [(0.3, 0.3), (1.0, 1.0), (1.0, 0.1)];
 const ETA: f32 = 1.5;
@@ -129,30 +128,6 @@ fn surfaces(kinds: &[Kind]) -> Vec<Box<dyn Phase>> {
         }
     }
     out
-}
-
-/// Maps `f` over `items` on two threads (results in order). Assertions inside `f` fail the
-/// test (the scope re-raises the panic).
-fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> Vec<R> {
-    let next = AtomicUsize::new(0);
-    let results = Mutex::new(Vec::with_capacity(items.len()));
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    if i >= items.len() {
-                        break;
-                    }
-                    let r = f(i, &items[i]);
-                    results.lock().unwrap().push((i, r));
-                }
-            });
-        }
-    });
-    let mut results = results.into_inner().unwrap();
-    results.sort_by_key(|(i, _)| *i);
-    results.into_iter().map(|(_, r)| r).collect()
 }
 
 fn wi_at(theta: f64) -> Vec3 {

@@ -13,6 +13,7 @@
 //! lobe at low roughness; the cosine component covers the multiply scattered light.
 //! Accumulation is in f64; every generator is a fixed-seed PCG.
 mod common;
+use common::par_map;
 
 use common::{Stats, TestRng, family_z, uniform64};
 use glam::Vec3;
@@ -23,8 +24,6 @@ use microsurface::{
 };
 use rand::RngExt;
 use std::f64::consts::{PI, TAU};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 const ETA: f32 = 1.5;
 /// Azimuth of the incident directions (so that anisotropic roughness matters).
@@ -252,28 +251,6 @@ fn point(
         stats.push(f64::from(m.eval(wi, wo, est, order, rng).x));
     }
     stats
-}
-
-/// Runs `f(index, item)` over two threads (work queue); results in item order. Each item must
-/// seed its own generator from its index, so results do not depend on scheduling.
-fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> Vec<R> {
-    let next = AtomicUsize::new(0);
-    let out: Mutex<Vec<Option<R>>> = Mutex::new((0..items.len()).map(|_| None).collect());
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    if i >= items.len() {
-                        break;
-                    }
-                    let r = f(i, &items[i]);
-                    out.lock().unwrap()[i] = Some(r);
-                }
-            });
-        }
-    });
-    out.into_inner().unwrap().into_iter().map(Option::unwrap).collect()
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -16,6 +16,7 @@
 //! of the estimate is at most a tenth of the multinomial variance, and that variance is
 //! still included in the statistic (with moment-matched degrees of freedom).
 mod common;
+use common::par_map;
 
 use common::{Stats, TestRng};
 use glam::{DVec3, Vec3};
@@ -25,8 +26,6 @@ use microsurface::{
 };
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 use std::f64::consts::{PI, TAU};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 const ALPHAS: [(f32, f32); 3] = [(0.5, 0.5), (1.5, 1.5), (1.0, 0.3)];
 const THETAS: [f64; 4] = [0.0, 0.8, 1.2, 1.5];
@@ -159,29 +158,6 @@ fn build(h: Height, s: Slope, alpha: (f32, f32), m: Mat) -> Box<dyn Bsdf> {
         Mat::Diffuse(a) => with_hs(h, s, alpha, m, Diffuse::new(Vec3::splat(a)).unwrap()),
         Mat::Dielectric => with_hs(h, s, alpha, m, Dielectric::new(ETA).unwrap()),
     }
-}
-
-/// Maps `f` over `items` on two threads (results in order); a panic in `f` fails the test.
-fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> Vec<R> {
-    let next = AtomicUsize::new(0);
-    let results = Mutex::new(Vec::with_capacity(items.len()));
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    if i >= items.len() {
-                        break;
-                    }
-                    let r = f(i, &items[i]);
-                    results.lock().unwrap().push((i, r));
-                }
-            });
-        }
-    });
-    let mut results = results.into_inner().unwrap();
-    results.sort_by_key(|(i, _)| *i);
-    results.into_iter().map(|(_, r)| r).collect()
 }
 
 /// A uniform direction with cos θ ∈ [z_lo, 1].

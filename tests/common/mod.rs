@@ -121,3 +121,27 @@ pub fn assert_two_sample(label: &str, a: &Stats, b: &Stats, z: f64, max_se: f64)
 pub fn dir(theta: f64, phi: f64) -> glam::Vec3 {
     glam::Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32)
 }
+
+/// Maps `f` over `items` on two threads (the machine's cores), results in input order. A
+/// panic in `f` fails the test (the scope re-raises it).
+pub fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> Vec<R> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let out: Mutex<Vec<Option<R>>> = Mutex::new((0..items.len()).map(|_| None).collect());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= items.len() {
+                        break;
+                    }
+                    let r = f(i, &items[i]);
+                    out.lock().unwrap()[i] = Some(r);
+                }
+            });
+        }
+    });
+    out.into_inner().unwrap().into_iter().map(Option::unwrap).collect()
+}

@@ -4,6 +4,7 @@
 
 pub mod chi2;
 pub mod quadrature;
+pub mod stochastic;
 
 use rand::SeedableRng;
 use statrs::distribution::{ContinuousCDF, Normal};

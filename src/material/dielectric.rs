@@ -52,6 +52,20 @@ impl Dielectric {
         self.eta
     }
 
+    /// A configuration with ωi on side `wi_outside`, expressed as the equivalent one with ωi
+    /// outside: unchanged from outside, flipped vertically (ω ↦ −ω, η ↦ 1/η, sides swapped)
+    /// from inside (Heitz et al. 2016, §3.4).
+    #[inline(always)]
+    fn outside_frame(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> (Self, Vec3, Vec3, bool) {
+        if wi_outside { (*self, wi, wo, wo_outside) } else { (self.flipped(), -wi, -wo, !wo_outside) }
+    }
+
     /// The same interface seen from inside: η ↦ 1/η.
     #[inline]
     pub fn flipped(&self) -> Self {
@@ -127,8 +141,9 @@ impl Dielectric {
     #[inline(always)]
     fn refract(&self, wi: Vec3, wm: Vec3) -> Vec3 {
         let c = wi.dot(wm);
-        let cos_t2 = 1.0 - (1.0 - c * c) / (self.eta * self.eta);
-        let cos_t = cos_t2.max(0.0).sqrt();
+        // η² cos²θt = c² + (η − 1)(η + 1), as in `fresnel_dielectric` (no cancellation near
+        // grazing or near η = 1)
+        let cos_t = (c * c + (self.eta - 1.0) * (self.eta + 1.0)).max(0.0).sqrt() / self.eta;
         ((c / self.eta - cos_t) * wm - wi / self.eta).normalize_or(-wm)
     }
 }
@@ -149,12 +164,7 @@ impl Material for Dielectric {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        let value = if wi_outside {
-            self.eval_phase_outside(slope, wi, wo, wo_outside)
-        } else {
-            self.flipped().eval_phase_outside(slope, -wi, -wo, !wo_outside)
-        };
-        Vec3::splat(value)
+        Vec3::splat(self.pdf_phase(slope, wi, wo, wi_outside, wo_outside))
     }
 
     const EXACT_PHASE_PDF: bool = true;
@@ -178,11 +188,8 @@ impl Material for Dielectric {
         wi_outside: bool,
         wo_outside: bool,
     ) -> f32 {
-        if wi_outside {
-            self.eval_phase_outside(slope, wi, wo, wo_outside)
-        } else {
-            self.flipped().eval_phase_outside(slope, -wi, -wo, !wo_outside)
-        }
+        let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
+        this.eval_phase_outside(slope, wi, wo, wo_outside)
     }
 
     /// Reflection F D/(4|cos θi|); transmission
@@ -199,12 +206,8 @@ impl Material for Dielectric {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        let value = if wi_outside {
-            self.vertex_outside(slope, wi, wo, wo_outside)
-        } else {
-            self.flipped().vertex_outside(slope, -wi, -wo, !wo_outside)
-        };
-        Vec3::splat(value)
+        let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
+        Vec3::splat(this.vertex_outside(slope, wi, wo, wo_outside))
     }
 
     /// ωm from D_ωi (of the flipped configuration inside), reflect with probability

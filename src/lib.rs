@@ -55,7 +55,7 @@ pub use microsurface::{
 };
 pub use position_free::{Estimator, PositionFree, Shadowing};
 pub use slope::{Beckmann, Ggx, MicrosurfaceSlope};
-pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma};
+pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{
     BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
     smith_normalization,

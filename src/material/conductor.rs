@@ -1,9 +1,9 @@
 //! Conductor microfacets.
 
-use super::{Material, PhaseSample, g2_reflection, reflect, reflection_half_vector};
+use super::{Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_half_vector};
 use crate::fresnel::{ComplexIor, fresnel_conductor};
 use crate::rng::uniform;
-use crate::slope::MicrosurfaceSlope;
+use crate::slope::{MicrosurfaceSlope, renormalize};
 use glam::Vec3;
 use rand::Rng;
 
@@ -56,8 +56,7 @@ impl Material for Conductor {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
-        let cos_ih = wi.as_dvec3().dot(wh);
-        self.fresnel(cos_ih as f32) * (0.25 * slope.d_wi64(wi, wh) / cos_ih) as f32
+        self.fresnel(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh)
     }
 
     const EXACT_PHASE_PDF: bool = true;
@@ -75,7 +74,7 @@ impl Material for Conductor {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return 0.0;
         };
-        (0.25 * slope.d_wi64(wi, wh) / wi.as_dvec3().dot(wh)) as f32
+        phase_reflection(slope, wi, wh)
     }
 
     /// F(ωi·ωh) D(ωh) / (4 |cos θi|) (Wang et al. 2022, eq. 2).
@@ -106,7 +105,7 @@ impl Material for Conductor {
         rng: &mut impl Rng,
     ) -> PhaseSample {
         let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        let wo = reflect(wi, wm).normalize_or(wm);
+        let wo = renormalize(reflect(wi, wm), wm);
         PhaseSample { wo, weight: self.fresnel(wi.dot(wm)), outside: true }
     }
 

@@ -1,10 +1,10 @@
 //! Dielectric microfacets.
 
-use super::{Material, PhaseSample, g2_reflection, reflect, reflection_half_vector};
+use super::{Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_half_vector};
 use crate::error::Error;
 use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_cosines};
 use crate::rng::uniform;
-use crate::slope::MicrosurfaceSlope;
+use crate::slope::{MicrosurfaceSlope, normalize_fast, renormalize};
 use crate::special::beta;
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -110,8 +110,7 @@ impl Dielectric {
     ) -> f32 {
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            let cos_ih = wi.as_dvec3().dot(wh);
-            fresnel_dielectric(cos_ih as f32, self.eta) * (0.25 * slope.d_wi64(wi, wh) / cos_ih) as f32
+            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta) * phase_reflection(slope, wi, wh)
         } else {
             let Some(r) = self.refraction(wi, wo) else { return 0.0 };
             let eta = f64::from(self.eta);
@@ -144,7 +143,7 @@ impl Dielectric {
         // η² cos²θt = c² + (η − 1)(η + 1), as in `fresnel_dielectric` (no cancellation near
         // grazing or near η = 1)
         let cos_t = (c * c + (self.eta - 1.0) * (self.eta + 1.0)).max(0.0).sqrt() / self.eta;
-        ((c / self.eta - cos_t) * wm - wi / self.eta).normalize_or(-wm)
+        normalize_fast((c / self.eta - cos_t) * wm - wi / self.eta, -wm)
     }
 }
 
@@ -225,7 +224,7 @@ impl Material for Dielectric {
         let wm = slope.sample_d_wi(wi_local, uniform(rng), uniform(rng));
         let f = fresnel_dielectric(wi_local.dot(wm), this.eta);
         let (wo_local, crossed) = if uniform(rng) < f {
-            (reflect(wi_local, wm).normalize_or(wm), false)
+            (renormalize(reflect(wi_local, wm), wm), false)
         } else {
             (this.refract(wi_local, wm), true)
         };

@@ -4,7 +4,7 @@ use super::{Material, PhaseSample, g2_reflection};
 use crate::error::Error;
 use crate::frame::{orthonormal_basis, sample_cosine_hemisphere};
 use crate::rng::uniform;
-use crate::slope::MicrosurfaceSlope;
+use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
 use rand::Rng;
@@ -114,7 +114,7 @@ impl Material for Diffuse {
         let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
         let local = sample_cosine_hemisphere(uniform(rng), uniform(rng));
         let (t, b) = orthonormal_basis(wm);
-        let wo = (local.x * t + local.y * b + local.z * wm).normalize_or(wm);
+        let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
         PhaseSample { wo, weight: self.albedo, outside: true }
     }
 

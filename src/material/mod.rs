@@ -136,3 +136,11 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
     }
     1.0 / (1.0 + slope.lambda(wi) + slope.lambda(wo))
 }
+
+/// D_ωi(ωh)/(4 ωi·ωh) = D(ωh)/(4 A(ωi)) for a valid reflection half vector ωh (ωh.z > 0,
+/// ωi·ωh > 0); 0 where ωi sees no microsurface.
+#[inline(always)]
+pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DVec3) -> f32 {
+    let area = slope.projected_area(wi);
+    if area <= 0.0 { 0.0 } else { (0.25 * slope.d64(wh) / f64::from(area)) as f32 }
+}

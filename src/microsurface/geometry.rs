@@ -113,3 +113,35 @@ pub(crate) fn next_c1(z: f32, lambda: f32, c1: f32, u: f32) -> Option<f32> {
         Some(c1 * (ln_1mu / -lambda).exp())
     }
 }
+
+/// The smallest |ln C¹| of a point where a ray hit the microsurface: hits lie strictly inside
+/// the surface (C¹ < 1), also after rounding, so that the point on the other side of a
+/// dielectric interface has ln C¹ = ln(1 − C¹) finite.
+const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
+
+/// Algorithm 1 of the supplement in log-C¹ space, the state of the random walks: the
+/// ln C¹ of the next intersection's height, or `None` if the ray escapes. `ln_c1` = 0 is a ray
+/// from above the surface; `lambda` is Λ(ω) for the ray direction with z-component `z`.
+///
+/// The ray escapes iff it goes up and ln(1 − u) ≤ Λ ln C¹; otherwise
+/// ln C¹' = ln C¹ − ln(1 − u)/Λ (above the horizon Λ ≥ 0 and the height increases, below it
+/// Λ ≤ −1 and it decreases). One logarithm per intersection, and the masking of the next
+/// event is exp(Λ ln C¹'): heights themselves are never needed (supplement §1.1). A horizontal
+/// ray (Λ saturated at `f32::MAX`) hits at its own height, or escapes from above the surface.
+#[inline(always)]
+pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32> {
+    // 1 − u: see `next_c1`
+    let ln_1mu = (1.0 - u).ln();
+    if z >= 0.0 && (lambda == 0.0 || ln_1mu <= lambda * ln_c1) {
+        return None;
+    }
+    Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
+}
+
+/// ln(1 − C¹) from ln C¹: the same point seen from the other side of the interface, in the
+/// vertically flipped frame (h ↦ −h; the height distributions are symmetric). Cancellation-free
+/// through exp_m1.
+#[inline(always)]
+pub(crate) fn flip_ln_c1(ln_c1: f32) -> f32 {
+    (-ln_c1.exp_m1()).ln()
+}

@@ -2,7 +2,7 @@
 //! multiple-scattering BSDF (Heitz et al. 2016, supplement §3.1 Algorithms 2–3 and §3.4).
 
 use super::Microsurface;
-use super::geometry::{escape_probability, next_c1};
+use super::geometry::{flip_ln_c1, next_ln_c1};
 use crate::height::MicrosurfaceHeight;
 use crate::material::Material;
 use crate::rng::uniform;
@@ -99,30 +99,34 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         if wo.z == 0.0 || (!M::TRANSMITS && wo.z < 0.0) {
             return Vec3::ZERO;
         }
-        let (height, slope) = (self.geometry.height(), self.geometry.slope());
+        let slope = self.geometry.slope();
         let wo_outside = wo.z > 0.0;
         // Λ of ωo seen from its own side, constant along the walk
         let lambda_o = slope.lambda(if wo_outside { wo } else { -wo });
         let last = order.last();
 
         let mut wr = -wi;
-        let mut h = if outside { f32::INFINITY } else { f32::NEG_INFINITY };
+        // ln C¹ of the current height in the frame of the current side (0: above the surface)
+        let mut ln_c1 = 0.0;
         let mut throughput = Vec3::ONE;
         let mut sum = Vec3::ZERO;
         for bounce in 1..=last {
-            let Some(next_h) = self.next_height(wr, h, outside, rng) else { break };
-            h = next_h;
+            let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else { break };
+            ln_c1 = next;
             if order.includes(bounce) {
                 let phase = self.material.eval_phase(slope, -wr, wo, outside, wo_outside, rng);
-                let shadowing = escape_probability(height.c1(if wo_outside { h } else { -h }), lambda_o);
-                if shadowing > 0.0 {
-                    sum += throughput * phase * shadowing;
+                if phase != Vec3::ZERO {
+                    let ln_c1_o = if outside == wo_outside { ln_c1 } else { flip_ln_c1(ln_c1) };
+                    sum += throughput * phase * (lambda_o * ln_c1_o).exp();
                 }
             }
             if bounce == last {
                 break;
             }
             let s = self.material.sample_phase(slope, -wr, outside, rng);
+            if s.outside != outside {
+                ln_c1 = flip_ln_c1(ln_c1);
+            }
             wr = s.wo;
             outside = s.outside;
             throughput *= s.weight;
@@ -143,14 +147,17 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut outside = Self::starting_side(wi)?;
         let slope = self.geometry.slope();
         let mut wr = -wi;
-        let mut h = if outside { f32::INFINITY } else { f32::NEG_INFINITY };
+        let mut ln_c1 = 0.0;
         let mut weight = Vec3::ONE;
         for bounces in 0..MAX_BOUNCES {
-            let Some(next_h) = self.next_height(wr, h, outside, rng) else {
+            let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else {
                 return Some(WalkSample { wo: wr, weight, bounces });
             };
-            h = next_h;
+            ln_c1 = next;
             let s = self.material.sample_phase(slope, -wr, outside, rng);
+            if s.outside != outside {
+                ln_c1 = flip_ln_c1(ln_c1);
+            }
             wr = s.wo;
             outside = s.outside;
             weight *= s.weight;
@@ -161,23 +168,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         None
     }
 
-    /// The height of the next intersection of the ray (ωr from height h on side `outside`),
-    /// or `None` if it escapes. Inside a dielectric the configuration is flipped vertically,
-    /// h ↦ −h (supplement §3.4; the height distributions are symmetric).
+    /// ln C¹ of the next intersection of the ray ωr leaving a point with ln C¹ = `ln_c1` on
+    /// side `outside`, or `None` if it escapes. Both are in the frame of that side: inside a
+    /// dielectric the configuration is flipped vertically (supplement §3.4).
     #[inline(always)]
-    fn next_height(&self, wr: Vec3, h: f32, outside: bool, rng: &mut impl Rng) -> Option<f32> {
-        let (height, slope) = (self.geometry.height(), self.geometry.slope());
-        let (w, h_local) = if outside { (wr, h) } else { (-wr, -h) };
-        let u = uniform(rng);
-        let h_next = if w.z == 0.0 {
-            // horizontal: hits at its own height (escapes if it starts above the surface)
-            if h_local == f32::INFINITY {
-                return None;
-            }
-            h_local
-        } else {
-            height.inv_c1(next_c1(w.z, slope.lambda(w), height.c1(h_local), u)?)
-        };
-        Some(if outside { h_next } else { -h_next })
+    fn next_ln_c1(&self, wr: Vec3, ln_c1: f32, outside: bool, rng: &mut impl Rng) -> Option<f32> {
+        let w = if outside { wr } else { -wr };
+        next_ln_c1(w.z, self.geometry.slope().lambda(w), ln_c1, uniform(rng))
     }
 }

@@ -1,8 +1,9 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, ensure_visible, normalize_scaled, projected_roughness_sq};
+use super::{MicrosurfaceSlope, check_roughness, ensure_visible, normalize_fast, projected_roughness_sq};
 use crate::error::Error;
-use core::f32::consts::{FRAC_1_PI, TAU};
+use crate::special::sin_cos_turns;
+use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
 
 /// Smallest cos θm kept when a sampled normal is turned into slopes (only
@@ -121,9 +122,9 @@ impl MicrosurfaceSlope for Ggx {
     /// also valid for ωi.z < 0).
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        let v = Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z).normalize_or(Vec3::Z);
+        let v = normalize_fast(Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z), Vec3::Z);
         let h = sample_visible_hemisphere(v, u1, u2);
-        ensure_visible(wi, normalize_scaled(Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z), Vec3::Z))
+        ensure_visible(wi, normalize_fast(Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z), Vec3::Z))
     }
 }
 
@@ -138,7 +139,7 @@ impl MicrosurfaceSlope for Ggx {
 fn sample_visible_hemisphere(v: Vec3, u1: f32, u2: f32) -> Vec3 {
     let z = (1.0 - u1) * (1.0 + v.z) - v.z;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
+    let (sin_phi, cos_phi) = sin_cos_turns(u2);
     // z + v.z = (1 − u1)(1 + v.z), written without the cancellation
     let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (1.0 - u1) * (1.0 + v.z));
     // v·h = 1 + v·c ≥ 0 exactly; near c = −v (measure zero) rounding can make it negative:

@@ -1,4 +1,5 @@
-//! Special functions used at run time: the error function, its inverse, log-gamma and beta.
+//! Special functions used at run time: the error function, its inverse, log-gamma and beta; the
+//! sine and cosine of an azimuth in turns.
 //!
 //! Each public function states its maximum error over its whole domain, measured against
 //! `statrs` in `tests/special_functions.rs`.
@@ -6,9 +7,11 @@
 mod erf;
 mod erfinv;
 mod gamma;
+mod trig;
 
 pub use erf::{erf, erfc};
 pub(crate) use erf::{erf64, erfc64, erfcx64};
 pub use erfinv::erfinv;
 pub(crate) use erfinv::{erfinv_from_both_ends, erfinv_from_both_ends_f32, erfinv64};
 pub use gamma::{beta, ln_beta, ln_gamma};
+pub use trig::sin_cos_turns;

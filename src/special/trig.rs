@@ -1,0 +1,32 @@
+//! Sine and cosine of an angle given in turns, for sampling azimuths.
+
+/// Taylor coefficients of sin(π f / 2) in f, for |f| ≤ ½ (truncation error ≤ 2e-9).
+const SIN: [f32; 5] = [1.570_796_3, -0.645_964_1, 0.079_692_63, -0.004_681_754, 0.000_160_441_18];
+/// Taylor coefficients of cos(π f / 2) in f² for |f| ≤ ½ (truncation error ≤ 2e-10).
+const COS: [f32; 6] = [1.0, -1.233_700_6, 0.253_669_5, -0.020_863_481, 0.000_919_260_3, -2.520_204_2e-5];
+
+/// (sin 2πu, cos 2πu) for u ∈ [0, 1]: the azimuth of a uniform sample, without a library
+/// call and without rounding 2πu.
+///
+/// 4u is split exactly into a quadrant q ∈ {0, …, 4} and a remainder f = 4u − q ∈ [−½, ½];
+/// sin and cos of πf/2 come from their Taylor polynomials (degrees 9 and 10) and are rotated
+/// by q quarter turns. Maximum absolute error 1.2e-7 over [0, 1] (measured 1.0e-7 against f64
+/// in `tests/special_functions.rs`; `(TAU * u).sin_cos()` in f32 errs by up to 4.2e-7 on the
+/// same grid, mostly from rounding the product 2πu).
+#[inline(always)]
+pub fn sin_cos_turns(u: f32) -> (f32, f32) {
+    debug_assert!((0.0..=1.0).contains(&u), "u = {u} outside [0, 1]");
+    let t = 4.0 * u;
+    // t + ½ ≥ 0, so truncation is the floor: q = round(t)
+    let q = (t + 0.5) as i32;
+    let f = t - q as f32;
+    let f2 = f * f;
+    let s = f * (SIN[0] + f2 * (SIN[1] + f2 * (SIN[2] + f2 * (SIN[3] + f2 * SIN[4]))));
+    let c = COS[0] + f2 * (COS[1] + f2 * (COS[2] + f2 * (COS[3] + f2 * (COS[4] + f2 * COS[5]))));
+    match q & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}

@@ -79,6 +79,19 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let n_camera = self.camera_subpath(start, max_sub, &mut camera, rng);
         let n_light = self.light_subpath(wo, wo_outside, max_sub, &mut light, rng);
 
+        // 1 + L̃ of every camera incident direction and the exit data of every light outgoing
+        // direction, shared by all the connections they take part in
+        let mut k_camera = [0.0f64; BDPT_MAX_SUBPATH + 1];
+        for (s, k) in k_camera.iter_mut().enumerate().take(n_camera + 1) {
+            let at = if s == 0 { start } else { camera[s - 1].next };
+            *k = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+        }
+        let mut exits = [self.exit(wo, wo_outside); BDPT_MAX_SUBPATH + 1];
+        for (t, exit) in exits.iter_mut().enumerate().take(n_light + 1).skip(1) {
+            let l = &light[t - 1];
+            *exit = self.exit(-l.incident.w, l.incident.outside);
+        }
+
         let mut pdf_forward = [0.0f64; 2 * BDPT_MAX_SUBPATH + 1];
         let mut pdf_reverse = [0.0f64; 2 * BDPT_MAX_SUBPATH + 1];
         let mut sum = DVec3::ZERO;
@@ -100,7 +113,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 if throughput == DVec3::ZERO {
                     continue;
                 }
-                let contribution = self.connect(at, out, out_outside, t == 0, rng);
+                let contribution = self.connect_known(at, k_camera[s], exits[t], t == 0, rng);
                 if contribution == DVec3::ZERO {
                     continue;
                 }

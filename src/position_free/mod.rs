@@ -52,6 +52,19 @@ pub struct PositionFree<S, M> {
     shadowing: Shadowing,
 }
 
+/// An outgoing direction of a vertex with what its shadowing factors need.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Exit {
+    /// The direction.
+    pub(crate) w: Vec3,
+    /// Its side of the interface.
+    pub(crate) outside: bool,
+    /// Whether it points up in its side frame.
+    pub(crate) can_exit: bool,
+    /// Λ in its side frame where it can exit, else 0.
+    pub(crate) lambda: f64,
+}
+
 /// The incident state at a vertex: the direction towards the previous vertex and its side.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Incident {
@@ -241,6 +254,63 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             return DVec3::ZERO;
         }
         self.material.vertex(&self.slope, at.w, wo, at.outside, wo_outside, rng).as_dvec3() * factor
+    }
+
+    /// The last-vertex contribution towards ωo ([`Self::connect`] with `last`), with the
+    /// incident 1 + L̃ = `k_in` and Λ of ωo in its side frame, `lambda_o`, already known.
+    #[inline]
+    pub(crate) fn connect_exit(
+        &self,
+        at: Incident,
+        k_in: f64,
+        wo: Vec3,
+        wo_outside: bool,
+        lambda_o: f64,
+        rng: &mut impl Rng,
+    ) -> DVec3 {
+        self.connect_known(
+            at,
+            k_in,
+            Exit { w: wo, outside: wo_outside, can_exit: true, lambda: lambda_o },
+            true,
+            rng,
+        )
+    }
+
+    /// [`Self::connect`] with the incident 1 + L̃ = `k_in` and the outgoing direction's exit
+    /// data already known.
+    #[inline]
+    pub(crate) fn connect_known(
+        &self,
+        at: Incident,
+        k_in: f64,
+        out: Exit,
+        last: bool,
+        rng: &mut impl Rng,
+    ) -> DVec3 {
+        if k_in == 0.0 {
+            return DVec3::ZERO;
+        }
+        let v = self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside);
+        let factor = if last { v.last } else { v.middle };
+        if factor == 0.0 {
+            return DVec3::ZERO;
+        }
+        self.material.vertex(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3() * factor
+    }
+
+    /// The exit data of an outgoing direction: whether it points up in its side frame (can
+    /// leave the surface) and then its Λ there (0 otherwise).
+    #[inline]
+    pub(crate) fn exit(&self, w: Vec3, outside: bool) -> Exit {
+        let frame = in_side_frame(w, outside);
+        let can_exit = frame.z > 0.0;
+        Exit {
+            w,
+            outside,
+            can_exit,
+            lambda: if can_exit { f64::from(self.slope.lambda(frame)) } else { 0.0 },
+        }
     }
 
     /// The last or continuing shadowing factor of a vertex with incident 1 + L̃ = `k_in`.

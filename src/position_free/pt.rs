@@ -24,19 +24,22 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             return Vec3::ZERO;
         };
         let last = order.last();
+        // Λ of ωo (constant) and 1 + L̃ of the current incident direction: one Λ per bounce
+        let lambda_o = f64::from(self.slope.lambda(in_side_frame(wo, wo_outside)));
+        let mut k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
         let mut throughput = DVec3::ONE;
         let mut sum = DVec3::ZERO;
         for bounce in 1..=last {
             if order.includes(bounce) {
-                sum += throughput * self.connect(at, wo, wo_outside, true, rng);
+                sum += throughput * self.connect_exit(at, k_in, wo, wo_outside, lambda_o, rng);
             }
             if bounce == last {
                 break;
             }
-            match self.extend(at, rng) {
-                Some((next, ratio)) => {
+            match self.extend_known(at, k_in, rng) {
+                Some((next, k_next, ratio)) => {
                     throughput *= ratio;
-                    at = next;
+                    (at, k_in) = (next, k_next);
                 }
                 None => break,
             }
@@ -65,5 +68,26 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         }
         let middle = self.shadowing_factor(k_in, s.wo, s.outside, at.outside == s.outside, false);
         Some((Incident { w: -s.wo, outside: s.outside }, s.weight.as_dvec3() * (k_in * middle)))
+    }
+
+    /// [`Self::extend`] with the incident 1 + L̃ = `k_in` known; also returns the next one.
+    /// Λ of the sampled direction serves both this vertex's continuing factor and the next
+    /// incident masking (Λ(−ω) = −1 − Λ(ω)), so a bounce evaluates Λ once.
+    #[inline]
+    fn extend_known(&self, at: Incident, k_in: f64, rng: &mut impl Rng) -> Option<(Incident, f64, DVec3)> {
+        if k_in == 0.0 || !k_in.is_finite() {
+            return None;
+        }
+        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let exit = in_side_frame(s.wo, s.outside);
+        let (middle, k_next) = if exit.z > 0.0 {
+            // the next incident direction −exit is below the horizon: 1 + L̃ = Λ(exit)
+            let lambda_out = f64::from(self.slope.lambda(exit));
+            (self.shadowing.vertex(k_in, true, lambda_out, at.outside == s.outside).middle, lambda_out)
+        } else {
+            (1.0 / k_in, inv_g1(&self.slope, -exit))
+        };
+        let next = Incident { w: -s.wo, outside: s.outside };
+        Some((next, k_next, s.weight.as_dvec3() * (k_in * middle)))
     }
 }

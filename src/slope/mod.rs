@@ -162,10 +162,18 @@ pub(crate) fn projected_roughness_sq(alpha_x: f32, alpha_y: f32, w: Vec3) -> f32
     x * x + y * y
 }
 
+/// Slopes below this in magnitude are turned into normals directly (their squares cannot
+/// overflow); larger ones are scaled first.
+const DIRECT_SLOPE_BELOW: f32 = 1e18;
+
 /// The unit normal (−x̃, −ỹ, 1)/‖·‖ of the slopes (x̃, ỹ), without overflow for huge slopes
 /// (an infinite slope gives the horizontal normal).
 #[inline(always)]
 pub(crate) fn normal_from_slopes(slope_x: f32, slope_y: f32) -> Vec3 {
+    if slope_x.abs() < DIRECT_SLOPE_BELOW && slope_y.abs() < DIRECT_SLOPE_BELOW {
+        let inv_len = 1.0 / (1.0 + slope_x * slope_x + slope_y * slope_y).sqrt();
+        return Vec3::new(-slope_x * inv_len, -slope_y * inv_len, inv_len);
+    }
     let (sx, sy) = (slope_x.clamp(-f32::MAX, f32::MAX), slope_y.clamp(-f32::MAX, f32::MAX));
     let scale = sx.abs().max(sy.abs()).max(1.0);
     normalize_scaled(Vec3::new(-sx / scale, -sy / scale, 1.0 / scale), Vec3::Z)

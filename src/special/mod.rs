@@ -5,13 +5,15 @@
 //! `statrs` in `tests/special_functions.rs`.
 
 mod erf;
+mod erfcx;
 mod erfinv;
 mod gamma;
 mod trig;
 
 pub use erf::{erf, erfc};
-pub(crate) use erf::{erf64, erfc64, erfcx64};
+pub(crate) use erf::{erf64, erfc64};
+pub(crate) use erfcx::erfcx64;
 pub use erfinv::erfinv;
-pub(crate) use erfinv::{erfinv_from_both_ends, erfinv_from_both_ends_f32, erfinv64};
+pub(crate) use erfinv::{erfc_inv_f32, erfinv_from_both_ends, erfinv64};
 pub use gamma::{beta, ln_beta, ln_gamma};
 pub use trig::sin_cos_turns;

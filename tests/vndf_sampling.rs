@@ -12,7 +12,7 @@
 mod common;
 
 use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate;
+use common::quadrature::{integrate, integrate_grid};
 use common::{Stats, assert_mean};
 use glam::Vec3;
 use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
@@ -111,25 +111,8 @@ fn integrate_visible<S: MicrosurfaceSlope>(s: &S, w: Vec3, mut g: impl FnMut(Vec
         let value = g(m);
         if value == 0.0 { 0.0 } else { value * ax * ay * dx * dy / (norm * norm * norm) }
     };
-    let (nu, nv) = (24, 12);
-    let mut total = 0.0;
-    for i in 0..nu {
-        let u0 = lo + (u_hi - lo) * i as f64 / nu as f64;
-        let u1 = lo + (u_hi - lo) * (i + 1) as f64 / nu as f64;
-        for j in 0..nv {
-            let v0 = -FRAC_PI_2 + std::f64::consts::PI * j as f64 / nv as f64;
-            let v1 = -FRAC_PI_2 + std::f64::consts::PI * (j + 1) as f64 / nv as f64;
-            total += {
-                // the absolute share of the tolerance, or a relative one for cells that hold
-                // much mass (where f32 rounding of the integrand, ~1e-7 relative, would
-                // otherwise drive the refinement to its maximum depth)
-                let rough = integrate(&mut f, u0, u1, v0, v1, 0.0, 0).abs();
-                let tol = (QUAD_TOL / (nu * nv) as f64).max(REL_TOL * rough);
-                integrate(&mut f, u0, u1, v0, v1, tol, MAX_DEPTH)
-            };
-        }
-    }
-    total
+    // an initial grid fine enough that the adaptive refinement sees every lobe
+    integrate_grid(&mut f, lo, u_hi, 24, 12, QUAD_TOL, REL_TOL, MAX_DEPTH)
 }
 
 /// One configuration of the suite.

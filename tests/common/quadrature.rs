@@ -67,6 +67,38 @@ fn refine(
         + refine(f, zm, z1, pm, p1, parts[3], t, depth - 1)
 }
 
+/// ∫∫ f over [u_lo, u_hi] × [−π/2, π/2] as the sum of an `nu` × `nv` grid of cells, each
+/// refined adaptively to the larger of its share of `abs_tol` and `rel_tol` times its own
+/// rough value (cells that hold much mass would otherwise be driven to `max_depth` by the f32
+/// rounding of the integrand, ~1e-7 relative). The grid must be fine enough for the adaptive
+/// refinement to see every lobe.
+#[allow(dead_code, clippy::too_many_arguments)]
+pub fn integrate_grid(
+    f: &mut impl FnMut(f64, f64) -> f64,
+    u_lo: f64,
+    u_hi: f64,
+    nu: usize,
+    nv: usize,
+    abs_tol: f64,
+    rel_tol: f64,
+    max_depth: u32,
+) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let mut total = 0.0;
+    for i in 0..nu {
+        let u0 = u_lo + (u_hi - u_lo) * i as f64 / nu as f64;
+        let u1 = u_lo + (u_hi - u_lo) * (i + 1) as f64 / nu as f64;
+        for j in 0..nv {
+            let v0 = -FRAC_PI_2 + PI * j as f64 / nv as f64;
+            let v1 = -FRAC_PI_2 + PI * (j + 1) as f64 / nv as f64;
+            let rough = integrate(f, u0, u1, v0, v1, 0.0, 0).abs();
+            let tol = (abs_tol / (nu * nv) as f64).max(rel_tol * rough);
+            total += integrate(f, u0, u1, v0, v1, tol, max_depth);
+        }
+    }
+    total
+}
+
 /// ∫ f(ω) dω over the whole sphere (or the upper hemisphere if `upper_only`), as a sum of
 /// adaptively refined cells of a `nz` × `nphi` grid in (cos θ, φ).
 pub fn integrate_sphere(

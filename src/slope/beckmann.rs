@@ -28,6 +28,9 @@ const AREA_LOG_SPACE_BELOW: f64 = 1e-280;
 /// Halley's step n/(1 − c) is taken only for |c| up to this (else Newton's step n): it then
 /// differs from Newton's by a factor in [2/3, 2].
 const HALLEY_MAX_CORRECTION: f64 = 0.5;
+/// The factor by which the iteration overestimates the error left after its last step,
+/// |g″/(2g′)|·step² (the asymptotic error of a Newton step, which bounds Halley's).
+const ERROR_ESTIMATE_SAFETY: f64 = 10.0;
 /// A hard cap on Halley–bisection iterations (never reached in the tests: typically 3–4).
 const MAX_ITERATIONS: usize = 64;
 
@@ -277,10 +280,12 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64) {
 ///
 /// ln S is concave (S is the integral of a log-concave density), so Newton's method from the
 /// left of the root climbs to it monotonically. The iteration takes Halley steps (Newton's
-/// with the curvature of ln S, which is known in closed form: cubic convergence, 3–4
-/// evaluations instead of 4–5), falls back to Newton's step where Halley's correction is not
-/// small, and replaces steps that leave the current bracket by bisection, or by a doubling
-/// step to the left while no lower bound is known.
+/// with the curvature of ln S, which is known in closed form: cubic convergence), falls back
+/// to Newton's step where Halley's correction is not small, and replaces steps that leave the
+/// current bracket by bisection, or by a doubling step to the left while no lower bound is
+/// known. It stops when the step, or ten times the error a Newton step of that size would
+/// leave, |g″/(2g′)|·step², is below the tolerance: 2–3.3 evaluations of ln S per sample at
+/// α = 1 (4–5 with plain Newton steps and the step test alone).
 #[inline]
 fn visible_slope_x(kappa: f64, u: f64) -> f64 {
     visible_slope_x_above(kappa, f64::NEG_INFINITY, u)
@@ -329,14 +334,21 @@ pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
         // evaluation and converges cubically. Where |c| is not small (near κ the curvature
         // diverges, and Halley's step would vanish far from the root) Newton's step is taken
         let newton = g / derivative;
-        let c = 0.5 * newton * (-1.0 / (kappa - x) - 2.0 * x - derivative);
+        let curvature = -1.0 / (kappa - x) - 2.0 * x - derivative;
+        let c = 0.5 * newton * curvature;
         let mut next = if c.abs() <= HALLEY_MAX_CORRECTION { x - newton / (1.0 - c) } else { x - newton };
-        if !(next > lo && next < hi) {
+        let bracketed = next > lo && next < hi;
+        if !bracketed {
             next = if lo.is_finite() { 0.5 * (lo + hi) } else { x - 2.0 * (hi - x) - 1.0 };
         }
         let step = next - x;
         x = next;
-        if step.abs() <= NEWTON_TOLERANCE * (1.0 + x.abs()) {
+        let tolerance = NEWTON_TOLERANCE * (1.0 + x.abs());
+        // a Newton or Halley step from error e leaves about |g″/(2g′)| e² or less: stop when
+        // that estimate (with a safety factor) is below the tolerance, one evaluation early
+        if step.abs() <= tolerance
+            || (bracketed && ERROR_ESTIMATE_SAFETY * 0.5 * curvature.abs() * step * step <= tolerance)
+        {
             break;
         }
     }

@@ -1,6 +1,9 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, ensure_visible, normalize_fast, projected_roughness_sq};
+use super::{
+    DIRECT_SCALE_RANGE, MicrosurfaceSlope, check_roughness, ensure_visible, normalize_fast, normalize_scaled,
+    projected_roughness_sq,
+};
 use crate::error::Error;
 use crate::special::sin_cos_turns;
 use core::f32::consts::FRAC_1_PI;
@@ -112,38 +115,48 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         // slopes are invariant under scaling, so the unnormalized normal serves
-        let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), u1, u2);
+        let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), 1.0, u1, u2);
         let z = m.z.max(MIN_SLOPE_COS * m.length());
         Vec2::new(-m.x / z, -m.y / z)
     }
 
     /// Exact for every ωi: stretch ωi to α = 1, sample the visible hemisphere with the
     /// spherical cap, unstretch (Dupuy and Benyoub 2023, with the cap z > −ωi.z, which is
-    /// also valid for ωi.z < 0).
+    /// also valid for ωi.z < 0). The stretched ωi is not normalized: the cap is sampled at its
+    /// scale (a square root, no division).
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        let v = normalize_fast(Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z), Vec3::Z);
-        let h = sample_visible_hemisphere(v, u1, u2);
+        let stretched = Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z);
+        let len_sq = stretched.length_squared();
+        let (v, len) = if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {
+            (stretched, len_sq.sqrt())
+        } else {
+            (normalize_scaled(stretched, Vec3::Z), 1.0)
+        };
+        let h = sample_visible_hemisphere(v, len, u1, u2);
         ensure_visible(wi, normalize_fast(Vec3::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z), Vec3::Z))
     }
 }
 
-/// Samples the normals of the unit upper hemisphere visible from the unit direction `v`, with
-/// density ∝ max(0, v·m) on m.z ≥ 0; returns them **unnormalized** (v + c, of length in
-/// [0, 2]), since every caller rescales anyway.
+/// Samples the normals of the unit upper hemisphere visible from the direction `v` of length
+/// `len` > 0, with density ∝ max(0, v·m) on m.z ≥ 0; returns them **unnormalized** (`len`
+/// times v̂ + c, of length in [0, 2 len]), since every caller rescales anyway.
 ///
-/// normalize(v + c) has density max(0, v·m)/π when c is uniform on the sphere (the map
-/// c = reflect(v, m) has Jacobian 4 v·m); restricting m.z ≥ 0 restricts c to the cap
-/// c.z ≥ −v.z, sampled uniformly by a uniform c.z. Returns 0 when v = −z (empty cap).
+/// normalize(v̂ + c) has density max(0, v̂·m)/π when c is uniform on the sphere (the map
+/// c = reflect(v̂, m) has Jacobian 4 v̂·m); restricting m.z ≥ 0 restricts c to the cap
+/// c.z ≥ −v̂.z, sampled uniformly by a uniform c.z. Everything is scaled by `len`, so that
+/// v̂ = v/len is never formed. Returns 0 when v̂ = −z (empty cap).
 #[inline(always)]
-fn sample_visible_hemisphere(v: Vec3, u1: f32, u2: f32) -> Vec3 {
-    let z = (1.0 - u1) * (1.0 + v.z) - v.z;
-    let r = (1.0 - z * z).max(0.0).sqrt();
+fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
+    // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
+    // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
+    let top = len + v.z;
+    let z_scaled = (1.0 - u1) * top - v.z;
+    let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
     let (sin_phi, cos_phi) = sin_cos_turns(u2);
-    // z + v.z = (1 − u1)(1 + v.z), written without the cancellation
-    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (1.0 - u1) * (1.0 + v.z));
-    // v·h = 1 + v·c ≥ 0 exactly; near c = −v (measure zero) rounding can make it negative:
-    // then return a grazing visible normal
-    // (the horizontal normal along v's azimuth is visible and in the upper hemisphere)
+    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (1.0 - u1) * top);
+    // v·h ≥ 0 exactly; near c = −v̂ (measure zero) rounding can make it negative: then return
+    // a grazing visible normal (the horizontal normal along v's azimuth is visible and in the
+    // upper hemisphere)
     if v.dot(h) < 0.0 { Vec3::new(v.x, v.y, 0.0) } else { h }
 }

@@ -181,14 +181,14 @@ pub(crate) fn normal_from_slopes(slope_x: f32, slope_y: f32) -> Vec3 {
 
 /// Squared lengths between these bounds are normalized directly: no component's square
 /// overflows, and components whose squares underflow are below 2⁻²⁴ of the length.
-const DIRECT_NORMALIZE_RANGE: (f32, f32) = (1e-30, 1e30);
+pub(crate) const DIRECT_SCALE_RANGE: (f32, f32) = (1e-30, 1e30);
 
 /// `v` normalized: directly where |v|² is in a safe range, else by [`normalize_scaled`]
 /// (`fallback` for a zero or non-finite vector).
 #[inline(always)]
 pub(crate) fn normalize_fast(v: Vec3, fallback: Vec3) -> Vec3 {
     let len_sq = v.length_squared();
-    if len_sq > DIRECT_NORMALIZE_RANGE.0 && len_sq < DIRECT_NORMALIZE_RANGE.1 {
+    if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {
         v * (1.0 / len_sq.sqrt())
     } else {
         normalize_scaled(v, fallback)

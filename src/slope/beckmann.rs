@@ -23,6 +23,8 @@ const PSI_SERIES_FROM: f64 = 8.0;
 /// lobe's width, reaches |cot θ| far below the horizon: a looser stop (3e-5 was tried with
 /// Newton steps) biases those thin lobes measurably.
 const NEWTON_TOLERANCE: f64 = 1e-7;
+/// Below this cos θm, D is 0 in double precision for every roughness an f32 holds.
+const D_VANISHES_BELOW_COS: f64 = 1e-100;
 /// Below this projected area (a ≈ 26 from below) D_ωi is evaluated in log space.
 const AREA_LOG_SPACE_BELOW: f64 = 1e-280;
 /// Halley's step n/(1 − c) is taken only for |c| up to this (else Newton's step n): it then
@@ -48,6 +50,10 @@ const MAX_ITERATIONS: usize = 64;
 pub struct Beckmann {
     alpha_x: f32,
     alpha_y: f32,
+    /// 1/αx, 1/αy and 1/(π αx αy) in double precision (D needs no division by them).
+    inv_alpha_x: f64,
+    inv_alpha_y: f64,
+    d_scale: f64,
 }
 
 impl Beckmann {
@@ -57,7 +63,14 @@ impl Beckmann {
     /// [`Error::InvalidParameter`] if `alpha_x` or `alpha_y` is NaN, infinite or ≤ 0.
     pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self, Error> {
         let (alpha_x, alpha_y) = check_roughness(alpha_x, alpha_y)?;
-        Ok(Self { alpha_x, alpha_y })
+        let (ax, ay) = (f64::from(alpha_x), f64::from(alpha_y));
+        Ok(Self {
+            alpha_x,
+            alpha_y,
+            inv_alpha_x: 1.0 / ax,
+            inv_alpha_y: 1.0 / ay,
+            d_scale: INV_PI / (ax * ay),
+        })
     }
 
     /// An isotropic Beckmann distribution, α = αx = αy.
@@ -71,13 +84,14 @@ impl Beckmann {
     /// D(ωm) in double precision (0 for ωm.z ≤ 0).
     #[inline]
     fn d_double(&self, wm: DVec3) -> f64 {
-        if wm.z <= 0.0 {
+        // also 0 where 0 < m.z < 1e-100: there the exponent exceeds 1e120 for every f32 α
+        if wm.z.is_nan() || wm.z < D_VANISHES_BELOW_COS {
             return 0.0;
         }
-        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
-        let (x, y, z) = (wm.x / ax, wm.y / ay, wm.z);
-        let z2 = z * z;
-        (-(x * x + y * y) / z2).exp() * INV_PI / (ax * ay * z2 * z2)
+        // one division; multiplied left to right, so that a vanishing exponential gives 0
+        let (x, y) = (wm.x * self.inv_alpha_x, wm.y * self.inv_alpha_y);
+        let inv_z2 = 1.0 / (wm.z * wm.z);
+        (-(x * x + y * y) * inv_z2).exp() * inv_z2 * inv_z2 * self.d_scale
     }
 
     /// The projected area in double precision.
@@ -249,8 +263,9 @@ pub(crate) fn one_minus_scaled_erfcx(u: f64) -> f64 {
     r2 * (1.0 - r2 * (3.0 - r2 * (15.0 - r2 * (105.0 - r2 * (945.0 - r2 * 10395.0)))))
 }
 
-/// ln S(x) and its derivative, where S(x) = ∫₋∞ˣ (κ − t) e^{−t²} dt is (up to a constant
-/// factor) the unnormalized CDF of the visible slopes, x < κ.
+/// ln S(x), its derivative g′ = (κ − x)e^{−x²}/S and g′/(κ − x) = e^{−x²}/S, where
+/// S(x) = ∫₋∞ˣ (κ − t) e^{−t²} dt is (up to a constant factor) the unnormalized CDF of the
+/// visible slopes, x < κ. One division (1/S or 1/ψ).
 ///
 /// S(x) = κ(√π/2) erfc(−x) + e^{−x²}/2. For x < 0 it is written e^{−u²} ψ(u)/2 with u = −x
 /// and ψ(u) = 1 + κ√π erfcx(u), so that the Gaussian factor is carried as a logarithm and
@@ -258,12 +273,13 @@ pub(crate) fn one_minus_scaled_erfcx(u: f64) -> f64 {
 /// `PSI_SERIES_FROM` it is evaluated as ((u + κ) + (−κ) r(u))/u with
 /// r(u) = 1 − √π u erfcx(u) from its asymptotic series, free of cancellation.
 #[inline]
-fn ln_s(kappa: f64, x: f64) -> (f64, f64) {
+fn ln_s(kappa: f64, x: f64) -> (f64, f64, f64) {
     if x >= 0.0 {
         // erfc(x) = e^{−x²} erfcx(x): one exponential
         let gauss = (-x * x).exp();
         let s = kappa * 0.5 * SQRT_PI * (2.0 - gauss * erfcx64(x)) + 0.5 * gauss;
-        return (s.ln(), (kappa - x) * gauss / s);
+        let over_gap = gauss / s;
+        return (s.ln(), (kappa - x) * over_gap, over_gap);
     }
     let u = -x;
     let psi = if kappa >= 0.0 || u < PSI_SERIES_FROM {
@@ -272,7 +288,8 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64) {
         // 1 + κ√π erfcx(u) = (u + κ − κ r(u))/u, with u + κ = κ − x
         ((kappa - x) - kappa * one_minus_scaled_erfcx(u)) / u
     };
-    (-u * u + (0.5 * psi).ln(), 2.0 * (kappa - x) / psi)
+    let over_gap = 2.0 / psi;
+    (-u * u + (0.5 * psi).ln(), (kappa - x) * over_gap, over_gap)
 }
 
 /// Samples x̃ < κ from the density ∝ (κ − x̃) e^{−x̃²}: the visible slopes at α = 1 seen from
@@ -322,21 +339,21 @@ pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
         x = 0.5 * (lo + hi);
     }
     for _ in 0..MAX_ITERATIONS {
-        let (value, derivative) = ln_s(kappa, x);
+        let (value, derivative, over_gap) = ln_s(kappa, x);
         let g = value - target;
         if g > 0.0 {
             hi = x;
         } else {
             lo = x;
         }
-        // Halley's step n/(1 − c) with Newton's n = g/g′ and c = n g″/(2g′): with
-        // g″/g′ = −1/(κ − x̃) − 2x̃ − g′ (from S′ = (κ − x̃)e^{−x̃²}) it costs no further
-        // evaluation and converges cubically. Where |c| is not small (near κ the curvature
-        // diverges, and Halley's step would vanish far from the root) Newton's step is taken
-        let newton = g / derivative;
-        let curvature = -1.0 / (kappa - x) - 2.0 * x - derivative;
-        let c = 0.5 * newton * curvature;
-        let mut next = if c.abs() <= HALLEY_MAX_CORRECTION { x - newton / (1.0 - c) } else { x - newton };
+        // Halley's step g g′/(g′² − g g″/2) with g″ = −g′/(κ − x̃) − g′(2x̃ + g′) (from
+        // S′ = (κ − x̃)e^{−x̃²}) costs no further evaluation and converges cubically. Where its
+        // correction c = g g″/(2g′²) exceeds ½ in magnitude (near κ the curvature diverges,
+        // and Halley's step would vanish far from the root) Newton's step g/g′ is taken
+        let second = -over_gap - derivative * (2.0 * x + derivative);
+        let d2 = derivative * derivative;
+        let halley = (g * second).abs() <= 2.0 * HALLEY_MAX_CORRECTION * d2;
+        let mut next = if halley { x - g * derivative / (d2 - 0.5 * g * second) } else { x - g / derivative };
         let bracketed = next > lo && next < hi;
         if !bracketed {
             next = if lo.is_finite() { 0.5 * (lo + hi) } else { x - 2.0 * (hi - x) - 1.0 };
@@ -347,7 +364,8 @@ pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
         // a Newton or Halley step from error e leaves about |g″/(2g′)| e² or less: stop when
         // that estimate (with a safety factor) is below the tolerance, one evaluation early
         if step.abs() <= tolerance
-            || (bracketed && ERROR_ESTIMATE_SAFETY * 0.5 * curvature.abs() * step * step <= tolerance)
+            || (bracketed
+                && ERROR_ESTIMATE_SAFETY * 0.5 * second.abs() * step * step <= tolerance * derivative)
         {
             break;
         }

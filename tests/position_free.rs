@@ -651,7 +651,7 @@ fn against_the_heitz_random_walk_per_order() {
 }
 
 fn heitz_comparison(per_order: bool) {
-    const N_PT: usize = 40_000;
+    const N_PT: usize = 60_000;
     const N_WALK: usize = 100_000;
     let orders = [only(1), only(2), only(3), ALL];
     let mut cases = Vec::new();

@@ -2,7 +2,7 @@
 //! per-strategy path densities and the balance heuristic.
 
 use super::segment::{in_side_frame, inv_g1};
-use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE};
+use super::{Exit, Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
 use crate::rng::uniform;
@@ -19,6 +19,10 @@ pub const BDPT_MAX_SUBPATH: usize = 48;
 struct CameraVertex {
     /// The incident state at vertex j + 1: −x_j and its side.
     next: Incident,
+    /// 1 + L̃ of that incident direction (the inverse of its masking).
+    k_next: f64,
+    /// Its connection to ωo (the last-vertex contribution without throughput).
+    connection: DVec3,
     /// Product of the throughput ratios of vertices 1..=j (Russian roulette included).
     throughput: DVec3,
     /// Density of x_j given the incident direction at vertex j.
@@ -44,6 +48,8 @@ struct LightVertex {
 
 const EMPTY_CAMERA: CameraVertex = CameraVertex {
     next: Incident { w: Vec3::Z, outside: true },
+    k_next: 0.0,
+    connection: DVec3::ZERO,
     throughput: DVec3::ZERO,
     pdf_forward: 0.0,
     pdf_reverse_prev: 0.0,
@@ -76,17 +82,18 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let max_sub = (last - 1).min(BDPT_MAX_SUBPATH);
         let mut camera = [EMPTY_CAMERA; BDPT_MAX_SUBPATH];
         let mut light = [EMPTY_LIGHT; BDPT_MAX_SUBPATH];
-        let n_camera = self.camera_subpath(start, max_sub, &mut camera, rng);
+        let to_wo = self.exit(wo, wo_outside);
+        let n_camera = self.camera_subpath(start, to_wo, max_sub, &mut camera, rng);
         let n_light = self.light_subpath(wo, wo_outside, max_sub, &mut light, rng);
 
         // 1 + L̃ of every camera incident direction and the exit data of every light outgoing
         // direction, shared by all the connections they take part in
         let mut k_camera = [0.0f64; BDPT_MAX_SUBPATH + 1];
-        for (s, k) in k_camera.iter_mut().enumerate().take(n_camera + 1) {
-            let at = if s == 0 { start } else { camera[s - 1].next };
-            *k = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+        k_camera[0] = inv_g1(&self.slope, in_side_frame(start.w, start.outside));
+        for s in 1..=n_camera {
+            k_camera[s] = camera[s - 1].k_next;
         }
-        let mut exits = [self.exit(wo, wo_outside); BDPT_MAX_SUBPATH + 1];
+        let mut exits = [to_wo; BDPT_MAX_SUBPATH + 1];
         for (t, exit) in exits.iter_mut().enumerate().take(n_light + 1).skip(1) {
             let l = &light[t - 1];
             *exit = self.exit(-l.incident.w, l.incident.outside);
@@ -113,7 +120,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 if throughput == DVec3::ZERO {
                     continue;
                 }
-                let contribution = self.connect_known(at, k_camera[s], exits[t], t == 0, rng);
+                let contribution = if t == 0 && s >= 1 {
+                    camera[s - 1].connection
+                } else {
+                    self.connect_known(at, k_camera[s], exits[t], t == 0, rng)
+                };
                 if contribution == DVec3::ZERO {
                     continue;
                 }
@@ -150,14 +161,16 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     fn camera_subpath(
         &self,
         start: Incident,
+        to_wo: Exit,
         max: usize,
         out: &mut [CameraVertex; BDPT_MAX_SUBPATH],
         rng: &mut impl Rng,
     ) -> usize {
         let mut at = start;
+        let mut k_at = inv_g1(&self.slope, in_side_frame(start.w, start.outside));
         let mut throughput = DVec3::ONE;
         for (j, slot) in out.iter_mut().enumerate().take(max) {
-            let Some((next, ratio)) = self.extend(at, rng) else { return j };
+            let Some((next, k_next, ratio)) = self.extend_known(at, k_at, rng) else { return j };
             throughput *= ratio;
             if throughput == DVec3::ZERO {
                 return j;
@@ -167,15 +180,17 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 f64::from(self.material.pdf_phase(&self.slope, at.w, x, at.outside, next.outside));
             let pdf_reverse_prev =
                 f64::from(self.material.pdf_phase(&self.slope, x, at.w, next.outside, at.outside));
+            // the connection of the new vertex to ωo, the (s, 0) strategy's
+            let connection = self.connect_known(next, k_next, to_wo, true, rng);
             if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
-                let q = throughput.max_element().min(1.0);
+                let q = survival_probability(throughput, k_next);
                 if f64::from(uniform(rng)) >= q {
                     return j;
                 }
                 throughput /= q;
             }
-            *slot = CameraVertex { next, throughput, pdf_forward, pdf_reverse_prev };
-            at = next;
+            *slot = CameraVertex { next, k_next, connection, throughput, pdf_forward, pdf_reverse_prev };
+            (at, k_at) = (next, k_next);
         }
         max
     }

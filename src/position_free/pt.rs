@@ -1,7 +1,7 @@
 //! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
 
 use super::segment::{in_side_frame, inv_g1};
-use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE};
+use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
 use crate::rng::uniform;
@@ -16,8 +16,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// A path is extended by sampling the phase function (exact full-spherical VNDF
     /// sampling): the vertex term and the sampling density cancel up to w/G1(ωin), so the
     /// throughput of a bounce is w·S_middle/G1(ωin) (w: the sample weight). Russian roulette
-    /// with survival probability min(1, max throughput) from the fourth vertex on keeps it
-    /// unbiased; the throughput is carried in f64. `order` selects all orders (no
+    /// from the fourth vertex on, with survival probability min(1, max throughput × max(1, G1)),
+    /// G1 of the next incident direction, keeps it unbiased and of finite variance (see
+    /// `survival_probability`); the throughput is carried in f64. `order` selects all orders (no
     /// truncation; [`crate::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
     pub fn eval_pt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         let (Some(mut at), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
@@ -47,7 +48,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 break;
             }
             if bounce >= ROULETTE_FROM_BOUNCE {
-                let q = throughput.max_element().min(1.0);
+                let q = survival_probability(throughput, k_in);
                 if f64::from(uniform(rng)) >= q {
                     break;
                 }
@@ -57,24 +58,17 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         sum.as_vec3()
     }
 
-    /// Samples the next direction from the incident state `at` and returns the next incident
-    /// state with the throughput ratio w·S_middle/G1(ωin) = w·k_in·S_middle.
-    #[inline]
-    pub(crate) fn extend(&self, at: Incident, rng: &mut impl Rng) -> Option<(Incident, DVec3)> {
-        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
-        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        if k_in == 0.0 || !k_in.is_finite() {
-            return None;
-        }
-        let middle = self.shadowing_factor(k_in, s.wo, s.outside, at.outside == s.outside, false);
-        Some((Incident { w: -s.wo, outside: s.outside }, s.weight.as_dvec3() * (k_in * middle)))
-    }
-
-    /// [`Self::extend`] with the incident 1 + L̃ = `k_in` known; also returns the next one.
-    /// Λ of the sampled direction serves both this vertex's continuing factor and the next
+    /// Samples the next direction from the incident state `at` (with 1 + L̃ = `k_in`) and
+    /// returns the next incident state, its 1 + L̃ and the throughput ratio
+    /// w·S_middle/G1(ωin) = w·k_in·S_middle. Λ of the sampled direction serves both this vertex's continuing factor and the next
     /// incident masking (Λ(−ω) = −1 − Λ(ω)), so a bounce evaluates Λ once.
     #[inline]
-    fn extend_known(&self, at: Incident, k_in: f64, rng: &mut impl Rng) -> Option<(Incident, f64, DVec3)> {
+    pub(crate) fn extend_known(
+        &self,
+        at: Incident,
+        k_in: f64,
+        rng: &mut impl Rng,
+    ) -> Option<(Incident, f64, DVec3)> {
         if k_in == 0.0 || !k_in.is_finite() {
             return None;
         }

@@ -22,8 +22,8 @@ use common::quadrature::integrate_sphere;
 use common::{Stats, TestRng};
 use glam::{DVec3, Vec3};
 use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope, PhaseSample,
-    UniformHeight,
+    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope,
+    PhaseSample, UniformHeight,
 };
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::{PI, TAU};
@@ -534,4 +534,49 @@ fn stochastic_chi2(
          (N = {n}, Σm̂ = {total:.5}, largest N·Var(m̂)/m = {max_ratio:.3})"
     );
     (p_value, max_ratio)
+}
+
+// ---------------------------------------------------------------------------------------------
+// the combined connection evaluation
+// ---------------------------------------------------------------------------------------------
+
+/// `Material::connection` (one half vector and one D for a conductor) returns exactly the
+/// vertex term and both phase-function densities of the separate calls, for random direction
+/// pairs on the whole sphere and every side combination.
+#[test]
+fn connection_equals_vertex_and_both_densities() {
+    fn check<S: MicrosurfaceSlope, M: Material>(
+        label: &str,
+        slope: S,
+        material: M,
+        rng: &mut TestRng,
+    ) -> usize {
+        let mut checked = 0;
+        for _ in 0..20_000 {
+            let (wi, wo) = (uniform_sphere(rng), uniform_sphere(rng));
+            for (a, b) in [(true, true), (true, false), (false, true), (false, false)] {
+                let (v, forward, reverse) = material.connection(&slope, wi, wo, a, b, rng);
+                let expected = (
+                    material.vertex(&slope, wi, wo, a, b, rng),
+                    material.pdf_phase(&slope, wi, wo, a, b),
+                    material.pdf_phase(&slope, wo, wi, b, a),
+                );
+                assert_eq!(
+                    (v, forward, reverse),
+                    expected,
+                    "{label}: ωi = {wi}, ωo = {wo}, sides ({a}, {b})"
+                );
+                checked += usize::from(forward > 0.0);
+            }
+        }
+        assert!(checked > 1000, "{label}: only {checked} non-zero densities checked");
+        checked
+    }
+    let mut rng = common::rng(0xc0ec);
+    let gold = ComplexIor::new(Vec3::new(0.18, 0.42, 1.37), Vec3::new(3.42, 2.35, 1.77)).unwrap();
+    for (ax, ay) in [(0.05, 0.05), (0.5, 0.5), (1.0, 0.2)] {
+        check("conductor GGX", Ggx::new(ax, ay).unwrap(), Conductor::perfect(), &mut rng);
+        check("gold GGX", Ggx::new(ax, ay).unwrap(), Conductor::new(gold), &mut rng);
+        check("gold Beckmann", Beckmann::new(ax, ay).unwrap(), Conductor::new(gold), &mut rng);
+    }
 }

@@ -95,6 +95,35 @@ impl Material for Conductor {
         self.fresnel(wi.as_dvec3().dot(wh) as f32) * (slope.d64(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
     }
 
+    /// One half vector and one D for the vertex term and both densities.
+    #[inline]
+    fn connection<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> (Vec3, f32, f32) {
+        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
+            return (Vec3::ZERO, 0.0, 0.0);
+        };
+        let d = slope.d64(wh);
+        let vertex = if wi.z == 0.0 {
+            Vec3::ZERO
+        } else {
+            self.fresnel(wi.as_dvec3().dot(wh) as f32) * (d / (4.0 * f64::from(wi.z.abs()))) as f32
+        };
+        // D(ωh)/(4 A(ω)), as `phase_reflection`; ωh is also the half vector of ωo → ωi
+        let pdf = |w: Vec3| {
+            let area = slope.projected_area(w);
+            if area <= 0.0 { 0.0 } else { (0.25 * d / f64::from(area)) as f32 }
+        };
+        let reverse = if wo.as_dvec3().dot(wh) > 0.0 { pdf(wo) } else { 0.0 };
+        (vertex, pdf(wi), reverse)
+    }
+
     /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm).
     #[inline]
     fn sample_phase<S: MicrosurfaceSlope>(

@@ -91,6 +91,28 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         rng: &mut impl Rng,
     ) -> Vec3;
 
+    /// The vertex term and the phase-function densities of ωo given ωi and of ωi given ωo
+    /// ([`Material::vertex`] and [`Material::pdf_phase`] both ways) of one connection, which an
+    /// implementation may compute together: a conductor evaluates one half vector and one D
+    /// for the three. The bidirectional position-free estimator needs all three for every
+    /// connection. Returns (vertex, pdf ωi → ωo, pdf ωo → ωi).
+    #[inline]
+    fn connection<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> (Vec3, f32, f32) {
+        (
+            self.vertex(slope, wi, wo, wi_outside, wo_outside, rng),
+            self.pdf_phase(slope, wi, wo, wi_outside, wo_outside),
+            self.pdf_phase(slope, wo, wi, wo_outside, wi_outside),
+        )
+    }
+
     /// (ηo/ηi)², the squared ratio of the indices on the two sides of an event from side
     /// `wi_outside` to side `wo_outside`: η² for a transmission into a dielectric, 1/η² out of
     /// it, 1 otherwise. It is the factor by which radiance transport differs from importance

@@ -120,10 +120,27 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 if throughput == DVec3::ZERO {
                     continue;
                 }
-                let contribution = if t == 0 && s >= 1 {
-                    camera[s - 1].connection
+                // the contribution of the connection with the densities of its direction pair
+                let (contribution, forward, reverse) = if t == 0 {
+                    let reverse = if s >= 1 {
+                        f64::from(self.material.pdf_phase(&self.slope, out, at.w, out_outside, at.outside))
+                    } else {
+                        0.0
+                    };
+                    let c = if s >= 1 {
+                        camera[s - 1].connection
+                    } else {
+                        self.connect_known(at, k_camera[0], exits[0], true, rng)
+                    };
+                    (c, 0.0, reverse)
                 } else {
-                    self.connect_known(at, k_camera[s], exits[t], t == 0, rng)
+                    let factor = self.connection_factor(at, k_camera[s], exits[t]);
+                    if factor == 0.0 {
+                        continue;
+                    }
+                    let (v, forward, reverse) =
+                        self.material.connection(&self.slope, at.w, out, at.outside, out_outside, rng);
+                    (v.as_dvec3() * factor, f64::from(forward), f64::from(reverse))
                 };
                 if contribution == DVec3::ZERO {
                     continue;
@@ -136,12 +153,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     }
                 }
                 if s >= 1 {
-                    pdf_reverse[s - 1] =
-                        f64::from(self.material.pdf_phase(&self.slope, out, at.w, out_outside, at.outside));
+                    pdf_reverse[s - 1] = reverse;
                 }
                 if t >= 1 {
-                    pdf_forward[s] =
-                        f64::from(self.material.pdf_phase(&self.slope, at.w, out, at.outside, out_outside));
+                    pdf_forward[s] = forward;
                     for j in (s + 1)..n {
                         let i = n - j; // light vertex whose sampled incident direction is −x_j
                         pdf_reverse[j - 1] = light[i - 1].pdf_reverse;

@@ -318,6 +318,16 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         self.material.vertex(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3() * factor
     }
 
+    /// The continuing shadowing factor of a connection from the incident state `at` (with
+    /// 1 + L̃ = `k_in`) through `out`; 0 where `at` sees no microsurface.
+    #[inline]
+    pub(crate) fn connection_factor(&self, at: Incident, k_in: f64, out: Exit) -> f64 {
+        if k_in == 0.0 {
+            return 0.0;
+        }
+        self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside).middle
+    }
+
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
     /// leave the surface) and then its Λ there (0 otherwise).
     #[inline]

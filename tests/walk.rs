@@ -140,7 +140,7 @@ fn reference_eval<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
     let mut h = if outside { f32::INFINITY } else { f32::NEG_INFINITY };
     let (mut throughput, mut sum) = (Vec3::ONE, Vec3::ZERO);
     for _ in 0..microsurface::MAX_BOUNCES {
-        let u = common::uniform64(rng) as f32;
+        let u = common::uniform32(rng);
         match geometry.sample_height(side(wr, outside), if outside { h } else { -h }, u) {
             HeightSample::Escape => break,
             HeightSample::Hit(local) => h = if outside { local } else { -local },

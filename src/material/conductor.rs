@@ -1,10 +1,13 @@
 //! Conductor microfacets.
 
-use super::{Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_half_vector};
+use super::{
+    Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_density,
+    reflection_half_vector,
+};
 use crate::fresnel::{ComplexIor, fresnel_conductor};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, renormalize};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rand::Rng;
 
 /// Conductor microfacets: specular reflection weighted by a Fresnel term
@@ -26,6 +29,16 @@ impl Conductor {
     /// A conductor with the given complex IOR.
     pub fn new(ior: ComplexIor) -> Self {
         Self { ior: Some(ior) }
+    }
+
+    /// The vertex term F(ωi·ωh) D(ωh)/(4 |cos θi|) of a valid reflection half vector with
+    /// D(ωh) = `d`; 0 for ωi on the horizon.
+    #[inline(always)]
+    fn reflection_vertex(&self, wi: Vec3, wh: DVec3, d: f64) -> Vec3 {
+        if wi.z == 0.0 {
+            return Vec3::ZERO;
+        }
+        self.fresnel(wi.as_dvec3().dot(wh) as f32) * (d / (4.0 * f64::from(wi.z.abs()))) as f32
     }
 
     /// The Fresnel term for the cosine between ωi and the facet normal.
@@ -88,11 +101,10 @@ impl Material for Conductor {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside && wi.z != 0.0)
-        else {
+        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
-        self.fresnel(wi.as_dvec3().dot(wh) as f32) * (slope.d64(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
+        self.reflection_vertex(wi, wh, slope.d64(wh))
     }
 
     /// One half vector and one D for the vertex term and both densities.
@@ -110,18 +122,9 @@ impl Material for Conductor {
             return (Vec3::ZERO, 0.0, 0.0);
         };
         let d = slope.d64(wh);
-        let vertex = if wi.z == 0.0 {
-            Vec3::ZERO
-        } else {
-            self.fresnel(wi.as_dvec3().dot(wh) as f32) * (d / (4.0 * f64::from(wi.z.abs()))) as f32
-        };
-        // D(ωh)/(4 A(ω)), as `phase_reflection`; ωh is also the half vector of ωo → ωi
-        let pdf = |w: Vec3| {
-            let area = slope.projected_area(w);
-            if area <= 0.0 { 0.0 } else { (0.25 * d / f64::from(area)) as f32 }
-        };
-        let reverse = if wo.as_dvec3().dot(wh) > 0.0 { pdf(wo) } else { 0.0 };
-        (vertex, pdf(wi), reverse)
+        // ωh is also the half vector of ωo → ωi
+        let reverse = if wo.as_dvec3().dot(wh) > 0.0 { reflection_density(slope, wo, d) } else { 0.0 };
+        (self.reflection_vertex(wi, wh, d), reflection_density(slope, wi, d), reverse)
     }
 
     /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm).

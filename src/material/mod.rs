@@ -163,6 +163,12 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
 /// ωi·ωh > 0); 0 where ωi sees no microsurface.
 #[inline(always)]
 pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DVec3) -> f32 {
-    let area = slope.projected_area(wi);
-    if area <= 0.0 { 0.0 } else { (0.25 * slope.d64(wh) / f64::from(area)) as f32 }
+    reflection_density(slope, wi, slope.d64(wh))
+}
+
+/// D(ωh)/(4 A(ω)) for D(ωh) = `d`: the reflection density of [`phase_reflection`] with D known.
+#[inline(always)]
+pub(crate) fn reflection_density<S: MicrosurfaceSlope>(slope: &S, w: Vec3, d: f64) -> f32 {
+    let area = slope.projected_area(w);
+    if area <= 0.0 { 0.0 } else { (0.25 * d / f64::from(area)) as f32 }
 }

@@ -134,7 +134,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     };
                     (c, 0.0, reverse)
                 } else {
-                    let factor = self.connection_factor(at, k_camera[s], exits[t]);
+                    let factor = self.shadowing_factor(at, k_camera[s], exits[t], false);
                     if factor == 0.0 {
                         continue;
                     }
@@ -231,7 +231,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
                 return i;
             }
-            let factor = self.shadowing_factor(k_in, b, b_outside, a.outside == b_outside, i == 0)
+            let factor = self.shadowing_factor(a, k_in, self.exit(b, b_outside), i == 0)
                 * f64::from(self.material.relative_eta_sq(a.outside, b_outside))
                 * f64::from(self.slope.projected_area(in_side_frame(b, b_outside)))
                 / f64::from(a.w.z.abs());

@@ -168,13 +168,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             if weight == Vec3::ZERO {
                 return None;
             }
-            let exit = in_side_frame(s.wo, s.outside);
-            if exit.z > 0.0 {
+            let out = self.exit(s.wo, s.outside);
+            if out.can_exit {
                 let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-                let lambda_out = f64::from(self.slope.lambda(exit));
-                let v = self.shadowing.vertex(k_in, true, lambda_out, at.outside == s.outside);
                 // P(exit) = S_last/(S_last + S_middle) = S_last/G1(ωin)
-                if f64::from(uniform(rng)) < v.last * k_in {
+                if f64::from(uniform(rng)) < self.shadowing_factor(at, k_in, out, true) * k_in {
                     return Some(WalkSample { wo: s.wo, weight, bounces });
                 }
             }
@@ -191,7 +189,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let at = Self::incident_single(wi)?;
         let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        let last = self.shadowing_factor(k_in, s.wo, s.outside, at.outside == s.outside, true) * k_in;
+        let last = self.shadowing_factor(at, k_in, self.exit(s.wo, s.outside), true) * k_in;
         let weight = s.weight * last as f32;
         (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
     }
@@ -265,35 +263,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         rng: &mut impl Rng,
     ) -> DVec3 {
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        if k_in == 0.0 {
-            return DVec3::ZERO;
-        }
-        let factor = self.shadowing_factor(k_in, wo, wo_outside, at.outside == wo_outside, last);
-        if factor == 0.0 {
-            return DVec3::ZERO;
-        }
-        self.material.vertex(&self.slope, at.w, wo, at.outside, wo_outside, rng).as_dvec3() * factor
-    }
-
-    /// The last-vertex contribution towards ωo ([`Self::connect`] with `last`), with the
-    /// incident 1 + L̃ = `k_in` and Λ of ωo in its side frame, `lambda_o`, already known.
-    #[inline]
-    pub(crate) fn connect_exit(
-        &self,
-        at: Incident,
-        k_in: f64,
-        wo: Vec3,
-        wo_outside: bool,
-        lambda_o: f64,
-        rng: &mut impl Rng,
-    ) -> DVec3 {
-        self.connect_known(
-            at,
-            k_in,
-            Exit { w: wo, outside: wo_outside, can_exit: true, lambda: lambda_o },
-            true,
-            rng,
-        )
+        self.connect_known(at, k_in, self.exit(wo, wo_outside), last, rng)
     }
 
     /// [`Self::connect`] with the incident 1 + L̃ = `k_in` and the outgoing direction's exit
@@ -307,25 +277,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         last: bool,
         rng: &mut impl Rng,
     ) -> DVec3 {
-        if k_in == 0.0 {
-            return DVec3::ZERO;
-        }
-        let v = self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside);
-        let factor = if last { v.last } else { v.middle };
+        let factor = self.shadowing_factor(at, k_in, out, last);
         if factor == 0.0 {
             return DVec3::ZERO;
         }
         self.material.vertex(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3() * factor
-    }
-
-    /// The continuing shadowing factor of a connection from the incident state `at` (with
-    /// 1 + L̃ = `k_in`) through `out`; 0 where `at` sees no microsurface.
-    #[inline]
-    pub(crate) fn connection_factor(&self, at: Incident, k_in: f64, out: Exit) -> f64 {
-        if k_in == 0.0 {
-            return 0.0;
-        }
-        self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside).middle
     }
 
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
@@ -342,20 +298,14 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         }
     }
 
-    /// The last or continuing shadowing factor of a vertex with incident 1 + L̃ = `k_in`.
+    /// The last (`last`) or continuing shadowing factor of a vertex with incident state `at`
+    /// (1 + L̃ = `k_in`) and outgoing direction `out`; 0 where `at` sees no microsurface.
     #[inline(always)]
-    pub(crate) fn shadowing_factor(
-        &self,
-        k_in: f64,
-        wo: Vec3,
-        wo_outside: bool,
-        reflect: bool,
-        last: bool,
-    ) -> f64 {
-        let exit = in_side_frame(wo, wo_outside);
-        let can_exit = exit.z > 0.0;
-        let lambda_out = if can_exit { f64::from(self.slope.lambda(exit)) } else { 0.0 };
-        let v = self.shadowing.vertex(k_in, can_exit, lambda_out, reflect);
+    pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, last: bool) -> f64 {
+        if k_in == 0.0 {
+            return 0.0;
+        }
+        let v = self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside);
         if last { v.last } else { v.middle }
     }
 }

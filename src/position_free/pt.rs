@@ -25,14 +25,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             return Vec3::ZERO;
         };
         let last = order.last();
-        // Λ of ωo (constant) and 1 + L̃ of the current incident direction: one Λ per bounce
-        let lambda_o = f64::from(self.slope.lambda(in_side_frame(wo, wo_outside)));
+        // the exit data of ωo (constant) and 1 + L̃ of the current incident direction: one Λ
+        // per bounce
+        let to_wo = self.exit(wo, wo_outside);
         let mut k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
         let mut throughput = DVec3::ONE;
         let mut sum = DVec3::ZERO;
         for bounce in 1..=last {
             if order.includes(bounce) {
-                sum += throughput * self.connect_exit(at, k_in, wo, wo_outside, lambda_o, rng);
+                sum += throughput * self.connect_known(at, k_in, to_wo, true, rng);
             }
             if bounce == last {
                 break;
@@ -73,14 +74,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             return None;
         }
         let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
-        let exit = in_side_frame(s.wo, s.outside);
-        let (middle, k_next) = if exit.z > 0.0 {
-            // the next incident direction −exit is below the horizon: 1 + L̃ = Λ(exit)
-            let lambda_out = f64::from(self.slope.lambda(exit));
-            (self.shadowing.vertex(k_in, true, lambda_out, at.outside == s.outside).middle, lambda_out)
-        } else {
-            (1.0 / k_in, inv_g1(&self.slope, -exit))
-        };
+        let out = self.exit(s.wo, s.outside);
+        let middle = self.shadowing_factor(at, k_in, out, false);
+        // the next incident direction −ω: below the horizon in its frame where ω can exit, and
+        // then 1 + L̃ = Λ(ω)
+        let k_next =
+            if out.can_exit { out.lambda } else { inv_g1(&self.slope, -in_side_frame(s.wo, s.outside)) };
         let next = Incident { w: -s.wo, outside: s.outside };
         Some((next, k_next, s.weight.as_dvec3() * (k_in * middle)))
     }

@@ -48,12 +48,17 @@ pub use bsdf::{
 pub use error::Error;
 pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
 pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+/// The vector library of the public API, re-exported so that users on another `glam` version
+/// can name the crate's types.
+pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
 pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
 pub use microsurface::{
     HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
 };
 pub use position_free::{Estimator, PositionFree, Shadowing};
+/// The random-number traits the research layer's walks take, re-exported for the same reason.
+pub use rand;
 pub use slope::{Beckmann, Ggx, MicrosurfaceSlope};
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{

@@ -12,7 +12,20 @@ mod reference;
 #[path = "stability/stiff.rs"]
 mod stiff;
 
+const USAGE: &str = "usage: cargo run --release --example stability
+
+Prints the accuracy map and the stiff-walk table as markdown. Takes no arguments other than
+--help.";
+
 fn main() {
+    if let Some(arg) = std::env::args().nth(1) {
+        if arg == "-h" || arg == "--help" {
+            println!("{USAGE}");
+            return;
+        }
+        eprintln!("unknown argument {arg}\n\n{USAGE}");
+        std::process::exit(2);
+    }
     println!("# Stability report\n");
     println!("## Accuracy map\n");
     println!(

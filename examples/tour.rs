@@ -46,7 +46,20 @@ fn row<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
     }
 }
 
+const USAGE: &str = "usage: cargo run --release --example tour
+
+Prints a short tour of what the crate computes (masking, visible normals, the random walks and
+their energy per bounce). Takes no arguments other than --help.";
+
 fn main() -> Result<(), microsurface::Error> {
+    if let Some(arg) = std::env::args().nth(1) {
+        if arg == "-h" || arg == "--help" {
+            println!("{USAGE}");
+            return Ok(());
+        }
+        eprintln!("unknown argument {arg}\n\n{USAGE}");
+        std::process::exit(2);
+    }
     let mut rng = Rng::seed_from_u64(2016);
 
     println!("microsurface — a tour\n");

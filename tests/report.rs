@@ -22,7 +22,9 @@ fn quick_report_is_complete_finite_and_consistent() {
     let summary = quick_report();
 
     // files
-    for name in ["errors.csv", "efficiency.csv", "energy.csv", "cost.csv", "lobes.csv", "summary.md"] {
+    for name in
+        ["errors.csv", "efficiency.csv", "ratios.csv", "energy.csv", "cost.csv", "lobes.csv", "summary.md"]
+    {
         assert!(summary.files.iter().any(|f| f.ends_with(name)), "{name} missing");
     }
     for config in Config::ALL {
@@ -82,6 +84,29 @@ fn quick_report_is_complete_finite_and_consistent() {
             );
         }
     }
+    // the lobes per order are estimated directly, so every order (3+ included) is ≥ 0
+    let lobes = summary.files.iter().find(|f| f.ends_with("lobes.csv")).expect("lobes.csv");
+    let text = std::fs::read_to_string(lobes).unwrap();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        for field in line.split(',').skip(3) {
+            let v: f64 = field.parse().expect("a number");
+            assert!(v >= 0.0, "lobes.csv:{}: negative value {field} in {line}", i + 1);
+        }
+    }
+
+    // every efficiency ratio comes with a confidence interval around it
+    assert_eq!(summary.ratios.len(), Config::ALL.len());
+    for (config, a, b) in &summary.ratios {
+        for r in [a, b] {
+            assert!(
+                r.pairs > 0 && r.lo.is_finite() && r.hi.is_finite() && r.lo < r.estimate && r.estimate < r.hi,
+                "{}: ratio {r:?}",
+                config.name()
+            );
+        }
+    }
+    assert!(summary.markdown.contains("95 % CI"));
+
     assert!(!summary.cost.is_empty());
     assert!(summary.markdown.contains("Efficiency ratios"));
 }

@@ -4,11 +4,12 @@
 use super::plot::{Canvas, PALETTE, Series, loglog_chart, polar_chart};
 use glam::Vec3;
 use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, UniformHeight,
+    Beckmann, Conductor, Dielectric, Diffuse, Ggx, MAX_BOUNCES, Material, Microsurface, MicrosurfaceSlope,
+    PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
 use rand::SeedableRng;
 use std::fmt::Write as _;
+use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -25,7 +26,7 @@ pub struct Options {
     pub out_dir: PathBuf,
     /// Worker threads.
     pub threads: usize,
-    /// Print a progress bar on stderr.
+    /// Print a progress bar on stderr (`main` sets it only when stderr is a terminal).
     pub progress: bool,
 }
 
@@ -202,11 +203,25 @@ struct Run {
     wo_label: &'static str,
     est: Est,
     values: Vec<f32>,
-    ns_per_sample: f64,
+    timing: Timing,
 }
 
-/// Runs `n` evaluations single-threaded and times them.
-fn run_estimator(config: Config, est: Est, wi: Vec3, wo: Vec3, n: usize, seed: u64) -> (Vec<f32>, f64) {
+/// The measured cost of one estimator run: the mean time per sample and its standard error
+/// from `TIMING_CHUNKS` separately timed chunks of the run.
+#[derive(Debug, Clone, Copy)]
+struct Timing {
+    ns_per_sample: f64,
+    ns_se: f64,
+}
+
+/// The number of separately timed chunks of an estimator run (for the SE of its cost).
+const TIMING_CHUNKS: usize = 16;
+
+/// Runs `n` evaluations single-threaded and times them in `TIMING_CHUNKS` chunks. The model
+/// and both directions pass through `black_box` on every call, so that nothing that depends
+/// on them is hoisted out of the timed loop (the error study estimates one value, so its
+/// inputs cannot rotate; `cost` rotates pre-generated directions).
+fn run_estimator(config: Config, est: Est, wi: Vec3, wo: Vec3, n: usize, seed: u64) -> (Vec<f32>, Timing) {
     fn go<S: MicrosurfaceSlope, M: Material>(
         m: Models<S, M>,
         est: Est,
@@ -214,12 +229,26 @@ fn run_estimator(config: Config, est: Est, wi: Vec3, wo: Vec3, n: usize, seed: u
         wo: Vec3,
         n: usize,
         seed: u64,
-    ) -> (Vec<f32>, f64) {
+    ) -> (Vec<f32>, Timing) {
         let mut rng = Rng::seed_from_u64(seed);
-        let start = Instant::now();
-        let values: Vec<f32> =
-            (0..n).map(|_| m.eval(est, wi, wo, ScatteringOrder::All, &mut rng) as f32).collect();
-        (values, start.elapsed().as_secs_f64() * 1e9 / n as f64)
+        let mut values = Vec::with_capacity(n);
+        let chunk = n.div_ceil(TIMING_CHUNKS).max(1);
+        let (mut total_ns, mut per_chunk) = (0.0, Vec::with_capacity(TIMING_CHUNKS));
+        while values.len() < n {
+            let len = chunk.min(n - values.len());
+            let start = Instant::now();
+            for _ in 0..len {
+                let v = black_box(&m).eval(est, black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng);
+                values.push(v as f32);
+            }
+            let ns = start.elapsed().as_secs_f64() * 1e9;
+            total_ns += ns;
+            per_chunk.push(ns / len as f64);
+        }
+        let k = per_chunk.len() as f64;
+        let mean_chunk = per_chunk.iter().sum::<f64>() / k;
+        let var_chunk = per_chunk.iter().map(|t| (t - mean_chunk).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
+        (values, Timing { ns_per_sample: total_ns / n as f64, ns_se: (var_chunk / k).sqrt() })
     }
     let ggx = |a| Ggx::isotropic(a).expect("valid α");
     match config {
@@ -282,6 +311,17 @@ fn mean_and_variance(values: &[f32]) -> (f64, f64) {
     (mean, var)
 }
 
+/// The standard error of the sample variance: the standard deviation of the squared
+/// deviations (x − mean)² over √n (delta method; it needs a finite fourth moment, so for
+/// heavy-tailed estimators it is itself uncertain).
+fn variance_se(values: &[f32], mean: f64) -> f64 {
+    let n = values.len() as f64;
+    let sq: Vec<f64> = values.iter().map(|&v| (f64::from(v) - mean).powi(2)).collect();
+    let m = sq.iter().sum::<f64>() / n;
+    let v = sq.iter().map(|q| (q - m).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    (v / n).sqrt()
+}
+
 /// One row of the efficiency table (all fields are read by `tests/report.rs`).
 #[allow(dead_code)]
 #[derive(Debug, Clone)]
@@ -292,7 +332,11 @@ pub struct EfficiencyRow {
     pub est: Est,
     pub mean: f64,
     pub std: f64,
+    /// Standard error of the sample variance σ̂² (`variance_se`).
+    pub variance_se: f64,
     pub ns_per_sample: f64,
+    /// Standard error of `ns_per_sample` over the timed chunks of the run.
+    pub ns_se: f64,
     pub reference: f64,
     pub reference_se: f64,
     /// 1/(relative variance × seconds per sample).
@@ -305,13 +349,35 @@ pub struct EfficiencyRow {
 /// furnace ∫eval, its SE).
 pub type EnergyRow = (String, f64, f64, f64, [f64; 4], f64, f64, f64);
 
+/// A ratio of efficiencies, geometric mean over θi and ωo, with its 95 % confidence interval.
+///
+/// Per (θi, ωo) the log ratio is ln e_a − ln e_b with e = reference²/(σ̂² t); its variance is
+/// propagated by the delta method from the standard errors of both sample variances
+/// (`variance_se`), of both times per sample (over the timed chunks) and, where the two
+/// estimators have different references, of both references. The geometric mean's log is the
+/// mean of the J log ratios with SE √(Σ var)/J; the interval is exp(mean ± 1.96 SE). It covers
+/// the sampling noise of one run (not a change of machine load between runs, nor the
+/// unreliability of σ̂² for heavy-tailed estimators).
+#[allow(dead_code)] // the components are read by tests/report.rs
+#[derive(Debug, Clone, Copy)]
+pub struct Ratio {
+    pub estimate: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// Geometric mean of σ̂²_b/σ̂²_a (relative variances): how much lower a's variance is.
+    pub variance_ratio: f64,
+    /// Geometric mean of t_a/t_b: how much more a costs per sample.
+    pub cost_ratio: f64,
+    /// The number of (θi, ωo) pairs in the mean.
+    pub pairs: usize,
+}
+
 /// What the report found, for the summary and the tests.
 #[derive(Debug, Clone, Default)]
 pub struct Summary {
     pub efficiency: Vec<EfficiencyRow>,
-    /// (config, ratio of PT-corr to walk efficiency, ratio of BDPT-corr to PT-corr), geometric
-    /// means over θi and ωo.
-    pub ratios: Vec<(Config, f64, f64)>,
+    /// (config, ratio of PT-corr to walk efficiency, ratio of BDPT-corr to PT-corr).
+    pub ratios: Vec<(Config, Ratio, Ratio)>,
     /// (label, θi, R, T, per order [1, 2, 3, 4+], mean bounces, furnace ∫eval, its SE).
     pub energy: Vec<EnergyRow>,
     /// (model, ns per eval, ns per sample, mean bounces).
@@ -346,13 +412,13 @@ fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io
     let jobs: Vec<_> = jobs.into_iter().enumerate().collect();
     let runs = parallel("error vs time", jobs, opts, |(i, (config, theta_i, label, wo, est, n, is_ref))| {
         let wi = dir(theta_i, 0.0);
-        let (values, ns) = run_estimator(config, est, wi, wo, n, seed_of(i));
-        (is_ref, Run { config, theta_i, wo_label: label, est, values, ns_per_sample: ns })
+        let (values, timing) = run_estimator(config, est, wi, wo, n, seed_of(i));
+        (is_ref, Run { config, theta_i, wo_label: label, est, values, timing })
     });
     let (refs, runs): (Vec<_>, Vec<_>) = runs.into_iter().partition(|(is_ref, _)| *is_ref);
     let mut csv = String::from("config,theta_i,wo,estimator,samples,time_s,rmse,rel_rmse\n");
     let mut eff_csv = String::from(
-        "config,theta_i,wo,estimator,mean,std,ns_per_sample,reference,reference_se,efficiency_per_s\n",
+        "config,theta_i,wo,estimator,mean,std,variance_se,ns_per_sample,ns_se,reference,reference_se,efficiency_per_s\n",
     );
     for (_, run) in &runs {
         let (mean, var) = mean_and_variance(&run.values);
@@ -385,7 +451,7 @@ fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io
                 .map(|c| (c.iter().map(|&v| f64::from(v)).sum::<f64>() / batch as f64 - reference).powi(2))
                 .sum::<f64>()
                 / batches as f64;
-            let seconds = batch as f64 * run.ns_per_sample * 1e-9;
+            let seconds = batch as f64 * run.timing.ns_per_sample * 1e-9;
             curve.push((batch, seconds, mse.sqrt() / scale));
             let _ = writeln!(
                 csv,
@@ -401,16 +467,18 @@ fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io
         }
         let rel_var = var / (scale * scale);
         let efficiency =
-            if rel_var > 0.0 { 1.0 / (rel_var * run.ns_per_sample * 1e-9) } else { f64::INFINITY };
+            if rel_var > 0.0 { 1.0 / (rel_var * run.timing.ns_per_sample * 1e-9) } else { f64::INFINITY };
+        let var_se = variance_se(&run.values, mean);
         let _ = writeln!(
             eff_csv,
-            "{},{},{},{},{mean:.6e},{:.4e},{:.1},{reference:.6e},{reference_se:.2e},{efficiency:.4e}",
+            "{},{},{},{},{mean:.6e},{:.4e},{var_se:.4e},{:.1},{:.2},{reference:.6e},{reference_se:.2e},{efficiency:.4e}",
             run.config.name(),
             run.theta_i,
             run.wo_label,
             run.est.name(),
             var.sqrt(),
-            run.ns_per_sample
+            run.timing.ns_per_sample,
+            run.timing.ns_se
         );
         summary.efficiency.push(EfficiencyRow {
             config: run.config,
@@ -419,7 +487,9 @@ fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io
             est: run.est,
             mean,
             std: var.sqrt(),
-            ns_per_sample: run.ns_per_sample,
+            variance_se: var_se,
+            ns_per_sample: run.timing.ns_per_sample,
+            ns_se: run.timing.ns_se,
             reference,
             reference_se,
             efficiency,
@@ -429,10 +499,14 @@ fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io
     write(opts, "errors.csv", &csv, summary)?;
     write(opts, "efficiency.csv", &eff_csv, summary)?;
 
-    // efficiency ratios (geometric means over θi and ωo where both are finite)
+    // efficiency ratios (geometric means over θi and ωo where both are finite), with
+    // delta-method confidence intervals (see `Ratio`)
+    let mut ratio_csv =
+        String::from("config,ratio,estimate,ci95_lo,ci95_hi,variance_ratio,cost_ratio,pairs\n");
     for config in Config::ALL {
         let ratio = |a: Est, b: Est| {
-            let logs: Vec<f64> = summary
+            let rel2 = |x: f64, se: f64| if x != 0.0 { (se / x).powi(2) } else { 0.0 };
+            let terms: Vec<(f64, f64, f64, f64)> = summary
                 .efficiency
                 .iter()
                 .filter(|r| r.config == config && r.est == a)
@@ -441,17 +515,57 @@ fn error_study(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io
                         r.config == config && r.est == b && r.theta_i == ra.theta_i && r.wo == ra.wo
                     })?;
                     let q = ra.efficiency / rb.efficiency;
-                    (q.is_finite() && q > 0.0).then(|| q.ln())
+                    if !(q.is_finite() && q > 0.0) {
+                        return None;
+                    }
+                    let (va, vb) = (ra.std * ra.std, rb.std * rb.std);
+                    let mut var_ln = rel2(va, ra.variance_se)
+                        + rel2(vb, rb.variance_se)
+                        + rel2(ra.ns_per_sample, ra.ns_se)
+                        + rel2(rb.ns_per_sample, rb.ns_se);
+                    if a.reference() != b.reference() {
+                        var_ln +=
+                            4.0 * (rel2(ra.reference, ra.reference_se) + rel2(rb.reference, rb.reference_se));
+                    }
+                    let rel_var = |r: &EfficiencyRow| r.std * r.std / (r.reference * r.reference);
+                    Some((
+                        q.ln(),
+                        var_ln,
+                        (rel_var(rb) / rel_var(ra)).ln(),
+                        (ra.ns_per_sample / rb.ns_per_sample).ln(),
+                    ))
                 })
                 .collect();
-            if logs.is_empty() { f64::NAN } else { (logs.iter().sum::<f64>() / logs.len() as f64).exp() }
+            let j = terms.len() as f64;
+            let mean = |f: fn(&(f64, f64, f64, f64)) -> f64| terms.iter().map(f).sum::<f64>() / j;
+            let (ln_q, se) = (mean(|t| t.0), terms.iter().map(|t| t.1).sum::<f64>().sqrt() / j);
+            Ratio {
+                estimate: ln_q.exp(),
+                lo: (ln_q - 1.96 * se).exp(),
+                hi: (ln_q + 1.96 * se).exp(),
+                variance_ratio: mean(|t| t.2).exp(),
+                cost_ratio: mean(|t| t.3).exp(),
+                pairs: terms.len(),
+            }
         };
-        summary.ratios.push((
-            config,
-            ratio(Est::PtCorrelated, Est::Walk),
-            ratio(Est::BdptCorrelated, Est::PtCorrelated),
-        ));
+        let (walk, bdpt) =
+            (ratio(Est::PtCorrelated, Est::Walk), ratio(Est::BdptCorrelated, Est::PtCorrelated));
+        for (name, r) in [("pt-corr/heitz-walk", walk), ("bdpt-corr/pt-corr", bdpt)] {
+            let _ = writeln!(
+                ratio_csv,
+                "{},{name},{:.4},{:.4},{:.4},{:.4},{:.4},{}",
+                config.name(),
+                r.estimate,
+                r.lo,
+                r.hi,
+                r.variance_ratio,
+                r.cost_ratio,
+                r.pairs
+            );
+        }
+        summary.ratios.push((config, walk, bdpt));
     }
+    write(opts, "ratios.csv", &ratio_csv, summary)?;
 
     // plots: θi = 1.0, mirror direction
     for config in Config::ALL {
@@ -498,6 +612,31 @@ fn save(opts: &Options, name: &str, canvas: &Canvas, summary: &mut Summary) -> s
     Ok(())
 }
 
+/// The continuation probability q of the random order of `orders_from_3`.
+const ORDER3_CONTINUE: f64 = 0.75;
+
+/// An unbiased estimate of the orders 3 and up of f·|cos θo| from one term: the order
+/// k = 3 + G, G geometric (P(G = g) = (1 − q) q^g, q = `ORDER3_CONTINUE`), capped at
+/// `MAX_BOUNCES` (which then takes the remaining mass q^{cap − 3}), evaluated with
+/// `ScatteringOrder::only(k)` and divided by P(k). Every term is ≥ 0 for non-negative
+/// models, unlike the difference total − order 1 − order 2. Its variance is finite when the
+/// order-k contributions fall faster than √q^k; it costs a walk of 3 + q/(1 − q) = 6 bounces
+/// on average.
+fn orders_from_3(eval: &impl Fn(ScatteringOrder, &mut Rng) -> f64, rng: &mut Rng) -> f64 {
+    let (mut k, mut p) = (3u32, 1.0 - ORDER3_CONTINUE);
+    while k < MAX_BOUNCES {
+        if rand::RngExt::random::<f64>(rng) >= ORDER3_CONTINUE {
+            break;
+        }
+        k += 1;
+        p *= ORDER3_CONTINUE;
+    }
+    if k == MAX_BOUNCES {
+        p *= 1.0 / (1.0 - ORDER3_CONTINUE);
+    }
+    eval(ScatteringOrder::only(k).expect("k ≥ 3"), rng) / p
+}
+
 /// The lobe materials: conductor, dielectric and diffuse on GGX α = 1.
 fn lobes(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Result<()> {
     let materials = ["conductor", "dielectric", "diffuse"];
@@ -526,51 +665,47 @@ fn lobes(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Resu
         // θo measured from the normal towards −x (the mirror side); beyond π/2 below
         let wo = Vec3::new(-(t.sin()) as f32, 0.0, t.cos() as f32);
         let mut rng = Rng::seed_from_u64(((m as u64) << 32) ^ (theta_i * 1e3) as u64 ^ (t * 1e6) as u64);
-        let mut go = |order: ScatteringOrder| -> f64 {
-            let eval = |rng: &mut Rng| -> f64 {
-                let v = match m {
-                    0 => Microsurface::new(UniformHeight, ggx, Conductor::perfect()).eval(wi, wo, order, rng),
-                    1 => Microsurface::new(UniformHeight, ggx, Dielectric::new(1.5).expect("valid η"))
-                        .eval(wi, wo, order, rng),
-                    _ => Microsurface::new(UniformHeight, ggx, Diffuse::white()).eval(wi, wo, order, rng),
-                };
-                f64::from(v.x)
+        let eval = |order: ScatteringOrder, rng: &mut Rng| -> f64 {
+            let v = match m {
+                0 => Microsurface::new(UniformHeight, ggx, Conductor::perfect()).eval(wi, wo, order, rng),
+                1 => Microsurface::new(UniformHeight, ggx, Dielectric::new(1.5).expect("valid η"))
+                    .eval(wi, wo, order, rng),
+                _ => Microsurface::new(UniformHeight, ggx, Diffuse::white()).eval(wi, wo, order, rng),
             };
-            (0..samples).map(|_| eval(&mut rng)).sum::<f64>() / samples as f64
+            f64::from(v.x)
+        };
+        let mut go = |order: ScatteringOrder| -> f64 {
+            (0..samples).map(|_| eval(order, &mut rng)).sum::<f64>() / samples as f64
         };
         let o1 = go(ScatteringOrder::only(1).expect("n > 0"));
         let o2 = go(ScatteringOrder::only(2).expect("n > 0"));
         let all = go(ScatteringOrder::All);
-        (o1, o2, all)
+        let o3plus = (0..samples).map(|_| orders_from_3(&eval, &mut rng)).sum::<f64>() / samples as f64;
+        (o1, o2, o3plus, all)
     });
     let mut csv = String::from("material,theta_i,theta_o,order1,order2,order3plus,total\n");
-    for (&(m, theta_i, t), &(o1, o2, all)) in jobs.iter().zip(&values) {
-        let _ = writeln!(
-            csv,
-            "{},{theta_i},{t:.4},{o1:.5e},{o2:.5e},{:.5e},{all:.5e}",
-            materials[m],
-            all - o1 - o2
-        );
+    for (&(m, theta_i, t), &(o1, o2, o3plus, all)) in jobs.iter().zip(&values) {
+        let _ = writeln!(csv, "{},{theta_i},{t:.4},{o1:.5e},{o2:.5e},{o3plus:.5e},{all:.5e}", materials[m]);
     }
     write(opts, "lobes.csv", &csv, summary)?;
     for (m, &name) in materials.iter().enumerate() {
         let (pw, ph) = (300u32, if name == "dielectric" { 300 } else { 220 });
         let mut canvas = Canvas::new(3 * pw, ph);
         for (k, theta_i) in THETAS.into_iter().enumerate() {
-            let rows: Vec<(f64, f64, f64, f64)> = jobs
+            let rows: Vec<(f64, f64, f64, f64, f64)> = jobs
                 .iter()
                 .zip(&values)
                 .filter(|((mm, ti, _), _)| *mm == m && *ti == theta_i)
-                .map(|(&(_, _, t), &(o1, o2, all))| (t, o1, o2, all))
+                .map(|(&(_, _, t), &(o1, o2, o3plus, all))| (t, o1, o2, o3plus, all))
                 .collect();
-            let pick = |f: fn(&(f64, f64, f64, f64)) -> f64| {
-                rows.iter().map(|r| (r.0, f(r).max(0.0))).collect::<Vec<_>>()
+            let pick = |f: fn(&(f64, f64, f64, f64, f64)) -> f64| {
+                rows.iter().map(|r| (r.0, f(r))).collect::<Vec<_>>()
             };
             let series = vec![
                 Series { label: "order 1".into(), points: pick(|r| r.1), color: PALETTE[0] },
                 Series { label: "order 2".into(), points: pick(|r| r.2), color: PALETTE[1] },
-                Series { label: "order 3+".into(), points: pick(|r| r.3 - r.1 - r.2), color: PALETTE[2] },
-                Series { label: "total".into(), points: pick(|r| r.3), color: PALETTE[3] },
+                Series { label: "order 3+".into(), points: pick(|r| r.3), color: PALETTE[2] },
+                Series { label: "total".into(), points: pick(|r| r.4), color: PALETTE[3] },
             ];
             let energy = summary
                 .energy
@@ -691,39 +826,67 @@ fn energy(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Res
     write(opts, "energy.csv", &csv, summary)
 }
 
-/// Single-threaded cost per call.
+/// The number of pre-generated outgoing directions the cost loops rotate through (a power of
+/// two).
+const COST_DIRECTIONS: usize = 1024;
+
+/// `COST_DIRECTIONS` outgoing directions from a fixed seed, uniform on the upper hemisphere
+/// (on the whole sphere when `transmits`), never horizontal.
+fn cost_directions(transmits: bool) -> Vec<Vec3> {
+    let mut rng = Rng::seed_from_u64(0xC057);
+    (0..COST_DIRECTIONS)
+        .map(|_| {
+            loop {
+                let u: f64 = rand::RngExt::random(&mut rng);
+                let v: f64 = rand::RngExt::random(&mut rng);
+                let z = if transmits { 1.0 - 2.0 * u } else { 1.0 - u };
+                if z != 0.0 {
+                    break dir(z.acos(), std::f64::consts::TAU * v);
+                }
+            }
+        })
+        .collect()
+}
+
+/// Single-threaded cost per call, like the criterion benches: ωi fixed (θi = 0.5), the ωo of
+/// `eval` rotated through `COST_DIRECTIONS` pre-generated directions, the model and every
+/// input behind `black_box` so that no work is hoisted out of the loop.
 fn cost(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Result<()> {
     let wi = dir(0.5, 0.0);
-    let wo = dir(0.7, 2.5);
     let n = budget.cost_calls;
     fn time<S: MicrosurfaceSlope, M: Material>(
         name: &str,
         m: Models<S, M>,
         wi: Vec3,
-        wo: Vec3,
         n: usize,
         out: &mut Vec<(String, f64, f64, f64)>,
     ) {
+        let wos = cost_directions(M::TRANSMITS);
         let mut rng = Rng::seed_from_u64(99);
         for est in Est::ALL {
             let start = Instant::now();
             let mut acc = 0.0;
-            for _ in 0..n {
-                acc += m.eval(est, wi, wo, ScatteringOrder::All, &mut rng);
+            for i in 0..n {
+                let wo = wos[i & (COST_DIRECTIONS - 1)];
+                acc += black_box(&m).eval(est, black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng);
             }
             let eval_ns = start.elapsed().as_secs_f64() * 1e9 / n as f64;
-            std::hint::black_box(acc);
+            black_box(acc);
             let start = Instant::now();
             let mut bounces = 0.0;
             for _ in 0..n {
+                let m = black_box(&m);
                 let s = match est {
                     Est::Single => None,
-                    Est::Walk => m.walk.sample(wi, &mut rng),
-                    Est::PtUncorrelated | Est::BdptUncorrelated => m.uncorrelated.sample(wi, &mut rng),
-                    Est::PtCorrelated | Est::BdptCorrelated => m.correlated.sample(wi, &mut rng),
+                    Est::Walk => m.walk.sample(black_box(wi), &mut rng),
+                    Est::PtUncorrelated | Est::BdptUncorrelated => {
+                        m.uncorrelated.sample(black_box(wi), &mut rng)
+                    }
+                    Est::PtCorrelated | Est::BdptCorrelated => m.correlated.sample(black_box(wi), &mut rng),
                 };
                 bounces += s.map_or(0.0, |s| f64::from(s.bounces));
             }
+            black_box(bounces);
             let sample_ns =
                 if est == Est::Single { f64::NAN } else { start.elapsed().as_secs_f64() * 1e9 / n as f64 };
             out.push((format!("{name} {}", est.name()), eval_ns, sample_ns, bounces / n as f64));
@@ -732,17 +895,10 @@ fn cost(opts: &Options, budget: Budget, summary: &mut Summary) -> std::io::Resul
     let ggx = Ggx::isotropic(0.5).expect("valid α");
     let beckmann = Beckmann::isotropic(0.5).expect("valid α");
     let mut rows = Vec::new();
-    time("conductor ggx a0.5", Models::new(ggx, Conductor::perfect()), wi, wo, n, &mut rows);
-    time("conductor beckmann a0.5", Models::new(beckmann, Conductor::perfect()), wi, wo, n, &mut rows);
-    time(
-        "dielectric ggx a0.5",
-        Models::new(ggx, Dielectric::new(1.5).expect("valid η")),
-        wi,
-        wo,
-        n,
-        &mut rows,
-    );
-    time("diffuse ggx a0.5", Models::new(ggx, Diffuse::white()), wi, wo, n, &mut rows);
+    time("conductor ggx a0.5", Models::new(ggx, Conductor::perfect()), wi, n, &mut rows);
+    time("conductor beckmann a0.5", Models::new(beckmann, Conductor::perfect()), wi, n, &mut rows);
+    time("dielectric ggx a0.5", Models::new(ggx, Dielectric::new(1.5).expect("valid η")), wi, n, &mut rows);
+    time("diffuse ggx a0.5", Models::new(ggx, Diffuse::white()), wi, n, &mut rows);
     let mut csv = String::from("model,ns_per_eval,ns_per_sample,mean_bounces_of_sample\n");
     for (name, e, s, b) in &rows {
         let _ = writeln!(csv, "{name},{e:.1},{s:.1},{b:.3}");
@@ -755,11 +911,33 @@ fn markdown(summary: &Summary) -> String {
     let mut md = String::from(
         "# microsurface report\n\n## Efficiency ratios (geometric means over θi ∈ {0, 1, 1.5} and three ωo)\n\n",
     );
-    md.push_str("| configuration | PT-corr / Heitz walk | BDPT-corr / PT-corr |\n|---|---|---|\n");
+    md.push_str(
+        "| configuration | PT-corr / Heitz walk [95 % CI] | variance ÷, cost × | BDPT-corr / PT-corr [95 % CI] | variance ÷, cost × |\n|---|---|---|---|---|\n",
+    );
     for (c, a, b) in &summary.ratios {
-        let _ = writeln!(md, "| {} | {a:.2} | {b:.2} |", c.name());
+        let _ = writeln!(
+            md,
+            "| {} | {:.2} [{:.2}, {:.2}] | {:.2}, {:.2} | {:.2} [{:.2}, {:.2}] | {:.2}, {:.2} |",
+            c.name(),
+            a.estimate,
+            a.lo,
+            a.hi,
+            a.variance_ratio,
+            a.cost_ratio,
+            b.estimate,
+            b.lo,
+            b.hi,
+            b.variance_ratio,
+            b.cost_ratio
+        );
     }
-    md.push_str("\nEfficiency = 1 / (relative variance × seconds per sample); a ratio above 1 means the first estimator reaches a given error sooner.\n");
+    md.push_str(
+        "\nEfficiency = 1 / (relative variance × seconds per sample); a ratio above 1 means the first estimator reaches a given error sooner. \
+         The interval propagates (delta method) the standard errors of the sample variances (from the variance of the squared deviations), \
+         of the times per sample (16 timed chunks per run) and of the references; it covers one run's sampling noise, not changes of machine load \
+         between runs. \"variance ÷\": how many times lower the first estimator's relative variance is; \"cost ×\": how many times more it costs per sample \
+         (geometric means).\n",
+    );
     md.push_str("\n## Efficiency per estimator at θi = 1.0, mirror direction (1/s)\n\n| configuration |");
     for est in Est::ALL {
         let _ = write!(md, " {} |", est.name());
@@ -786,7 +964,7 @@ fn markdown(summary: &Summary) -> String {
             o[0], o[1], o[2], o[3]
         );
     }
-    md.push_str("\n## Cost (single thread, θi = 0.5, α = 0.5)\n\n| model | ns / eval | ns / sample | mean bounces |\n|---|---|---|---|\n");
+    md.push_str("\n## Cost (single thread, θi = 0.5, α = 0.5; eval rotates 1024 pre-generated ωo, uniform on the hemisphere or, for the dielectric, the sphere; inputs behind black_box)\n\n| model | ns / eval | ns / sample | mean bounces |\n|---|---|---|---|\n");
     for (name, e, s, b) in &summary.cost {
         let _ = writeln!(md, "| {name} | {e:.0} | {s:.0} | {b:.2} |");
     }

@@ -60,7 +60,10 @@ fn main() {
     let start = Instant::now();
     let (image, _) = std::thread::scope(|s| {
         let progress = s.spawn(|| {
-            while show_progress {
+            if !show_progress {
+                return;
+            }
+            loop {
                 let done = stats.rows_done.load(Ordering::Relaxed);
                 let bar = 30 * done / height as usize;
                 eprint!("\r[{}{}] {done}/{height} rows", "=".repeat(bar), " ".repeat(30 - bar));

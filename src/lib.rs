@@ -28,6 +28,7 @@
 
 #![warn(missing_docs)]
 
+mod albedo;
 mod bsdf;
 mod error;
 mod frame;
@@ -41,6 +42,7 @@ mod slope;
 mod special;
 mod vndf;
 
+pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
 pub use bsdf::{
     Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder, MicrofacetBsdf,
     SampleFlags, ShadingFrame, Technique, Transport,

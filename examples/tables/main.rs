@@ -1,0 +1,287 @@
+//! Generates the crate's single-scattering albedo tables (`src/albedo/data.rs`) by
+//! deterministic quadrature, on all cores, and exports them for shaders.
+//!
+//! ```sh
+//! cargo run --release --example tables            # rebuild src/albedo/data.rs and target/tables/
+//! cargo run --release --example tables -- --quick # recompute a subset, check it against the shipped tables
+//! ```
+//!
+//! Quadrature is deterministic, so a rebuild reproduces the shipped tables bit for bit
+//! whatever the number of threads. Every node is computed at two resolutions (6 and 12 panels of
+//! 16-point Gauss–Legendre per variable); the run fails if they differ by more than 1e-6.
+
+mod quadrature;
+
+use quadrature::{Family, gauss_legendre, single_scattering_albedo};
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Nodes per axis (as `microsurface::ALBEDO_TABLE_SIZE`).
+const N: usize = microsurface::ALBEDO_TABLE_SIZE;
+/// The roughness at which the r = 0 row (the α → 0 limit profile) is evaluated.
+const ALPHA_LIMIT: f64 = 1e-6;
+/// Quadrature panels per variable for the shipped values, and for the error estimate.
+const PANELS: usize = 12;
+const CHECK_PANELS: usize = 6;
+/// Largest accepted disagreement of the two resolutions.
+const MAX_QUADRATURE_ERROR: f64 = 1e-6;
+/// Panels of the E_avg integral over X (half of them for its error estimate).
+const AVERAGE_PANELS: usize = 12;
+/// Cells recomputed by `--quick`.
+const QUICK_CELLS: usize = 24;
+
+/// The α of roughness node j.
+fn alpha_of_node(j: usize) -> f64 {
+    let r = j as f64 / (N - 1) as f64;
+    (r * r).max(ALPHA_LIMIT)
+}
+
+/// μ of direction coordinate x at roughness α: μ = X α/(1 + α − X), X = x².
+fn mu_of(x: f64, alpha: f64) -> f64 {
+    let big_x = x * x;
+    if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) }
+}
+
+/// E at node (i, j).
+fn node(family: Family, i: usize, j: usize, panels: usize) -> f64 {
+    let alpha = alpha_of_node(j);
+    single_scattering_albedo(family, mu_of(i as f64 / (N - 1) as f64, alpha), alpha, panels)
+}
+
+/// Below this μ the E_avg integrand is dropped: ∫₀^μ E μ dμ ≤ μ²/2 = 5e-15.
+const AVERAGE_MU_MIN: f64 = 1e-7;
+
+/// E_avg(α) = 2∫ E μ dμ = 2∫ E μ² d(ln μ) over ln μ ∈ [ln 1e-7, 0], with `outer` panels over
+/// ln μ and `panels` for each E: E varies on the scale of μ itself (its features sit at μ ≈ α
+/// and at μ → 0), which a logarithmic variable resolves at every α.
+fn average(family: Family, alpha: f64, outer: usize, panels: usize) -> f64 {
+    2.0 * gauss_legendre(AVERAGE_MU_MIN.ln(), 0.0, outer, |t| {
+        let mu = t.exp();
+        single_scattering_albedo(family, mu, alpha, panels) * mu * mu
+    })
+}
+
+/// Runs `f` on every index in 0..n on all cores; results in index order.
+fn par_map<T: Send>(n: usize, label: &str, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+    let show = std::io::stderr().is_terminal();
+    let mut parts: Vec<Vec<(usize, T)>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut out = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, Ordering::Relaxed);
+                        if k >= n {
+                            break;
+                        }
+                        out.push((k, f(k)));
+                        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                        if show && (d % 8 == 0 || d == n) {
+                            let bar = "#".repeat(40 * d / n);
+                            eprint!("\r{label:>24} [{bar:<40}] {d}/{n}");
+                        }
+                    }
+                    out
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().expect("worker panicked")).collect()
+    });
+    if show {
+        eprintln!();
+    }
+    let mut all: Vec<(usize, T)> = parts.drain(..).flatten().collect();
+    all.sort_by_key(|(k, _)| *k);
+    all.into_iter().map(|(_, v)| v).collect()
+}
+
+/// The shipped tables of one family, computed.
+struct Tables {
+    directional: Vec<f32>,
+    average: Vec<f32>,
+}
+
+fn build(family: Family) -> Tables {
+    let name = family.name();
+    let cells = par_map(N * N, &format!("{name} E(mu, alpha)"), |k| {
+        let (i, j) = (k % N, k / N);
+        let fine = node(family, i, j, PANELS);
+        let coarse = node(family, i, j, CHECK_PANELS);
+        (fine, (fine - coarse).abs())
+    });
+    let worst = cells.iter().map(|c| c.1).fold(0.0, f64::max);
+    println!("{name}: E nodes, largest disagreement of {CHECK_PANELS} and {PANELS} panels: {worst:.2e}");
+    assert!(
+        worst <= MAX_QUADRATURE_ERROR,
+        "{name}: quadrature error estimate {worst:.2e} > {MAX_QUADRATURE_ERROR:e}"
+    );
+    let averages = par_map(N, &format!("{name} E_avg(alpha)"), |j| {
+        let alpha = alpha_of_node(j);
+        let fine = average(family, alpha, AVERAGE_PANELS, PANELS);
+        (fine, (fine - average(family, alpha, AVERAGE_PANELS / 2, CHECK_PANELS)).abs())
+    });
+    let worst = averages.iter().map(|c| c.1).fold(0.0, f64::max);
+    println!("{name}: E_avg nodes, largest disagreement: {worst:.2e}");
+    assert!(worst <= MAX_QUADRATURE_ERROR, "{name}: E_avg error estimate {worst:.2e}");
+    Tables {
+        directional: cells.iter().map(|c| c.0 as f32).collect(),
+        average: averages.iter().map(|c| c.0 as f32).collect(),
+    }
+}
+
+/// The interpolation error of the shipped lookups at the cell centres (and segment midpoints
+/// for E_avg) against direct quadrature: (max, RMS, max for E_avg).
+fn interpolation_error(family: Family) -> (f64, f64, f64) {
+    let table = table_of(family);
+    let errors = par_map((N - 1) * (N - 1), &format!("{} interpolation", family.name()), |k| {
+        let (x, r) =
+            (((k % (N - 1)) as f64 + 0.5) / (N - 1) as f64, ((k / (N - 1)) as f64 + 0.5) / (N - 1) as f64);
+        let alpha = r * r;
+        let mu = mu_of(x, alpha);
+        let exact = single_scattering_albedo(family, mu, alpha, CHECK_PANELS);
+        (f64::from(table.directional(mu as f32, alpha as f32).expect("in range")) - exact).abs()
+    });
+    let max = errors.iter().copied().fold(0.0, f64::max);
+    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+    let avg_errors = par_map(N - 1, &format!("{} E_avg interpolation", family.name()), |j| {
+        let r = (j as f64 + 0.5) / (N - 1) as f64;
+        let exact = average(family, r * r, AVERAGE_PANELS / 2, CHECK_PANELS);
+        (f64::from(table.average((r * r) as f32).expect("in range")) - exact).abs()
+    });
+    (max, rms, avg_errors.iter().copied().fold(0.0, f64::max))
+}
+
+fn table_of(family: Family) -> microsurface::AlbedoTable {
+    match family {
+        Family::Ggx => microsurface::AlbedoTable::GGX,
+        Family::Beckmann => microsurface::AlbedoTable::BECKMANN,
+    }
+}
+
+/// The Rust source of `src/albedo/data.rs`.
+fn source(tables: &[(Family, Tables)]) -> String {
+    let mut s = String::from(
+        "//! Generated by `cargo run --release --example tables`: do not edit.\n//!\n//! Single-scattering albedo \
+         nodes (see `AlbedoTable` for the axes).\n\n",
+    );
+    for (family, t) in tables {
+        let upper = family.name().to_uppercase();
+        let _ = writeln!(s, "/// E(μ, α) of {}, row-major, roughness slowest.", family.name());
+        let _ = writeln!(s, "pub(crate) static {upper}_DIRECTIONAL: [f32; {}] = [", N * N);
+        for row in t.directional.chunks(8) {
+            let _ =
+                writeln!(s, "    {},", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "));
+        }
+        let _ = writeln!(s, "];\n/// E_avg(α) of {}.", family.name());
+        let _ = writeln!(s, "pub(crate) static {upper}_AVERAGE: [f32; {N}] = [");
+        for row in t.average.chunks(8) {
+            let _ =
+                writeln!(s, "    {},", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "));
+        }
+        let _ = writeln!(s, "];");
+    }
+    s
+}
+
+/// Writes little-endian f32 exports with a description of their layout.
+fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let mut readme = String::from(
+        "Little-endian f32 arrays, no header.\n\n\
+         <family>_directional.f32: 32 x 32 values E[j][i], j (roughness) slowest.\n\
+         r = j/31, alpha = r^2 (row j = 0: the alpha -> 0 limit profile); x = i/31,\n\
+         mu = X alpha/(1 + alpha - X) with X = x^2. Lookup of (mu, alpha):\n\
+         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), bilinear in (x, r) at (31 x, 31 r).\n\
+         <family>_average.f32: 32 values E_avg[j] at r = j/31, linear in r.\n",
+    );
+    for (family, t) in tables {
+        for (suffix, values) in [("directional", &t.directional), ("average", &t.average)] {
+            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+            std::fs::write(dir.join(format!("{}_{suffix}.f32", family.name())), bytes)?;
+        }
+    }
+    readme.push_str("\nSee microsurface::AlbedoTable for the definition and the measured errors.\n");
+    std::fs::write(dir.join("README.txt"), readme)
+}
+
+/// `--quick`: recomputes a fixed pseudo-random subset of nodes and checks them bit for bit.
+fn quick() {
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut failures = 0;
+    for family in [Family::Ggx, Family::Beckmann] {
+        let table = table_of(family);
+        for _ in 0..QUICK_CELLS {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            let k = (state >> 33) as usize % (N * N);
+            let value = node(family, k % N, k / N, PANELS) as f32;
+            let shipped = table.directional_nodes()[k];
+            if value.to_bits() != shipped.to_bits() {
+                failures += 1;
+                println!("{} node {k}: recomputed {value:?}, shipped {shipped:?}", family.name());
+            }
+        }
+        let j = (state >> 40) as usize % N;
+        let value = average(family, alpha_of_node(j), AVERAGE_PANELS, PANELS) as f32;
+        if value.to_bits() != table.average_nodes()[j].to_bits() {
+            failures += 1;
+            println!(
+                "{} E_avg node {j}: recomputed {value:?}, shipped {:?}",
+                family.name(),
+                table.average_nodes()[j]
+            );
+        }
+    }
+    println!("tables --quick: {} nodes recomputed, {failures} differ", 2 * (QUICK_CELLS + 1));
+    assert_eq!(failures, 0, "the shipped tables are not reproduced bit for bit");
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!(
+            "usage: cargo run --release --example tables [-- --quick | --interpolation]\n\n  (no flag)        rebuild \
+             src/albedo/data.rs and target/tables/*.f32, print the quadrature error estimates\n  --interpolation  \
+             measure the lookups' interpolation error at the cell centres against quadrature\n  --quick          recompute a \
+             subset of nodes and check them against the shipped tables bit for bit"
+        );
+        return;
+    }
+    if args.iter().any(|a| a == "--quick") {
+        quick();
+        return;
+    }
+    if args.iter().any(|a| a == "--interpolation") {
+        for family in [Family::Ggx, Family::Beckmann] {
+            let (max, rms, avg) = interpolation_error(family);
+            println!(
+                "{}: interpolation error at cell centres: E max {max:.2e}, RMS {rms:.2e}; E_avg max {avg:.2e}",
+                family.name()
+            );
+        }
+        return;
+    }
+    let start = std::time::Instant::now();
+    let tables: Vec<(Family, Tables)> =
+        [Family::Ggx, Family::Beckmann].into_iter().map(|f| (f, build(f))).collect();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = root.join("src/albedo/data.rs");
+    let text = source(&tables);
+    let changed = std::fs::read_to_string(&path).map_or(true, |old| old != text);
+    std::fs::write(&path, text).expect("write src/albedo/data.rs");
+    export(&tables, &root.join("target/tables")).expect("write target/tables");
+    println!(
+        "wrote {} ({}), target/tables/ in {:.1} s",
+        path.display(),
+        if changed { "changed" } else { "unchanged" },
+        start.elapsed().as_secs_f64()
+    );
+    if changed {
+        println!(
+            "the tables changed: rebuild and run with --interpolation to measure the interpolation error"
+        );
+    }
+}

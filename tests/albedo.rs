@@ -1,0 +1,225 @@
+//! The single-scattering albedo tables (`AlbedoTable`) against independent Monte Carlo
+//! estimates from the crate's exact visible-normal samplers and from the random walk's first
+//! order: nodes, interpolation between nodes within the stated bound, the average albedo, and
+//! the range policy.
+
+mod common;
+
+use common::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
+use glam::Vec3;
+use microsurface::{
+    ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Conductor, Ggx, Microsurface, MicrosurfaceSlope, UniformHeight,
+};
+use rand::RngExt;
+
+/// Family-wise significance of each test.
+const FAMILY_ALPHA: f64 = 1e-3;
+/// Monte Carlo samples per checked value.
+const SAMPLES: usize = 1 << 17;
+/// Largest standard error accepted for a checked value (so that the comparison means something).
+const MAX_SE: f64 = 2e-3;
+/// The interpolation errors the tables' documentation states (cell centres, measured by the
+/// generator): GGX, Beckmann.
+const STATED_INTERPOLATION_ERROR: [f64; 2] = [1.2e-3, 3.7e-3];
+/// The interpolation errors of E_avg the documentation states (midpoints between nodes): GGX,
+/// Beckmann.
+const STATED_AVERAGE_ERROR: [f64; 2] = [3.0e-4, 2.4e-4];
+/// The roughness of the r = 0 row.
+const ALPHA_LIMIT: f32 = 1e-6;
+
+/// One estimate of E(μ, α): the visible normal ωm ~ D_ωi, the mirror direction ωo, and the
+/// weight G2/G1 = (1 + Λi)/(1 + Λi + Λo) where ωo is above the horizon (F = 1).
+fn albedo_sample<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, rng: &mut TestRng) -> f64 {
+    let wm = slope.sample_d_wi(wi, uniform32(rng), uniform32(rng));
+    let wo = (2.0 * wi.dot(wm) * wm - wi).normalize();
+    if wo.z <= 0.0 {
+        return 0.0;
+    }
+    let (li, lo) = (f64::from(slope.lambda(wi)), f64::from(slope.lambda(wo)));
+    (1.0 + li) / (1.0 + li + lo)
+}
+
+/// Monte Carlo E(μ, α) of one family (0: GGX, 1: Beckmann).
+fn albedo(family: usize, mu: f32, alpha: f32, samples: usize, seed: u64) -> Stats {
+    let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    let mut r = rng(seed);
+    let mut stats = Stats::default();
+    for _ in 0..samples {
+        stats.push(match family {
+            0 => albedo_sample(&Ggx::isotropic(alpha).unwrap(), wi, &mut r),
+            _ => albedo_sample(&Beckmann::isotropic(alpha).unwrap(), wi, &mut r),
+        });
+    }
+    stats
+}
+
+fn table(family: usize) -> AlbedoTable {
+    [AlbedoTable::GGX, AlbedoTable::BECKMANN][family]
+}
+
+/// (μ, α) of node (i, j), as the table's documentation defines the axes.
+fn node_coordinates(i: usize, j: usize) -> (f32, f32) {
+    let last = (ALBEDO_TABLE_SIZE - 1) as f64;
+    let r = j as f64 / last;
+    let alpha = (r * r).max(f64::from(ALPHA_LIMIT));
+    let big_x = (i as f64 / last).powi(2);
+    let mu = if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
+    (mu as f32, alpha as f32)
+}
+
+#[test]
+fn nodes_match_an_independent_monte_carlo_estimate() {
+    let mut pick = rng(11);
+    let cells: Vec<(usize, usize, usize)> = (0..2)
+        .flat_map(|family| {
+            (0..10)
+                .map(|_| {
+                    (family, pick.random_range(0..ALBEDO_TABLE_SIZE), pick.random_range(0..ALBEDO_TABLE_SIZE))
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let z = family_z(FAMILY_ALPHA, cells.len());
+    let results = par_map(&cells, |k, &(family, i, j)| {
+        let (mu, alpha) = node_coordinates(i, j);
+        (mu, alpha, albedo(family, mu, alpha, SAMPLES, 100 + k as u64))
+    });
+    for (&(family, i, j), (mu, alpha, stats)) in cells.iter().zip(&results) {
+        let node = f64::from(table(family).directional_nodes()[j * ALBEDO_TABLE_SIZE + i]);
+        let label = format!("{} node ({i}, {j}) μ = {mu:e}, α = {alpha:e}", table(family).name());
+        // the node's own quadrature error is below 1e-6 and its f32 rounding below 6e-8
+        assert_mean(&label, stats, node, z, MAX_SE, 1e-6);
+    }
+}
+
+#[test]
+fn the_lookup_reproduces_the_nodes() {
+    for family in 0..2 {
+        for j in [1, 7, 31] {
+            for i in [0, 5, 17, 31] {
+                let (mu, alpha) = node_coordinates(i, j);
+                let node = table(family).directional_nodes()[j * ALBEDO_TABLE_SIZE + i];
+                let lookup = table(family).directional(mu, alpha).unwrap();
+                // the coordinates round-trip through f32 arithmetic
+                assert!((lookup - node).abs() < 2e-5, "node ({i}, {j}): lookup {lookup}, node {node}");
+            }
+        }
+    }
+}
+
+#[test]
+fn interpolation_between_nodes_is_within_the_stated_bound() {
+    let mut pick = rng(12);
+    let points: Vec<(usize, f32, f32)> = (0..2)
+        .flat_map(|family| {
+            (0..12)
+                .map(|_| {
+                    let alpha = pick.random_range(0.0f32..1.0).powi(2).max(1e-4);
+                    let mu = pick.random_range(0.0f32..1.0).powi(2);
+                    (family, mu, alpha)
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let z = family_z(FAMILY_ALPHA, points.len());
+    let results =
+        par_map(&points, |k, &(family, mu, alpha)| albedo(family, mu, alpha, SAMPLES, 200 + k as u64));
+    for (&(family, mu, alpha), stats) in points.iter().zip(&results) {
+        let lookup = f64::from(table(family).directional(mu, alpha).unwrap());
+        let label = format!("{} lookup at μ = {mu}, α = {alpha}", table(family).name());
+        assert_mean(&label, stats, lookup, z, MAX_SE, STATED_INTERPOLATION_ERROR[family]);
+    }
+}
+
+#[test]
+fn average_albedo_matches_cosine_weighted_monte_carlo() {
+    let cases: Vec<(usize, f32)> =
+        (0..2).flat_map(|f| [1e-4f32, 1e-3, 0.01, 0.2, 0.55, 1.0].map(|a| (f, a))).collect();
+    let z = family_z(FAMILY_ALPHA, cases.len());
+    let results = par_map(&cases, |k, &(family, alpha)| {
+        // μ with density 2μ: E_avg = E[E(μ)]
+        let mut r = rng(300 + k as u64);
+        let mut stats = Stats::default();
+        for _ in 0..SAMPLES {
+            let mu = uniform32(&mut r).sqrt();
+            let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+            stats.push(match family {
+                0 => albedo_sample(&Ggx::isotropic(alpha).unwrap(), wi, &mut r),
+                _ => albedo_sample(&Beckmann::isotropic(alpha).unwrap(), wi, &mut r),
+            });
+        }
+        stats
+    });
+    for (&(family, alpha), stats) in cases.iter().zip(&results) {
+        let average = f64::from(table(family).average(alpha).unwrap());
+        let label = format!("{} E_avg(α = {alpha})", table(family).name());
+        // off-node values carry E_avg's interpolation error
+        assert_mean(&label, stats, average, z, MAX_SE, STATED_AVERAGE_ERROR[family]);
+    }
+}
+
+#[test]
+fn first_order_of_the_random_walk_equals_the_table() {
+    // the walk's order-1 energy is the single-scattering albedo: an estimate by another model
+    let cases = [(0usize, 31usize, 31usize), (0, 12, 20), (1, 31, 16), (1, 6, 9)];
+    let z = family_z(FAMILY_ALPHA, cases.len());
+    let results = par_map(&cases, |k, &(family, i, j)| {
+        let (mu, alpha) = node_coordinates(i, j);
+        let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+        let mut r = rng(400 + k as u64);
+        let mut stats = Stats::default();
+        for _ in 0..SAMPLES {
+            let single = match family {
+                0 => Microsurface::new(UniformHeight, Ggx::isotropic(alpha).unwrap(), Conductor::perfect())
+                    .sample(wi, &mut r)
+                    .is_some_and(|s| s.bounces == 1),
+                _ => Microsurface::new(
+                    UniformHeight,
+                    Beckmann::isotropic(alpha).unwrap(),
+                    Conductor::perfect(),
+                )
+                .sample(wi, &mut r)
+                .is_some_and(|s| s.bounces == 1),
+            };
+            stats.push(if single { 1.0 } else { 0.0 });
+        }
+        stats
+    });
+    for (&(family, i, j), stats) in cases.iter().zip(&results) {
+        let node = f64::from(table(family).directional_nodes()[j * ALBEDO_TABLE_SIZE + i]);
+        assert_mean(
+            &format!("{} walk order 1 at node ({i}, {j})", table(family).name()),
+            stats,
+            node,
+            z,
+            MAX_SE,
+            1e-6,
+        );
+    }
+}
+
+#[test]
+fn public_reference_values() {
+    // GGX single scattering, F = 1: E(μ = 1, α = 1) ≈ 0.307 and E_avg(α = 1) ≈ 0.409 in the
+    // tables Cycles ships (roughness axis √α)
+    let e = AlbedoTable::GGX.directional(1.0, 1.0).unwrap();
+    assert!((e - 0.307).abs() < 1e-3, "E(1, 1) = {e}");
+    let e_avg = AlbedoTable::GGX.average(1.0).unwrap();
+    assert!((e_avg - 0.409).abs() < 2e-3, "E_avg(1) = {e_avg}");
+}
+
+#[test]
+fn out_of_range_gives_none() {
+    for t in [AlbedoTable::GGX, AlbedoTable::BECKMANN] {
+        for (mu, alpha) in
+            [(0.5, 0.0), (0.5, -0.1), (0.5, 1.01), (-0.1, 0.5), (1.1, 0.5), (f32::NAN, 0.5), (0.5, f32::NAN)]
+        {
+            assert_eq!(t.directional(mu, alpha), None, "{} at ({mu}, {alpha})", t.name());
+        }
+        for alpha in [0.0, -1.0, 1.5, f32::NAN, f32::INFINITY] {
+            assert_eq!(t.average(alpha), None, "{} average at {alpha}", t.name());
+        }
+        // the ends of the range are in it
+        assert!(t.directional(0.0, 1.0).is_some() && t.directional(1.0, 1e-7).is_some());
+    }
+}

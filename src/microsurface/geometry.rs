@@ -138,6 +138,38 @@ pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32>
     Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
 }
 
+/// ln C¹ of the first intersection of a ray arriving from below the macrosurface, for an
+/// opaque microsurface lit (or seen) from ωi with ωi.z < 0, from one uniform `u` ∈ [0, 1);
+/// `lambda_up` = Λ(−ωi) = |1 + Λ(ωi)| = 1/G1(ωi), the full-spherical masking's inverse (Wang
+/// et al. 2022, eq. 10). `None` if Λ(−ωi) = 0 (ωi at the nadir, or Λ underflowed): ωi then
+/// sees no microsurface (projected area 0).
+///
+/// ln C¹₁ = ln(1 − u)/Λ(−ωi): the first hit's C¹ has the CDF C^{1/G1(ωi)}. From above,
+/// Algorithm 1 of the supplement started at h = +∞ gives C^{1 + Λ(ωi)} = C^{1/G1(ωi)}, the
+/// visible-height distribution G1(ωi, h)/G1(ωi); below the horizon the full-spherical Smith
+/// model keeps that form with 1/G1(ωi) = A(ωi)/|cos θi| (A the projected area of the facets
+/// facing ωi). A literal ray from h = −∞ does not work: hits occur at the rate Λ(−ωi) per
+/// unit of ln C¹, so from ln C¹ = −∞ the first hit is at C¹ = 0 almost surely and nothing
+/// escapes (0^Λ = 0), the hemispherical model's black result. This choice makes the walk's
+/// single-scattering term the full-spherical height-correlated one, E[C^{Λ(ωo)}] =
+/// Λ(−ωi)/(Λ(−ωi) + Λ(ωo)), i.e. G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17), and the
+/// first vertex the position-free model's vertex reached from below (see DESIGN.md,
+/// “Multiple scattering for views below the macrosurface”).
+///
+/// The result lies in [−f32::MAX, −f32::MIN_POSITIVE]: ln(1 − u)/Λ overflows only for
+/// Λ(−ωi) < 5e-38 (ωi within ~1e-19 rad of the nadir), where every further escape
+/// probability C¹^Λ rounds to 0 anyway (or is exactly 1 for Λ = 0), so −f32::MAX keeps the
+/// walk's arithmetic finite (no 0·∞) without changing any result.
+#[inline]
+pub(crate) fn first_ln_c1_from_below(lambda_up: f32, u: f32) -> Option<f32> {
+    if !(lambda_up > 0.0) {
+        return None;
+    }
+    // 1 − u: see `next_c1`
+    let ln_1mu = (1.0 - u).ln();
+    Some((ln_1mu / lambda_up).clamp(f32::MIN, -MIN_HIT_DEPTH))
+}
+
 /// ln(1 − C¹) from ln C¹: the same point seen from the other side of the interface, in the
 /// vertically flipped frame (h ↦ −h; the height distributions are symmetric). Cancellation-free
 /// through exp_m1.

@@ -1,0 +1,326 @@
+//! Multiple scattering for views below the macrosurface (normal mapping): the random walk of
+//! Heitz et al. 2016 and the position-free estimators of Wang et al. 2022 for an opaque
+//! material lit from ωi with ωi.z < 0 (DESIGN.md, “Multiple scattering for views below the
+//! macrosurface”).
+//!
+//! Configurations: conductor F = 1 and gold, white and coloured diffuse, over GGX and
+//! Beckmann, for ωi.z ∈ {−0.072, −0.3, −0.6} (just below the horizon to deep below).
+//!
+//! - energy: every walk of an F = 1 material returns (no walk is lost) with weight exactly 1;
+//!   ∫ eval dωo = 1 (the furnace through `eval`); for absorptive materials the mean sample
+//!   weight equals ∫ eval dωo (eval and sample consistent), per scattering order too;
+//! - order 1: the energy of the walk's first bounce equals the single-scattering backfacing
+//!   albedo (the crate's full-spherical single-scattering model, integrated by quadrature),
+//!   and the total is at least that;
+//! - χ² of the walk's `sample` against its stochastic density `eval`;
+//! - position-free PT and BDPT, correlated and uncorrelated: furnace, PT = BDPT, order 1 =
+//!   single scattering, χ² of `sample` against `eval_pt`;
+//! - the renderer API: a white furnace with a tilted shading normal through
+//!   `MicrofacetBsdf` (every technique), views above the geometric surface but below the
+//!   shading hemisphere.
+//!
+//! Statistics: |mean − expected| ≤ z·SE (two-sample: z·√(SE1² + SE2²)), z = `family_z(0.01,
+//! m)` over the m assertions of a test function, each with an upper bound on its SE.
+mod common;
+
+use common::stochastic::stochastic_chi2;
+use common::{Stats, assert_mean, assert_two_sample, family_z, par_map, sidak};
+use glam::{DVec3, Vec3};
+use microsurface::{
+    Beckmann, Bsdf, ComplexIor, Conductor, Diffuse, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
+    MicrosurfaceSlope, PositionFree, ScatteringOrder, ShadingFrame, Shadowing, Technique, UniformHeight,
+};
+use std::f64::consts::{PI, TAU};
+
+/// z of the incident directions below the horizon.
+const WI_Z: [f32; 3] = [-0.072, -0.3, -0.6];
+/// Azimuth of every incident direction.
+const PHI_I: f32 = 0.7;
+const GGX_ALPHA: f32 = 0.5;
+const BECKMANN_ALPHA: f32 = 0.8;
+
+fn wi_below(z: f32) -> Vec3 {
+    let r = (1.0 - z * z).sqrt();
+    Vec3::new(r * PHI_I.cos(), r * PHI_I.sin(), z)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Mat {
+    /// F = 1.
+    Perfect,
+    /// Gold (absorptive, coloured).
+    Gold,
+    /// Albedo 1.
+    WhiteDiffuse,
+    /// A coloured albedo.
+    Diffuse,
+}
+
+impl Mat {
+    const ALL: [Mat; 4] = [Mat::Perfect, Mat::Gold, Mat::WhiteDiffuse, Mat::Diffuse];
+
+    fn white(self) -> bool {
+        matches!(self, Mat::Perfect | Mat::WhiteDiffuse)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Slope {
+    Ggx,
+    Beckmann,
+}
+
+/// Calls `$body` with `$s` bound to the microsurface of the slope and material.
+macro_rules! with_surface {
+    ($slope:expr, $mat:expr, |$s:ident| $body:expr) => {
+        match ($slope, $mat) {
+            (Slope::Ggx, m) => {
+                let slope = Ggx::new(GGX_ALPHA, GGX_ALPHA).unwrap();
+                match m {
+                    Mat::Perfect => {
+                        let $s = Microsurface::new(UniformHeight, slope, Conductor::perfect());
+                        $body
+                    }
+                    Mat::Gold => {
+                        let $s = Microsurface::new(UniformHeight, slope, Conductor::new(ComplexIor::GOLD));
+                        $body
+                    }
+                    Mat::WhiteDiffuse => {
+                        let $s = Microsurface::new(UniformHeight, slope, Diffuse::white());
+                        $body
+                    }
+                    Mat::Diffuse => {
+                        let $s = Microsurface::new(UniformHeight, slope, diffuse());
+                        $body
+                    }
+                }
+            }
+            (Slope::Beckmann, m) => {
+                let slope = Beckmann::new(BECKMANN_ALPHA, BECKMANN_ALPHA).unwrap();
+                match m {
+                    Mat::Perfect => {
+                        let $s = Microsurface::new(UniformHeight, slope, Conductor::perfect());
+                        $body
+                    }
+                    Mat::Gold => {
+                        let $s = Microsurface::new(UniformHeight, slope, Conductor::new(ComplexIor::GOLD));
+                        $body
+                    }
+                    Mat::WhiteDiffuse => {
+                        let $s = Microsurface::new(UniformHeight, slope, Diffuse::white());
+                        $body
+                    }
+                    Mat::Diffuse => {
+                        let $s = Microsurface::new(UniformHeight, slope, diffuse());
+                        $body
+                    }
+                }
+            }
+        }
+    };
+}
+
+fn diffuse() -> Diffuse {
+    Diffuse::new(Vec3::new(0.8, 0.5, 0.2)).unwrap()
+}
+
+fn mean3(v: Vec3) -> f64 {
+    f64::from(v.x + v.y + v.z) / 3.0
+}
+
+/// A uniform direction on the upper hemisphere (density 1/(2π)).
+fn uniform_upper(rng: &mut common::TestRng) -> Vec3 {
+    let z = 1.0 - common::uniform64(rng);
+    let phi = TAU * common::uniform64(rng);
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z).as_vec3()
+}
+
+/// Per-order energies of `sample` (orders 1, 2, ≥ 3 and the total) and the number of walks
+/// lost (`None`).
+struct SampleEnergy {
+    orders: [Stats; 3],
+    total: Stats,
+    lost: usize,
+}
+
+fn sample_energy(n: usize, mut sample: impl FnMut() -> Option<(Vec3, u32)>) -> SampleEnergy {
+    let mut e = SampleEnergy { orders: [Stats::default(); 3], total: Stats::default(), lost: 0 };
+    for _ in 0..n {
+        let s = sample();
+        if s.is_none() {
+            e.lost += 1;
+        }
+        let (w, k) = s.map_or((0.0, 0), |(w, k)| (mean3(w), k));
+        for (o, stats) in e.orders.iter_mut().enumerate() {
+            let hit = if o < 2 { k as usize == o + 1 } else { k >= 3 };
+            stats.push(if hit { w } else { 0.0 });
+        }
+        e.total.push(w);
+    }
+    e
+}
+
+/// An importance-sampled ωo and its density: for conductors the defensive mixture ½ phase
+/// function (exact density `pdf_phase`) + ½ cosine lobe; for diffuse facets the cosine lobe.
+fn importance<S: MicrosurfaceSlope, M: Material>(
+    pf: &PositionFree<S, M>,
+    wi: Vec3,
+    rng: &mut common::TestRng,
+) -> (Vec3, f64) {
+    let cosine = |w: Vec3| f64::from(w.z.max(0.0)) / PI;
+    if !M::EXACT_PHASE_PDF {
+        let w = microsurface::sample_cosine_hemisphere(common::uniform32(rng), common::uniform32(rng));
+        return (w, cosine(w));
+    }
+    let w = if common::uniform64(rng) < 0.5 {
+        // the phase function's sampler (exact density `pdf_phase`; a direction below the
+        // horizon, where every integrand here is 0, is kept with its density)
+        pf.material().sample_phase(pf.slope(), wi, true, rng).wo
+    } else {
+        microsurface::sample_cosine_hemisphere(common::uniform32(rng), common::uniform32(rng))
+    };
+    let phase = f64::from(pf.material().pdf_phase(pf.slope(), wi, w, true, true));
+    (w, 0.5 * phase + 0.5 * cosine(w))
+}
+
+/// ∫ eval(ωi, ωo) dωo by importance sampling (`direction`: ωo and its density), for orders 1, 2, ≥ 3
+/// (from `Only(1)`, `Only(2)` and `All` minus `UpTo(2)` on independent calls) and all.
+fn eval_energy(
+    n: usize,
+    rng: &mut common::TestRng,
+    mut direction: impl FnMut(&mut common::TestRng) -> (Vec3, f64),
+    mut eval: impl FnMut(Vec3, ScatteringOrder) -> Vec3,
+) -> [Stats; 4] {
+    let mut out = [Stats::default(); 4];
+    let (one, two, up_to_two) = (
+        ScatteringOrder::only(1).unwrap(),
+        ScatteringOrder::only(2).unwrap(),
+        ScatteringOrder::up_to(2).unwrap(),
+    );
+    for _ in 0..n {
+        let (wo, pdf) = direction(rng);
+        let w = 1.0 / pdf;
+        let all = mean3(eval(wo, ScatteringOrder::All)) * w;
+        out[0].push(mean3(eval(wo, one)) * w);
+        out[1].push(mean3(eval(wo, two)) * w);
+        out[2].push(all - mean3(eval(wo, up_to_two)) * w);
+        out[3].push(all);
+    }
+    out
+}
+
+/// The single-scattering backfacing albedo ∫ f1·cos θo dωo of the crate's full-spherical
+/// single-scattering model (`PositionFree::eval_single_scattering`, correlated: G2 =
+/// 1/(Λ(−ωi) + Λ(ωo))), by adaptive quadrature for conductors (exact integrand) and by
+/// uniform sampling for diffuse facets (stochastic integrand). The quadrature is returned as
+/// one observation (SE 0); its error (below 1e-5) is far below the tests' SE.
+fn single_albedo<S: MicrosurfaceSlope, M: Material>(pf: &PositionFree<S, M>, wi: Vec3, seed: u64) -> Stats {
+    let mut rng = common::rng(seed);
+    if M::EXACT_PHASE_PDF {
+        // the integrand peaks about the mirror direction: integrate on a fine grid of cells
+        let mut f = |z: f64, phi: f64| {
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let wo = DVec3::new(r * phi.cos(), r * phi.sin(), z).as_vec3();
+            mean3(pf.eval_single_scattering(wi, wo, &mut rng))
+        };
+        let (nz, np) = (8, 16);
+        let mut sum = 0.0;
+        for iz in 0..nz {
+            for ip in 0..np {
+                let (z0, z1) = (iz as f64 / nz as f64, (iz + 1) as f64 / nz as f64);
+                let (p0, p1) = (TAU * ip as f64 / np as f64, TAU * (ip + 1) as f64 / np as f64);
+                sum += common::quadrature::integrate(&mut f, z0, z1, p0, p1, 1e-7, 6);
+            }
+        }
+        let mut s = Stats::default();
+        s.push(sum);
+        s
+    } else {
+        let mut s = Stats::default();
+        for _ in 0..200_000 {
+            let wo = uniform_upper(&mut rng);
+            s.push(mean3(pf.eval_single_scattering(wi, wo, &mut rng)) * TAU);
+        }
+        s
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The random walk
+// ---------------------------------------------------------------------------------------------
+
+/// Walks per configuration for the energy tests, and ωo per configuration for ∫ eval.
+const WALKS: usize = 40_000;
+const EVALS: usize = 10_000;
+
+/// (i)–(iii): energy conservation and sample = eval per order, order 1 = single scattering.
+#[test]
+fn walk_energy_orders_and_single_scattering() {
+    let cases: Vec<(Slope, Mat, f32)> = [Slope::Ggx, Slope::Beckmann]
+        .into_iter()
+        .flat_map(|s| Mat::ALL.into_iter().flat_map(move |m| WI_Z.into_iter().map(move |z| (s, m, z))))
+        .collect();
+    // per case: 4 (sample vs eval: orders 1, 2, ≥3, total) + 2 (order 1 vs single: sample,
+    // eval) + 1 (furnace through eval, white) + 1 (total ≥ single)
+    let z = family_z(0.01, cases.len() * 8);
+    let lines = par_map(&cases, |i, &(slope, mat, wz)| {
+        with_surface!(slope, mat, |surface| {
+            let wi = wi_below(wz);
+            let label = format!("walk {slope:?} {mat:?} ωi.z = {wz}");
+            let mut rng = common::rng(100 + i as u64);
+            let e = sample_energy(WALKS, || surface.sample(wi, &mut rng).map(|s| (s.weight, s.bounces)));
+            let mut eval_rng = common::rng(200 + i as u64);
+            let mut inner = common::rng(300 + i as u64);
+            let pf = PositionFree::new(*surface.slope(), *surface.material(), Shadowing::Correlated);
+            let ev = eval_energy(
+                EVALS,
+                &mut eval_rng,
+                |r| importance(&pf, wi, r),
+                |wo, order| surface.eval(wi, wo, order, &mut inner),
+            );
+            let single_stats = single_albedo(&pf, wi, 400 + i as u64);
+            if mat.white() {
+                // every walk returns, with weight exactly 1
+                assert_eq!(e.lost, 0, "{label}: {} of {WALKS} walks lost", e.lost);
+                assert_eq!(e.total.std(), 0.0, "{label}: F = 1 weights are not all 1");
+                assert_eq!(e.total.mean(), 1.0, "{label}: F = 1 weights are not all 1");
+                assert_mean(&format!("{label}: furnace ∫eval"), &ev[3], 1.0, z, 0.02, 0.0);
+            } else {
+                assert!(e.lost as f64 <= 1e-3 * WALKS as f64, "{label}: {} walks lost", e.lost);
+            }
+            for (o, name) in ["order 1", "order 2", "orders ≥ 3", "all orders"].into_iter().enumerate() {
+                let sampled = if o < 3 { &e.orders[o] } else { &e.total };
+                assert_two_sample(&format!("{label}: {name}, sample vs ∫eval"), sampled, &ev[o], z, 0.02);
+            }
+            // order 1 of both against the single-scattering albedo
+            let single = single_stats.mean();
+            assert_two_sample(
+                &format!("{label}: order 1 (sample) = single"),
+                &e.orders[0],
+                &single_stats,
+                z,
+                0.01,
+            );
+            assert_two_sample(&format!("{label}: order 1 (∫eval) = single"), &ev[0], &single_stats, z, 0.01);
+            let total = e.total.mean();
+            let se = (e.total.se().powi(2) + single_stats.se().powi(2)).sqrt();
+            assert!(
+                total >= single - z * se,
+                "{label}: total {total} < single-scattering albedo {single} − z·SE ({z:.2} × {se:.2e})"
+            );
+            assert!(single > 0.01, "{label}: single-scattering albedo {single}: the order-1 test is vacuous");
+            format!(
+                "{label}: single {single:.4}, orders {:.4} {:.4} {:.4}, total {total:.4} (∫eval {:.4} ± {:.4})",
+                e.orders[0].mean(),
+                e.orders[1].mean(),
+                e.orders[2].mean(),
+                ev[3].mean(),
+                ev[3].se()
+            )
+        })
+    });
+    for l in lines {
+        println!("{l}");
+    }
+}

@@ -324,3 +324,301 @@ fn walk_energy_orders_and_single_scattering() {
         println!("{l}");
     }
 }
+
+/// Cells of the χ² tests (cos θ × φ on the upper hemisphere) and samples per test.
+const CHI2_NZ: usize = 6;
+const CHI2_NPHI: usize = 12;
+const CHI2_N: usize = 10_000;
+
+/// The χ² configurations: F = 1 materials, whose walk density is exactly eval (f·cos θo).
+fn chi2_cases() -> Vec<(Slope, Mat, f32)> {
+    vec![
+        (Slope::Ggx, Mat::Perfect, -0.072),
+        (Slope::Ggx, Mat::Perfect, -0.3),
+        (Slope::Ggx, Mat::Perfect, -0.6),
+        (Slope::Beckmann, Mat::Perfect, -0.3),
+        (Slope::Ggx, Mat::WhiteDiffuse, -0.6),
+        (Slope::Beckmann, Mat::WhiteDiffuse, -0.072),
+    ]
+}
+
+/// (iv) χ² of the walk's `sample` against its stochastic density: for F = 1 every walk
+/// returns with weight 1, so the density of ωo is eval(ωi, ωo) = f·cos θo.
+#[test]
+fn walk_sampling_chi2() {
+    let cases = chi2_cases();
+    let alpha = sidak(0.01, cases.len());
+    let out = par_map(&cases, |i, &(slope, mat, wz)| {
+        with_surface!(slope, mat, |surface| {
+            let wi = wi_below(wz);
+            let label = format!("walk χ² {slope:?} {mat:?} ωi.z = {wz}");
+            let mut rng = common::rng(600 + i as u64);
+            let mut eval_rng = common::rng(700 + i as u64);
+            let r = stochastic_chi2(
+                &label,
+                0.0,
+                CHI2_NZ,
+                CHI2_NPHI,
+                &mut |wo| mean3(surface.eval(wi, wo, ScatteringOrder::All, &mut eval_rng)),
+                &mut || surface.sample(wi, &mut rng).map(|s| s.wo),
+                CHI2_N,
+                alpha,
+            );
+            assert!((r.mass - 1.0).abs() < 0.05, "{label}: ∫ density = {}: not a furnace", r.mass);
+            format!("{label}: p = {:.3}, dof = {:.1}, ∫ = {:.4}", r.p_value, r.dof, r.mass)
+        })
+    });
+    for l in out {
+        println!("{l}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Position-free PT and BDPT
+// ---------------------------------------------------------------------------------------------
+
+/// Calls `$body` with `$pf` bound to the position-free model.
+macro_rules! with_position_free {
+    ($slope:expr, $mat:expr, $shadowing:expr, |$pf:ident| $body:expr) => {
+        with_surface!($slope, $mat, |surface| {
+            let $pf = PositionFree::new(*surface.slope(), *surface.material(), $shadowing);
+            $body
+        })
+    };
+}
+
+const PF_WALKS: usize = 20_000;
+const PF_EVALS: usize = 4_000;
+
+/// (v) The position-free model from below: sample weights (F = 1: exactly 1, none lost),
+/// furnace through `eval_pt` and `eval_bdpt`, PT = BDPT, sample = ∫eval_pt per order, and
+/// order 1 = the model's single-scattering albedo.
+#[test]
+fn position_free_energy_pt_bdpt_and_orders() {
+    let mut cases = Vec::new();
+    for slope in [Slope::Ggx, Slope::Beckmann] {
+        for mat in [Mat::Perfect, Mat::Gold, Mat::WhiteDiffuse] {
+            for wz in [-0.072, -0.6] {
+                for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
+                    cases.push((slope, mat, wz, shadowing));
+                }
+            }
+        }
+    }
+    // per case: 4 (sample vs ∫eval_pt per order and total) + 1 (PT = BDPT) + 2 (furnace PT,
+    // BDPT; or sample vs BDPT) + 1 (order 1 = single) + 1 (total ≥ single)
+    let z = family_z(0.01, cases.len() * 9);
+    let lines = par_map(&cases, |i, &(slope, mat, wz, shadowing)| {
+        with_position_free!(slope, mat, shadowing, |pf| {
+            let wi = wi_below(wz);
+            let label = format!("position-free {shadowing:?} {slope:?} {mat:?} ωi.z = {wz}");
+            let mut rng = common::rng(1000 + i as u64);
+            let e = sample_energy(PF_WALKS, || pf.sample(wi, &mut rng).map(|s| (s.weight, s.bounces)));
+            let mut inner = common::rng(1100 + i as u64);
+            let pt = eval_energy(
+                PF_EVALS,
+                &mut common::rng(1200 + i as u64),
+                |r| importance(&pf, wi, r),
+                |wo, order| pf.eval_pt(wi, wo, order, &mut inner),
+            );
+            let mut bdpt = Stats::default();
+            let mut dir_rng = common::rng(1300 + i as u64);
+            for _ in 0..PF_EVALS {
+                let (wo, pdf) = importance(&pf, wi, &mut dir_rng);
+                bdpt.push(mean3(pf.eval_bdpt(wi, wo, ScatteringOrder::All, &mut inner)) / pdf);
+            }
+            let single_stats = single_albedo(&pf, wi, 1400 + i as u64);
+            let single = single_stats.mean();
+            if mat.white() {
+                assert_eq!(e.lost, 0, "{label}: {} of {PF_WALKS} walks lost", e.lost);
+                assert!(
+                    e.total.mean() == 1.0 && e.total.std() == 0.0,
+                    "{label}: F = 1 weights are not all 1"
+                );
+                assert_mean(&format!("{label}: furnace ∫eval_pt"), &pt[3], 1.0, z, 0.02, 0.0);
+                assert_mean(&format!("{label}: furnace ∫eval_bdpt"), &bdpt, 1.0, z, 0.02, 0.0);
+            } else {
+                assert!(e.lost as f64 <= 1e-3 * PF_WALKS as f64, "{label}: {} walks lost", e.lost);
+                assert_two_sample(&format!("{label}: sample vs ∫eval_bdpt"), &e.total, &bdpt, z, 0.02);
+            }
+            assert_two_sample(&format!("{label}: ∫eval_pt = ∫eval_bdpt"), &pt[3], &bdpt, z, 0.03);
+            for (o, name) in ["order 1", "order 2", "orders ≥ 3", "all orders"].into_iter().enumerate() {
+                let sampled = if o < 3 { &e.orders[o] } else { &e.total };
+                assert_two_sample(&format!("{label}: {name}, sample vs ∫eval_pt"), sampled, &pt[o], z, 0.02);
+            }
+            assert_two_sample(
+                &format!("{label}: order 1 (sample) = single"),
+                &e.orders[0],
+                &single_stats,
+                z,
+                0.01,
+            );
+            let se = (e.total.se().powi(2) + single_stats.se().powi(2)).sqrt();
+            assert!(e.total.mean() >= single - z * se, "{label}: total {} < single {single}", e.total.mean());
+            assert!(single > 0.01, "{label}: single-scattering albedo {single}: the order-1 test is vacuous");
+            format!(
+                "{label}: single {single:.4}, sample orders {:.4} {:.4} {:.4} total {:.4}; ∫PT {:.4} ± {:.4}, ∫BDPT {:.4} ± {:.4}",
+                e.orders[0].mean(),
+                e.orders[1].mean(),
+                e.orders[2].mean(),
+                e.total.mean(),
+                pt[3].mean(),
+                pt[3].se(),
+                bdpt.mean(),
+                bdpt.se()
+            )
+        })
+    });
+    for l in lines {
+        println!("{l}");
+    }
+}
+
+/// (iv)–(v) χ² of the position-free `sample` against its stochastic density `eval_pt` (F = 1:
+/// weights 1, so the density is f·cos θo), both shadowing models.
+#[test]
+fn position_free_sampling_chi2() {
+    let cases = [
+        (Slope::Ggx, Mat::Perfect, -0.072, Shadowing::Correlated),
+        (Slope::Ggx, Mat::Perfect, -0.6, Shadowing::Uncorrelated),
+        (Slope::Beckmann, Mat::WhiteDiffuse, -0.3, Shadowing::Correlated),
+        (Slope::Ggx, Mat::WhiteDiffuse, -0.6, Shadowing::Uncorrelated),
+    ];
+    let alpha = sidak(0.01, cases.len());
+    let out = par_map(&cases, |i, &(slope, mat, wz, shadowing)| {
+        with_position_free!(slope, mat, shadowing, |pf| {
+            let wi = wi_below(wz);
+            let label = format!("position-free χ² {shadowing:?} {slope:?} {mat:?} ωi.z = {wz}");
+            let mut rng = common::rng(1500 + i as u64);
+            let mut eval_rng = common::rng(1600 + i as u64);
+            let r = stochastic_chi2(
+                &label,
+                0.0,
+                CHI2_NZ,
+                CHI2_NPHI,
+                &mut |wo| mean3(pf.eval_pt(wi, wo, ScatteringOrder::All, &mut eval_rng)),
+                &mut || pf.sample(wi, &mut rng).map(|s| s.wo),
+                CHI2_N,
+                alpha,
+            );
+            assert!((r.mass - 1.0).abs() < 0.05, "{label}: ∫ density = {}: not a furnace", r.mass);
+            format!("{label}: p = {:.3}, dof = {:.1}, ∫ = {:.4}", r.p_value, r.dof, r.mass)
+        })
+    });
+    for l in out {
+        println!("{l}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The renderer API: a white furnace under a tilted shading normal
+// ---------------------------------------------------------------------------------------------
+
+/// The multiple-scattering techniques of `MicrofacetBsdf`.
+const MULTIPLE: [(&str, Technique); 5] = [
+    ("walk", Technique::RandomWalk),
+    ("pf-pt-corr", Technique::PositionFree { estimator: Estimator::Pt, shadowing: Shadowing::Correlated }),
+    (
+        "pf-pt-uncorr",
+        Technique::PositionFree { estimator: Estimator::Pt, shadowing: Shadowing::Uncorrelated },
+    ),
+    (
+        "pf-bdpt-corr",
+        Technique::PositionFree { estimator: Estimator::Bdpt, shadowing: Shadowing::Correlated },
+    ),
+    (
+        "pf-bdpt-uncorr",
+        Technique::PositionFree { estimator: Estimator::Bdpt, shadowing: Shadowing::Uncorrelated },
+    ),
+];
+
+/// The shading normal's tilt from the geometric normal (+z), towards +x.
+const TILT: f32 = 0.6;
+/// Polar angles (from the geometric normal, towards −x) of the views: above the geometric
+/// surface, below the shading hemisphere (β > π/2 − TILT ≈ 0.97).
+const VIEW_BETAS: [f32; 3] = [1.05, 1.25, 1.5];
+const BSDF_SAMPLES: usize = 10_000;
+const BSDF_EVALS: usize = 3_000;
+
+/// A white furnace through the `Bsdf` trait with a tilted shading normal: for views above the
+/// geometric surface but below the shading hemisphere (wo.z < 0 in the shading frame), every
+/// multiple-scattering technique of a white material (conductor F = 1, white diffuse; GGX
+/// and Beckmann) returns a sample for every call with weight 1, ∫ f |cos θi| dωi = 1 (by
+/// importance sampling through `eval`), and this albedo is at least
+/// the single-scattering technique's (its mean sample weight).
+#[test]
+fn bsdf_white_furnace_with_tilted_shading_normals() {
+    let frame = ShadingFrame::from_normal(Vec3::new(TILT.sin(), 0.0, TILT.cos())).unwrap();
+    let mut cases = Vec::new();
+    for slope in [Slope::Ggx, Slope::Beckmann] {
+        for mat in [Mat::Perfect, Mat::WhiteDiffuse] {
+            for beta in VIEW_BETAS {
+                for t in 0..MULTIPLE.len() {
+                    cases.push((slope, mat, beta, t));
+                }
+            }
+        }
+    }
+    // per case: furnace through eval, and multiple ≥ single
+    let z = family_z(0.01, cases.len() * 2);
+    let lines = par_map(&cases, |i, &(slope, mat, beta, t)| {
+        with_surface!(slope, mat, |surface| {
+            let (tname, technique) = MULTIPLE[t];
+            let world = Vec3::new(-beta.sin(), 0.0, beta.cos());
+            let wo = frame.to_local(world);
+            assert!(world.z > 0.0 && wo.z < 0.0, "the view must be backfacing in the shading frame only");
+            let label =
+                format!("Bsdf {tname} {slope:?} {mat:?}, view β = {beta} (shading wo.z = {:.3})", wo.z);
+            let b = MicrofacetBsdf::new(UniformHeight, *surface.slope(), *surface.material())
+                .with_technique(technique);
+            let single = b.with_technique(Technique::SingleScattering);
+            let mut rng = common::rng(2000 + i as u64);
+            let mut single_stats = Stats::default();
+            for _ in 0..BSDF_SAMPLES {
+                let s = b.sample(wo, &mut rng);
+                let s = s.unwrap_or_else(|| panic!("{label}: no sample for a backfacing view"));
+                // (the flags follow their documented shading-frame convention: wi on the other
+                // side of the shading plane than wo reads `transmission`)
+                assert!(s.wi.z > 0.0, "{label}: sample {s:?} below the shading hemisphere");
+                assert!((s.weight - Vec3::ONE).abs().max_element() < 1e-6, "{label}: weight {}", s.weight);
+                assert!(s.pdf > 0.0 && s.pdf.is_finite(), "{label}: pdf {}", s.pdf);
+                single_stats.push(b_weight(single.sample(wo, &mut rng)));
+            }
+            // wi importance-sampled from the view's phase function and a cosine lobe
+            let pf = PositionFree::new(*surface.slope(), *surface.material(), Shadowing::Correlated);
+            let mut furnace = Stats::default();
+            for _ in 0..BSDF_EVALS {
+                let (wi, pdf) = importance(&pf, wo, &mut rng);
+                furnace.push(mean3(b.eval(wo, wi, &mut rng).f) * f64::from(wi.z.max(0.0)) / pdf);
+            }
+            assert_mean(&format!("{label}: ∫ f cos θi"), &furnace, 1.0, z, 0.02, 0.0);
+            let se = (furnace.se().powi(2) + single_stats.se().powi(2)).sqrt();
+            assert!(
+                furnace.mean() >= single_stats.mean() - z * se,
+                "{label}: albedo {} < single-scattering albedo {} − z·SE ({z:.2} × {se:.2e})",
+                furnace.mean(),
+                single_stats.mean()
+            );
+            assert!(
+                single_stats.mean() < 0.99,
+                "{label}: single scattering {} is no lower bound",
+                single_stats.mean()
+            );
+            format!(
+                "{label}: ∫ f cos = {:.4} ± {:.4}, single {:.4} ± {:.4}",
+                furnace.mean(),
+                furnace.se(),
+                single_stats.mean(),
+                single_stats.se()
+            )
+        })
+    });
+    for l in lines {
+        println!("{l}");
+    }
+}
+
+/// The mean weight of an optional `Bsdf` sample (0 for none).
+fn b_weight(s: Option<microsurface::BsdfSample>) -> f64 {
+    s.map_or(0.0, |s| mean3(s.weight))
+}

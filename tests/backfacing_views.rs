@@ -622,3 +622,43 @@ fn bsdf_white_furnace_with_tilted_shading_normals() {
 fn b_weight(s: Option<microsurface::BsdfSample>) -> f64 {
     s.map_or(0.0, |s| mean3(s.weight))
 }
+
+/// The walk's order-1 estimate equals `Microsurface::eval_single_scattering` (the
+/// full-spherical G2 = 1/(Λ(−ωi) + Λ(ωo))) pointwise, for conductors (exact reference) at
+/// several ωo.
+#[test]
+fn walk_order_one_matches_single_scattering_pointwise() {
+    let mut cases = Vec::new();
+    for slope in [Slope::Ggx, Slope::Beckmann] {
+        for mat in [Mat::Perfect, Mat::Gold] {
+            for wz in WI_Z {
+                for k in 0..4 {
+                    cases.push((slope, mat, wz, k));
+                }
+            }
+        }
+    }
+    let z = family_z(0.01, cases.len());
+    par_map(&cases, |i, &(slope, mat, wz, k)| {
+        with_surface!(slope, mat, |surface| {
+            let wi = wi_below(wz);
+            // ωo: drawn from the phase function (where single scattering lives), above z = 0.05
+            let mut dir_rng = common::rng(2400 + i as u64);
+            let wo = loop {
+                let w = surface.sample_phase(wi, &mut dir_rng).wo;
+                if w.z > 0.05 {
+                    break w;
+                }
+            };
+            let label = format!("order 1 {slope:?} {mat:?} ωi.z = {wz}, ωo #{k} = {wo}");
+            let mut rng = common::rng(2500 + i as u64);
+            let exact = mean3(surface.eval_single_scattering(wi, wo, &mut rng));
+            let mut st = Stats::default();
+            for _ in 0..20_000 {
+                st.push(mean3(surface.eval(wi, wo, ScatteringOrder::only(1).unwrap(), &mut rng)));
+            }
+            assert!(exact > 0.0, "{label}: single scattering is 0: the test is vacuous");
+            assert_mean(&label, &st, exact, z, 0.02 * exact.max(0.05), 1e-6 * exact);
+        })
+    });
+}

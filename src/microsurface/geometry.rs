@@ -162,7 +162,7 @@ pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32>
 /// walk's arithmetic finite (no 0·∞) without changing any result.
 #[inline]
 pub(crate) fn first_ln_c1_from_below(lambda_up: f32, u: f32) -> Option<f32> {
-    if !(lambda_up > 0.0) {
+    if lambda_up.is_nan() || lambda_up <= 0.0 {
         return None;
     }
     // 1 − u: see `next_c1`

@@ -244,7 +244,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// `None` if ωi is not below the horizon, the material transmits, Λ(−ωi) = 0, the path was
     /// absorbed, or it reached [`MAX_BOUNCES`].
     pub fn sample_from_below(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
-        if M::TRANSMITS || !(wi.z < 0.0) {
+        if M::TRANSMITS || wi.z.is_nan() || wi.z >= 0.0 {
             return None;
         }
         let slope = self.geometry.slope();

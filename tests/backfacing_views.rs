@@ -662,3 +662,126 @@ fn walk_order_one_matches_single_scattering_pointwise() {
         })
     });
 }
+
+// ---------------------------------------------------------------------------------------------
+// Height space
+// ---------------------------------------------------------------------------------------------
+
+/// The first height from below (`MicrosurfaceGeometry::sample_height_from_below`) has
+/// C¹(h₁) with CDF C^{Λ(−ωi)}: E[C¹(h₁)^a] = Λ(−ωi)/(Λ(−ωi) + a), for uniform and Gaussian
+/// heights (a = Λ(ωo) gives the order-1 escape probability).
+#[test]
+fn first_height_from_below_follows_the_full_spherical_masking() {
+    let slope = Ggx::new(GGX_ALPHA, GGX_ALPHA).unwrap();
+    let cases: Vec<(bool, f32, f32)> = [false, true]
+        .into_iter()
+        .flat_map(|g| WI_Z.into_iter().flat_map(move |z| [0.5f32, 2.0].into_iter().map(move |a| (g, z, a))))
+        .collect();
+    let z = family_z(0.01, cases.len());
+    for (i, &(gaussian, wz, a)) in cases.iter().enumerate() {
+        let wi = wi_below(wz);
+        let k = f64::from(slope.lambda(-wi));
+        let mut rng = common::rng(2700 + i as u64);
+        let mut st = Stats::default();
+        for _ in 0..20_000 {
+            let u = common::uniform32(&mut rng);
+            let c = if gaussian {
+                let g = microsurface::MicrosurfaceGeometry::new(microsurface::GaussianHeight, slope);
+                microsurface::MicrosurfaceHeight::c1(g.height(), g.sample_height_from_below(wi, u).unwrap())
+            } else {
+                let g = microsurface::MicrosurfaceGeometry::new(UniformHeight, slope);
+                microsurface::MicrosurfaceHeight::c1(g.height(), g.sample_height_from_below(wi, u).unwrap())
+            };
+            st.push(f64::from(c).powf(f64::from(a)));
+        }
+        let expected = k / (k + f64::from(a));
+        let label = format!("first height from below, gaussian = {gaussian}, ωi.z = {wz}, a = {a}");
+        assert_mean(&label, &st, expected, z, 0.01, 2e-6);
+    }
+    // no first hit for directions that are not below the horizon, or from the nadir
+    let g = microsurface::MicrosurfaceGeometry::new(UniformHeight, slope);
+    assert_eq!(g.sample_height_from_below(Vec3::Z, 0.5), None);
+    assert_eq!(g.sample_height_from_below(-Vec3::Z, 0.5), None);
+}
+
+/// The random walk from below in height space (first height from
+/// `sample_height_from_below`, then `sample_height`, supplement Algorithm 3) has the per-order
+/// energies and exit distribution (mean cos θo) of the C¹-space walk, for Gaussian and
+/// uniform heights (gold, GGX and Beckmann).
+#[test]
+fn height_space_walk_from_below_matches_the_c1_walk() {
+    use microsurface::{GaussianHeight, HeightSample, MicrosurfaceGeometry};
+    // The height-space walk needs f32 heights that resolve the first hit's depth
+    // (E[ln C¹₁] = −1/Λ(−ωi)): uniform heights resolve C¹ only to ~6e-8 near the bottom
+    // (h = 2C¹ − 1; below, h = −1 and C¹ = 0, where no walk escapes), and any f32 C¹ leaves the
+    // normal range below ln C¹ = −87, with probability e^{−87 Λ(−ωi)} (3 % for Beckmann α = 0.8
+    // at ωi.z = −0.6, measured as a 3 % energy deficit). The cases stay where both effects are
+    // far below the SE; the C¹ walk, which carries ln C¹, has neither.
+    let cases: Vec<(Slope, bool, f32)> = vec![
+        (Slope::Ggx, true, -0.072),
+        (Slope::Ggx, true, -0.6),
+        (Slope::Ggx, false, -0.072),
+        (Slope::Beckmann, true, -0.072),
+        (Slope::Beckmann, true, -0.3),
+        (Slope::Beckmann, false, -0.072),
+    ];
+    // per case: orders 1, 2, ≥ 3, and the mean exit cosine
+    let z = family_z(0.01, cases.len() * 4);
+    par_map(&cases, |i, &(slope, gaussian, wz)| {
+        with_surface!(slope, Mat::Gold, |surface| {
+            let wi = wi_below(wz);
+            let label = format!("height-space walk {slope:?} gaussian = {gaussian} ωi.z = {wz}");
+            let material = *surface.material();
+            let s = *surface.slope();
+            let mut rng = common::rng(2800 + i as u64);
+            // one walk in height space: (weight, bounces, exit cosine)
+            let height_walk = |rng: &mut common::TestRng| -> Option<(Vec3, u32, f32)> {
+                let (g_u, g_g) = (
+                    MicrosurfaceGeometry::new(UniformHeight, s),
+                    MicrosurfaceGeometry::new(GaussianHeight, s),
+                );
+                let u = common::uniform32(rng);
+                let mut h = if gaussian {
+                    g_g.sample_height_from_below(wi, u)?
+                } else {
+                    g_u.sample_height_from_below(wi, u)?
+                };
+                let (mut wr, mut weight) = (-wi, Vec3::ONE);
+                for bounces in 1..=microsurface::MAX_BOUNCES {
+                    let p = material.sample_phase(&s, -wr, true, rng);
+                    wr = p.wo;
+                    weight *= p.weight;
+                    let u = common::uniform32(rng);
+                    let next =
+                        if gaussian { g_g.sample_height(wr, h, u) } else { g_u.sample_height(wr, h, u) };
+                    match next {
+                        HeightSample::Hit(h2) => h = h2,
+                        HeightSample::Escape => return Some((weight, bounces, wr.z)),
+                    }
+                }
+                None
+            };
+            let mut cos_h = Stats::default();
+            let e_h = sample_energy(WALKS, || {
+                let r = height_walk(&mut rng);
+                if let Some((_, _, c)) = r {
+                    cos_h.push(f64::from(c));
+                }
+                r.map(|(w, k, _)| (w, k))
+            });
+            let mut cos_c = Stats::default();
+            let mut rng_c = common::rng(2900 + i as u64);
+            let e_c = sample_energy(WALKS, || {
+                let r = surface.sample(wi, &mut rng_c);
+                if let Some(s) = r {
+                    cos_c.push(f64::from(s.wo.z));
+                }
+                r.map(|s| (s.weight, s.bounces))
+            });
+            for (o, name) in ["order 1", "order 2", "orders ≥ 3"].into_iter().enumerate() {
+                assert_two_sample(&format!("{label}: {name}"), &e_h.orders[o], &e_c.orders[o], z, 0.01);
+            }
+            assert_two_sample(&format!("{label}: mean exit cos θo"), &cos_h, &cos_c, z, 0.01);
+        })
+    });
+}

@@ -83,6 +83,37 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
     }
 }
 
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
+    /// Samples the height of the first intersection of a ray arriving from below the
+    /// macrosurface, lit (or seen) from `wi` with ωi.z < 0 (the ray travels along −ωi,
+    /// upwards), from one uniform `u` ∈ [0, 1): h₁ = C⁻¹(exp(ln(1 − u)/Λ(−ωi))), whose C¹ has
+    /// the CDF C^{1/G1(ωi)} with the full-spherical G1(ωi) = 1/|1 + Λ(ωi)| (Wang et al. 2022,
+    /// eq. 10): the visible-height distribution of a ray from above (Algorithm 1 of the
+    /// supplement started at h = +∞) extended to the lower hemisphere. The height-space form
+    /// of the random walk's backfacing start ([`Microsurface::eval_from_below`]); further
+    /// heights follow from [`MicrosurfaceGeometry::sample_height`].
+    ///
+    /// `None` if ωi is not below the horizon, or if Λ(−ωi) = 0 (ωi at the nadir sees no
+    /// microsurface). In f32, C¹ = exp(ln C¹) leaves the normal range for ln C¹ < −87, which
+    /// happens with probability e^{−87 Λ(−ωi)} (2e-4 for Λ(−ωi) = 0.1): the height then
+    /// saturates towards C⁻¹(0) and loses the depth; and the height itself resolves C¹ only
+    /// to its own rounding near the bottom (uniform heights: h = 2C¹ − 1, C¹ to ~6e-8, below
+    /// which h = −1 and C¹ = 0, where no ray escapes). Deep first hits (views from well below
+    /// the horizon, E[ln C¹₁] = −1/Λ(−ωi)) are therefore only usable with a height
+    /// distribution that resolves its tail (Gaussian); the C¹-space walk carries ln C¹ and has
+    /// no such floor.
+    ///
+    /// [`Microsurface::eval_from_below`]: crate::Microsurface::eval_from_below
+    #[inline]
+    pub fn sample_height_from_below(&self, wi: Vec3, u: f32) -> Option<f32> {
+        if wi.z.is_nan() || wi.z >= 0.0 {
+            return None;
+        }
+        let ln_c1 = first_ln_c1_from_below(self.slope.lambda(-wi), u)?;
+        Some(self.height.inv_c1(ln_c1.exp()))
+    }
+}
+
 /// C¹(h)^Λ for Λ ≥ 0: the probability of escaping from a point whose height has CDF value
 /// `c1`. 0^0 = 1 (a ray straight up from the bottom escapes).
 #[inline(always)]

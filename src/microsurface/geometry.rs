@@ -187,10 +187,12 @@ pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32>
 /// first vertex the position-free model's vertex reached from below (see DESIGN.md,
 /// “Multiple scattering for views below the macrosurface”).
 ///
-/// The result lies in [−f32::MAX, −f32::MIN_POSITIVE]: ln(1 − u)/Λ overflows only for
-/// Λ(−ωi) < 5e-38 (ωi within ~1e-19 rad of the nadir), where every further escape
-/// probability C¹^Λ rounds to 0 anyway (or is exactly 1 for Λ = 0), so −f32::MAX keeps the
-/// walk's arithmetic finite (no 0·∞) without changing any result.
+/// The result lies in [−f32::MAX, −f32::MIN_POSITIVE]. ln(1 − u)/Λ overflows only for
+/// Λ(−ωi) < 5e-38 (GGX: ωi within ~1e-19 rad of the nadir; Beckmann: a denormal Λ, smooth
+/// surfaces seen from well below). There the depth is not representable in f32; the clamp
+/// keeps the walk's arithmetic finite (no 0·∞, no NaN), but the walk is then inaccurate
+/// (the later escape probabilities e^{Λ(ω) ln C¹}, with Λ(ω) of the same tiny order, are
+/// distorted). See DESIGN.md for this limitation.
 #[inline]
 pub(crate) fn first_ln_c1_from_below(lambda_up: f32, u: f32) -> Option<f32> {
     if lambda_up.is_nan() || lambda_up <= 0.0 {

@@ -75,7 +75,8 @@ pub struct WalkSample {
 
 impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S, M> {
     /// The side of the interface a walk for the incident direction `wi` starts on, or `None`
-    /// if the material cannot be lit from there.
+    /// if the ordinary walk cannot start there (an opaque material lit from below starts in
+    /// [`Microsurface::eval_from_below`] / [`Microsurface::sample_from_below`] instead).
     #[inline(always)]
     fn starting_side(wi: Vec3) -> Option<bool> {
         if wi.z > 0.0 {

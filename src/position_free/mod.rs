@@ -160,7 +160,8 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     ///
     /// The weight is f·|cos θo|/pdf exactly: the product of the sample weights (Fresnel for
     /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
-    /// the material, or the walk reached [`crate::MAX_BOUNCES`].
+    /// the material (on the horizon, or at the nadir of an opaque material, where no facet
+    /// faces it), or the walk reached [`crate::MAX_BOUNCES`].
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         let mut at = Self::incident(wi)?;
         if wi.z < 0.0 && inv_g1(&self.slope, in_side_frame(at.w, at.outside)) == 0.0 {

@@ -11,10 +11,14 @@
 //!   weight equals ∫ eval dωo (eval and sample consistent), per scattering order too;
 //! - order 1: the energy of the walk's first bounce equals the single-scattering backfacing
 //!   albedo (the crate's full-spherical single-scattering model, integrated by quadrature),
-//!   and the total is at least that;
+//!   and the total is at least that; pointwise, the order-1 eval equals
+//!   `eval_single_scattering`;
 //! - χ² of the walk's `sample` against its stochastic density `eval`;
-//! - position-free PT and BDPT, correlated and uncorrelated: furnace, PT = BDPT, order 1 =
-//!   single scattering, χ² of `sample` against `eval_pt`;
+//! - height space: the first height's C¹ follows C^{Λ(−ωi)}, and the height-space walk from
+//!   below matches the C¹ walk (Gaussian and uniform heights);
+//! - position-free PT and BDPT, correlated and uncorrelated: furnace, PT = BDPT (integrated
+//!   and pointwise), sample = ∫eval_pt per order, order 1 = single scattering, χ² of `sample`
+//!   against `eval_pt`;
 //! - the renderer API: a white furnace with a tilted shading normal through
 //!   `MicrofacetBsdf` (every technique), views above the geometric surface but below the
 //!   shading hemisphere.

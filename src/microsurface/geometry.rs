@@ -83,6 +83,37 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
     }
 }
 
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
+    /// Samples the height of the first intersection of a ray arriving from below the
+    /// macrosurface, lit (or seen) from `wi` with ωi.z < 0 (the ray travels along −ωi,
+    /// upwards), from one uniform `u` ∈ [0, 1): h₁ = C⁻¹(exp(ln(1 − u)/Λ(−ωi))), whose C¹ has
+    /// the CDF C^{1/G1(ωi)} with the full-spherical G1(ωi) = 1/|1 + Λ(ωi)| (Wang et al. 2022,
+    /// eq. 10): the visible-height distribution of a ray from above (Algorithm 1 of the
+    /// supplement started at h = +∞) extended to the lower hemisphere. The height-space form
+    /// of the random walk's backfacing start ([`Microsurface::eval_from_below`]); further
+    /// heights follow from [`MicrosurfaceGeometry::sample_height`].
+    ///
+    /// `None` if ωi is not below the horizon, or if Λ(−ωi) = 0 (ωi at the nadir sees no
+    /// microsurface). In f32, C¹ = exp(ln C¹) leaves the normal range for ln C¹ < −87, which
+    /// happens with probability e^{−87 Λ(−ωi)} (2e-4 for Λ(−ωi) = 0.1): the height then
+    /// saturates towards C⁻¹(0) and loses the depth; and the height itself resolves C¹ only
+    /// to its own rounding near the bottom (uniform heights: h = 2C¹ − 1, C¹ to ~6e-8, below
+    /// which h = −1 and C¹ = 0, where no ray escapes). Deep first hits (views from well below
+    /// the horizon, E[ln C¹₁] = −1/Λ(−ωi)) are therefore only usable with a height
+    /// distribution that resolves its tail (Gaussian); the C¹-space walk carries ln C¹ and has
+    /// no such floor.
+    ///
+    /// [`Microsurface::eval_from_below`]: crate::Microsurface::eval_from_below
+    #[inline]
+    pub fn sample_height_from_below(&self, wi: Vec3, u: f32) -> Option<f32> {
+        if wi.z.is_nan() || wi.z >= 0.0 {
+            return None;
+        }
+        let ln_c1 = first_ln_c1_from_below(self.slope.lambda(-wi), u)?;
+        Some(self.height.inv_c1(ln_c1.exp()))
+    }
+}
+
 /// C¹(h)^Λ for Λ ≥ 0: the probability of escaping from a point whose height has CDF value
 /// `c1`. 0^0 = 1 (a ray straight up from the bottom escapes).
 #[inline(always)]
@@ -136,6 +167,40 @@ pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32>
         return None;
     }
     Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
+}
+
+/// ln C¹ of the first intersection of a ray arriving from below the macrosurface, for an
+/// opaque microsurface lit (or seen) from ωi with ωi.z < 0, from one uniform `u` ∈ [0, 1);
+/// `lambda_up` = Λ(−ωi) = |1 + Λ(ωi)| = 1/G1(ωi), the full-spherical masking's inverse (Wang
+/// et al. 2022, eq. 10). `None` if Λ(−ωi) = 0 (ωi at the nadir, or Λ underflowed): ωi then
+/// sees no microsurface (projected area 0).
+///
+/// ln C¹₁ = ln(1 − u)/Λ(−ωi): the first hit's C¹ has the CDF C^{1/G1(ωi)}. From above,
+/// Algorithm 1 of the supplement started at h = +∞ gives C^{1 + Λ(ωi)} = C^{1/G1(ωi)}, the
+/// visible-height distribution G1(ωi, h)/G1(ωi); below the horizon the full-spherical Smith
+/// model keeps that form with 1/G1(ωi) = A(ωi)/|cos θi| (A the projected area of the facets
+/// facing ωi). A literal ray from h = −∞ does not work: hits occur at the rate Λ(−ωi) per
+/// unit of ln C¹, so from ln C¹ = −∞ the first hit is at C¹ = 0 almost surely and nothing
+/// escapes (0^Λ = 0), the hemispherical model's black result. This choice makes the walk's
+/// single-scattering term the full-spherical height-correlated one, E[C^{Λ(ωo)}] =
+/// Λ(−ωi)/(Λ(−ωi) + Λ(ωo)), i.e. G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17), and the
+/// first vertex the position-free model's vertex reached from below (see DESIGN.md,
+/// “Multiple scattering for views below the macrosurface”).
+///
+/// The result lies in [−f32::MAX, −f32::MIN_POSITIVE]. ln(1 − u)/Λ overflows only for
+/// Λ(−ωi) < 5e-38 (GGX: ωi within ~1e-19 rad of the nadir; Beckmann: a denormal Λ, smooth
+/// surfaces seen from well below). There the depth is not representable in f32; the clamp
+/// keeps the walk's arithmetic finite (no 0·∞, no NaN), but the walk is then inaccurate
+/// (the later escape probabilities e^{Λ(ω) ln C¹}, with Λ(ω) of the same tiny order, are
+/// distorted). See DESIGN.md for this limitation.
+#[inline]
+pub(crate) fn first_ln_c1_from_below(lambda_up: f32, u: f32) -> Option<f32> {
+    if lambda_up.is_nan() || lambda_up <= 0.0 {
+        return None;
+    }
+    // 1 − u: see `next_c1`
+    let ln_1mu = (1.0 - u).ln();
+    Some((ln_1mu / lambda_up).clamp(f32::MIN, -MIN_HIT_DEPTH))
 }
 
 /// ln(1 − C¹) from ln C¹: the same point seen from the other side of the interface, in the

@@ -9,6 +9,7 @@ pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 
 use crate::height::MicrosurfaceHeight;
 use crate::material::{Material, PhaseSample};
+use crate::position_free::{PositionFree, Shadowing};
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
@@ -79,11 +80,18 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     }
 
     /// The single-scattering BSDF times |cos θo| (what `eval` with
-    /// [`ScatteringOrder::Only`]`(1)` estimates). Zero for ωi at or below the horizon, except
-    /// for a dielectric, which is evaluated from inside.
+    /// [`ScatteringOrder::Only`]`(1)` estimates). Zero for ωi or ωo on the horizon and for an
+    /// opaque material's ωo below it. A dielectric lit from below is evaluated from inside; an
+    /// opaque material lit from below the macrosurface (a backfacing view) has the
+    /// full-spherical height-correlated masking G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022,
+    /// eq. 17), the order-1 term of [`Microsurface::eval_from_below`].
     #[inline]
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
         if !M::TRANSMITS && (wi.z <= 0.0 || wo.z <= 0.0) {
+            if wi.z < 0.0 && wo.z > 0.0 {
+                let pf = PositionFree::new(*self.slope(), self.material, Shadowing::Correlated);
+                return pf.eval_single_scattering(wi, wo, rng);
+            }
             return Vec3::ZERO;
         }
         self.material.eval_single_scattering(self.geometry.slope(), wi, wo, rng)

@@ -2,7 +2,7 @@
 //! multiple-scattering BSDF (Heitz et al. 2016, supplement §3.1 Algorithms 2–3 and §3.4).
 
 use super::Microsurface;
-use super::geometry::{flip_ln_c1, next_ln_c1};
+use super::geometry::{first_ln_c1_from_below, flip_ln_c1, next_ln_c1};
 use crate::height::MicrosurfaceHeight;
 use crate::material::Material;
 use crate::rng::uniform;
@@ -75,7 +75,8 @@ pub struct WalkSample {
 
 impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S, M> {
     /// The side of the interface a walk for the incident direction `wi` starts on, or `None`
-    /// if the material cannot be lit from there.
+    /// if the ordinary walk cannot start there (an opaque material lit from below starts in
+    /// [`Microsurface::eval_from_below`] / [`Microsurface::sample_from_below`] instead).
     #[inline(always)]
     fn starting_side(wi: Vec3) -> Option<bool> {
         if wi.z > 0.0 {
@@ -92,10 +93,19 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// unbiased: average several calls.
     ///
     /// `order` selects all bounces, exactly the n-th, or the first n. Returns 0 when ωi or ωo
-    /// lies on the horizon, and for opaque materials when either is below it. A dielectric
-    /// lit from inside (ωi.z < 0) is evaluated as the flipped configuration, η ↦ 1/η.
+    /// lies on the horizon, and for opaque materials when ωo is below it. A dielectric lit
+    /// from inside (ωi.z < 0) is evaluated as the flipped configuration, η ↦ 1/η. An opaque
+    /// material lit from below the macrosurface (ωi.z < 0: a backfacing view under a normal
+    /// map) starts with the full-spherical first intersection of
+    /// [`Microsurface::eval_from_below`].
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
-        let Some(mut outside) = Self::starting_side(wi) else { return Vec3::ZERO };
+        let Some(mut outside) = Self::starting_side(wi) else {
+            return if !M::TRANSMITS && wi.z < 0.0 {
+                self.eval_from_below(wi, wo, order, rng)
+            } else {
+                Vec3::ZERO
+            };
+        };
         if wo.z == 0.0 || (!M::TRANSMITS && wo.z < 0.0) {
             return Vec3::ZERO;
         }
@@ -141,10 +151,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// §3.4 for the dielectric).
     ///
     /// Returns the exit direction, the path weight f·|cos θo|/pdf and the number of bounces;
-    /// `None` if ωi cannot light the material (on the horizon, or below it for an opaque
-    /// material), if the path was fully absorbed, or if it reached [`MAX_BOUNCES`].
+    /// `None` if ωi cannot light the material (on the horizon, or at the nadir for an opaque
+    /// material), if the path was fully absorbed, or if it reached [`MAX_BOUNCES`]. An opaque
+    /// material lit from below the macrosurface (ωi.z < 0) is sampled by
+    /// [`Microsurface::sample_from_below`].
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
-        let mut outside = Self::starting_side(wi)?;
+        let Some(mut outside) = Self::starting_side(wi) else {
+            return if !M::TRANSMITS && wi.z < 0.0 { self.sample_from_below(wi, rng) } else { None };
+        };
         let slope = self.geometry.slope();
         let mut wr = -wi;
         let mut ln_c1 = 0.0;
@@ -163,6 +177,91 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
+            }
+        }
+        None
+    }
+
+    /// [`Microsurface::eval`] for an opaque material lit from below the macrosurface
+    /// (ωi.z < 0, the ray travels upwards): a backfacing view under a normal map.
+    ///
+    /// The full-spherical Smith model gives ωi the projected area A(ωi) = (1 + Λ(ωi)) cos θi
+    /// = Λ(−ωi)|cos θi| > 0 of the facets with ωi·ωm > 0, whose normals follow the VNDF D_ωi
+    /// (sampled exactly on the whole sphere), and the masking G1(ωi) = 1/|1 + Λ(ωi)| (Wang et
+    /// al. 2022, eq. 10). The first intersection's ln C¹ is ln(1 − u)/Λ(−ωi)
+    /// (`first_ln_c1_from_below`: the visible-height distribution C^{1/G1(ωi)} of Algorithm 1
+    /// of the supplement, extended to the lower hemisphere); from there the walk is the
+    /// ordinary one (supplement §3.1, Algorithm 2), every exit being upwards. Its order-1 term
+    /// is exactly p(ωi, ωo) Λ(−ωi)/(Λ(−ωi) + Λ(ωo)) = F D G2/(4|cos θi|) with the full-spherical
+    /// G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17) of the single-scattering model.
+    ///
+    /// 0 when ωo is at or below the horizon, or when Λ(−ωi) = 0 (ωi at the nadir sees no
+    /// microsurface). Stochastic and unbiased, consistent with
+    /// [`Microsurface::sample_from_below`] (the same walk).
+    pub fn eval_from_below(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        if M::TRANSMITS || !(wi.z < 0.0 && wo.z > 0.0) {
+            return Vec3::ZERO;
+        }
+        let slope = self.geometry.slope();
+        let mut wr = -wi;
+        let Some(mut ln_c1) = first_ln_c1_from_below(slope.lambda(wr), uniform(rng)) else {
+            return Vec3::ZERO;
+        };
+        let lambda_o = slope.lambda(wo);
+        let last = order.last();
+        let mut throughput = Vec3::ONE;
+        let mut sum = Vec3::ZERO;
+        let mut bounce = 1;
+        loop {
+            if order.includes(bounce) {
+                let phase = self.material.eval_phase(slope, -wr, wo, true, true, rng);
+                if phase != Vec3::ZERO {
+                    sum += throughput * phase * (lambda_o * ln_c1).exp();
+                }
+            }
+            if bounce == last {
+                break;
+            }
+            let s = self.material.sample_phase(slope, -wr, true, rng);
+            wr = s.wo;
+            throughput *= s.weight;
+            if throughput == Vec3::ZERO {
+                break;
+            }
+            let Some(next) = self.next_ln_c1(wr, ln_c1, true, rng) else { break };
+            ln_c1 = next;
+            bounce += 1;
+        }
+        sum
+    }
+
+    /// [`Microsurface::sample`] for an opaque material lit from below the macrosurface
+    /// (ωi.z < 0): the walk of [`Microsurface::eval_from_below`] (first intersection at
+    /// ln C¹ = ln(1 − u)/Λ(−ωi), normal from D_ωi), then the ordinary walk (supplement §3.1,
+    /// Algorithm 3). Every path leaves upwards, so for F = 1 the weight is exactly 1 (energy is
+    /// conserved, up to walks reaching [`MAX_BOUNCES`]); otherwise it is the product of the
+    /// phase-sample weights, f·|cos θo|/pdf.
+    ///
+    /// `None` if ωi is not below the horizon, the material transmits, Λ(−ωi) = 0, the path was
+    /// absorbed, or it reached [`MAX_BOUNCES`].
+    pub fn sample_from_below(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
+        if M::TRANSMITS || wi.z.is_nan() || wi.z >= 0.0 {
+            return None;
+        }
+        let slope = self.geometry.slope();
+        let mut wr = -wi;
+        let mut ln_c1 = first_ln_c1_from_below(slope.lambda(wr), uniform(rng))?;
+        let mut weight = Vec3::ONE;
+        for bounces in 1..=MAX_BOUNCES {
+            let s = self.material.sample_phase(slope, -wr, true, rng);
+            wr = s.wo;
+            weight *= s.weight;
+            if weight == Vec3::ZERO {
+                return None;
+            }
+            match self.next_ln_c1(wr, ln_c1, true, rng) {
+                Some(next) => ln_c1 = next,
+                None => return Some(WalkSample { wo: wr, weight, bounces }),
             }
         }
         None

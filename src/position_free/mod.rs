@@ -63,7 +63,9 @@ pub enum Estimator {
 ///
 /// Directions follow the crate's conventions (local frame, both pointing away from the
 /// surface); evaluations return f·|cos θo| per RGB channel. A dielectric is evaluated from
-/// inside for ωi.z < 0.
+/// inside for ωi.z < 0; an opaque material accepts ωi below the horizon as light arriving
+/// from below the macrosurface (a backfacing view under a normal map), every estimator
+/// included.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PositionFree<S, M> {
     slope: S,
@@ -141,11 +143,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         self.connect(start, wo, wo_outside, true, rng).as_vec3()
     }
 
-    /// [`PositionFree::eval_single_scattering`] that also accepts ωi below the horizon for an
-    /// opaque material (a backfacing view under normal mapping), like
-    /// [`PositionFree::sample_single`] and [`PositionFree::pdf_single`].
+    /// [`PositionFree::eval_single_scattering`], which accepts ωi below the horizon for an
+    /// opaque material (a backfacing view under normal mapping), like every estimator of this
+    /// model (kept for the renderer adapter).
     pub(crate) fn eval_single_backfacing(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
-        let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
         self.connect(start, wo, wo_outside, true, rng).as_vec3()
@@ -158,9 +160,14 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     ///
     /// The weight is f·|cos θo|/pdf exactly: the product of the sample weights (Fresnel for
     /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
-    /// the material, or the walk reached [`crate::MAX_BOUNCES`].
+    /// the material (on the horizon, or at the nadir of an opaque material, where no facet
+    /// faces it), or the walk reached [`crate::MAX_BOUNCES`].
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         let mut at = Self::incident(wi)?;
+        if wi.z < 0.0 && inv_g1(&self.slope, in_side_frame(at.w, at.outside)) == 0.0 {
+            // ωi at the nadir of an opaque material: no facet faces it (projected area 0)
+            return None;
+        }
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
             let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
@@ -186,7 +193,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// weight is v·S_last·|cos θo|/pdf exactly. Returns (ωo, weight); `None` if ωi cannot light
     /// the material or the sampled direction cannot leave the surface.
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
-        let at = Self::incident_single(wi)?;
+        let at = Self::incident(wi)?;
         let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
         let last = self.shadowing_factor(at, k_in, self.exit(s.wo, s.outside), true) * k_in;
@@ -197,7 +204,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The density of [`PositionFree::sample_single`]: the phase function's sampling density
     /// (exact for conductors and dielectrics).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
-        let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
         self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside)
@@ -217,26 +224,25 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
     }
 
-    /// The incident state for the macro direction ωi, or `None` if the material cannot be lit
-    /// from there (on the horizon, or below it for an opaque material).
+    /// The incident state for the macro direction ωi, or `None` on the horizon.
+    ///
+    /// A dielectric lit from below is lit from inside. An opaque material lit from below the
+    /// macrosurface (a backfacing view under a normal map: Tokuyoshi; Wang et al. 2022 §3.5)
+    /// keeps the outside state: its first vertex is then exactly a vertex reached from below,
+    /// which the path integral already contains after any upward bounce (Wang et al. 2022,
+    /// Fig. 5): incident masking G1(ωi) = 1/|1 + Λ(ωi)| = 1/Λ(−ωi) (eq. 10), the VNDF D_ωi on
+    /// the whole sphere, and the shadowing factors of eqs. 17–18 with 1 + L̃ = Λ(−ωi). Every
+    /// exit of an opaque path is upwards. See DESIGN.md, “Multiple scattering for views below
+    /// the macrosurface”.
     #[inline(always)]
     pub(crate) fn incident(wi: Vec3) -> Option<Incident> {
-        if wi.z > 0.0 {
+        if wi.z > 0.0 || (!M::TRANSMITS && wi.z < 0.0) {
             Some(Incident { w: wi, outside: true })
         } else if M::TRANSMITS && wi.z < 0.0 {
             Some(Incident { w: wi, outside: false })
         } else {
             None
         }
-    }
-
-    /// Like [`Self::incident`], but an opaque material also accepts ωi below the horizon: a
-    /// single bounce is well defined there (the full-spherical masking and VNDF handle it),
-    /// which is what a renderer meets when a shading normal makes the view backfacing
-    /// (Tokuyoshi; Wang et al. 2022 §3.5, normal mapping).
-    #[inline(always)]
-    pub(crate) fn incident_single(wi: Vec3) -> Option<Incident> {
-        if !M::TRANSMITS && wi.z < 0.0 { Some(Incident { w: wi, outside: true }) } else { Self::incident(wi) }
     }
 
     /// The side of the macro direction ωo, or `None` if light cannot leave there.

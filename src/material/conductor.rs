@@ -4,7 +4,9 @@ use super::{
     Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_density,
     reflection_half_vector,
 };
-use crate::fresnel::{ComplexIor, fresnel_conductor};
+use crate::contract::is_cosine;
+use crate::contract::is_direction;
+use crate::fresnel::{ComplexIor, conductor_reflectance};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, renormalize};
 use glam::{DVec3, Vec3};
@@ -38,15 +40,26 @@ impl Conductor {
         if wi.z == 0.0 {
             return Vec3::ZERO;
         }
-        self.fresnel(wi.as_dvec3().dot(wh) as f32) * (d / (4.0 * f64::from(wi.z.abs()))) as f32
+        self.reflectance(wi.as_dvec3().dot(wh) as f32) * (d / (4.0 * f64::from(wi.z.abs()))) as f32
     }
 
     /// The Fresnel term for the cosine between ωi and the facet normal.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `cos_theta` that is NaN or beyond
+    /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives `Vec3::NAN` (a debug
+    /// assertion in debug builds).
     #[inline(always)]
     pub fn fresnel(&self, cos_theta: f32) -> Vec3 {
+        require!(is_cosine(cos_theta), Vec3::NAN; cos_theta);
+        self.reflectance(cos_theta)
+    }
+
+    /// [`Conductor::fresnel`] without the argument check, for the walks' own cosines.
+    #[inline(always)]
+    fn reflectance(&self, cos_theta: f32) -> Vec3 {
         match &self.ior {
             None => Vec3::ONE,
-            Some(ior) => fresnel_conductor(cos_theta, ior),
+            Some(ior) => conductor_reflectance(cos_theta, ior),
         }
     }
 }
@@ -66,10 +79,11 @@ impl Material for Conductor {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
-        self.fresnel(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh)
+        self.reflectance(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh)
     }
 
     const EXACT_PHASE_PDF: bool = true;
@@ -84,6 +98,7 @@ impl Material for Conductor {
         wi_outside: bool,
         wo_outside: bool,
     ) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return 0.0;
         };
@@ -101,6 +116,7 @@ impl Material for Conductor {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
@@ -118,6 +134,7 @@ impl Material for Conductor {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> (Vec3, f32, f32) {
+        require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0, 0.0); wi, wo);
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return (Vec3::ZERO, 0.0, 0.0);
         };
@@ -136,9 +153,10 @@ impl Material for Conductor {
         _wi_outside: bool,
         rng: &mut impl Rng,
     ) -> PhaseSample {
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
         let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
         let wo = renormalize(reflect(wi, wm), wm);
-        PhaseSample { wo, weight: self.fresnel(wi.dot(wm)), outside: true }
+        PhaseSample { wo, weight: self.reflectance(wi.dot(wm)), outside: true }
     }
 
     /// F(ωi·ωh) D(ωh) G2(ωi, ωo) / (4 cos θi) (the Cook–Torrance BRDF times cos θo).
@@ -150,6 +168,7 @@ impl Material for Conductor {
         wo: Vec3,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let g2 = g2_reflection(slope, wi, wo);
         if g2 == 0.0 {
             return Vec3::ZERO;

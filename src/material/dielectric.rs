@@ -1,8 +1,9 @@
 //! Dielectric microfacets.
 
 use super::{Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_half_vector};
+use crate::contract::is_direction;
 use crate::error::Error;
-use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_cosines};
+use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, normalize_fast, renormalize};
 use crate::special::beta;
@@ -110,7 +111,7 @@ impl Dielectric {
     ) -> f32 {
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta) * phase_reflection(slope, wi, wh)
+            dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta) * phase_reflection(slope, wi, wh)
         } else {
             let Some(r) = self.refraction(wi, wo) else { return 0.0 };
             let eta = f64::from(self.eta);
@@ -126,7 +127,7 @@ impl Dielectric {
         }
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta)
+            dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
                 * (slope.d64(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
         } else {
             let Some(r) = self.refraction(wi, wo) else { return 0.0 };
@@ -163,6 +164,7 @@ impl Material for Dielectric {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        // the argument check is `pdf_phase`'s
         Vec3::splat(self.pdf_phase(slope, wi, wo, wi_outside, wo_outside))
     }
 
@@ -187,6 +189,7 @@ impl Material for Dielectric {
         wi_outside: bool,
         wo_outside: bool,
     ) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
         this.eval_phase_outside(slope, wi, wo, wo_outside)
     }
@@ -205,6 +208,7 @@ impl Material for Dielectric {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
         Vec3::splat(this.vertex_outside(slope, wi, wo, wo_outside))
     }
@@ -220,9 +224,10 @@ impl Material for Dielectric {
         wi_outside: bool,
         rng: &mut impl Rng,
     ) -> PhaseSample {
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: wi_outside }; wi);
         let (this, wi_local, sign) = if wi_outside { (*self, wi, 1.0) } else { (self.flipped(), -wi, -1.0) };
         let wm = slope.sample_d_wi(wi_local, uniform(rng), uniform(rng));
-        let f = fresnel_dielectric(wi_local.dot(wm), this.eta);
+        let f = dielectric_reflectance(wi_local.dot(wm), this.eta);
         let (wo_local, crossed) = if uniform(rng) < f {
             (renormalize(reflect(wi_local, wm), wm), false)
         } else {
@@ -242,6 +247,7 @@ impl Material for Dielectric {
         wo: Vec3,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if wi.z < 0.0 {
             return self.flipped().eval_single_scattering(slope, -wi, -wo, rng);
         }

@@ -1,8 +1,9 @@
 //! Diffuse (Lambertian) microfacets.
 
 use super::{Material, PhaseSample, g2_reflection};
+use crate::contract::is_direction;
 use crate::error::Error;
-use crate::frame::{orthonormal_basis, sample_cosine_hemisphere};
+use crate::frame::{basis, cosine_hemisphere};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
@@ -56,6 +57,7 @@ impl Material for Diffuse {
         wo_outside: bool,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if !(wi_outside && wo_outside) {
             return Vec3::ZERO;
         }
@@ -72,11 +74,12 @@ impl Material for Diffuse {
     fn pdf_phase<S: MicrosurfaceSlope>(
         &self,
         _slope: &S,
-        _wi: Vec3,
+        wi: Vec3,
         wo: Vec3,
         wi_outside: bool,
         wo_outside: bool,
     ) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         if !(wi_outside && wo_outside) {
             return 0.0;
         }
@@ -95,6 +98,7 @@ impl Material for Diffuse {
         wo_outside: bool,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if !(wi_outside && wo_outside) || wi.z == 0.0 {
             return Vec3::ZERO;
         }
@@ -111,9 +115,10 @@ impl Material for Diffuse {
         _wi_outside: bool,
         rng: &mut impl Rng,
     ) -> PhaseSample {
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
         let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        let local = sample_cosine_hemisphere(uniform(rng), uniform(rng));
-        let (t, b) = orthonormal_basis(wm);
+        let local = cosine_hemisphere(uniform(rng), uniform(rng));
+        let (t, b) = basis(wm);
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
         PhaseSample { wo, weight: self.albedo, outside: true }
     }
@@ -129,6 +134,7 @@ impl Material for Diffuse {
         wo: Vec3,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let g2 = g2_reflection(slope, wi, wo);
         if g2 == 0.0 {
             return Vec3::ZERO;

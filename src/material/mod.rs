@@ -9,6 +9,7 @@ pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 
+use crate::contract::is_direction;
 use crate::slope::MicrosurfaceSlope;
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -34,6 +35,14 @@ pub struct PhaseSample {
 /// transmit is only evaluated with both true. Phase functions are flipped vertically inside a
 /// dielectric (supplement §3.4), so every method is written for `wi_outside = true` and
 /// inside configurations are mapped to it.
+///
+/// Invalid input ([policy](crate#invalid-input)), the same for every method and every
+/// material of the crate: a `wi` or `wo` that is zero, has a NaN or ±∞ component, or is not
+/// unit within [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE) trips a debug assertion in
+/// debug builds; release builds return 0 from the evaluations and densities (`eval_phase`,
+/// `pdf_phase`, `vertex`, `connection`, `eval_single_scattering`) and, from `sample_phase`, a
+/// [`PhaseSample`] with a NaN `wo` and a zero weight. Grazing and below-horizon unit
+/// directions are valid.
 pub trait Material: Copy + core::fmt::Debug + Send + Sync {
     /// Whether light can cross the interface (dielectrics).
     const TRANSMITS: bool;
@@ -106,6 +115,7 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         wo_outside: bool,
         rng: &mut impl Rng,
     ) -> (Vec3, f32, f32) {
+        require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0, 0.0); wi, wo);
         (
             self.vertex(slope, wi, wo, wi_outside, wo_outside, rng),
             self.pdf_phase(slope, wi, wo, wi_outside, wo_outside),

@@ -3,6 +3,7 @@
 
 use super::Microsurface;
 use super::geometry::{flip_ln_c1, next_ln_c1};
+use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::Material;
 use crate::rng::uniform;
@@ -94,7 +95,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// `order` selects all bounces, exactly the n-th, or the first n. Returns 0 when ωi or ωo
     /// lies on the horizon, and for opaque materials when either is below it. A dielectric
     /// lit from inside (ωi.z < 0) is evaluated as the flipped configuration, η ↦ 1/η.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let Some(mut outside) = Self::starting_side(wi) else { return Vec3::ZERO };
         if wo.z == 0.0 || (!M::TRANSMITS && wo.z < 0.0) {
             return Vec3::ZERO;
@@ -143,7 +148,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// Returns the exit direction, the path weight f·|cos θo|/pdf and the number of bounces;
     /// `None` if ωi cannot light the material (on the horizon, or below it for an opaque
     /// material), if the path was fully absorbed, or if it reached [`MAX_BOUNCES`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
+        require!(is_direction(wi), None; wi);
         let mut outside = Self::starting_side(wi)?;
         let slope = self.geometry.slope();
         let mut wr = -wi;

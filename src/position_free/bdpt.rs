@@ -3,6 +3,7 @@
 
 use super::segment::{in_side_frame, inv_g1};
 use super::{Exit, Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
+use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
 use crate::rng::uniform;
@@ -74,7 +75,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The densities are exact for conductors and dielectrics; for diffuse facets the MIS
     /// weights use [`Material::pdf_phase`]'s deterministic approximation, which keeps the
     /// estimator unbiased (the weights still sum to one).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_bdpt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };

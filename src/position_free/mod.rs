@@ -14,6 +14,7 @@ mod segment;
 
 pub use segment::Shadowing;
 
+use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::WalkSample;
 use crate::rng::uniform;
@@ -116,6 +117,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     }
 
     /// Evaluates f·|cos θo| with the chosen estimator and orders; unbiased and stochastic.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): checked by the estimators
+    /// ([`PositionFree::eval_pt`], [`PositionFree::eval_bdpt`]): 0 for a `wi` or `wo` that is
+    /// not a unit direction.
     pub fn eval(
         &self,
         wi: Vec3,
@@ -134,7 +139,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// times |cos θo| with this model's masking-shadowing — G1(ωi)G1(ωo) uncorrelated,
     /// 1/(1 + Λ(ωi) + Λ(ωo)) or B(1 + Λ(ωi), 1 + Λ(−ωo)) correlated. Exact, except for diffuse
     /// facets (unbiased estimate).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
@@ -159,7 +168,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The weight is f·|cos θo|/pdf exactly: the product of the sample weights (Fresnel for
     /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
     /// the material, or the walk reached [`crate::MAX_BOUNCES`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
+        require!(is_direction(wi), None; wi);
         let mut at = Self::incident(wi)?;
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
@@ -185,7 +198,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// sampling and the material's event choice), weighted by w·S_last/G1(ωi) so that the
     /// weight is v·S_last·|cos θo|/pdf exactly. Returns (ωo, weight); `None` if ωi cannot light
     /// the material or the sampled direction cannot leave the surface.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
+        require!(is_direction(wi), None; wi);
         let at = Self::incident_single(wi)?;
         let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
@@ -196,7 +213,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
 
     /// The density of [`PositionFree::sample_single`]: the phase function's sampling density
     /// (exact for conductors and dielectrics).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
@@ -208,7 +229,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// on ωo's side (divided between both sides for a dielectric). Like the papers' `pdf()`,
     /// it is **not** the density of what `sample` draws (which has no closed form); the
     /// weights of `sample` never use it.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };

@@ -11,6 +11,8 @@ pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use ggx::Ggx;
 
+#[allow(unused_imports)]
+pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -20,6 +22,14 @@ use glam::{DVec3, Vec2, Vec3};
 /// Implementors provide the primitives `p22`, `d`, `lambda`, `projected_area` and
 /// `sample_p22_11`; `alpha_i`, `d_wi` and `sample_d_wi` are derived (and may be overridden
 /// with faster or more accurate forms).
+///
+/// Invalid input ([policy](crate#invalid-input)), the same for every method and every
+/// implementation of the crate: a direction argument that is zero, has a NaN or ±∞ component,
+/// or is not unit within [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE), a NaN slope, or
+/// a uniform outside [0, 1] trips a debug assertion in debug builds; release builds return 0
+/// from the densities (`p22`, `d`, `d64`, `d_wi`, `d_wi64`), NaN from `lambda`,
+/// `projected_area` and `alpha_i`, and a NaN vector from the samplers (`sample_p22_11`,
+/// `sample_d_wi`). Grazing and below-horizon unit directions are valid everywhere.
 pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along x.
     fn alpha_x(&self) -> f32;
@@ -59,12 +69,14 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Beckmann exponent t).
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        require!(is_direction64(wm), 0.0; wm);
         f64::from(self.d(wm.as_vec3()))
     }
 
     /// D_ωi(ωm) in double precision for ωm given in double precision (see [`Self::d64`]).
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
+        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
         let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
@@ -77,6 +89,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// (supplement §2.1). At ω = ±z, where φ is undefined, returns αx.
     #[inline]
     fn alpha_i(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
         // scaled by the larger horizontal component so that x² + y² cannot underflow
         let scale = w.x.abs().max(w.y.abs());
         if scale == 0.0 {
@@ -92,6 +105,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// i.e. ωi = −z).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         let cos_im = wi.dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
@@ -110,6 +124,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// returns +z.
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
         let (ax, ay) = (self.alpha_x(), self.alpha_y());
         let stretched = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         let sin_theta = (stretched.x * stretched.x + stretched.y * stretched.y).sqrt();

@@ -14,9 +14,14 @@
 //!   that return a bare vector; NaN for every other quantity, which has no neutral value
 //!   (Λ, G1, projected areas, Fresnel terms, heights, C¹, normalization factors).
 //!
-//! Grazing, exactly horizontal and below-horizon unit directions are valid input. The checks
-//! sit at the public boundary only: the walks call the same functions with directions they
-//! produced themselves, and the cost of a check is a length and a predicted branch.
+//! Grazing, exactly horizontal and below-horizon unit directions are valid input.
+//!
+//! The checks sit at the public boundary only. Inside the walks, which call the slope and
+//! material methods once or more per bounce with directions they produced themselves (unit up
+//! to rounding), the crate calls their `*_unchecked` twins (hidden trait methods that default
+//! to the checked ones, and that the crate's slopes and materials override with the unchecked
+//! bodies) and the unchecked Fresnel and frame helpers: a walk pays for the check of its own
+//! arguments once per call, never per bounce.
 
 use glam::{DVec3, Vec3};
 

@@ -80,6 +80,19 @@ impl Material for Conductor {
         _rng: &mut impl Rng,
     ) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_phase_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
+    }
+
+    #[inline]
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
@@ -99,6 +112,18 @@ impl Material for Conductor {
         wo_outside: bool,
     ) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
+        self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside)
+    }
+
+    #[inline]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return 0.0;
         };
@@ -117,10 +142,23 @@ impl Material for Conductor {
         _rng: &mut impl Rng,
     ) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
+    }
+
+    #[inline]
+    fn vertex_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return Vec3::ZERO;
         };
-        self.reflection_vertex(wi, wh, slope.d64(wh))
+        self.reflection_vertex(wi, wh, slope.d64_unchecked(wh))
     }
 
     /// One half vector and one D for the vertex term and both densities.
@@ -135,10 +173,23 @@ impl Material for Conductor {
         _rng: &mut impl Rng,
     ) -> (Vec3, f32, f32) {
         require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0, 0.0); wi, wo);
+        self.connection_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
+    }
+
+    #[inline]
+    fn connection_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> (Vec3, f32, f32) {
         let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
             return (Vec3::ZERO, 0.0, 0.0);
         };
-        let d = slope.d64(wh);
+        let d = slope.d64_unchecked(wh);
         // ωh is also the half vector of ωo → ωi
         let reverse = if wo.as_dvec3().dot(wh) > 0.0 { reflection_density(slope, wo, d) } else { 0.0 };
         (self.reflection_vertex(wi, wh, d), reflection_density(slope, wi, d), reverse)
@@ -154,7 +205,18 @@ impl Material for Conductor {
         rng: &mut impl Rng,
     ) -> PhaseSample {
         require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        self.sample_phase_unchecked(slope, wi, _wi_outside, rng)
+    }
+
+    #[inline]
+    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         let wo = renormalize(reflect(wi, wm), wm);
         PhaseSample { wo, weight: self.reflectance(wi.dot(wm)), outside: true }
     }
@@ -174,7 +236,7 @@ impl Material for Conductor {
             return Vec3::ZERO;
         }
         let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
-        let value = (slope.d64(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32;
+        let value = (slope.d64_unchecked(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32;
         self.fresnel(wi.as_dvec3().dot(wh) as f32) * value
     }
 }

@@ -58,10 +58,23 @@ impl Material for Diffuse {
         rng: &mut impl Rng,
     ) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_phase_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    #[inline]
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
         if !(wi_outside && wo_outside) {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0))
     }
 
@@ -80,6 +93,18 @@ impl Material for Diffuse {
         wo_outside: bool,
     ) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
+        self.pdf_phase_unchecked(_slope, wi, wo, wi_outside, wo_outside)
+    }
+
+    #[inline]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        _slope: &S,
+        _wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
         if !(wi_outside && wo_outside) {
             return 0.0;
         }
@@ -99,11 +124,24 @@ impl Material for Diffuse {
         rng: &mut impl Rng,
     ) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    #[inline]
+    fn vertex_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
         if !(wi_outside && wo_outside) || wi.z == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * slope.projected_area(wi) / wi.z.abs())
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
     /// ωm from D_ωi, then ωo cosine-distributed about ωm; weight a.
@@ -116,7 +154,18 @@ impl Material for Diffuse {
         rng: &mut impl Rng,
     ) -> PhaseSample {
         require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        self.sample_phase_unchecked(slope, wi, _wi_outside, rng)
+    }
+
+    #[inline]
+    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         let local = cosine_hemisphere(uniform(rng), uniform(rng));
         let (t, b) = basis(wm);
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
@@ -139,8 +188,8 @@ impl Material for Diffuse {
         if g2 == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        let g2_given_g1 = (1.0 + slope.lambda(wi)) * g2;
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        let g2_given_g1 = (1.0 + slope.lambda_unchecked(wi)) * g2;
         self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * g2_given_g1)
     }
 }

@@ -116,10 +116,88 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         rng: &mut impl Rng,
     ) -> (Vec3, f32, f32) {
         require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0, 0.0); wi, wo);
+        self.connection_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    // The methods without the argument check, for the crate's walks, which call them once or
+    // more per bounce with directions they produced themselves (unit up to rounding). The
+    // required ones default to the checked methods, so that a material outside the crate
+    // keeps its own behaviour; the crate's materials override them with the unchecked bodies.
+
+    /// [`Material::eval_phase`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
+        self.eval_phase(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    /// [`Material::sample_phase`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        self.sample_phase(slope, wi, wi_outside, rng)
+    }
+
+    /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
+        self.pdf_phase(slope, wi, wo, wi_outside, wo_outside)
+    }
+
+    /// [`Material::vertex`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn vertex_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
+        self.vertex(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    /// [`Material::connection`] without the argument check (crate-internal hot path): by
+    /// default the three separate unchecked calls.
+    #[doc(hidden)]
+    #[inline]
+    fn connection_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> (Vec3, f32, f32) {
         (
-            self.vertex(slope, wi, wo, wi_outside, wo_outside, rng),
-            self.pdf_phase(slope, wi, wo, wi_outside, wo_outside),
-            self.pdf_phase(slope, wo, wi, wo_outside, wi_outside),
+            self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, rng),
+            self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside),
+            self.pdf_phase_unchecked(slope, wo, wi, wo_outside, wi_outside),
         )
     }
 
@@ -166,19 +244,19 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
     if wi.z <= 0.0 || wo.z <= 0.0 {
         return 0.0;
     }
-    1.0 / (1.0 + slope.lambda(wi) + slope.lambda(wo))
+    1.0 / (1.0 + slope.lambda_unchecked(wi) + slope.lambda_unchecked(wo))
 }
 
 /// D_ωi(ωh)/(4 ωi·ωh) = D(ωh)/(4 A(ωi)) for a valid reflection half vector ωh (ωh.z > 0,
 /// ωi·ωh > 0); 0 where ωi sees no microsurface.
 #[inline(always)]
 pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DVec3) -> f32 {
-    reflection_density(slope, wi, slope.d64(wh))
+    reflection_density(slope, wi, slope.d64_unchecked(wh))
 }
 
 /// D(ωh)/(4 A(ω)) for D(ωh) = `d`: the reflection density of [`phase_reflection`] with D known.
 #[inline(always)]
 pub(crate) fn reflection_density<S: MicrosurfaceSlope>(slope: &S, w: Vec3, d: f64) -> f32 {
-    let area = slope.projected_area(w);
+    let area = slope.projected_area_unchecked(w);
     if area <= 0.0 { 0.0 } else { (0.25 * d / f64::from(area)) as f32 }
 }

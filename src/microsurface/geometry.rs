@@ -54,7 +54,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
         if w.z <= 0.0 {
             return 0.0;
         }
-        1.0 / (1.0 + self.slope.lambda(w))
+        1.0 / (1.0 + self.slope.lambda_unchecked(w))
     }
 
     /// The masking function at height h, G1(ω, h) = C¹(h)^Λ(ω) for ω.z > 0 and 0 for ω.z ≤ 0
@@ -69,7 +69,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
         if w.z <= 0.0 {
             return 0.0;
         }
-        escape_probability(self.height.c1(h), self.slope.lambda(w))
+        escape_probability(self.height.c1(h), self.slope.lambda_unchecked(w))
     }
 
     /// Samples the height of the next intersection of a ray leaving height `h0` in direction
@@ -90,7 +90,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
         if w.z == 0.0 {
             return if h0 == f32::INFINITY { HeightSample::Escape } else { HeightSample::Hit(h0) };
         }
-        match next_c1(w.z, self.slope.lambda(w), self.height.c1(h0), u) {
+        match next_c1(w.z, self.slope.lambda_unchecked(w), self.height.c1(h0), u) {
             Some(c) => HeightSample::Hit(self.height.inv_c1(c)),
             None => HeightSample::Escape,
         }

@@ -107,7 +107,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let slope = self.geometry.slope();
         let wo_outside = wo.z > 0.0;
         // Λ of ωo seen from its own side, constant along the walk
-        let lambda_o = slope.lambda(if wo_outside { wo } else { -wo });
+        let lambda_o = slope.lambda_unchecked(if wo_outside { wo } else { -wo });
         let last = order.last();
 
         let mut wr = -wi;
@@ -119,7 +119,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else { break };
             ln_c1 = next;
             if order.includes(bounce) {
-                let phase = self.material.eval_phase(slope, -wr, wo, outside, wo_outside, rng);
+                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, outside, wo_outside, rng);
                 if phase != Vec3::ZERO {
                     let ln_c1_o = if outside == wo_outside { ln_c1 } else { flip_ln_c1(ln_c1) };
                     sum += throughput * phase * (lambda_o * ln_c1_o).exp();
@@ -128,7 +128,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase(slope, -wr, outside, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
             if s.outside != outside {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
@@ -163,7 +163,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 return Some(WalkSample { wo: wr, weight, bounces });
             };
             ln_c1 = next;
-            let s = self.material.sample_phase(slope, -wr, outside, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
             if s.outside != outside {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
@@ -183,6 +183,6 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     #[inline(always)]
     fn next_ln_c1(&self, wr: Vec3, ln_c1: f32, outside: bool, rng: &mut impl Rng) -> Option<f32> {
         let w = if outside { wr } else { -wr };
-        next_ln_c1(w.z, self.geometry.slope().lambda(w), ln_c1, uniform(rng))
+        next_ln_c1(w.z, self.geometry.slope().lambda_unchecked(w), ln_c1, uniform(rng))
     }
 }

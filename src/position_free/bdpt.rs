@@ -128,7 +128,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 // the contribution of the connection with the densities of its direction pair
                 let (contribution, forward, reverse) = if t == 0 {
                     let reverse = if s >= 1 {
-                        f64::from(self.material.pdf_phase(&self.slope, out, at.w, out_outside, at.outside))
+                        f64::from(self.material.pdf_phase_unchecked(
+                            &self.slope,
+                            out,
+                            at.w,
+                            out_outside,
+                            at.outside,
+                        ))
                     } else {
                         0.0
                     };
@@ -143,8 +149,14 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     if factor == 0.0 {
                         continue;
                     }
-                    let (v, forward, reverse) =
-                        self.material.connection(&self.slope, at.w, out, at.outside, out_outside, rng);
+                    let (v, forward, reverse) = self.material.connection_unchecked(
+                        &self.slope,
+                        at.w,
+                        out,
+                        at.outside,
+                        out_outside,
+                        rng,
+                    );
                     (v.as_dvec3() * factor, f64::from(forward), f64::from(reverse))
                 };
                 if contribution == DVec3::ZERO {
@@ -197,9 +209,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             }
             let x = -next.w;
             let pdf_forward =
-                f64::from(self.material.pdf_phase(&self.slope, at.w, x, at.outside, next.outside));
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, at.w, x, at.outside, next.outside));
             let pdf_reverse_prev =
-                f64::from(self.material.pdf_phase(&self.slope, x, at.w, next.outside, at.outside));
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, x, at.w, next.outside, at.outside));
             // the connection of the new vertex to ωo, the (s, 0) strategy's
             let connection = self.connect_known(next, k_next, to_wo, true, rng);
             if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
@@ -230,7 +242,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let (mut b, mut b_outside) = (wo, wo_outside);
         let mut throughput = DVec3::ONE;
         for (i, slot) in out.iter_mut().enumerate().take(max) {
-            let s = self.material.sample_phase(&self.slope, b, b_outside, rng);
+            let s = self.material.sample_phase_unchecked(&self.slope, b, b_outside, rng);
             let a = Incident { w: s.wo, outside: s.outside };
             let k_in = inv_g1(&self.slope, in_side_frame(a.w, a.outside));
             if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
@@ -238,17 +250,18 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             }
             let factor = self.shadowing_factor(a, k_in, self.exit(b, b_outside), i == 0)
                 * f64::from(self.material.relative_eta_sq(a.outside, b_outside))
-                * f64::from(self.slope.projected_area(in_side_frame(b, b_outside)))
+                * f64::from(self.slope.projected_area_unchecked(in_side_frame(b, b_outside)))
                 / f64::from(a.w.z.abs());
             throughput *= s.weight.as_dvec3() * factor;
             if throughput == DVec3::ZERO || !throughput.is_finite() {
                 return i;
             }
-            let pdf_reverse = f64::from(self.material.pdf_phase(&self.slope, b, a.w, b_outside, a.outside));
+            let pdf_reverse =
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, b, a.w, b_outside, a.outside));
             let pdf_forward_out = if i == 0 {
                 0.0
             } else {
-                f64::from(self.material.pdf_phase(&self.slope, a.w, b, a.outside, b_outside))
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, a.w, b, a.outside, b_outside))
             };
             if i as u32 + 1 >= ROULETTE_FROM_BOUNCE {
                 let q = throughput.max_element().min(1.0);

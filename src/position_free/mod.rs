@@ -176,7 +176,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let mut at = Self::incident(wi)?;
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
-            let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
@@ -204,7 +204,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
         require!(is_direction(wi), None; wi);
         let at = Self::incident_single(wi)?;
-        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
         let last = self.shadowing_factor(at, k_in, self.exit(s.wo, s.outside), true) * k_in;
         let weight = s.weight * last as f32;
@@ -221,7 +221,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let (Some(start), Some(wo_outside)) = (Self::incident_single(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside)
+        self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside)
     }
 
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
@@ -237,7 +237,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        let single = self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside);
+        let single = self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside);
         let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
         (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
     }
@@ -306,7 +306,8 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         if factor == 0.0 {
             return DVec3::ZERO;
         }
-        self.material.vertex(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3() * factor
+        self.material.vertex_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3()
+            * factor
     }
 
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
@@ -319,7 +320,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             w,
             outside,
             can_exit,
-            lambda: if can_exit { f64::from(self.slope.lambda(frame)) } else { 0.0 },
+            lambda: if can_exit { f64::from(self.slope.lambda_unchecked(frame)) } else { 0.0 },
         }
     }
 

@@ -78,7 +78,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         if k_in == 0.0 || !k_in.is_finite() {
             return None;
         }
-        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
         let out = self.exit(s.wo, s.outside);
         let middle = self.shadowing_factor(at, k_in, out, false);
         // the next incident direction −ω: below the horizon in its frame where ω can exit, and

@@ -158,12 +158,22 @@ impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
         require!(is_direction64(wm), 0.0; wm);
+        self.d64_unchecked(wm)
+    }
+
+    #[inline]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
         self.d_double(wm)
     }
 
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
+        self.lambda_unchecked(w)
+    }
+
+    #[inline]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let a = f64::from(w.z.abs()) / q.sqrt();
         let up = lambda_up64(a);
@@ -174,6 +184,11 @@ impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w)
+    }
+
+    #[inline]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         self.projected_area64(w) as f32
     }
 
@@ -183,12 +198,17 @@ impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
-        self.d_wi64(wi, wm.as_dvec3()) as f32
+        self.d_wi64_unchecked(wi, wm.as_dvec3()) as f32
     }
 
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
         require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
+        self.d_wi64_unchecked(wi, wm)
+    }
+
+    #[inline]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
         let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
@@ -216,6 +236,11 @@ impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+        self.sample_d_wi_unchecked(wi, u1, u2)
+    }
+
+    #[inline]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
         let (sx, sy, z) = (ax * f64::from(wi.x), ay * f64::from(wi.y), f64::from(wi.z));
         let len_xy = (sx * sx + sy * sy).sqrt();

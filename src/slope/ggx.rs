@@ -2,7 +2,7 @@
 
 use super::{
     DIRECT_SCALE_RANGE, MicrosurfaceSlope, check_roughness, ensure_visible, is_direction, is_direction64,
-    is_uniform, normalize_fast, normalize_scaled, projected_roughness_sq,
+    is_uniform, normalize_fast, normalize_scaled, projected_roughness_sq, smith_d_wi64,
 };
 use crate::error::Error;
 use crate::special::sin_cos_turns;
@@ -55,6 +55,11 @@ fn lambda_up(q: f32, z: f32) -> f32 {
 
 impl MicrosurfaceSlope for Ggx {
     #[inline]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
+        smith_d_wi64(self, wi, wm)
+    }
+
+    #[inline]
     fn alpha_x(&self) -> f32 {
         self.alpha_x
     }
@@ -88,6 +93,11 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
         require!(is_direction64(wm), 0.0; wm);
+        self.d64_unchecked(wm)
+    }
+
+    #[inline]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
         if wm.z <= 0.0 {
             return 0.0;
         }
@@ -100,6 +110,11 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
+        self.lambda_unchecked(w)
+    }
+
+    #[inline]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         if w.z >= 0.0 { lambda_up(q, w.z) } else { -1.0 - lambda_up(q, -w.z) }
     }
@@ -110,6 +125,11 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w)
+    }
+
+    #[inline]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         let root = (w.z * w.z + q).sqrt();
         if w.z >= 0.0 { 0.5 * (w.z + root) } else { q / (2.0 * (root - w.z)) }
@@ -137,6 +157,11 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+        self.sample_d_wi_unchecked(wi, u1, u2)
+    }
+
+    #[inline]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let stretched = Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z);
         let len_sq = stretched.length_squared();
         let (v, len) = if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {

@@ -11,7 +11,6 @@ pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use ggx::Ggx;
 
-#[allow(unused_imports)]
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
@@ -77,12 +76,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
         require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
-        let cos_im = wi.as_dvec3().dot(wm);
-        if cos_im <= 0.0 || wm.z <= 0.0 {
-            return 0.0;
-        }
-        let area = f64::from(self.projected_area(wi));
-        if area <= 0.0 { 0.0 } else { cos_im * self.d64(wm) / area }
+        smith_d_wi64(self, wi, wm)
     }
 
     /// The projected roughness αᵢ = √(cos²φ αx² + sin²φ αy²) in the azimuth of ω
@@ -135,6 +129,57 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         let slope_y = ay * (sin_phi * s.x + cos_phi * s.y);
         ensure_visible(wi, normal_from_slopes(slope_x, slope_y))
     }
+
+    // The same quantities without the argument check, for the crate's walks, which call them
+    // once or more per bounce with directions they produced themselves (unit up to rounding).
+    // Each defaults to the checked method, so that an implementation outside the crate keeps
+    // its own overrides; the crate's slopes override them with the unchecked bodies.
+
+    /// [`Self::lambda`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
+        self.lambda(w)
+    }
+
+    /// [`Self::projected_area`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
+        self.projected_area(w)
+    }
+
+    /// [`Self::d64`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
+        self.d64(wm)
+    }
+
+    /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
+        self.d_wi64(wi, wm)
+    }
+
+    /// [`Self::sample_d_wi`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        self.sample_d_wi(wi, u1, u2)
+    }
+}
+
+/// The default D_ωi(ωm) in double precision, cos⟨ωi, ωm⟩ D(ωm)/A(ωi), without the argument check.
+#[inline(always)]
+pub(crate) fn smith_d_wi64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: DVec3) -> f64 {
+    let cos_im = wi.as_dvec3().dot(wm);
+    if cos_im <= 0.0 || wm.z <= 0.0 {
+        return 0.0;
+    }
+    let area = f64::from(slope.projected_area_unchecked(wi));
+    if area <= 0.0 { 0.0 } else { cos_im * slope.d64_unchecked(wm) / area }
 }
 
 /// An f32 dot product of two unit vectors above this is positive in exact arithmetic too

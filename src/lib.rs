@@ -25,9 +25,24 @@
 //! assert!(s.bounces >= 1 && s.weight == Vec3::ONE);
 //! # Ok::<(), microsurface::Error>(())
 //! ```
+//!
+//! # Invalid input
+//!
+//! One policy for every public entry point: an argument outside its function's domain (a
+//! direction that is zero, has a NaN or ±∞ component, or is not unit within
+//! [`DIRECTION_TOLERANCE`]; a NaN scalar; a uniform outside [0, 1], a cosine beyond
+//! ±(1 + [`DIRECTION_TOLERANCE`]), an η that is not finite and > 0) is a contract violation. It
+//! panics in debug builds (a debug assertion whose message starts with `invalid input`), and
+//! release builds return the function's documented *nothing*, never a plausible value: 0 for
+//! BSDF values, phase functions and densities; `None` from samplers that return an `Option`
+//! and a NaN direction (with a zero weight) from those that do not; NaN for quantities
+//! without a neutral value (Λ, G1, projected areas, Fresnel terms, heights). Grazing, exactly
+//! horizontal and below-horizon unit directions are valid input.
 
 #![warn(missing_docs)]
 
+#[macro_use]
+mod contract;
 mod bsdf;
 mod error;
 mod frame;
@@ -45,6 +60,7 @@ pub use bsdf::{
     Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder, MicrofacetBsdf,
     SampleFlags, ShadingFrame, Technique, Transport,
 };
+pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
 pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
 pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};

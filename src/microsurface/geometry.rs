@@ -1,6 +1,7 @@
 //! Material-independent geometry of the microsurface: masking and the height of the next
 //! intersection (Heitz et al. 2016, supplement §3.1).
 
+use crate::contract::{is_direction, is_uniform};
 use crate::height::MicrosurfaceHeight;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
@@ -44,23 +45,31 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
 
     /// The masking function averaged over heights, G1(ω) = 1/(1 + Λ(ω)) for ω.z > 0 and 0 for
     /// ω.z ≤ 0 (supplement §3.1). In [0, 1]; 1 at the zenith, 0 at the horizon.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `w` that is not a unit direction gives
+    /// NaN (a debug assertion in debug builds).
     #[inline]
     pub fn g1(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
         if w.z <= 0.0 {
             return 0.0;
         }
-        1.0 / (1.0 + self.slope.lambda(w))
+        1.0 / (1.0 + self.slope.lambda_unchecked(w))
     }
 
     /// The masking function at height h, G1(ω, h) = C¹(h)^Λ(ω) for ω.z > 0 and 0 for ω.z ≤ 0
     /// (supplement §3.1): the probability that a ray leaving height h in direction ω escapes.
     /// `h` may be +∞ (above the surface: 1).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `w` that is not a unit direction or a
+    /// NaN `h` gives NaN (a debug assertion in debug builds).
     #[inline]
     pub fn g1_at(&self, w: Vec3, h: f32) -> f32 {
+        require!(is_direction(w) && !h.is_nan(), f32::NAN; w, h);
         if w.z <= 0.0 {
             return 0.0;
         }
-        escape_probability(self.height.c1(h), self.slope.lambda(w))
+        escape_probability(self.height.c1(h), self.slope.lambda_unchecked(w))
     }
 
     /// Samples the height of the next intersection of a ray leaving height `h0` in direction
@@ -71,12 +80,17 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
     /// Special cases: a ray straight up (Λ = 0) always escapes; a downward ray always hits
     /// (below h0; straight down, uniformly in C¹ below h0); a horizontal ray hits at h0
     /// itself, or escapes if h0 = +∞.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `w` that is not a unit direction, a
+    /// NaN `h0` or a `u` outside [0, 1] gives `HeightSample::Hit(NaN)` (a debug assertion in
+    /// debug builds).
     #[inline]
     pub fn sample_height(&self, w: Vec3, h0: f32, u: f32) -> HeightSample {
+        require!(is_direction(w) && !h0.is_nan() && is_uniform(u), HeightSample::Hit(f32::NAN); w, h0, u);
         if w.z == 0.0 {
             return if h0 == f32::INFINITY { HeightSample::Escape } else { HeightSample::Hit(h0) };
         }
-        match next_c1(w.z, self.slope.lambda(w), self.height.c1(h0), u) {
+        match next_c1(w.z, self.slope.lambda_unchecked(w), self.height.c1(h0), u) {
             Some(c) => HeightSample::Hit(self.height.inv_c1(c)),
             None => HeightSample::Escape,
         }

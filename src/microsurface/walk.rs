@@ -3,6 +3,7 @@
 
 use super::Microsurface;
 use super::geometry::{first_ln_c1_from_below, flip_ln_c1, next_ln_c1};
+use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::Material;
 use crate::rng::uniform;
@@ -98,7 +99,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// material lit from below the macrosurface (ωi.z < 0: a backfacing view under a normal
     /// map) starts with the full-spherical first intersection of
     /// [`Microsurface::eval_from_below`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let Some(mut outside) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 {
                 self.eval_from_below(wi, wo, order, rng)
@@ -112,7 +117,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let slope = self.geometry.slope();
         let wo_outside = wo.z > 0.0;
         // Λ of ωo seen from its own side, constant along the walk
-        let lambda_o = slope.lambda(if wo_outside { wo } else { -wo });
+        let lambda_o = slope.lambda_unchecked(if wo_outside { wo } else { -wo });
         let last = order.last();
 
         let mut wr = -wi;
@@ -124,7 +129,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else { break };
             ln_c1 = next;
             if order.includes(bounce) {
-                let phase = self.material.eval_phase(slope, -wr, wo, outside, wo_outside, rng);
+                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, outside, wo_outside, rng);
                 if phase != Vec3::ZERO {
                     let ln_c1_o = if outside == wo_outside { ln_c1 } else { flip_ln_c1(ln_c1) };
                     sum += throughput * phase * (lambda_o * ln_c1_o).exp();
@@ -133,7 +138,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase(slope, -wr, outside, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
             if s.outside != outside {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
@@ -155,7 +160,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// material), if the path was fully absorbed, or if it reached [`MAX_BOUNCES`]. An opaque
     /// material lit from below the macrosurface (ωi.z < 0) is sampled by
     /// [`Microsurface::sample_from_below`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
+        require!(is_direction(wi), None; wi);
         let Some(mut outside) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 { self.sample_from_below(wi, rng) } else { None };
         };
@@ -168,7 +177,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 return Some(WalkSample { wo: wr, weight, bounces });
             };
             ln_c1 = next;
-            let s = self.material.sample_phase(slope, -wr, outside, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
             if s.outside != outside {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
@@ -214,7 +223,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut bounce = 1;
         loop {
             if order.includes(bounce) {
-                let phase = self.material.eval_phase(slope, -wr, wo, true, true, rng);
+                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, true, true, rng);
                 if phase != Vec3::ZERO {
                     sum += throughput * phase * (lambda_o * ln_c1).exp();
                 }
@@ -222,7 +231,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase(slope, -wr, true, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, true, rng);
             wr = s.wo;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {
@@ -253,7 +262,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut ln_c1 = first_ln_c1_from_below(slope.lambda(wr), uniform(rng))?;
         let mut weight = Vec3::ONE;
         for bounces in 1..=MAX_BOUNCES {
-            let s = self.material.sample_phase(slope, -wr, true, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, true, rng);
             wr = s.wo;
             weight *= s.weight;
             if weight == Vec3::ZERO {
@@ -273,6 +282,6 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     #[inline(always)]
     fn next_ln_c1(&self, wr: Vec3, ln_c1: f32, outside: bool, rng: &mut impl Rng) -> Option<f32> {
         let w = if outside { wr } else { -wr };
-        next_ln_c1(w.z, self.geometry.slope().lambda(w), ln_c1, uniform(rng))
+        next_ln_c1(w.z, self.geometry.slope().lambda_unchecked(w), ln_c1, uniform(rng))
     }
 }

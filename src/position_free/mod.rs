@@ -14,6 +14,7 @@ mod segment;
 
 pub use segment::Shadowing;
 
+use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::WalkSample;
 use crate::rng::uniform;
@@ -118,6 +119,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     }
 
     /// Evaluates f·|cos θo| with the chosen estimator and orders; unbiased and stochastic.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): checked by the estimators
+    /// ([`PositionFree::eval_pt`], [`PositionFree::eval_bdpt`]): 0 for a `wi` or `wo` that is
+    /// not a unit direction.
     pub fn eval(
         &self,
         wi: Vec3,
@@ -136,7 +141,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// times |cos θo| with this model's masking-shadowing — G1(ωi)G1(ωo) uncorrelated,
     /// 1/(1 + Λ(ωi) + Λ(ωo)) or B(1 + Λ(ωi), 1 + Λ(−ωo)) correlated. Exact, except for diffuse
     /// facets (unbiased estimate).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
@@ -162,7 +171,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
     /// the material (on the horizon, or at the nadir of an opaque material, where no facet
     /// faces it), or the walk reached [`crate::MAX_BOUNCES`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
+        require!(is_direction(wi), None; wi);
         let mut at = Self::incident(wi)?;
         if wi.z < 0.0 && inv_g1(&self.slope, in_side_frame(at.w, at.outside)) == 0.0 {
             // ωi at the nadir of an opaque material: no facet faces it (projected area 0)
@@ -170,7 +183,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         }
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
-            let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
@@ -192,9 +205,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// sampling and the material's event choice), weighted by w·S_last/G1(ωi) so that the
     /// weight is v·S_last·|cos θo|/pdf exactly. Returns (ωo, weight); `None` if ωi cannot light
     /// the material or the sampled direction cannot leave the surface.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
+        require!(is_direction(wi), None; wi);
         let at = Self::incident(wi)?;
-        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
         let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
         let last = self.shadowing_factor(at, k_in, self.exit(s.wo, s.outside), true) * k_in;
         let weight = s.weight * last as f32;
@@ -203,11 +220,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
 
     /// The density of [`PositionFree::sample_single`]: the phase function's sampling density
     /// (exact for conductors and dielectrics).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside)
+        self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside)
     }
 
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
@@ -215,11 +236,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// on ωo's side (divided between both sides for a dielectric). Like the papers' `pdf()`,
     /// it is **not** the density of what `sample` draws (which has no closed form); the
     /// weights of `sample` never use it.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        let single = self.material.pdf_phase(&self.slope, start.w, wo, start.outside, wo_outside);
+        let single = self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside);
         let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
         (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
     }
@@ -287,7 +312,8 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         if factor == 0.0 {
             return DVec3::ZERO;
         }
-        self.material.vertex(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3() * factor
+        self.material.vertex_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3()
+            * factor
     }
 
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
@@ -300,7 +326,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             w,
             outside,
             can_exit,
-            lambda: if can_exit { f64::from(self.slope.lambda(frame)) } else { 0.0 },
+            lambda: if can_exit { f64::from(self.slope.lambda_unchecked(frame)) } else { 0.0 },
         }
     }
 

@@ -30,7 +30,11 @@ pub(crate) fn in_side_frame(w: Vec3, outside: bool) -> Vec3 {
 /// evaluated directly, without cancellation. In [0, ∞): 0 only straight from below.
 #[inline(always)]
 pub(crate) fn inv_g1<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> f64 {
-    if w.z >= 0.0 { 1.0 + f64::from(slope.lambda(w)) } else { f64::from(slope.lambda(-w)) }
+    if w.z >= 0.0 {
+        1.0 + f64::from(slope.lambda_unchecked(w))
+    } else {
+        f64::from(slope.lambda_unchecked(-w))
+    }
 }
 
 /// The shadowing factors of one vertex: `last` when the path leaves through the outgoing

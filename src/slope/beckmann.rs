@@ -1,6 +1,9 @@
 //! The Beckmann slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, ensure_visible, normal_from_slopes};
+use super::{
+    MicrosurfaceSlope, check_roughness, ensure_visible, is_direction, is_direction64, is_uniform,
+    normal_from_slopes,
+};
 use crate::error::Error;
 use crate::special::{erfc_inv_f32, erfcx64};
 use glam::{DVec3, Vec2, Vec3};
@@ -138,6 +141,7 @@ impl MicrosurfaceSlope for Beckmann {
 
     #[inline]
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
+        require!(!slope_x.is_nan() && !slope_y.is_nan(), 0.0; slope_x, slope_y);
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
         let (x, y) = (f64::from(slope_x) / ax, f64::from(slope_y) / ay);
         ((-(x * x) - y * y).exp() * INV_PI / (ax * ay)) as f32
@@ -147,16 +151,29 @@ impl MicrosurfaceSlope for Beckmann {
     /// an f32 exponent E grows as E·2⁻²⁴, and m.z⁴ would underflow before the exponential.
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
+        require!(is_direction(wm), 0.0; wm);
         self.d_double(wm.as_dvec3()) as f32
     }
 
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        require!(is_direction64(wm), 0.0; wm);
+        self.d64_unchecked(wm)
+    }
+
+    #[inline]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
         self.d_double(wm)
     }
 
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.lambda_unchecked(w)
+    }
+
+    #[inline]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let a = f64::from(w.z.abs()) / q.sqrt();
         let up = lambda_up64(a);
@@ -166,6 +183,12 @@ impl MicrosurfaceSlope for Beckmann {
 
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w)
+    }
+
+    #[inline]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         self.projected_area64(w) as f32
     }
 
@@ -174,11 +197,18 @@ impl MicrosurfaceSlope for Beckmann {
     /// logarithms ln D − ln A, with ln A = −a² + ln(αᵢ sin θ/(2√π)) + ln(1 − √π a erfcx(a)).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
-        self.d_wi64(wi, wm.as_dvec3()) as f32
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
+        self.d_wi64_unchecked(wi, wm.as_dvec3()) as f32
     }
 
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
+        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
+        self.d_wi64_unchecked(wi, wm)
+    }
+
+    #[inline]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
         let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
@@ -205,6 +235,12 @@ impl MicrosurfaceSlope for Beckmann {
     /// their spread (5 % at |cot θ| = 480).
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+        self.sample_d_wi_unchecked(wi, u1, u2)
+    }
+
+    #[inline]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
         let (sx, sy, z) = (ax * f64::from(wi.x), ay * f64::from(wi.y), f64::from(wi.z));
         let len_xy = (sx * sx + sy * sy).sqrt();
@@ -227,6 +263,11 @@ impl MicrosurfaceSlope for Beckmann {
     /// visible, returns the zero slope.
     #[inline]
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        require!(
+            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
+            Vec2::NAN;
+            cos_theta, sin_theta, u1, u2
+        );
         let (c, s) = (f64::from(cos_theta), f64::from(sin_theta));
         let slope_x = if s > 0.0 {
             visible_slope_x(c / s, f64::from(u1))

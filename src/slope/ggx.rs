@@ -1,8 +1,8 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
 use super::{
-    DIRECT_SCALE_RANGE, MicrosurfaceSlope, check_roughness, ensure_visible, normalize_fast, normalize_scaled,
-    projected_roughness_sq,
+    DIRECT_SCALE_RANGE, MicrosurfaceSlope, check_roughness, ensure_visible, is_direction, is_direction64,
+    is_uniform, normalize_fast, normalize_scaled, projected_roughness_sq, smith_d_wi64,
 };
 use crate::error::Error;
 use crate::special::sin_cos_turns;
@@ -55,6 +55,11 @@ fn lambda_up(q: f32, z: f32) -> f32 {
 
 impl MicrosurfaceSlope for Ggx {
     #[inline]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
+        smith_d_wi64(self, wi, wm)
+    }
+
+    #[inline]
     fn alpha_x(&self) -> f32 {
         self.alpha_x
     }
@@ -66,6 +71,7 @@ impl MicrosurfaceSlope for Ggx {
 
     #[inline]
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
+        require!(!slope_x.is_nan() && !slope_y.is_nan(), 0.0; slope_x, slope_y);
         let (x, y) = (slope_x / self.alpha_x, slope_y / self.alpha_y);
         let t = 1.0 + x * x + y * y;
         FRAC_1_PI / (self.alpha_x * self.alpha_y * t * t)
@@ -75,6 +81,7 @@ impl MicrosurfaceSlope for Ggx {
     /// multiplied through by cos⁴θm, finite down to m.z = 0.
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
+        require!(is_direction(wm), 0.0; wm);
         if wm.z <= 0.0 {
             return 0.0;
         }
@@ -85,6 +92,12 @@ impl MicrosurfaceSlope for Ggx {
 
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        require!(is_direction64(wm), 0.0; wm);
+        self.d64_unchecked(wm)
+    }
+
+    #[inline]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
         if wm.z <= 0.0 {
             return 0.0;
         }
@@ -96,6 +109,12 @@ impl MicrosurfaceSlope for Ggx {
 
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.lambda_unchecked(w)
+    }
+
+    #[inline]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         if w.z >= 0.0 { lambda_up(q, w.z) } else { -1.0 - lambda_up(q, -w.z) }
     }
@@ -105,6 +124,12 @@ impl MicrosurfaceSlope for Ggx {
     /// cancellation there.
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w)
+    }
+
+    #[inline]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         let root = (w.z * w.z + q).sqrt();
         if w.z >= 0.0 { 0.5 * (w.z + root) } else { q / (2.0 * (root - w.z)) }
@@ -114,6 +139,11 @@ impl MicrosurfaceSlope for Ggx {
     /// to cos θm = 0 are computed with cos θm = `f32::MIN_POSITIVE` (finite, probability 0).
     #[inline]
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        require!(
+            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
+            Vec2::NAN;
+            cos_theta, sin_theta, u1, u2
+        );
         // slopes are invariant under scaling, so the unnormalized normal serves
         let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), 1.0, u1, u2);
         let z = m.z.max(MIN_SLOPE_COS * m.length());
@@ -126,6 +156,12 @@ impl MicrosurfaceSlope for Ggx {
     /// scale (a square root, no division).
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+        self.sample_d_wi_unchecked(wi, u1, u2)
+    }
+
+    #[inline]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let stretched = Vec3::new(self.alpha_x * wi.x, self.alpha_y * wi.y, wi.z);
         let len_sq = stretched.length_squared();
         let (v, len) = if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {

@@ -11,6 +11,7 @@ pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use ggx::Ggx;
 
+pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -20,6 +21,14 @@ use glam::{DVec3, Vec2, Vec3};
 /// Implementors provide the primitives `p22`, `d`, `lambda`, `projected_area` and
 /// `sample_p22_11`; `alpha_i`, `d_wi` and `sample_d_wi` are derived (and may be overridden
 /// with faster or more accurate forms).
+///
+/// Invalid input ([policy](crate#invalid-input)), the same for every method and every
+/// implementation of the crate: a direction argument that is zero, has a NaN or ±∞ component,
+/// or is not unit within [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE), a NaN slope, or
+/// a uniform outside [0, 1] trips a debug assertion in debug builds; release builds return 0
+/// from the densities (`p22`, `d`, `d64`, `d_wi`, `d_wi64`), NaN from `lambda`,
+/// `projected_area` and `alpha_i`, and a NaN vector from the samplers (`sample_p22_11`,
+/// `sample_d_wi`). Grazing and below-horizon unit directions are valid everywhere.
 pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along x.
     fn alpha_x(&self) -> f32;
@@ -59,24 +68,22 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Beckmann exponent t).
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        require!(is_direction64(wm), 0.0; wm);
         f64::from(self.d(wm.as_vec3()))
     }
 
     /// D_ωi(ωm) in double precision for ωm given in double precision (see [`Self::d64`]).
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
-        let cos_im = wi.as_dvec3().dot(wm);
-        if cos_im <= 0.0 || wm.z <= 0.0 {
-            return 0.0;
-        }
-        let area = f64::from(self.projected_area(wi));
-        if area <= 0.0 { 0.0 } else { cos_im * self.d64(wm) / area }
+        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
+        smith_d_wi64(self, wi, wm)
     }
 
     /// The projected roughness αᵢ = √(cos²φ αx² + sin²φ αy²) in the azimuth of ω
     /// (supplement §2.1). At ω = ±z, where φ is undefined, returns αx.
     #[inline]
     fn alpha_i(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
         // scaled by the larger horizontal component so that x² + y² cannot underflow
         let scale = w.x.abs().max(w.y.abs());
         if scale == 0.0 {
@@ -92,6 +99,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// i.e. ωi = −z).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         let cos_im = wi.dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
@@ -110,6 +118,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// returns +z.
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
         let (ax, ay) = (self.alpha_x(), self.alpha_y());
         let stretched = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         let sin_theta = (stretched.x * stretched.x + stretched.y * stretched.y).sqrt();
@@ -120,6 +129,57 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         let slope_y = ay * (sin_phi * s.x + cos_phi * s.y);
         ensure_visible(wi, normal_from_slopes(slope_x, slope_y))
     }
+
+    // The same quantities without the argument check, for the crate's walks, which call them
+    // once or more per bounce with directions they produced themselves (unit up to rounding).
+    // Each defaults to the checked method, so that an implementation outside the crate keeps
+    // its own overrides; the crate's slopes override them with the unchecked bodies.
+
+    /// [`Self::lambda`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
+        self.lambda(w)
+    }
+
+    /// [`Self::projected_area`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
+        self.projected_area(w)
+    }
+
+    /// [`Self::d64`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
+        self.d64(wm)
+    }
+
+    /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
+        self.d_wi64(wi, wm)
+    }
+
+    /// [`Self::sample_d_wi`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        self.sample_d_wi(wi, u1, u2)
+    }
+}
+
+/// The default D_ωi(ωm) in double precision, cos⟨ωi, ωm⟩ D(ωm)/A(ωi), without the argument check.
+#[inline(always)]
+pub(crate) fn smith_d_wi64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: DVec3) -> f64 {
+    let cos_im = wi.as_dvec3().dot(wm);
+    if cos_im <= 0.0 || wm.z <= 0.0 {
+        return 0.0;
+    }
+    let area = f64::from(slope.projected_area_unchecked(wi));
+    if area <= 0.0 { 0.0 } else { cos_im * slope.d64_unchecked(wm) / area }
 }
 
 /// An f32 dot product of two unit vectors above this is positive in exact arithmetic too

@@ -2,6 +2,7 @@
 
 use super::VisibleNormalSampler;
 use super::disk::{half_space_band, sample_band};
+use crate::contract::{are_uniform, is_direction};
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes};
 use crate::special::{erf64, erfinv64};
 use glam::Vec3;
@@ -24,11 +25,13 @@ pub struct SmithVndf<S>(pub S);
 impl<S: MicrosurfaceSlope> VisibleNormalSampler for SmithVndf<S> {
     #[inline]
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         self.0.sample_d_wi(wi, u[0], u[1])
     }
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
@@ -42,11 +45,13 @@ pub struct GgxSphericalCap(pub Ggx);
 impl VisibleNormalSampler for GgxSphericalCap {
     #[inline]
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         self.0.sample_d_wi(wi, u[0], u[1])
     }
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
@@ -63,6 +68,7 @@ pub struct GgxDisk(pub Ggx);
 impl VisibleNormalSampler for GgxDisk {
     #[inline]
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         let (ax, ay) = (self.0.alpha_x(), self.0.alpha_y());
         let v = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         let len_xy = (v.x * v.x + v.y * v.y).sqrt();
@@ -82,6 +88,7 @@ impl VisibleNormalSampler for GgxDisk {
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
@@ -99,6 +106,7 @@ pub struct BeckmannNewton(pub Beckmann);
 
 impl VisibleNormalSampler for BeckmannNewton {
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         let (ax, ay) = (self.0.alpha_x(), self.0.alpha_y());
         let v = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         if v.z <= 0.0 {
@@ -114,6 +122,7 @@ impl VisibleNormalSampler for BeckmannNewton {
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }

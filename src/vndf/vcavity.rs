@@ -2,6 +2,7 @@
 
 use super::VisibleNormalSampler;
 use super::disk::{half_space_band, sample_band};
+use crate::contract::{are_uniform, is_direction, is_plane_normal};
 use crate::slope::{
     Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes, one_minus_scaled_erfcx,
     visible_slope_x_above,
@@ -20,6 +21,13 @@ const BOUNDARY_SLOPE_FACTOR: f32 = 3.0;
 
 /// Slope distributions with the closed forms the V-cavity model needs: the hit probability
 /// H(i) and restricted samplers (Tokuyoshi, supplement §2.2–2.3).
+///
+/// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit direction,
+/// a plane normal `k` whose squared length is not a normal finite f32 (zero, NaN, ∞, or so
+/// short or long that it under- or overflows; its length is otherwise free), or a uniform outside
+/// [0, 1] trips a debug assertion in debug builds; release builds return NaN from the
+/// probabilities, −∞ from `ln_d` (the logarithm of the density's nothing, 0) and a NaN normal
+/// from the samplers.
 pub trait VCavitySlope: MicrosurfaceSlope {
     /// The hit probability H(i) = ∫ G(i, m) max(i·m, 0) D(m) dm / |i·n| (§2.2): 1 for
     /// i.z ≥ 0; for i.z < 0 in closed form.
@@ -31,12 +39,14 @@ pub trait VCavitySlope: MicrosurfaceSlope {
 
     /// ln H(i) in double precision (finite where H underflows in f32).
     fn ln_hit_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         f64::from(self.hit_probability(wi)).ln()
     }
 
     /// For a backfacing i: the probability 2 ∫_{x<3cotθ} P2 / H(i) of the branch that samples
     /// D(m) m.z below the boundary slope (Tokuyoshi, eq. 5), in [0, 1].
     fn projected_branch_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         let boundary = Vec3::new(wi.x, wi.y, BOUNDARY_SLOPE_FACTOR * wi.z);
         let h = self.hit_probability(wi);
         if h <= 0.0 {
@@ -48,6 +58,7 @@ pub trait VCavitySlope: MicrosurfaceSlope {
 
     /// ln D(m) in double precision (−∞ where D is 0).
     fn ln_d(&self, wm: Vec3) -> f64 {
+        require!(is_direction(wm), f64::NEG_INFINITY; wm);
         self.d64(wm.as_dvec3()).ln()
     }
 
@@ -89,6 +100,7 @@ impl VCavitySlope for Ggx {
     /// evaluated without cancellation as q (1/(A + 3|i_z|) + 1/(B + |i_z|))/(A + B) with
     /// A = √(q + 9 i_z²), B = √(q + i_z²).
     fn hit_probability(&self, wi: Vec3) -> f32 {
+        require!(is_direction(wi), f32::NAN; wi);
         if wi.z >= 0.0 {
             return 1.0;
         }
@@ -101,6 +113,7 @@ impl VCavitySlope for Ggx {
 
     /// ½ + k_z / (2√(αx² k_x² + αy² k_y² + k_z²)).
     fn frontfacing_proportion(&self, k: Vec3) -> f32 {
+        require!(is_plane_normal(k), f32::NAN; k);
         let ks = stretch(self, k);
         0.5 + 0.5 * ks.z / ks.length()
     }
@@ -108,6 +121,7 @@ impl VCavitySlope for Ggx {
     /// In the stretched configuration D m.z is uniform on the projected disk; the plane
     /// m·k = 0 cuts it along the azimuth of k (Tokuyoshi, listing 2).
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; k, u1, u2);
         let ks = stretch(self, k).normalize_or(Vec3::Z);
         let (e, f) = azimuth_frame(ks);
         let (lo, hi) = (-ks.z, 1.0);
@@ -120,6 +134,7 @@ impl VCavitySlope for Ggx {
     /// The disk method of Heitz 2018 with the band limited by both the horizon and the plane
     /// m·k = 0 (Tokuyoshi, listing 3).
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; wi, k, u1, u2);
         let v = stretch(self, wi).normalize_or(Vec3::Z);
         let ks = stretch(self, k).normalize_or(Vec3::Z);
         let len_xy = (v.x * v.x + v.y * v.y).sqrt();
@@ -144,6 +159,7 @@ impl VCavitySlope for Beckmann {
     /// u = i_z/√(αx² i_x² + αy² i_y²) (§2.2); evaluated with w = −u > 0 as
     /// (3 erfc(3w) − erfc(w))/2 − e^{−w²} expm1(−8w²)/(2√π w), without cancellation at w → 0.
     fn hit_probability(&self, wi: Vec3) -> f32 {
+        require!(is_direction(wi), f32::NAN; wi);
         if wi.z >= 0.0 {
             return 1.0;
         }
@@ -158,6 +174,7 @@ impl VCavitySlope for Beckmann {
     /// −w² + ln(r(w)/(2√π w) + e^{−8w²}(3 erfcx(3w)/2 − 1/(2√π w))) with
     /// r(w) = 1 − √π w erfcx(w) from its asymptotic series (no underflow, no cancellation).
     fn ln_hit_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         if wi.z >= 0.0 {
             return 0.0;
         }
@@ -178,6 +195,7 @@ impl VCavitySlope for Beckmann {
 
     /// erfc(3w)/H(i) in log space: −9w² + ln erfcx(3w) − ln H.
     fn projected_branch_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         let v = stretch64(self, wi);
         let q = v.x * v.x + v.y * v.y;
         if q == 0.0 {
@@ -190,6 +208,7 @@ impl VCavitySlope for Beckmann {
 
     /// −t − ln(π αx αy m.z⁴), t = (m.x²/αx² + m.y²/αy²)/m.z².
     fn ln_d(&self, wm: Vec3) -> f64 {
+        require!(is_direction(wm), f64::NEG_INFINITY; wm);
         if wm.z <= 0.0 {
             return f64::NEG_INFINITY;
         }
@@ -201,6 +220,7 @@ impl VCavitySlope for Beckmann {
 
     /// ½ erfc(−k_z/√(αx² k_x² + αy² k_y²)).
     fn frontfacing_proportion(&self, k: Vec3) -> f32 {
+        require!(is_plane_normal(k), f32::NAN; k);
         let ks = stretch(self, k);
         let len = f64::from(ks.truncate().length());
         if len == 0.0 {
@@ -212,6 +232,7 @@ impl VCavitySlope for Beckmann {
     /// Gaussian slopes, the one along the azimuth of k truncated to x̃ < k_z/|k_xy|
     /// (Tokuyoshi, listing 4), by inversion from the nearer end.
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; k, u1, u2);
         let ks = stretch(self, k);
         let (e, f) = azimuth_frame(ks);
         let len = f64::from(ks.truncate().length());
@@ -231,6 +252,7 @@ impl VCavitySlope for Beckmann {
     /// The exact visible-slope inversion limited to x̃ ∈ [3 cot θ, cot θ) (Tokuyoshi, listings
     /// 5–6, with the safeguarded log-space solver of [`Beckmann`]).
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; wi, k, u1, u2);
         let v = stretch64(self, wi);
         let ks = stretch64(self, k);
         let (e, f) = azimuth_frame(v.as_vec3());
@@ -259,8 +281,12 @@ pub struct VCavity<S>(pub S);
 
 impl<S: VCavitySlope> VCavity<S> {
     /// The V-cavity masking function G(i, m) (eq. 3).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit
+    /// direction gives NaN (a debug assertion in debug builds).
     #[inline]
     pub fn masking(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), f32::NAN; wi, wm);
         let cos_im = wi.dot(wm);
         if cos_im <= 0.0 {
             return 0.0;
@@ -269,6 +295,9 @@ impl<S: VCavitySlope> VCavity<S> {
     }
 
     /// The hit probability H(i) (§2.2).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// NaN (a debug assertion in debug builds).
     #[inline]
     pub fn hit_probability(&self, wi: Vec3) -> f32 {
         self.0.hit_probability(wi)
@@ -281,6 +310,7 @@ impl<S: VCavitySlope> VisibleNormalSampler for VCavity<S> {
     /// 2 ∫_{x<3cotθ} P2 / H(i) a normal from D(m) m.z limited to slopes below 3 cot θ, otherwise
     /// one from the Smith VNDF limited to [3 cot θ, cot θ) (Tokuyoshi, listing 1).
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         if wi.z >= 0.0 {
             let m1 = self.0.sample_projected(Vec3::Z, u[0], u[1]);
             let m2 = Vec3::new(-m1.x, -m1.y, m1.z);
@@ -308,6 +338,7 @@ impl<S: VCavitySlope> VisibleNormalSampler for VCavity<S> {
     /// 2 D(m) m.z (i·m)⁺ / ((i·m)⁺ + (i·m′)⁺) with m′ the mirror image of m, which stays finite at
     /// grazing incidence.
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         // the visibility test in f64, like the Smith densities (near the nadir ⟨i, m⟩ is tiny)
         if wi.as_dvec3().dot(wm.as_dvec3()) <= 0.0 || wm.z <= 0.0 {
             return 0.0;

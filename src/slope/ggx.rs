@@ -5,6 +5,7 @@ use super::{
     projected_roughness_sq,
 };
 use crate::error::Error;
+use crate::rng::cut_tails;
 use crate::special::sin_cos_turns;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
@@ -46,8 +47,9 @@ impl Ggx {
     }
 }
 
-/// Λ for the upper hemisphere from q = (αᵢ sin θ)² and z = cos θ ≥ 0, in the
-/// cancellation-free form q / (2z(z + √(z² + q))); saturates to `f32::MAX` at z = 0.
+/// Λ for the upper hemisphere from q = (αᵢ sin θ)² and z = cos θ ≥ 0 (+0 at the horizon: the
+/// caller passes |cos θ|), in the cancellation-free form q / (2z(z + √(z² + q))); saturates to
+/// `f32::MAX` at z = +0.
 #[inline(always)]
 fn lambda_up(q: f32, z: f32) -> f32 {
     (q / (2.0 * z * (z + (z * z + q).sqrt()))).min(f32::MAX)
@@ -97,7 +99,10 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
-        if w.z >= 0.0 { lambda_up(q, w.z) } else { -1.0 - lambda_up(q, -w.z) }
+        // Λ of the upper hemisphere at |cos θ|: z = −0 is the horizon seen from above, like +0
+        // (passing w.z itself gave lambda_up(q, −0) = q/(−0) = −∞)
+        let up = lambda_up(q, w.z.abs());
+        if w.z >= 0.0 { up } else { -1.0 - up }
     }
 
     /// ½(cos θ + √(cos²θ + αᵢ² sin²θ)) above the horizon (supplement §2.3) and the
@@ -112,10 +117,15 @@ impl MicrosurfaceSlope for Ggx {
 
     /// Visible slopes at α = 1 from the spherical-cap sampler. Slopes of normals that round
     /// to cos θm = 0 are computed with cos θm = `f32::MIN_POSITIVE` (finite, probability 0).
+    /// Seen from straight below (θ = π), where nothing is visible (the cap is empty), returns
+    /// the zero slope, like [`Beckmann`](super::Beckmann).
     #[inline]
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         // slopes are invariant under scaling, so the unnormalized normal serves
         let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), 1.0, u1, u2);
+        if m == Vec3::ZERO {
+            return Vec2::ZERO;
+        }
         let z = m.z.max(MIN_SLOPE_COS * m.length());
         Vec2::new(-m.x / z, -m.y / z)
     }
@@ -146,17 +156,41 @@ impl MicrosurfaceSlope for Ggx {
 /// c = reflect(v̂, m) has Jacobian 4 v̂·m); restricting m.z ≥ 0 restricts c to the cap
 /// c.z ≥ −v̂.z, sampled uniformly by a uniform c.z. Everything is scaled by `len`, so that
 /// v̂ = v/len is never formed. Returns 0 when v̂ = −z (empty cap).
+///
+/// The cap's height uniform u1 is cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy, `rng`):
+/// the sample for u1 = 0 has 2⁻²⁴ of the cap above it instead of sitting on its pole, the one
+/// for u1 = 1 − 2⁻²⁴ has 2⁻²⁴ below it. The azimuth u2 is not cut.
+///
+/// The azimuth ψ = 2π u2 of c is measured from −v's horizontal direction ê, and the horizontal
+/// part of h is formed as (s − r cos ψ) ê − r sin ψ ê⊥ (s = |v_xy|, r = len |c_xy|) with
+/// s − r cos ψ = (s² − r²)/(s + r) + 2r sin²(ψ/2) and s² − r² = (len c.z − v.z) len (c.z + v̂.z):
+/// no cancellation where c approaches −v̂ (the bottom of the cap, u1 → 1, on the far side),
+/// where the sum v_xy + c_xy of nearly opposite vectors would be all rounding (a normal of
+/// the wrong direction, often not visible, replaced by a horizontal one of density 0).
 #[inline(always)]
 fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
+    let u1 = cut_tails(u1);
     // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
     // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
     let top = len + v.z;
-    let z_scaled = (1.0 - u1) * top - v.z;
+    let h_z = (1.0 - u1) * top;
+    let z_scaled = h_z - v.z;
     let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = sin_cos_turns(u2);
-    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, (1.0 - u1) * top);
-    // v·h ≥ 0 exactly; near c = −v̂ (measure zero) rounding can make it negative: then return
-    // a grazing visible normal (the horizontal normal along v's azimuth is visible and in the
-    // upper hemisphere)
-    if v.dot(h) < 0.0 { Vec3::new(v.x, v.y, 0.0) } else { h }
+    let s = (v.x * v.x + v.y * v.y).sqrt();
+    // sin and cos of ψ/2 = π u2
+    let (sin_half, cos_half) = sin_cos_turns(0.5 * u2);
+    if s == 0.0 {
+        // v along ±z: any azimuth origin; ψ measured from −x
+        let (sin_psi, cos_psi) = (2.0 * sin_half * cos_half, 1.0 - 2.0 * sin_half * sin_half);
+        return Vec3::new(-r * cos_psi, -r * sin_psi, h_z);
+    }
+    // one division for 1/s and 1/(s + r): inv = 1/(s (s + r))
+    let inv = 1.0 / (s * (s + r));
+    let along = (z_scaled - v.z) * h_z * inv + 2.0 * r * sin_half * sin_half * (s + r) * inv;
+    let across = -2.0 * r * sin_half * cos_half * (s + r) * inv;
+    // (along ê + across ê⊥) with ê = v_xy/s, ê⊥ = (−ê.y, ê.x); `along` and `across` carry 1/s.
+    // v·h = len²(1 + v̂·c) ≥ 0 is second order in |v̂ + c| where c → −v̂: a test of its sign
+    // in f32 would be all rounding there, while h itself is accurate (callers that need the
+    // normal visible in f32 nudge it, see `ensure_visible`)
+    Vec3::new(along * v.x - across * v.y, along * v.y + across * v.x, h_z)
 }

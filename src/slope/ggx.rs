@@ -161,12 +161,10 @@ impl MicrosurfaceSlope for Ggx {
 /// the sample for u1 = 0 has 2⁻²⁴ of the cap above it instead of sitting on its pole, the one
 /// for u1 = 1 − 2⁻²⁴ has 2⁻²⁴ below it. The azimuth u2 is not cut.
 ///
-/// The azimuth ψ = 2π u2 of c is measured from −v's horizontal direction ê, and the horizontal
-/// part of h is formed as (s − r cos ψ) ê − r sin ψ ê⊥ (s = |v_xy|, r = len |c_xy|) with
-/// s − r cos ψ = (s² − r²)/(s + r) + 2r sin²(ψ/2) and s² − r² = (len c.z − v.z) len (c.z + v̂.z):
-/// no cancellation where c approaches −v̂ (the bottom of the cap, u1 → 1, on the far side),
-/// where the sum v_xy + c_xy of nearly opposite vectors would be all rounding (a normal of
-/// the wrong direction, often not visible, replaced by a horizontal one of density 0).
+/// The horizontal part v_xy + len c_xy is a sum of nearly opposite vectors where c approaches
+/// −v̂ (the bottom of the cap, u1 → 1, on the far side): its f32 error, about 2ε len, is at most
+/// 16ε relative while |h| ≥ len/8, and beyond that h is recomputed by
+/// [`cap_near_opposite`] without cancellation (about 1 % of the samples above the horizon).
 #[inline(always)]
 fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
     let u1 = cut_tails(u1);
@@ -176,21 +174,44 @@ fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
     let h_z = (1.0 - u1) * top;
     let z_scaled = h_z - v.z;
     let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
-    let s = (v.x * v.x + v.y * v.y).sqrt();
-    // sin and cos of ψ/2 = π u2
-    let (sin_half, cos_half) = sin_cos_turns(0.5 * u2);
-    if s == 0.0 {
-        // v along ±z: any azimuth origin; ψ measured from −x
-        let (sin_psi, cos_psi) = (2.0 * sin_half * cos_half, 1.0 - 2.0 * sin_half * sin_half);
-        return Vec3::new(-r * cos_psi, -r * sin_psi, h_z);
+    let (sin_phi, cos_phi) = sin_cos_turns(u2);
+    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
+    if h.length_squared() >= NEAR_OPPOSITE_SQ * (len * len) {
+        return h;
     }
-    // one division for 1/s and 1/(s + r): inv = 1/(s (s + r))
-    let inv = 1.0 / (s * (s + r));
-    let along = (z_scaled - v.z) * h_z * inv + 2.0 * r * sin_half * sin_half * (s + r) * inv;
-    let across = -2.0 * r * sin_half * cos_half * (s + r) * inv;
-    // (along ê + across ê⊥) with ê = v_xy/s, ê⊥ = (−ê.y, ê.x); `along` and `across` carry 1/s.
-    // v·h = len²(1 + v̂·c) ≥ 0 is second order in |v̂ + c| where c → −v̂: a test of its sign
-    // in f32 would be all rounding there, while h itself is accurate (callers that need the
-    // normal visible in f32 nudge it, see `ensure_visible`)
-    Vec3::new(along * v.x - across * v.y, along * v.y + across * v.x, h_z)
+    cap_near_opposite(v, u1, u2).unwrap_or(h)
+}
+
+/// |h|² below this fraction of len² is recomputed by [`cap_near_opposite`].
+const NEAR_OPPOSITE_SQ: f32 = 1.0 / 64.0;
+
+/// h = v + len c for a cap point c near −v̂, in double precision and in the azimuth frame of v:
+/// with s = |v_xy|, ê = v_xy/s, ψ = 2π u2 − φ(−ê) the azimuth of c_xy measured from −ê (so
+/// that the map is the same as the direct one, up to the f32 error of its azimuth) and
+/// r = len |c_xy|, h_xy = (s − r cos ψ) ê − r sin ψ ê⊥ with
+/// s − r cos ψ = (s² − r²)/(s + r) + 2r sin²(ψ/2), all without cancellation:
+/// with z = len c.z = (1 − u1)(len + v.z) − v.z and r² = u1 (len + v.z)(len + z) as in the
+/// direct form, s² − r² = (z − v.z)(z + v.z). Here len = |v| in double precision: the f32
+/// `len` of the caller differs from |v| by ε len, and near −v̂ a sphere of that radius instead
+/// of |v| moves the point by about as much as |h| itself. `None` for v along ±z (no
+/// cancellation there: v_xy = 0).
+#[inline(never)]
+fn cap_near_opposite(v: Vec3, u1: f32, u2: f32) -> Option<Vec3> {
+    let (vx, vy, vz, u1) = (f64::from(v.x), f64::from(v.y), f64::from(v.z), f64::from(u1));
+    let s = vx.hypot(vy);
+    if s == 0.0 {
+        return None;
+    }
+    let len = s.hypot(vz);
+    let top = len + vz;
+    let h_z = (1.0 - u1) * top;
+    let z = h_z - vz;
+    let r = (u1 * top * (len + z)).max(0.0).sqrt();
+    let s_sq_minus_r_sq = (z - vz) * h_z;
+    let psi = core::f64::consts::TAU * f64::from(u2) - (-vy).atan2(-vx);
+    let (sin_half, cos_half) = (0.5 * psi).sin_cos();
+    let along = s_sq_minus_r_sq / (s + r) + 2.0 * r * sin_half * sin_half;
+    let across = -2.0 * r * sin_half * cos_half;
+    let (ex, ey) = (vx / s, vy / s);
+    Some(Vec3::new((along * ex - across * ey) as f32, (along * ey + across * ex) as f32, h_z as f32))
 }

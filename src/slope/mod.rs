@@ -94,9 +94,14 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// The distribution of visible normals D_ωi(ωm) = ⟨ωi, ωm⟩ D(ωm) / projected_area(ωi)
     /// (supplement §2.1), for any ωi. Zero where ωi sees no microsurface (projected area 0,
     /// i.e. ωi = −z).
+    ///
+    /// ⟨ωi, ωm⟩ is evaluated in f64 from the f32 vectors, the visibility test that the samplers
+    /// guarantee for their normals (`ensure_visible`): in f32 it rounds to ≤ 0 for normals
+    /// within ~1e-7 of grazing, which the samplers do return (at the bottom of the spherical
+    /// cap, u1 = 1 − 2⁻²⁴).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
-        let cos_im = wi.dot(wm);
+        let cos_im = wi.as_dvec3().dot(wm.as_dvec3());
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
@@ -104,7 +109,7 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         if area <= 0.0 {
             return 0.0;
         }
-        cos_im * self.d(wm) / area
+        cos_im as f32 * self.d(wm) / area
     }
 
     /// Samples a normal ωm from D_ωi exactly, for any ωi on the sphere, from two uniforms in

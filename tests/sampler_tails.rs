@@ -32,7 +32,7 @@ const EXTREMES: [f32; 2] = [0.0, U_MAX];
 /// Uniforms for the other coordinate of a 2D sampler.
 const OTHERS: [f32; 5] = [0.0, 0.25, 0.5, 0.8, U_MAX];
 
-/// sin θ and cos θ of the test directions' polar angles, from above the horizon to far below.
+/// Polar angles of the incident directions, from the zenith to far below the horizon.
 const THETAS: [f64; 7] = [0.0, 0.3, 1.0, 1.45, 1.7, 2.2, 2.8];
 
 struct Report {
@@ -94,7 +94,8 @@ fn gaussian_tail(x: f64) -> f64 {
 }
 
 /// The visible-slope density ∝ (κ − x) e^{−x²} on x < κ (α = 1, cot θ = κ): the probabilities
-/// below x and above x, by quadrature (the mass is within 12 of κ − and below κ).
+/// below x and above x, by Simpson quadrature on [min(κ, 0) − 12, κ] (beyond it the density
+/// is below e^{−144}).
 fn visible_slope_tails(kappa: f64, x: f64) -> (f64, f64) {
     let f = |t: f64| (kappa - t) * (-t * t).exp();
     // the density's support that matters: [min(κ, 0) − 12, κ]

@@ -7,7 +7,12 @@
 //!
 //! Conventions: directions are unit `glam::Vec3` in a local frame whose z axis is the
 //! macrosurface normal; every direction points away from the surface. Evaluations of BSDFs
-//! return f·|cos θo|. See the README for the model table and the validation suite.
+//! return f·|cos θo|. A zero component of a direction may have either sign: −0 is treated
+//! exactly like +0 (ω.z = −0 is the horizon seen from above). Samplers take uniforms in [0, 1)
+//! and cut the tails of every quantile they invert at 2⁻²⁴, the spacing of 24-bit uniforms
+//! (u is used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴)): no sample lies beyond the last 2⁻²⁴ of its
+//! distribution, so the extreme uniforms never put a point mass where the model has almost
+//! nothing. See the README for the model table and the validation suite.
 //!
 //! ```
 //! use microsurface::{Conductor, Ggx, Microsurface, ScatteringOrder, UniformHeight};

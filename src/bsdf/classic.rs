@@ -5,7 +5,7 @@ use super::{Bsdf, BsdfSample, BsdfValue, SampleFlags, is_direction};
 use crate::error::Error;
 use crate::frame::sample_cosine_hemisphere;
 use crate::fresnel::fresnel_schlick;
-use crate::rng::uniform;
+use crate::rng::{cut_tails, uniform};
 use crate::special::erfc64;
 use core::f32::consts::{FRAC_1_PI, TAU};
 use glam::Vec3;
@@ -139,8 +139,10 @@ impl ClassicBrdf {
         }
     }
 
-    /// cos θm of a normal sampled from D(m) cos θm (CS500, "Sampling a BRDF").
+    /// cos θm of a normal sampled from D(m) cos θm (CS500, "Sampling a BRDF"), with the tails
+    /// cut at 2⁻²⁴ (the crate's tail policy: u = 0 would give Phong's horizon normal).
     fn sample_cos_theta_m(&self, u: f32) -> f32 {
+        let u = cut_tails(u);
         match self.ndf {
             // D(m) cos θm ∝ cos^(e+1) θm: cos θm = u^(1/(e+2)) (Walter et al. 2007, eq. 30; the
             // CS500 handout's 1/(e+1) samples cos^e θm instead)

@@ -5,6 +5,7 @@ use super::{
     normal_from_slopes,
 };
 use crate::error::Error;
+use crate::rng::cut_tails64;
 use crate::special::{erfc_inv_f32, erfcx64};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -14,10 +15,6 @@ const SQRT_PI: f64 = 1.772_453_850_905_516;
 const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
 /// 1/π.
 const INV_PI: f64 = core::f64::consts::FRAC_1_PI;
-/// Uniforms are kept at least this far from 0 and 1 before they are inverted through a
-/// Gaussian tail: the quantile of 1e-30 is finite (|x̃| ≈ 8.3 at α = 1) and the probability
-/// mass left out is 1e-30.
-const MIN_TAIL_PROBABILITY: f64 = 1e-30;
 /// From this u = −x̃ on, 1 − m√π erfcx(u) is evaluated by its asymptotic series (which is free
 /// of the cancellation the direct form suffers for large u).
 const PSI_SERIES_FROM: f64 = 8.0;
@@ -281,11 +278,13 @@ impl MicrosurfaceSlope for Beckmann {
 }
 
 /// The quantile of the slope density exp(−x²)/√π: erf⁻¹(2u − 1), evaluated from the nearer
-/// end of [0, 1] in single precision (relative error below 4e-7, see `erfc_inv_f32`); the
-/// tails are cut at probability 1e-30.
+/// end of [0, 1] in single precision (relative error below 4e-7, see `erfc_inv_f32`). Both
+/// tails are cut at probability 2⁻²⁴ (the crate's tail policy, `rng`): u = 0 gives
+/// x̃ = −3.744, with 2⁻²⁴ of the density below it, and u = 1 − 2⁻²⁴ gives +3.744.
 #[inline]
 pub(crate) fn gaussian_slope(u: f64) -> f64 {
-    let tail = u.min(1.0 - u).max(MIN_TAIL_PROBABILITY);
+    let u = cut_tails64(u);
+    let tail = u.min(1.0 - u);
     let x = f64::from(erfc_inv_f32(tail as f32));
     if u < 0.5 { -x } else { x }
 }
@@ -352,9 +351,12 @@ fn visible_slope_x(kappa: f64, u: f64) -> f64 {
 /// Like [`visible_slope_x`], restricted to x̃ ∈ [`lower`, κ) (`lower` may be −∞): solves
 /// S(x̃) = S(lower) + u (S(κ) − S(lower)) in log space. Used by the V-cavity sampler, whose
 /// unmasked part is the Smith VNDF limited to slopes above 3 cot θ (Tokuyoshi, listing 5).
+///
+/// u is cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy, `rng`): the lowest sample has 2⁻²⁴ of
+/// the visible slopes below it, the highest 2⁻²⁴ between it and κ (where the density vanishes).
 #[inline]
 pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
-    let u = u.clamp(MIN_TAIL_PROBABILITY, 1.0);
+    let u = cut_tails64(u);
     let ln_u = u.ln();
     let ln_s_kappa = ln_s(kappa, kappa).0;
     let (target, mut lo) = if lower > f64::NEG_INFINITY && lower < kappa {

@@ -46,8 +46,9 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Smith's Λ(ω) on the whole sphere (supplement §2.2–2.3, with the sign of a kept).
     ///
     /// Λ ≥ 0 for ω.z > 0 (0 at the zenith), Λ(−ω) = −1 − Λ(ω) below the horizon (−1 at the
-    /// nadir). At exactly grazing ω.z = ±0 the exact value is +∞; the result saturates to
-    /// `f32::MAX` there (and to −`f32::MAX`−1 below), never leaving the finite numbers.
+    /// nadir). At exactly grazing ω.z = ±0 (both signs of zero are the horizon seen from
+    /// above) the exact value is +∞; the result saturates to `f32::MAX` there (and to
+    /// −`f32::MAX` just below it), never leaving the finite numbers.
     fn lambda(&self, w: Vec3) -> f32;
 
     /// The projected area ∫⟨ω, ωm⟩ D(ωm) dωm = (1 + Λ(ω)) cos θ ≥ 0, for every ω
@@ -58,7 +59,10 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Samples visible slopes of the distribution stretched to α = 1, seen from the direction
     /// (sin θ, 0, cos θ), θ ∈ [0, π] (supplement §2.1, `sampleP22_11`).
     ///
-    /// Takes cos θ and sin θ ≥ 0 rather than θ, and two uniforms in [0, 1).
+    /// Takes cos θ and sin θ ≥ 0 rather than θ (either may be ±0, treated alike), and two
+    /// uniforms in [0, 1). Implementations cut the tails of the quantiles they invert at 2⁻²⁴
+    /// (u is used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴); the crate's tail policy): no sample lies
+    /// beyond the last 2⁻²⁴ of the model.
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2;
 
     /// D for a normal given in double precision, evaluated in double precision. The default
@@ -97,10 +101,15 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// The distribution of visible normals D_ωi(ωm) = ⟨ωi, ωm⟩ D(ωm) / projected_area(ωi)
     /// (supplement §2.1), for any ωi. Zero where ωi sees no microsurface (projected area 0,
     /// i.e. ωi = −z).
+    ///
+    /// ⟨ωi, ωm⟩ is evaluated in f64 from the f32 vectors, the visibility test that the samplers
+    /// guarantee for their normals (`ensure_visible`): in f32 it rounds to ≤ 0 for normals
+    /// within ~1e-7 of grazing, which the samplers do return (at the bottom of the spherical
+    /// cap, u1 = 1 − 2⁻²⁴).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
-        let cos_im = wi.dot(wm);
+        let cos_im = wi.as_dvec3().dot(wm.as_dvec3());
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
@@ -108,14 +117,14 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         if area <= 0.0 {
             return 0.0;
         }
-        cos_im * self.d(wm) / area
+        cos_im as f32 * self.d(wm) / area
     }
 
     /// Samples a normal ωm from D_ωi exactly, for any ωi on the sphere, from two uniforms in
     /// [0, 1) (supplement §2.1: stretch to α = 1, sample slopes, rotate, unstretch).
     ///
     /// Always returns a unit vector with ωm.z ≥ 0. For ωi = −z, which sees no microsurface,
-    /// returns +z.
+    /// returns +z. Tails are cut at 2⁻²⁴ as in [`Self::sample_p22_11`].
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);

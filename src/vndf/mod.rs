@@ -26,7 +26,9 @@ use glam::Vec3;
 /// A sampler of microfacet normals visible from an incident direction, with its density.
 pub trait VisibleNormalSampler: Copy + core::fmt::Debug + Send + Sync {
     /// A normal ωm (unit, ωm.z ≥ 0) visible from ωi, from uniforms in [0, 1). Smith samplers
-    /// use `u[0]` and `u[1]`; V-cavity samplers also `u[2]`. All three must be in [0, 1].
+    /// use `u[0]` and `u[1]`; V-cavity samplers also `u[2]`. Every quantile is inverted with
+    /// its tails cut at 2⁻²⁴ (u used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴), the crate's tail policy): no
+    /// sample lies beyond the last 2⁻²⁴ of the distribution, at either end.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction or a
     /// uniform outside [0, 1] gives `Vec3::NAN` (a debug assertion in debug builds).

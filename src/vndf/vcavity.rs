@@ -3,6 +3,7 @@
 use super::VisibleNormalSampler;
 use super::disk::{half_space_band, sample_band};
 use crate::contract::{are_uniform, is_direction, is_plane_normal};
+use crate::rng::cut_tails64;
 use crate::slope::{
     Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes, one_minus_scaled_erfcx,
     visible_slope_x_above,
@@ -62,10 +63,12 @@ pub trait VCavitySlope: MicrosurfaceSlope {
         self.d64(wm.as_dvec3()).ln()
     }
 
-    /// A normal distributed as D(m) m.z restricted to m·k > 0 (k = +z: unrestricted).
+    /// A normal distributed as D(m) m.z restricted to m·k > 0 (k = +z: unrestricted), from
+    /// uniforms in [0, 1) whose quantiles' tails are cut at 2⁻²⁴ (the crate's tail policy).
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3;
 
-    /// A normal distributed as the Smith VNDF of ωi restricted to m·k ≤ 0.
+    /// A normal distributed as the Smith VNDF of ωi restricted to m·k ≤ 0, with tails cut at
+    /// 2⁻²⁴ like [`Self::sample_projected`].
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3;
 }
 
@@ -125,8 +128,8 @@ impl VCavitySlope for Ggx {
         let ks = stretch(self, k).normalize_or(Vec3::Z);
         let (e, f) = azimuth_frame(ks);
         let (lo, hi) = (-ks.z, 1.0);
-        let (w, u) = sample_band(u1, u2, lo, hi);
-        let z = (1.0 - u * u - w * w).max(0.0).sqrt();
+        let p = sample_band(u1, u2, lo, hi);
+        let (w, u, z) = (p.t1, p.t2, p.t3);
         let (x, y) = (u * e.x + w * f.x, u * e.y + w * f.y);
         Vec3::new(self.alpha_x() * x, self.alpha_y() * y, z).normalize_or(Vec3::Z)
     }
@@ -147,8 +150,8 @@ impl VCavitySlope for Ggx {
         let (lo_h, hi_h) = half_space_band(t2_axis.z, v.z, true);
         let (lo_k, hi_k) = half_space_band(t2_axis.dot(ks), v.dot(ks), false);
         let (lo, hi) = (lo_h.max(lo_k), hi_h.min(hi_k).max(lo_h.max(lo_k)));
-        let (t1, t2) = sample_band(u1, u2, lo, hi);
-        let t3 = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
+        let p = sample_band(u1, u2, lo, hi);
+        let (t1, t2, t3) = (p.t1, p.t2, p.t3);
         let h = t1 * t1_axis + t2 * t2_axis + t3 * v;
         Vec3::new(self.alpha_x() * h.x, self.alpha_y() * h.y, h.z.max(0.0)).normalize_or(Vec3::Z)
     }
@@ -238,7 +241,8 @@ impl VCavitySlope for Beckmann {
         let len = f64::from(ks.truncate().length());
         // share of N(0, ½) below the boundary, as a complement 2P = erfc(−boundary)
         let two_p = if len == 0.0 { 2.0 } else { erfc64(-f64::from(ks.z) / len) };
-        let q = f64::from(u1) * two_p; // erfc(−x̃) = q
+        // tails cut at 2⁻²⁴ (the crate's tail policy): u1 = 0 would give x̃ = −26.5
+        let q = cut_tails64(f64::from(u1)) * two_p; // erfc(−x̃) = q
         let x = if q <= 1.0 {
             -erfinv_from_both_ends(1.0 - q, q.max(f64::MIN_POSITIVE))
         } else {

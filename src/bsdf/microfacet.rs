@@ -200,7 +200,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Bsdf for Microfac
         };
         let pdf = self.pdf(wo, wi);
         let weight = weight * self.transport_scale(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite() && weight.is_finite() && is_direction(wi)) || wi.z == 0.0 {
+        // a subnormal pdf has lost its f32 precision (it arises only where the sampled lobe is
+        // narrower than the f32 direction grid, see `PositionFree::sample_single`)
+        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite() && weight.is_finite() && is_direction(wi))
+            || wi.z == 0.0
+        {
             return None;
         }
         let reflection = (wi.z > 0.0) == (wo.z > 0.0);

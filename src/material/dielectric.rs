@@ -255,7 +255,7 @@ impl Material for Dielectric {
                 * (slope.d64(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32
         } else {
             let Some(r) = self.refraction(wi, wo) else { return Vec3::ZERO };
-            let g2 = beta(1.0 + f64::from(slope.lambda(wi)), 1.0 + f64::from(slope.lambda(-wo)));
+            let g2 = beta(1.0 + slope.lambda64(wi), 1.0 + slope.lambda64(-wo));
             let eta = f64::from(self.eta);
             (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64(r.wh) * g2
                 / (f64::from(wi.z) * r.denom_sq)) as f32

@@ -132,7 +132,10 @@ impl Material for Conductor {
         (self.reflection_vertex(wi, wh, d), reflection_density(slope, wi, d), reverse)
     }
 
-    /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm).
+    /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm); for ωi·ωm below
+    /// `FRESNEL_AT_HALF_VECTOR_BELOW` F takes the cosine of the half vector recomputed from the
+    /// f32 ωi and ωo, as the evaluations do, so that weight = F·(the phase density ratio) holds
+    /// to f32 precision (before: 3.5e-4 apart for gold, GGX α = 1e-4 at cos θi = 1e-4).
     #[inline]
     fn sample_phase<S: MicrosurfaceSlope>(
         &self,

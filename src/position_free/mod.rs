@@ -21,7 +21,7 @@ use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec3};
 use rand::Rng;
-use segment::{VertexShadowing, in_side_frame, inv_g1};
+use segment::{LAMBDA_SATURATION, VertexShadowing, in_side_frame, inv_g1};
 
 /// Russian roulette starts after this many sampled bounces (it is unbiased at any depth).
 const ROULETTE_FROM_BOUNCE: u32 = 3;
@@ -340,14 +340,18 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     pub(crate) fn exit(&self, w: Vec3, outside: bool) -> Exit {
         let frame = in_side_frame(w, outside);
         let can_exit = frame.z > 0.0;
-        Exit { w, outside, can_exit, lambda: if can_exit { self.slope.lambda64(frame) } else { 0.0 } }
+        let lambda = if can_exit { self.slope.lambda64(frame).min(LAMBDA_SATURATION) } else { 0.0 };
+        Exit { w, outside, can_exit, lambda }
     }
 
     /// The last (`last`) or continuing shadowing factor of a vertex with incident state `at`
-    /// (1 + L̃ = `k_in`) and outgoing direction `out`; 0 where `at` sees no microsurface.
+    /// (1 + L̃ = `k_in`) and outgoing direction `out`; 0 where `at` sees no microsurface and
+    /// where k_in < `LAMBDA_RATIO_LOG_BELOW` (S would overflow: use [`Self::relative_shadowing`]).
     #[inline(always)]
     pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, last: bool) -> f64 {
-        if k_in == 0.0 {
+        // S ∝ G1in = 1/k_in overflows for a subnormal f64 k_in; its product with a vertex term
+        // (∝ k_in) is formed by `relative_shadowing` instead, where callers need it
+        if k_in < LAMBDA_RATIO_LOG_BELOW {
             return 0.0;
         }
         let v = self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside);

@@ -70,10 +70,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         k_in: f64,
         rng: &mut impl Rng,
     ) -> Option<(Incident, f64, DVec3)> {
-        // k_in = 0 is also the f64 underflow of a backfacing Beckmann Λ(−ωin), where the path
-        // goes on; only straight from below (no projected area at all) does it end
-        let frame = in_side_frame(at.w, at.outside);
-        if !k_in.is_finite() || (k_in == 0.0 && frame.x == 0.0 && frame.y == 0.0) {
+        if k_in == 0.0 || !k_in.is_finite() {
             return None;
         }
         let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);

@@ -31,10 +31,19 @@ pub(crate) fn in_side_frame(w: Vec3, outside: bool) -> Vec3 {
 /// it is tiny there for small α. In [0, ∞]: 0 straight from below, and also where Λ(−ω)
 /// underflows f64 (Beckmann, |cot θ|/αᵢ > 26.6; the masking ratios of such a vertex are then
 /// formed from ln Λ, see `PositionFree::relative_shadowing`).
+///
+/// Saturates at [`LAMBDA_SATURATION`] (exactly grazing directions, where the exact value is +∞).
 #[inline(always)]
 pub(crate) fn inv_g1<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> f64 {
-    if w.z >= 0.0 { 1.0 + slope.lambda64(w) } else { slope.lambda64(-w) }
+    let k = if w.z >= 0.0 { 1.0 + slope.lambda64(w) } else { slope.lambda64(-w) };
+    k.min(LAMBDA_SATURATION)
 }
+
+/// The largest Λ and 1 + L̃ the shadowing factors take (`f32::MAX`, as the f32 Λ saturates):
+/// at exactly grazing directions the exact value is +∞, which would turn
+/// ln Γ(1 + k) − ln Γ(1 + k + Λ) into ∞ − ∞. Every factor is 0 or 1 to f64 precision from
+/// far below it on.
+pub(crate) const LAMBDA_SATURATION: f64 = f32::MAX as f64;
 
 /// The shadowing factors of one vertex: `last` when the path leaves through the outgoing
 /// direction, `middle` when it continues (Wang et al. 2022, eqs. 7–8, 12–13 and 17–23,

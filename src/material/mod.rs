@@ -62,6 +62,16 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
     /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
     const EXACT_PHASE_PDF: bool;
 
+    /// Whether the interface does not interact with light at all: every facet event keeps the
+    /// direction and the weight (a dielectric with η = 1 exactly: F = 0, refraction is the
+    /// identity). The random walks then return ωo = −ωi with weight 1 as one event instead of
+    /// walking the interface's crossings, whose number grows without bound at grazing
+    /// incidence, and their evaluations are 0 (the BSDF is a Dirac). False by default.
+    #[inline]
+    fn is_transparent(&self) -> bool {
+        false
+    }
+
     /// The solid-angle density with which [`Material::sample_phase`] draws ωo on side
     /// `wo_outside` from ωi on side `wi_outside`: the phase function without the per-channel
     /// weight. Exact for conductors and dielectrics; for diffuse facets, whose density has no

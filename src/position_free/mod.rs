@@ -164,6 +164,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// the material, or the walk reached [`crate::MAX_BOUNCES`].
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         let mut at = Self::incident(wi)?;
+        if self.material.is_transparent() {
+            // the Dirac ωo = −ωi of an interface that does not interact (see `Material`)
+            return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 1 });
+        }
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
             let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);

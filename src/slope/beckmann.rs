@@ -169,7 +169,7 @@ impl MicrosurfaceSlope for Beckmann {
     }
 
     /// ln Λ = −a² + ln r(a) − ln(2a√π) with a = cot θ/αᵢ and r = 1 − √π a erfcx(a)
-    /// ([`one_minus_scaled_erfcx`]): no exponential, so it stays finite (and relative error
+    /// (`one_minus_scaled_erfcx`): no exponential, so it stays finite (and relative error
     /// below 3e-14 of ln Λ's magnitude or 1e-13 absolute) where Λ underflows f64 (a > 26.6).
     #[inline]
     fn ln_lambda(&self, w: Vec3) -> f64 {

@@ -180,6 +180,10 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
 /// [`MicrosurfaceSlope::d64`]) plus the final rounding to f32.
 #[inline(always)]
 pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DVec3) -> f32 {
+    if wi.z > 0.0 {
+        // front-facing: A ≥ cos θi, nothing underflows (the walks' hot path)
+        return reflection_density(slope, wi, slope.d64(wh));
+    }
     let cos_ih = wi.as_dvec3().dot(wh);
     if cos_ih <= 0.0 {
         return 0.0;
@@ -188,9 +192,10 @@ pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DV
 }
 
 /// D(ωh)/(4 A(ω)) for D(ωh) = `d`: the reflection density of [`phase_reflection`] with D known
-/// (A in f64: below the horizon it underflows f32 long before f64).
+/// (A in f64 below the horizon, where it underflows f32 long before f64; above it A ≥ cos θ
+/// and the f32 area serves).
 #[inline(always)]
 pub(crate) fn reflection_density<S: MicrosurfaceSlope>(slope: &S, w: Vec3, d: f64) -> f32 {
-    let area = slope.projected_area64(w);
+    let area = if w.z > 0.0 { f64::from(slope.projected_area(w)) } else { slope.projected_area64(w) };
     if area <= 0.0 { 0.0 } else { (0.25 * d / area) as f32 }
 }

@@ -183,6 +183,15 @@ impl Material for Dielectric {
 
     const EXACT_PHASE_PDF: bool = true;
 
+    /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not
+    /// transparent: from the denser side a ray below the critical angle, cos θ < √(2|η − 1|),
+    /// is totally reflected, and elsewhere the walk's many crossings do bend it (see
+    /// [`crate::MAX_BOUNCES`]).
+    #[inline]
+    fn is_transparent(&self) -> bool {
+        self.eta == 1.0
+    }
+
     #[inline]
     fn relative_eta_sq(&self, wi_outside: bool, wo_outside: bool) -> f32 {
         match (wi_outside, wo_outside) {
@@ -310,10 +319,7 @@ impl Material for Dielectric {
                 * (slope.d64_unchecked(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32
         } else {
             let Some(r) = self.refraction(wi, wo) else { return Vec3::ZERO };
-            let g2 = beta(
-                1.0 + f64::from(slope.lambda_unchecked(wi)),
-                1.0 + f64::from(slope.lambda_unchecked(-wo)),
-            );
+            let g2 = beta(1.0 + slope.lambda64(wi), 1.0 + slope.lambda64(-wo));
             let eta = f64::from(self.eta);
             (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64_unchecked(r.wh) * g2
                 / (f64::from(wi.z) * r.denom_sq)) as f32

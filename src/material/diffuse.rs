@@ -189,7 +189,9 @@ impl Material for Diffuse {
             return Vec3::ZERO;
         }
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
-        let g2_given_g1 = (1.0 + slope.lambda_unchecked(wi)) * g2;
+        // (1 + Λi)/(1 + Λi + Λo) in f64: the f32 factors saturate near grazing
+        let k = 1.0 + slope.lambda64(wi);
+        let g2_given_g1 = (k / (k + slope.lambda64(wo))) as f32;
         self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * g2_given_g1)
     }
 }

@@ -71,6 +71,16 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
     /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
     const EXACT_PHASE_PDF: bool;
 
+    /// Whether the interface does not interact with light at all: every facet event keeps the
+    /// direction and the weight (a dielectric with η = 1 exactly: F = 0, refraction is the
+    /// identity). The random walks then return ωo = −ωi with weight 1 as one event instead of
+    /// walking the interface's crossings, whose number grows without bound at grazing
+    /// incidence, and their evaluations are 0 (the BSDF is a Dirac). False by default.
+    #[inline]
+    fn is_transparent(&self) -> bool {
+        false
+    }
+
     /// The solid-angle density with which [`Material::sample_phase`] draws ωo on side
     /// `wo_outside` from ωi on side `wi_outside`: the phase function without the per-channel
     /// weight. Exact for conductors and dielectrics; for diffuse facets, whose density has no
@@ -244,19 +254,37 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
     if wi.z <= 0.0 || wo.z <= 0.0 {
         return 0.0;
     }
-    1.0 / (1.0 + slope.lambda_unchecked(wi) + slope.lambda_unchecked(wo))
+    // in f64: the f32 Λ saturates at f32::MAX near grazing, where 1 + Λi + Λo would overflow
+    (1.0 / (1.0 + slope.lambda64(wi) + slope.lambda64(wo))) as f32
 }
 
 /// D_ωi(ωh)/(4 ωi·ωh) = D(ωh)/(4 A(ωi)) for a valid reflection half vector ωh (ωh.z > 0,
 /// ωi·ωh > 0); 0 where ωi sees no microsurface.
+///
+/// Formed from [`MicrosurfaceSlope::d_wi64`], the visible-normal density itself: for a
+/// backfacing ωi both D(ωh) and A(ωi) are of order e^{−a²} (Beckmann, a = |cot θi|/αᵢ) and
+/// underflow f64 from a ≈ 26.6 on, where D_ωi is still evaluated (in log space). Relative
+/// error: that of D_ωi (a few f64 ulps times the condition numbers of D, see
+/// [`MicrosurfaceSlope::d64`]) plus the final rounding to f32.
 #[inline(always)]
 pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DVec3) -> f32 {
-    reflection_density(slope, wi, slope.d64_unchecked(wh))
+    if wi.z > 0.0 {
+        // front-facing: A ≥ cos θi, nothing underflows (the walks' hot path)
+        return reflection_density(slope, wi, slope.d64_unchecked(wh));
+    }
+    let cos_ih = wi.as_dvec3().dot(wh);
+    if cos_ih <= 0.0 {
+        return 0.0;
+    }
+    (0.25 * slope.d_wi64_unchecked(wi, wh) / cos_ih) as f32
 }
 
-/// D(ωh)/(4 A(ω)) for D(ωh) = `d`: the reflection density of [`phase_reflection`] with D known.
+/// D(ωh)/(4 A(ω)) for D(ωh) = `d`: the reflection density of [`phase_reflection`] with D known
+/// (A in f64 below the horizon, where it underflows f32 long before f64; above it A ≥ cos θ
+/// and the f32 area serves).
 #[inline(always)]
 pub(crate) fn reflection_density<S: MicrosurfaceSlope>(slope: &S, w: Vec3, d: f64) -> f32 {
-    let area = slope.projected_area_unchecked(w);
-    if area <= 0.0 { 0.0 } else { (0.25 * d / f64::from(area)) as f32 }
+    let area =
+        if w.z > 0.0 { f64::from(slope.projected_area_unchecked(w)) } else { slope.projected_area64(w) };
+    if area <= 0.0 { 0.0 } else { (0.25 * d / area) as f32 }
 }

@@ -80,12 +80,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         }
         let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
         let out = self.exit(s.wo, s.outside);
-        let middle = self.shadowing_factor(at, k_in, out, false);
+        // k_in·S_middle, exact also where k_in underflows (a backfacing low-roughness vertex)
+        let middle = self.relative_shadowing(at, k_in, out).middle;
         // the next incident direction −ω: below the horizon in its frame where ω can exit, and
         // then 1 + L̃ = Λ(ω)
         let k_next =
             if out.can_exit { out.lambda } else { inv_g1(&self.slope, -in_side_frame(s.wo, s.outside)) };
         let next = Incident { w: -s.wo, outside: s.outside };
-        Some((next, k_next, s.weight.as_dvec3() * (k_in * middle)))
+        Some((next, k_next, s.weight.as_dvec3() * middle))
     }
 }

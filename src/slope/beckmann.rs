@@ -96,7 +96,7 @@ impl Beckmann {
 
     /// The projected area in double precision.
     #[inline]
-    fn projected_area64(&self, w: Vec3) -> f64 {
+    fn projected_area_double(&self, w: Vec3) -> f64 {
         let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let root_q = q.sqrt();
         let z = f64::from(w.z);
@@ -171,11 +171,34 @@ impl MicrosurfaceSlope for Beckmann {
 
     #[inline]
     fn lambda_unchecked(&self, w: Vec3) -> f32 {
+        (self.lambda64(w) as f32).clamp(-f32::MAX, f32::MAX)
+    }
+
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
         let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let a = f64::from(w.z.abs()) / q.sqrt();
         let up = lambda_up64(a);
-        let value = if w.z >= 0.0 { up } else { -1.0 - up };
-        (value as f32).clamp(-f32::MAX, f32::MAX)
+        if w.z >= 0.0 { up } else { -1.0 - up }
+    }
+
+    /// ln Λ = −a² + ln r(a) − ln(2a√π) with a = cot θ/αᵢ and r = 1 − √π a erfcx(a)
+    /// (`one_minus_scaled_erfcx`): no exponential, so it stays finite (and relative error
+    /// below 3e-14 of ln Λ's magnitude or 1e-13 absolute) where Λ underflows f64 (a > 26.6).
+    #[inline]
+    fn ln_lambda(&self, w: Vec3) -> f64 {
+        if w.z < 0.0 {
+            return f64::NAN;
+        }
+        let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
+        let a = f64::from(w.z) / q.sqrt();
+        if a == 0.0 {
+            return f64::INFINITY;
+        }
+        if a.is_infinite() {
+            return f64::NEG_INFINITY;
+        }
+        -a * a + (one_minus_scaled_erfcx(a) * (0.5 * INV_SQRT_PI) / a).ln()
     }
 
     #[inline]
@@ -186,7 +209,12 @@ impl MicrosurfaceSlope for Beckmann {
 
     #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
-        self.projected_area64(w) as f32
+        self.projected_area_double(w) as f32
+    }
+
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        self.projected_area_double(w)
     }
 
     /// Evaluated in double precision; when ωi is so far below the horizon that the
@@ -210,7 +238,7 @@ impl MicrosurfaceSlope for Beckmann {
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
-        let area = self.projected_area64(wi);
+        let area = self.projected_area_double(wi);
         if area > AREA_LOG_SPACE_BELOW {
             return cos_im * self.d_double(wm) / area;
         }

@@ -109,6 +109,24 @@ impl MicrosurfaceSlope for Ggx {
         core::f64::consts::FRAC_1_PI / (ax * ay * t * t)
     }
 
+    /// The f32 form's cancellation-free q / (2z(z + √(z² + q))) in f64.
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
+        let (x, y) = (f64::from(self.alpha_x) * f64::from(w.x), f64::from(self.alpha_y) * f64::from(w.y));
+        let (q, z) = (x * x + y * y, f64::from(w.z).abs());
+        let up = q / (2.0 * z * (z + (z * z + q).sqrt()));
+        if w.z >= 0.0 { up } else { -1.0 - up }
+    }
+
+    /// The f32 forms of [`Self::projected_area`] in f64.
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        let (x, y) = (f64::from(self.alpha_x) * f64::from(w.x), f64::from(self.alpha_y) * f64::from(w.y));
+        let (q, z) = (x * x + y * y, f64::from(w.z));
+        let root = (z * z + q).sqrt();
+        if z >= 0.0 { 0.5 * (z + root) } else { q / (2.0 * (root - z)) }
+    }
+
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
@@ -208,7 +226,10 @@ fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
     let u1 = cut_tails(u1);
     // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
     // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
-    let top = len + v.z;
+    // len + v.z written as (v.x² + v.y²)/(len − v.z) below the horizon: for a backfacing ωi
+    // of a low-roughness surface v̂ ≈ −z and the direct sum cancels (GGX α = 1e-4 at θ = 2.3:
+    // it rounded to 0 and every sample became the fallback horizontal normal)
+    let top = if v.z >= 0.0 { len + v.z } else { (v.x * v.x + v.y * v.y) / (len - v.z) };
     let h_z = (1.0 - u1) * top;
     let z_scaled = h_z - v.z;
     let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();

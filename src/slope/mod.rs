@@ -56,6 +56,48 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// 0 at the nadir and ½ αᵢ sin θ at the horizon.
     fn projected_area(&self, w: Vec3) -> f32;
 
+    /// Λ(ω) in double precision, unsaturated: ±∞ at exactly grazing ω.z = ±0 (see
+    /// [`Self::lambda`] for the rest of the contract).
+    ///
+    /// Below the horizon the masking of a backfacing direction is G1(ω) = 1/|1 + Λ(ω)| =
+    /// 1/Λ(−ω), and Λ(−ω) is tiny there for small α (Beckmann: e^{−a²}, a = |cot θ|/αᵢ, an
+    /// f32 subnormal from a ≈ 9.6 on); its f32 rounding loses all precision long before it
+    /// reaches 0. The default widens [`Self::lambda`]; [`Ggx`] and [`Beckmann`] evaluate it in
+    /// f64 (GGX's Λ ≥ 1e-106 for every f32 direction and α, so it never underflows; Beckmann's
+    /// underflows f64 from a ≈ 26.6 on, see [`Self::ln_lambda`]).
+    /// A precision primitive of the crate's walks and single scattering: no argument check
+    /// (callers pass unit directions), hence hidden.
+    #[doc(hidden)]
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
+        f64::from(self.lambda_unchecked(w))
+    }
+
+    /// ln Λ(ω) for ω on or above the horizon (ω.z ≥ 0): −∞ at the zenith, +∞ at ω.z = 0;
+    /// NaN below the horizon (outside the domain).
+    ///
+    /// The masking ratio Λ(ω′)/Λ(−ω) of a backfacing vertex (both factors tiny) is formed as
+    /// exp(ln Λ(ω′) − ln Λ(−ω)) where Λ underflows in f64. The default is `lambda64(w).ln()`;
+    /// [`Beckmann`] evaluates −a² + ln(r(a)/(2a√π)) directly, finite for every a > 0.
+    /// A precision primitive of the crate's walks and single scattering: no argument check
+    /// (callers pass unit directions), hence hidden.
+    #[doc(hidden)]
+    #[inline]
+    fn ln_lambda(&self, w: Vec3) -> f64 {
+        if w.z < 0.0 { f64::NAN } else { self.lambda64(w).ln() }
+    }
+
+    /// The projected area in double precision (see [`Self::projected_area`]): below the
+    /// horizon it is Λ(−ω)|cos θ|, which underflows f32 far earlier than f64. The default
+    /// widens [`Self::projected_area`]; [`Ggx`] and [`Beckmann`] evaluate it in f64.
+    /// A precision primitive of the crate's walks and single scattering: no argument check
+    /// (callers pass unit directions), hence hidden.
+    #[doc(hidden)]
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        f64::from(self.projected_area_unchecked(w))
+    }
+
     /// Samples visible slopes of the distribution stretched to α = 1, seen from the direction
     /// (sin θ, 0, cos θ), θ ∈ [0, π] (supplement §2.1, `sampleP22_11`).
     ///
@@ -187,7 +229,7 @@ pub(crate) fn smith_d_wi64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: DVec3)
     if cos_im <= 0.0 || wm.z <= 0.0 {
         return 0.0;
     }
-    let area = f64::from(slope.projected_area_unchecked(wi));
+    let area = slope.projected_area64(wi);
     if area <= 0.0 { 0.0 } else { cos_im * slope.d64_unchecked(wm) / area }
 }
 

@@ -59,7 +59,15 @@ pub fn smith_normalization<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: Vec3) 
     if wi.dot(wm) <= 0.0 {
         return 0.0;
     }
-    let area = slope.projected_area(wi);
-    // saturates like Λ where the projected area is subnormal (near the nadir)
-    if area <= 0.0 { 0.0 } else { (wi.z.abs() / area).min(f32::MAX) }
+    // the area in f64: below the horizon it is Λ(−i)|i_z|, an f32 subnormal for low roughness
+    // long before the ratio leaves the f32 range; saturates like Λ near the nadir
+    let area = slope.projected_area64(wi);
+    if area > 0.0 {
+        (f64::from(wi.z.abs()) / area).min(f64::from(f32::MAX)) as f32
+    } else if wi.x == 0.0 && wi.y == 0.0 {
+        0.0
+    } else {
+        // the area underflowed f64 (Beckmann, |cot θ|/αᵢ > 26.6): the ratio is far above f32::MAX
+        f32::MAX
+    }
 }

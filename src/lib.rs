@@ -42,8 +42,9 @@ mod special;
 mod vndf;
 
 pub use bsdf::{
-    Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder, MicrofacetBsdf,
-    SampleFlags, ShadingFrame, Technique, Transport,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder,
+    MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit,
+    Technique, Transport,
 };
 pub use error::Error;
 pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};

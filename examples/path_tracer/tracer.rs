@@ -323,7 +323,8 @@ pub fn render(
                                 let path = (u64::from(y as u32) * u64::from(width) + u64::from(x))
                                     * u64::from(spp)
                                     + u64::from(i);
-                                let l = radiance(scene, camera.origin, d, 64, path, &mut rng, stats).as_dvec3();
+                                let l =
+                                    radiance(scene, camera.origin, d, 64, path, &mut rng, stats).as_dvec3();
                                 s += l;
                                 let m = l.element_sum() / 3.0;
                                 s2 += m * m;
@@ -374,7 +375,9 @@ fn diffuse(technique: Technique, albedo: Vec3) -> Material {
 }
 
 fn classic(kd: Vec3, ks: Vec3, alpha: f32) -> Material {
-    Box::new(ClassicBrdf::new(kd, ks, ClassicNdf::Ggx(alpha), ClassicMasking::Exact).expect("valid parameters"))
+    Box::new(
+        ClassicBrdf::new(kd, ks, ClassicNdf::Ggx(alpha), ClassicMasking::Exact).expect("valid parameters"),
+    )
 }
 
 pub const BDPT: Technique =

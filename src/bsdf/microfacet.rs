@@ -151,7 +151,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     pub fn new(slope: S, material: M) -> Result<Self, Error> {
         let alpha = slope.alpha_x().max(slope.alpha_y());
         if !(alpha <= MAX_WALK_ALPHA) {
-            return Err(Error::InvalidParameter { name: "alpha", value: alpha, expected: "at most 10 (MAX_WALK_ALPHA)" });
+            return Err(Error::InvalidParameter {
+                name: "alpha",
+                value: alpha,
+                expected: "at most 10 (MAX_WALK_ALPHA)",
+            });
         }
         let specular = material.always_specular() || (M::SMOOTH_IS_SPECULAR && alpha < SMOOTH_ALPHA);
         Ok(Self {
@@ -346,7 +350,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         let (walk_out, weight, exact_pdf) = match self.technique {
             Technique::SingleScattering => {
                 let mut rng = PrimedRng::new(&uniforms, hash);
-                let (out, weight) = self.position_free(Shadowing::Correlated).sample_single(walk_in, &mut rng)?;
+                let (out, weight) =
+                    self.position_free(Shadowing::Correlated).sample_single(walk_in, &mut rng)?;
                 (out, weight, M::EXACT_PHASE_PDF)
             }
             Technique::RandomWalk => {

@@ -293,6 +293,19 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         }
     }
 
+    /// f for valid, non-horizontal directions of a non-specular BSDF: the research layer's
+    /// f·|cos| of the walk entering along wo and leaving along wi, divided by |cos θi|, with
+    /// the transport factor; 0 if not finite.
+    #[inline(always)]
+    fn f_checked(&self, wo: Vec3, wi: Vec3, key: u64) -> Vec3 {
+        let (walk_in, walk_out) = (wo, wi);
+        let seed = self.seed;
+        let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
+        let f_cos_wi = self.research_f_cos_out(walk_in, walk_out, &mut rng);
+        let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
+        if f.is_finite() { f } else { Vec3::ZERO }
+    }
+
     /// The Dirac lobe's sample.
     #[inline]
     fn sample_specular(&self, wo: Vec3, uc: f32) -> Option<BsdfSample> {
@@ -312,6 +325,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 }
 
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<S, M> {
+    #[inline]
     fn flags(&self) -> BsdfFlags {
         let index_matched = self.surface.material().always_specular();
         BsdfFlags {
@@ -323,19 +337,16 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         }
     }
 
+    #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
         let exact = self.exact_eval();
         if !valid_direction(wo) || !valid_direction(wi) || wi.z == 0.0 || self.specular {
             return BsdfValue { f: Vec3::ZERO, exact };
         }
-        let (walk_in, walk_out) = (wo, wi);
-        let seed = self.seed;
-        let mut rng = PrimedRng::new(&[], || Hasher::new(seed, key).directions(wo, wi));
-        let f_cos_wi = self.research_f_cos_out(walk_in, walk_out, &mut rng);
-        let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
-        BsdfValue { f: if f.is_finite() { f } else { Vec3::ZERO }, exact }
+        BsdfValue { f: self.f_checked(wo, wi, key), exact }
     }
 
+    #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
         if !valid_direction(wo) || !valid_uniforms(uc, u) {
             return None;
@@ -344,7 +355,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
             return self.sample_specular(wo, uc);
         }
         let seed = self.seed;
-        let hash = || Hasher::new(seed, key).direction_uniforms(wo, uc, u);
+        let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
         let uniforms = [u.x, u.y, uc];
         let walk_in = wo;
         let (walk_out, weight, exact_pdf) = match self.technique {
@@ -381,6 +392,23 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         Some(BsdfSample { wi, weight, pdf, eta: self.relative_eta(wo, wi), flags })
     }
 
+    /// One validation of the directions for both (the research layer has no combined
+    /// evaluation to share more).
+    #[inline]
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        let exact = self.exact_eval();
+        if !valid_direction(wo) || !valid_direction(wi) || self.specular {
+            return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
+        }
+        let pdf = self.research_pdf_out(wo, wi);
+        let pdf = if pdf.is_finite() { pdf } else { 0.0 };
+        if wi.z == 0.0 {
+            return (BsdfValue { f: Vec3::ZERO, exact }, pdf);
+        }
+        (BsdfValue { f: self.f_checked(wo, wi, key), exact }, pdf)
+    }
+
+    #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if !valid_direction(wo) || !valid_direction(wi) || self.specular {
             return 0.0;

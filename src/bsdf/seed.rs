@@ -8,11 +8,6 @@ use glam::{Vec2, Vec3};
 use rand::TryRng;
 use rand_pcg::Pcg64Mcg;
 
-/// 2⁶⁴/φ, the Weyl increment of splitmix64: keeps the absorbed state away from the fixed
-/// point 0 of [`mix64`].
-const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-/// An odd constant that separates the two 64-bit halves of the generator state.
-const SECOND_HALF: u64 = 0xd1b5_4a32_d192_ed03;
 /// 2²⁴: the resolution of the crate's uniforms (`crate::rng::uniform` keeps the top 24 bits
 /// of a `u32`).
 const UNIFORM_STEPS: f32 = 16_777_216.0;
@@ -20,6 +15,18 @@ const UNIFORM_STEPS: f32 = 16_777_216.0;
 const MAX_UNIFORM_STEP: u32 = (1 << 24) - 1;
 /// The most caller uniforms a primed generator hands out.
 const MAX_PRIMED: usize = 4;
+
+/// Odd 64-bit constants (the first digits of π, e and √2 in hexadecimal, forced odd) that
+/// keep the inputs of [`mum`] away from 0 and break its symmetry.
+const P: [u64; 7] = [
+    0x243f_6a88_85a3_08d3,
+    0x1319_8a2e_0370_7345,
+    0xa409_3822_299f_31d1,
+    0x082e_fa98_ec4e_6c89,
+    0x4528_21e6_38d0_1377,
+    0xbe54_66cf_34e9_0c6d,
+    0xb7e1_5162_8aed_2a6b,
+];
 
 /// The splitmix64 finalizer (Stafford's "Mix13"): a bijection of `u64` with full avalanche
 /// (every input bit flips every output bit with probability ≈ ½).
@@ -32,47 +39,55 @@ pub(crate) fn mix64(mut x: u64) -> u64 {
     x ^ (x >> 31)
 }
 
-/// A running hash of a call's arguments: every `absorb` adds the Weyl increment and the
-/// word, then mixes, so that equal words at different positions hash differently.
+/// The folded 128-bit product of two words (wyhash's "mum"): one multiplication mixes 128
+/// input bits into 64.
+#[inline(always)]
+fn mum(a: u64, b: u64) -> u64 {
+    let r = u128::from(a) * u128::from(b);
+    (r as u64) ^ ((r >> 64) as u64)
+}
+
+/// The bit patterns of two floats in one word (so −0 and +0 differ, as do any two inputs
+/// whose bits differ).
+#[inline(always)]
+fn pair(a: f32, b: f32) -> u64 {
+    u64::from(a.to_bits()) | (u64::from(b.to_bits()) << 32)
+}
+
+/// A 64-bit hash of a call's arguments: the BSDF's seed, the caller's key and three words of
+/// float bits. The three products of the first level are independent (the processor runs
+/// them in parallel), a fourth combines them and the splitmix64 finalizer avalanches the
+/// result: about 30 cycles of latency, against about 70 for absorbing the six words one
+/// splitmix64 round after another.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Hasher(u64);
 
 impl Hasher {
-    /// A hash started from the BSDF's seed and the caller's key.
     #[inline(always)]
-    pub(crate) fn new(seed: u64, key: u64) -> Self {
-        Self(mix64(seed.wrapping_add(GOLDEN_GAMMA)) ^ key).absorb(0)
+    fn of(seed: u64, key: u64, w: [u64; 3]) -> Self {
+        let a = mum(seed ^ P[0], key ^ P[1]);
+        let b = mum(w[0] ^ P[2], w[1] ^ P[3]);
+        let c = mum(w[2] ^ P[4], a ^ P[5]);
+        Self(mix64(mum(b ^ P[6], c ^ P[0]) ^ a))
     }
 
+    /// The hash of an evaluation: seed, key and the directions (wo, wi).
     #[inline(always)]
-    fn absorb(self, word: u64) -> Self {
-        Self(mix64(self.0.wrapping_add(GOLDEN_GAMMA) ^ word))
+    pub(crate) fn directions(seed: u64, key: u64, a: Vec3, b: Vec3) -> Self {
+        Self::of(seed, key, [pair(a.x, a.y), pair(a.z, b.x), pair(b.y, b.z)])
     }
 
-    /// Absorbs the bit patterns of two floats (so −0 and +0 differ, as do any two inputs
-    /// whose bits differ).
+    /// The hash of a sample: seed, key, the direction wo and the caller's uniforms.
     #[inline(always)]
-    fn absorb_pair(self, a: f32, b: f32) -> Self {
-        self.absorb(u64::from(a.to_bits()) | (u64::from(b.to_bits()) << 32))
-    }
-
-    /// Absorbs a direction and a direction (eval) — three words.
-    #[inline(always)]
-    pub(crate) fn directions(self, a: Vec3, b: Vec3) -> Self {
-        self.absorb_pair(a.x, a.y).absorb_pair(a.z, b.x).absorb_pair(b.y, b.z)
-    }
-
-    /// Absorbs a direction and the caller's uniforms (sample) — three words.
-    #[inline(always)]
-    pub(crate) fn direction_uniforms(self, w: Vec3, uc: f32, u: Vec2) -> Self {
-        self.absorb_pair(w.x, w.y).absorb_pair(w.z, uc).absorb_pair(u.x, u.y)
+    pub(crate) fn direction_uniforms(seed: u64, key: u64, w: Vec3, uc: f32, u: Vec2) -> Self {
+        Self::of(seed, key, [pair(w.x, w.y), pair(w.z, uc), pair(u.x, u.y)])
     }
 
     /// The PCG generator with this hash as its state (the second half of the 128-bit state
     /// is a second, independent mix of the hash).
     #[inline(always)]
     pub(crate) fn generator(self) -> Pcg64Mcg {
-        let low = mix64(self.0 ^ SECOND_HALF);
+        let low = mix64(self.0 ^ P[1]);
         Pcg64Mcg::new((u128::from(self.0) << 64) | u128::from(low))
     }
 }
@@ -168,7 +183,7 @@ mod tests {
 
     #[test]
     fn primed_uniforms_come_back_first() {
-        let h = Hasher::new(1, 2).directions(Vec3::Z, Vec3::X);
+        let h = Hasher::directions(1, 2, Vec3::Z, Vec3::X);
         let mut r = PrimedRng::new(&[0.25, 0.5, 0.999_999_94], || h);
         assert_eq!(uniform(&mut r), 0.25);
         assert_eq!(uniform(&mut r), 0.5);
@@ -184,11 +199,51 @@ mod tests {
 
     #[test]
     fn hash_depends_on_every_argument() {
-        let base = Hasher::new(3, 4).directions(Vec3::Z, Vec3::X).0;
-        assert_ne!(base, Hasher::new(4, 4).directions(Vec3::Z, Vec3::X).0);
-        assert_ne!(base, Hasher::new(3, 5).directions(Vec3::Z, Vec3::X).0);
-        assert_ne!(base, Hasher::new(3, 4).directions(Vec3::X, Vec3::Z).0);
-        assert_ne!(base, Hasher::new(3, 4).directions(Vec3::new(0.0, -0.0, 1.0), Vec3::X).0);
-        assert_eq!(base, Hasher::new(3, 4).directions(Vec3::Z, Vec3::X).0);
+        let h = |seed, key, a, b| Hasher::directions(seed, key, a, b).0;
+        let base = h(3, 4, Vec3::Z, Vec3::X);
+        assert_ne!(base, h(4, 4, Vec3::Z, Vec3::X));
+        assert_ne!(base, h(3, 5, Vec3::Z, Vec3::X));
+        assert_ne!(base, h(4, 3, Vec3::Z, Vec3::X));
+        assert_ne!(base, h(3, 4, Vec3::X, Vec3::Z));
+        assert_ne!(base, h(3, 4, Vec3::new(0.0, -0.0, 1.0), Vec3::X));
+        assert_eq!(base, h(3, 4, Vec3::Z, Vec3::X));
+    }
+
+    /// Avalanche of the seeded generator's first output: flipping any one of the 320 input
+    /// bits (seed, key, six floats) flips each output bit with probability ½. Over 200 random
+    /// inputs per bit, the mean number of flipped output bits is 32 ± 0.28 (binomial SE): the
+    /// worst input bit must stay within 32 ± 2.
+    #[test]
+    fn one_input_bit_flips_half_the_output_bits() {
+        let mut rng = Pcg64Mcg::new(0x5eed);
+        let mut next = || rand::Rng::next_u64(&mut rng);
+        let out = |w: [u64; 5]| {
+            let f = |x: u64| f32::from_bits(x as u32);
+            let g = |x: u64| f32::from_bits((x >> 32) as u32);
+            let h = Hasher::directions(
+                w[0],
+                w[1],
+                Vec3::new(f(w[2]), g(w[2]), f(w[3])),
+                Vec3::new(g(w[3]), f(w[4]), g(w[4])),
+            );
+            rand::Rng::next_u64(&mut h.generator())
+        };
+        let inputs: Vec<[u64; 5]> = (0..200).map(|_| [next(), next(), next(), next(), next()]).collect();
+        let mut worst = 0.0f64;
+        for word in 0..5 {
+            for bit in 0..64 {
+                let flips: u32 = inputs
+                    .iter()
+                    .map(|&w| {
+                        let mut v = w;
+                        v[word] ^= 1 << bit;
+                        (out(w) ^ out(v)).count_ones()
+                    })
+                    .sum();
+                let mean = f64::from(flips) / inputs.len() as f64;
+                worst = worst.max((mean - 32.0).abs());
+            }
+        }
+        assert!(worst <= 2.0, "an input bit flips on average {worst} bits away from 32");
     }
 }

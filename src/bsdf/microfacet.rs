@@ -150,7 +150,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     /// stop being bounded in time.
     pub fn new(slope: S, material: M) -> Result<Self, Error> {
         let alpha = slope.alpha_x().max(slope.alpha_y());
-        if !(alpha <= MAX_WALK_ALPHA) {
+        // a slope's roughness is finite and > 0 (its constructor checks it)
+        if alpha > MAX_WALK_ALPHA {
             return Err(Error::InvalidParameter {
                 name: "alpha",
                 value: alpha,

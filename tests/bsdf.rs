@@ -1738,7 +1738,7 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
     let mut rng = common::rng(8700);
     let (mut reflections, mut refractions) = (0, 0);
     for _ in 0..2000 {
-        let wo = dir(1.4 * uniform64(&mut rng), 6.28 * uniform64(&mut rng));
+        let wo = dir(1.4 * uniform64(&mut rng), 2.0 * PI * uniform64(&mut rng));
         let u = Vec2::new(grid(uniform32(&mut rng)), grid(uniform32(&mut rng)));
         let uc = grid(uniform32(&mut rng));
         let m = slope.sample_d_wi(wo, u.x, u.y);

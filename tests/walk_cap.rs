@@ -165,6 +165,10 @@ fn cap_removes_less_than_1e4_of_the_albedo() {
 #[test]
 fn near_index_matched_dielectrics_terminate() {
     use microsurface::{Bsdf, MicrofacetBsdf};
+    /// A uniform in [0, 1) with 24 random bits.
+    fn unit(rng: &mut impl rand::Rng) -> f32 {
+        (rng.next_u32() >> 8) as f32 / 16_777_216.0
+    }
     const N_MATCHED: usize = 10_000;
     const N_WORST: usize = 1_000;
     const N_BSDF: usize = 500;
@@ -191,9 +195,12 @@ fn near_index_matched_dielectrics_terminate() {
                 Some(s) => longest = longest.max(s.bounces),
             }
         }
-        let bsdf =
-            MicrofacetBsdf::new(UniformHeight, Ggx::isotropic(1.0).unwrap(), Dielectric::new(eta).unwrap());
-        let missing = (0..N_BSDF).filter(|_| bsdf.sample(wi, &mut rng).is_none()).count();
+        let bsdf = MicrofacetBsdf::new(Ggx::isotropic(1.0).unwrap(), Dielectric::new(eta).unwrap()).unwrap();
+        let missing = (0..N_BSDF)
+            .filter(|_| {
+                bsdf.sample(wi, unit(&mut rng), glam::Vec2::new(unit(&mut rng), unit(&mut rng))).is_none()
+            })
+            .count();
         (capped, longest, missing)
     });
     for (&(eta, cos, inside, n), &(capped, longest, missing)) in cases.iter().zip(&results) {

@@ -4,7 +4,7 @@ use crate::contract::is_cosine;
 use glam::Vec3;
 
 /// Schlick's approximation F = F0 + (1 − F0)(1 − |cos θ|)⁵ per channel (Schlick 1994), with
-/// F0 the reflectance at normal incidence (the CS500 project's K_s). Its error against the
+/// F0 the reflectance at normal incidence (`ClassicBrdf`'s specular colour K_s). Its error against the
 /// exact dielectric term is below 0.01 for η ∈ [1.3, 1.7] outside total internal reflection.
 ///
 /// Invalid input ([policy](crate#invalid-input)): a `cos_theta` that is NaN or beyond

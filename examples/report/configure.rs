@@ -70,7 +70,7 @@ impl Budget {
             Self {
                 samples: 1 << 15,
                 reference_factor: 4,
-                lobe_angles: 37,
+                lobe_angles: 61,
                 lobe_samples: 1 << 12,
                 lobe_rel_se: 0.01,
                 lobe_max_samples: 1 << 18,

@@ -6,6 +6,7 @@ use super::configure::{Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, 
 use super::reduce::{LobePanel, Results};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// A rendered figure: its file name, its SVG text and a caption for the HTML page.
 pub struct Figure {
@@ -204,11 +205,12 @@ fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResu
     Ok(Figure { file: format!("error_vs_time_{}.svg", config.name()), svg, title })
 }
 
-/// A round step for the radial scale: 1, 2 or 5 × 10^k, about a third of `r`.
+/// A round step for the radial scale: the smallest 1, 2, 2.5 or 5 × 10^k of at least a quarter
+/// of `r` (two to four labelled circles).
 fn radial_step(r: f64) -> f64 {
-    let raw = r / 3.0;
+    let raw = r / 4.0;
     let p = 10f64.powf(raw.log10().floor());
-    [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p)
+    [1.0, 2.0, 2.5, 5.0, 10.0].into_iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p)
 }
 
 /// Lobes per order: rows θi, columns the three models.
@@ -240,7 +242,7 @@ fn lobes(results: &Results, material: MaterialKind, budget: &Budget) -> PlotResu
                 ),
                 "Radial circles in sr⁻¹, one scale per row; legends: the albedo of each order (from sampled scatterings of the same model).".to_string(),
                 format!(
-                    "Walk: its eval; position-free: PT. {}–{} evaluations per order and angle, until the SE of the total is ≤ {} % of the panel's peak; largest SE: {:.2} %.",
+                    "Walk: its eval; position-free: PT. {}–{} evaluations per order and angle, until the SE of the total is ≤ {} % of the panel's peak in a pilot run; largest SE: {:.2} % of the peak.",
                     panels.iter().map(|p| p.samples.0).min().unwrap_or(0),
                     panels.iter().map(|p| p.samples.1).max().unwrap_or(0),
                     100.0 * budget.lobe_rel_se,
@@ -290,8 +292,8 @@ fn lobe_panel(area: &Area, panel: &LobePanel, r_max: f64, full_circle: bool) -> 
     let mut chart = ChartBuilder::on(&plot).margin(4).build_cartesian_2d(-half_w..half_w, y_lo..y_hi)?;
     let step = radial_step(r_max);
     let circle_end = if full_circle { std::f64::consts::TAU } else { std::f64::consts::PI };
-    let mut r = step;
-    while r <= r_max * 1.0001 {
+    let circles: Vec<f64> = (1..).map(|k| f64::from(k) * step).take_while(|r| *r <= r_max * 1.0001).collect();
+    for &r in &circles {
         let circle: Vec<(f64, f64)> = (0..=180)
             .map(|i| {
                 let a = circle_end * f64::from(i) / 180.0;
@@ -302,9 +304,8 @@ fn lobe_panel(area: &Area, panel: &LobePanel, r_max: f64, full_circle: bool) -> 
         chart.draw_series(std::iter::once(Text::new(
             format!("{}", (r * 1e6).round() / 1e6),
             (r, 0.0),
-            (FONT, 13).into_font().color(&GRAY),
+            (FONT, 13).into_font().color(&GRAY).pos(Pos::new(HPos::Right, VPos::Top)),
         )))?;
-        r += step;
     }
     chart.draw_series(LineSeries::new([(-half_w, 0.0), (half_w, 0.0)], GRAY.stroke_width(1)))?;
     let (si, ci) = (panel.theta_i.sin(), panel.theta_i.cos());

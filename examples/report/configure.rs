@@ -438,15 +438,29 @@ impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
         f64::from(v.element_sum()) / 3.0
     }
 
-    /// One sampled scattering of a model: (weight, outgoing z, bounces).
-    pub fn sample(&self, model: Model, wi: Vec3, rng: &mut Rng) -> Option<(f64, f32, u32)> {
+    /// One sampled scattering of a model.
+    pub fn sample(&self, model: Model, wi: Vec3, rng: &mut Rng) -> Option<Scattered> {
         let s = match model {
             Model::Walk => self.walk.sample(wi, rng),
             Model::Uncorrelated => self.uncorrelated.sample(wi, rng),
             Model::Correlated => self.correlated.sample(wi, rng),
         }?;
-        Some((f64::from(s.weight.element_sum()) / 3.0, s.wo.z, s.bounces))
+        Some(Scattered {
+            weight: f64::from(s.weight.element_sum()) / 3.0,
+            reflected: s.wo.z > 0.0,
+            bounces: s.bounces,
+        })
     }
+}
+
+/// What `Models::sample` keeps of a sampled scattering.
+#[derive(Debug, Clone, Copy)]
+pub struct Scattered {
+    /// The weight f·cos/pdf, mean over RGB.
+    pub weight: f64,
+    /// Whether ωo is above the macrosurface.
+    pub reflected: bool,
+    pub bounces: u32,
 }
 
 /// The direction at polar angle θ and azimuth φ.

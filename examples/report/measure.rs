@@ -248,6 +248,7 @@ fn error_study(opts: &Options, budget: &Budget) -> (Vec<EstimatorRun>, Vec<Refer
 
 /// Albedo per order from sampled scatterings and (for the walk) the white furnace.
 struct EnergyTask {
+    surface: Surface,
     model: Model,
     theta_i: f64,
     walks: usize,
@@ -256,27 +257,36 @@ struct EnergyTask {
 }
 
 impl WithModels for EnergyTask {
-    type Out = (f64, f64, [f64; 4], f64, Option<Estimate>);
+    type Out = EnergyRow;
 
     fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
         let mut rng = Rng::seed_from_u64(self.seed);
         let wi = dir(self.theta_i, 0.0);
-        let (mut r, mut t, mut orders, mut bounces) = (0.0, 0.0, [0.0; 4], 0.0);
+        let mut row = EnergyRow {
+            surface: self.surface,
+            model: self.model,
+            theta_i: self.theta_i,
+            reflected: 0.0,
+            transmitted: 0.0,
+            orders: [0.0; 4],
+            mean_bounces: 0.0,
+            furnace: None,
+        };
         let n = self.walks as f64;
         for _ in 0..self.walks {
-            if let Some((weight, z, b)) = m.sample(self.model, wi, &mut rng) {
-                let w = weight / n;
-                if z > 0.0 {
-                    r += w
+            if let Some(s) = m.sample(self.model, wi, &mut rng) {
+                let w = s.weight / n;
+                if s.reflected {
+                    row.reflected += w
                 } else {
-                    t += w
+                    row.transmitted += w
                 }
-                orders[(b as usize).clamp(1, 4) - 1] += w;
-                bounces += f64::from(b) / n;
+                row.orders[(s.bounces as usize).clamp(1, 4) - 1] += w;
+                row.mean_bounces += f64::from(s.bounces) / n;
             }
         }
         if self.model != Model::Walk {
-            return (r, t, orders, bounces, None);
+            return row;
         }
         // ωo from a mixture of the uniform sphere and (when its density is exact) the
         // first-bounce phase function, so that sharp lobes (α = 0.1) are found
@@ -298,7 +308,8 @@ impl WithModels for EnergyTask {
                 f64::from(walk.eval(wi, wo, ScatteringOrder::All, &mut rng).x) / density
             })
             .collect();
-        (r, t, orders, bounces, Some(Estimate::of(furnace.iter().copied())))
+        row.furnace = Some(Estimate::of(furnace.iter().copied()));
+        row
     }
 }
 
@@ -323,10 +334,8 @@ fn energy(opts: &Options, budget: &Budget) -> Vec<EnergyRow> {
             ^ (surface.material as u64 + 1) << 32
             ^ (surface.slope as u64 + 1) << 40
             ^ (model as u64) << 48;
-        let task =
-            EnergyTask { model, theta_i, walks: budget.energy_walks, furnace: budget.furnace_samples, seed };
-        let (reflected, transmitted, orders, mean_bounces, furnace) = with_surface(surface, task);
-        EnergyRow { surface, model, theta_i, reflected, transmitted, orders, mean_bounces, furnace }
+        let (walks, furnace) = (budget.energy_walks, budget.furnace_samples);
+        with_surface(surface, EnergyTask { surface, model, theta_i, walks, furnace, seed })
     })
 }
 
@@ -569,7 +578,7 @@ impl WithModels for CostTask {
                 let mut bounces = 0.0;
                 for _ in 0..n {
                     let s = black_box(&m).sample(est.model(), black_box(wi), &mut rng);
-                    bounces += s.map_or(0.0, |s| f64::from(s.2));
+                    bounces += s.map_or(0.0, |s| f64::from(s.bounces));
                 }
                 black_box(bounces);
                 (Some(start.elapsed().as_secs_f64() * 1e9 / n as f64), Some(bounces / n as f64))

@@ -209,9 +209,21 @@ fn rel2(x: f64, se: f64) -> f64 {
     if x != 0.0 { (se / x).powi(2) } else { 0.0 }
 }
 
+/// The logarithms behind a ratio in one case.
+struct LogTerms {
+    /// ln(e_a / e_b).
+    ratio: f64,
+    /// Its delta-method variance.
+    variance: f64,
+    /// ln of the relative-variance ratio σ̂²_b/σ̂²_a.
+    variance_ratio: f64,
+    /// ln of the cost ratio t_a/t_b.
+    cost_ratio: f64,
+}
+
 fn ratio(config: Config, kind: RatioKind, index: &HashMap<(Case, Est), &EfficiencyRow>) -> Ratio {
     let (a, b) = kind.estimators();
-    let terms: Vec<(f64, f64, f64, f64)> = Case::all(config)
+    let terms: Vec<LogTerms> = Case::all(config)
         .into_iter()
         .filter_map(|case| {
             let (ra, rb) = (index.get(&(case, a))?, index.get(&(case, b))?);
@@ -229,25 +241,25 @@ fn ratio(config: Config, kind: RatioKind, index: &HashMap<(Case, Est), &Efficien
                     * (rel2(ra.reference.mean, ra.reference.se) + rel2(rb.reference.mean, rb.reference.se));
             }
             let rel_var = |r: &EfficiencyRow| r.std * r.std / (r.reference.mean * r.reference.mean);
-            Some((
-                q.ln(),
-                var_ln,
-                (rel_var(rb) / rel_var(ra)).ln(),
-                (ra.timing.ns_per_sample / rb.timing.ns_per_sample).ln(),
-            ))
+            Some(LogTerms {
+                ratio: q.ln(),
+                variance: var_ln,
+                variance_ratio: (rel_var(rb) / rel_var(ra)).ln(),
+                cost_ratio: (ra.timing.ns_per_sample / rb.timing.ns_per_sample).ln(),
+            })
         })
         .collect();
     let j = terms.len() as f64;
-    let mean = |f: fn(&(f64, f64, f64, f64)) -> f64| terms.iter().map(f).sum::<f64>() / j;
-    let (ln_q, se) = (mean(|t| t.0), terms.iter().map(|t| t.1).sum::<f64>().sqrt() / j);
+    let mean = |f: fn(&LogTerms) -> f64| terms.iter().map(f).sum::<f64>() / j;
+    let (ln_q, se) = (mean(|t| t.ratio), terms.iter().map(|t| t.variance).sum::<f64>().sqrt() / j);
     Ratio {
         config,
         kind,
         estimate: ln_q.exp(),
         lo: (ln_q - 1.96 * se).exp(),
         hi: (ln_q + 1.96 * se).exp(),
-        variance_ratio: mean(|t| t.2).exp(),
-        cost_ratio: mean(|t| t.3).exp(),
+        variance_ratio: mean(|t| t.variance_ratio).exp(),
+        cost_ratio: mean(|t| t.cost_ratio).exp(),
         pairs: terms.len(),
     }
 }

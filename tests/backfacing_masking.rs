@@ -29,7 +29,10 @@ const FRESNEL_TOL: f32 = 1e-5;
 type Mf<S, M> = MicrofacetBsdf<S, M>;
 
 fn single<S: MicrosurfaceSlope, M: Material + SpecularLimit>(slope: S, m: M) -> Mf<S, M> {
-    MicrofacetBsdf::new(slope, m).expect("valid parameters").with_technique(Technique::SingleScattering)
+    MicrofacetBsdf::new(slope, m)
+        .expect("valid parameters")
+        .without_smooth_limit()
+        .with_technique(Technique::SingleScattering)
 }
 
 /// Draws `n` samples from `wo`; checks each against f·|cos|/pdf and returns how many exist

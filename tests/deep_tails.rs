@@ -22,7 +22,10 @@ const FRESNEL_TOL: f32 = 1e-5;
 type Mf<S, M> = MicrofacetBsdf<S, M>;
 
 fn single<S: MicrosurfaceSlope, M: Material + SpecularLimit>(slope: S, m: M) -> Mf<S, M> {
-    MicrofacetBsdf::new(slope, m).expect("valid parameters").with_technique(Technique::SingleScattering)
+    MicrofacetBsdf::new(slope, m)
+        .expect("valid parameters")
+        .without_smooth_limit()
+        .with_technique(Technique::SingleScattering)
 }
 
 /// A uniform in [0, 1) with 24 random bits.

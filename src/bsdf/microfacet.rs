@@ -173,6 +173,16 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         })
     }
 
+    /// The same BSDF evaluated as a rough microfacet lobe however smooth it is: the Dirac limit
+    /// below [`SMOOTH_ALPHA`] is not applied (a dielectric of η = 1, which has no rough lobe,
+    /// stays a Dirac lobe). For references and tests below α = 10⁻³, where the lobe is valid
+    /// but too narrow for an integrator to use.
+    #[must_use]
+    pub fn without_smooth_limit(self) -> Self {
+        let specular = self.surface.material().always_specular();
+        Self { specular, ..self }
+    }
+
     /// The same BSDF evaluated with another technique.
     pub fn with_technique(self, technique: Technique) -> Self {
         Self { technique, ..self }

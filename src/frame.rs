@@ -1,14 +1,28 @@
 //! Local frames and hemisphere sampling.
 
+use crate::contract::{is_direction, is_uniform};
+use crate::rng::cut_tails;
 use core::f32::consts::FRAC_PI_4;
 use glam::{Vec2, Vec3};
 
 /// Two unit vectors (t, b) completing the unit vector `n` to a right-handed orthonormal basis
 /// (t, b, n), branch-free except for the sign of n.z (Duff et al. 2017, “Building an
-/// Orthonormal Basis, Revisited”, JCGT 6(1)).
+/// Orthonormal Basis, Revisited”, JCGT 6(1)). n.z = −0 is treated like +0 (the upper
+/// hemisphere's basis; Duff et al.'s copysign would pick the lower one's).
+///
+/// Invalid input ([policy](crate#invalid-input)): an `n` that is not a unit direction
+/// (zero, NaN or ±∞ components, |‖n‖² − 1| > [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives
+/// (`Vec3::NAN`, `Vec3::NAN`) (a debug assertion in debug builds).
 #[inline]
 pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
-    let sign = 1.0f32.copysign(n.z);
+    require!(is_direction(n), (Vec3::NAN, Vec3::NAN); n);
+    basis(n)
+}
+
+/// [`orthonormal_basis`] without the argument check, for the crate's own unit normals.
+#[inline(always)]
+pub(crate) fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
     (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
@@ -16,21 +30,61 @@ pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
 
 /// Maps two uniforms in [0, 1) to the unit disk, preserving relative areas (Shirley and
 /// Chiu 1997, concentric map).
+///
+/// The square's boundary goes to the rim: the uniforms are cut to [2⁻²⁴, 1 − 2⁻²⁴] first (the
+/// crate's tail policy), so that every point has at least 2⁻²³ of the disk's area outside its
+/// radius (u = 0 would put 2⁻²⁴ of the samples on the rim itself).
+///
+/// Invalid input ([policy](crate#invalid-input)): a uniform that is NaN or outside
+/// [0, 1] gives `Vec2::NAN` (a debug assertion in debug builds).
 #[inline]
 pub fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
-    let (a, b) = (2.0 * u1 - 1.0, 2.0 * u2 - 1.0);
+    require!(is_uniform(u1) && is_uniform(u2), Vec2::NAN; u1, u2);
+    disk(u1, u2)
+}
+
+/// [`concentric_disk`] without the argument check, for the crate's own uniforms.
+#[inline(always)]
+pub(crate) fn disk(u1: f32, u2: f32) -> Vec2 {
+    let (r, cos_phi, sin_phi) = concentric_polar(u1, u2);
+    Vec2::new(r * cos_phi, r * sin_phi)
+}
+
+/// The concentric map in polar form: (r, cos φ, sin φ) with r signed (the point is
+/// r (cos φ, sin φ)) and |r| = max(|2u1 − 1|, |2u2 − 1|) exact, so that 1 − r² can be formed
+/// as (1 − |r|)(1 + |r|) without cancellation. Uniforms are cut as in [`concentric_disk`].
+#[inline(always)]
+fn concentric_polar(u1: f32, u2: f32) -> (f32, f32, f32) {
+    let (a, b) = (2.0 * cut_tails(u1) - 1.0, 2.0 * cut_tails(u2) - 1.0);
     if a == 0.0 && b == 0.0 {
-        return Vec2::ZERO;
+        return (0.0, 1.0, 0.0);
     }
     let (r, phi) =
         if a * a > b * b { (a, FRAC_PI_4 * (b / a)) } else { (b, 2.0 * FRAC_PI_4 - FRAC_PI_4 * (a / b)) };
     let (s, c) = phi.sin_cos();
-    Vec2::new(r * c, r * s)
+    (r, c, s)
 }
 
-/// A cosine-distributed direction about +z (density cos θ/π), from two uniforms.
+/// A cosine-distributed direction about +z (density cos θ/π), from two uniforms in [0, 1)
+/// (the concentric disk lifted to the hemisphere).
+///
+/// cos θ = √((1 − r)(1 + r)) from the disk radius r exactly, not from the rounded disk point:
+/// with the uniforms cut at 2⁻²⁴ (the crate's tail policy) the lowest direction has
+/// cos²θ ≥ 2⁻²², i.e. at least that share of the density below it, and never lies on the
+/// horizon, where the density is 0. Unit up to rounding (|‖ω‖² − 1| ≤ 4 ulp).
+///
+/// Invalid input ([policy](crate#invalid-input)): a uniform that is NaN or outside
+/// [0, 1] gives `Vec3::NAN` (a debug assertion in debug builds).
 #[inline]
 pub fn sample_cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
-    let d = concentric_disk(u1, u2);
-    Vec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
+    require!(is_uniform(u1) && is_uniform(u2), Vec3::NAN; u1, u2);
+    cosine_hemisphere(u1, u2)
+}
+
+/// [`sample_cosine_hemisphere`] without the argument check, for the crate's own uniforms.
+#[inline(always)]
+pub(crate) fn cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
+    let (r, cos_phi, sin_phi) = concentric_polar(u1, u2);
+    let radius = r.abs();
+    Vec3::new(r * cos_phi, r * sin_phi, ((1.0 - radius) * (1.0 + radius)).sqrt())
 }

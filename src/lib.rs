@@ -1,13 +1,76 @@
 //! # microsurface
 //!
-//! Physically based microfacet BSDFs on Smith microsurfaces, with multiple scattering:
+//! Physically based microfacet BSDFs on Smith microsurfaces, **with multiple scattering**:
 //! the random-walk BSDFs of Heitz, Hanika, d'Eon and Dachsbacher 2016 (“Multiple-Scattering
-//! Microfacet BSDFs with the Smith Model”) on conductor, diffuse and dielectric microfacets,
-//! built on height distributions, slope distributions and exact visible-normal sampling.
+//! Microfacet BSDFs with the Smith Model”) and the position-free estimators of Wang et al.
+//! 2022 on conductor, diffuse and dielectric microfacets, built on exact visible-normal
+//! sampling, behind a small renderer-facing trait.
 //!
-//! Conventions: directions are unit `glam::Vec3` in a local frame whose z axis is the
-//! macrosurface normal; every direction points away from the surface. Evaluations of BSDFs
-//! return f·|cos θo|. See the README for the model table and the validation suite.
+//! ## For a renderer: [`Bsdf`]
+//!
+//! Build a material once, then evaluate, sample and query the density in the local shading
+//! frame of each hit ([`ShadingFrame`]). `sample` takes the renderer's own uniforms (a 1D
+//! and a 2D sample, like pbrt's `Sample_f(wo, uc, u)`); every call is a pure function of its
+//! arguments, so renders are reproducible for any thread count, and `Vec<Box<dyn Bsdf>>`
+//! holds mixed materials.
+//!
+//! ```
+//! use microsurface::glam::{Vec2, Vec3};
+//! use microsurface::{Bsdf, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, ShadingFrame};
+//!
+//! // gold and glass with multiple scattering (the random walk of Heitz et al., all orders)
+//! let gold = MicrofacetBsdf::new(Ggx::isotropic(0.4)?, Conductor::new(ComplexIor::GOLD))?;
+//! let glass = MicrofacetBsdf::new(Ggx::new(0.3, 0.15)?, Dielectric::new(1.5)?)?;
+//! let materials: Vec<Box<dyn Bsdf>> = vec![Box::new(gold), Box::new(glass)];
+//!
+//! // at a hit: the shading frame of the normal, the view direction in it
+//! let frame = ShadingFrame::from_normal(Vec3::new(0.0, 1.0, 0.2)).expect("a non-zero normal");
+//! let ray_dir = Vec3::new(0.3, -0.9, 0.1).normalize();
+//! let wo = frame.to_local(-ray_dir);
+//! for bsdf in &materials {
+//!     // BSDF sampling with the renderer's uniforms: weight = f·|cos θi|/pdf
+//!     if let Some(s) = bsdf.sample(wo, 0.42, Vec2::new(0.17, 0.83)) {
+//!         let next_ray_dir = frame.to_world(s.wi);
+//!         assert!(s.weight.is_finite() && s.pdf > 0.0 && next_ray_dir.is_normalized());
+//!         // transmissions carry the relative index (for Russian roulette): η or 1/η
+//!         assert!(s.flags.reflection || s.eta != 1.0);
+//!     }
+//!     // light sampling: f (no cosine) and the BSDF's density for the MIS weight
+//!     let wi = frame.to_local(Vec3::new(0.2, 1.0, 0.3).normalize());
+//!     let (f, pdf) = bsdf.eval_with_pdf(wo, wi);
+//!     assert!(f.f.is_finite() && pdf >= 0.0 && pdf == bsdf.pdf(wo, wi));
+//! }
+//! # Ok::<(), microsurface::Error>(())
+//! ```
+//!
+//! [`Technique`] chooses single scattering (exact, cheapest), the random walk, or the
+//! position-free PT and BDPT estimators; [`ClassicBrdf`] is the classic Lambert plus
+//! Cook–Torrance BRDF. Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes
+//! (`flags().specular`).
+//!
+//! ## Conventions: one per layer
+//!
+//! Directions are unit `glam::Vec3` in a local frame whose z axis is the (shading) normal, and
+//! every direction points away from the surface. The two layers name and orient them
+//! differently:
+//!
+//! * **Renderer layer** ([`Bsdf`], pbrt's convention): `eval(wo, wi)` with `wo` towards the
+//!   viewer and `wi` towards the light returns **f** (no cosine); a sample's weight is
+//!   f·|cos θi|/pdf.
+//! * **Research layer** ([`Microsurface`], [`PositionFree`], [`Material`], the papers'
+//!   convention): `eval(wi, wo)` with `wi` the direction light arrives from and `wo` the one it
+//!   leaves along returns **f·|cos θo|**, stochastic evaluations take `&mut impl Rng`, and a
+//!   walk sample's weight is f·|cos θo|/pdf.
+//!
+//! A zero component of a direction may have either sign: −0 is treated exactly like +0
+//! (ω.z = −0 is the horizon seen from above). Samplers take uniforms in [0, 1) and cut the
+//! tails of every quantile they invert at 2⁻²⁴, the spacing of 24-bit uniforms (u is used as
+//! clamp(u, 2⁻²⁴, 1 − 2⁻²⁴)): no sample lies beyond the last 2⁻²⁴ of its distribution, so the
+//! extreme uniforms never put a point mass where the model has almost nothing.
+//!
+//! See the README for the model table, the validation suite and the report.
+//!
+//! ## For research: the random walks themselves
 //!
 //! ```
 //! use microsurface::{Conductor, Ggx, Microsurface, ScatteringOrder, UniformHeight};
@@ -18,6 +81,7 @@
 //! let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
 //! let (wi, wo) = (Vec3::new(0.3, 0.0, 0.954).normalize(), Vec3::Z);
 //! let n = 10_000;
+//! // f·|cos θo| (the research layer's convention), averaged over independent walks
 //! let f_cos: f32 = (0..n).map(|_| surface.eval(wi, wo, ScatteringOrder::All, &mut rng).x).sum::<f32>() / n as f32;
 //! let single = surface.eval_single_scattering(wi, wo, &mut rng).x;
 //! assert!(f_cos > single); // multiple scattering adds energy
@@ -25,9 +89,24 @@
 //! assert!(s.bounces >= 1 && s.weight == Vec3::ONE);
 //! # Ok::<(), microsurface::Error>(())
 //! ```
+//!
+//! # Invalid input
+//!
+//! One policy for every public entry point: an argument outside its function's domain (a
+//! direction that is zero, has a NaN or ±∞ component, or is not unit within
+//! [`DIRECTION_TOLERANCE`]; a NaN scalar; a uniform outside [0, 1], a cosine beyond
+//! ±(1 + [`DIRECTION_TOLERANCE`]), an η that is not finite and > 0) is a contract violation. It
+//! panics in debug builds (a debug assertion whose message starts with `invalid input`), and
+//! release builds return the function's documented *nothing*, never a plausible value: 0 for
+//! BSDF values, phase functions and densities; `None` from samplers that return an `Option`
+//! and a NaN direction (with a zero weight) from those that do not; NaN for quantities
+//! without a neutral value (Λ, G1, projected areas, Fresnel terms, heights). Grazing, exactly
+//! horizontal and below-horizon unit directions are valid input.
 
 #![warn(missing_docs)]
 
+#[macro_use]
+mod contract;
 mod albedo;
 mod bsdf;
 mod error;
@@ -44,9 +123,11 @@ mod vndf;
 
 pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
 pub use bsdf::{
-    Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder, MicrofacetBsdf,
-    SampleFlags, ShadingFrame, Technique, Transport,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, EnergyByOrder,
+    MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit,
+    Technique, Transport,
 };
+pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
 pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
 pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};

@@ -13,14 +13,14 @@
 //! Determinism: every property runs with `RngSeed::Fixed` and no failure persistence, so
 //! CI runs the same cases every time (override the count with `PROPTEST_CASES` if needed).
 //! Case counts: 384 per property, 96 for the random walks and position-free estimators.
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use microsurface::{
     Beckmann, BeckmannNewton, Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor,
     Dielectric, Diffuse, Estimator, GaussianHeight, GgxDisk, GgxSphericalCap, HeightSample, Material,
     MicrofacetBsdf, Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, SmithVndf, Technique, Transport, UniformHeight, VCavity, VCavitySlope,
-    VisibleNormalSampler, beta, erf, erfc, erfinv, fresnel_conductor, fresnel_dielectric, fresnel_schlick,
-    ln_beta, ln_gamma, smith_normalization,
+    ScatteringOrder, Shadowing, SmithVndf, SpecularLimit, Technique, Transport, UniformHeight, VCavity,
+    VCavitySlope, VisibleNormalSampler, beta, erf, erfc, erfinv, fresnel_conductor, fresnel_dielectric,
+    fresnel_schlick, ln_beta, ln_gamma, smith_normalization,
 };
 use microsurface::{Ggx, MAX_BOUNCES};
 use proptest::prelude::*;
@@ -121,7 +121,7 @@ fn bounded_weight(v: Vec3) -> bool {
 
 /// Calls `visit` with the model's static types.
 trait Visit {
-    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material + SpecularLimit>(
         &self,
         h: H,
         s: S,
@@ -253,7 +253,7 @@ struct PhaseProps {
 }
 
 impl Visit for PhaseProps {
-    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material + SpecularLimit>(
         &self,
         h: H,
         s: S,
@@ -318,7 +318,7 @@ struct WalkProps {
 }
 
 impl Visit for WalkProps {
-    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material + SpecularLimit>(
         &self,
         h: H,
         s: S,
@@ -349,7 +349,7 @@ struct PfProps {
 }
 
 impl Visit for PfProps {
-    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material + SpecularLimit>(
         &self,
         _h: H,
         s: S,
@@ -387,14 +387,15 @@ struct BsdfProps {
 }
 
 impl Visit for BsdfProps {
-    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+    fn visit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material + SpecularLimit>(
         &self,
-        h: H,
+        _: H,
         s: S,
         m: M,
     ) -> TestCaseResult {
         let (wo, wi) = (self.wo, self.wi);
         let mut rng = Rng::seed_from_u64(self.seed);
+        let mut uniform = || (rand::Rng::next_u32(&mut rng) >> 8) as f32 / 16_777_216.0;
         let techniques = [
             Technique::SingleScattering,
             Technique::RandomWalk,
@@ -403,11 +404,12 @@ impl Visit for BsdfProps {
         ];
         for technique in techniques {
             for transport in [Transport::Radiance, Transport::Importance] {
-                let b = MicrofacetBsdf::new(h, s, m).with_technique(technique).with_transport(transport);
-                let f = b.eval(wo, wi, &mut rng).f;
+                let b =
+                    MicrofacetBsdf::new(s, m).unwrap().with_technique(technique).with_transport(transport);
+                let f = b.eval(wo, wi).f;
                 prop_assert!(non_negative(f), "{m:?} {technique:?} eval({wo}, {wi}) = {f}");
                 prop_assert!(density(b.pdf(wo, wi)), "{m:?} {technique:?} pdf = {}", b.pdf(wo, wi));
-                if let Some(smp) = b.sample(wo, &mut rng) {
+                if let Some(smp) = b.sample(wo, uniform(), Vec2::new(uniform(), uniform())) {
                     prop_assert!(unit(smp.wi), "{m:?} {technique:?} sample({wo}).wi = {}", smp.wi);
                     prop_assert!(smp.pdf > 0.0 && smp.pdf.is_finite(), "pdf {}", smp.pdf);
                     prop_assert!(non_negative(smp.weight), "{m:?} {technique:?} weight {}", smp.weight);
@@ -550,10 +552,11 @@ proptest! {
         prop_assert!(density(b.d(m)), "{ndf:?} D({m}) = {}", b.d(m));
         let g1 = b.g1(wi);
         prop_assert!((0.0..=1.0 + 1e-6).contains(&g1), "{ndf:?} G1({wi}) = {g1}");
-        let f = b.eval(wo, wi, &mut rng).f;
+        let mut uniform = || (rand::Rng::next_u32(&mut rng) >> 8) as f32 / 16_777_216.0;
+        let f = b.eval(wo, wi).f;
         prop_assert!(non_negative(f), "{ndf:?} eval({wo}, {wi}) = {f}");
         prop_assert!(density(b.pdf(wo, wi)), "{ndf:?} pdf = {}", b.pdf(wo, wi));
-        if let Some(s) = b.sample(wo, &mut rng) {
+        if let Some(s) = b.sample(wo, uniform(), Vec2::new(uniform(), uniform())) {
             prop_assert!(unit(s.wi) && s.wi.z > 0.0, "{ndf:?} sample({wo}).wi = {}", s.wi);
             prop_assert!(s.pdf > 0.0 && s.pdf.is_finite() && non_negative(s.weight), "{ndf:?} sample {s:?}");
         }

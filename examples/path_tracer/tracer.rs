@@ -1,14 +1,20 @@
 //! A small CPU path tracer over the `microsurface` BSDFs: spheres, one spherical area light,
 //! an environment; next-event estimation, Russian roulette and multiple importance sampling
-//! (the CS500 algorithm with MIS). Shared by `main.rs` and `tests/path_tracer.rs`.
+//! (the classic unidirectional path tracer with MIS). Shared by `main.rs` and
+//! `tests/path_tracer.rs`.
+//!
+//! The materials are a `Vec<Box<dyn Bsdf>>`: no enum, no dispatch macro. The BSDF samples
+//! are driven by the tracer's own uniforms; the stochastic BSDFs get the path's index as
+//! their key, so a render is a pure function of its seed (identical for any thread count).
 #![allow(dead_code)]
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use microsurface::{
     Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor, Dielectric, Diffuse, Estimator,
-    Ggx, MicrofacetBsdf, ScatteringOrder, ShadingFrame, Shadowing, Technique, UniformHeight,
+    Ggx, MicrofacetBsdf, ScatteringOrder, ShadingFrame, Shadowing, Technique,
 };
 use rand::Rng;
+use rand::RngExt;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// Offset of secondary ray origins along the normal.
@@ -18,37 +24,8 @@ const ROULETTE_DEPTH: u32 = 3;
 /// Highest survival probability of the roulette.
 const ROULETTE_MAX_SURVIVAL: f32 = 0.95;
 
-/// The materials of the scene, statically dispatched by a `match`.
-#[derive(Debug, Clone, Copy)]
-pub enum Material {
-    Conductor(MicrofacetBsdf<UniformHeight, Ggx, Conductor>),
-    Dielectric(MicrofacetBsdf<UniformHeight, Ggx, Dielectric>),
-    Diffuse(MicrofacetBsdf<UniformHeight, Ggx, Diffuse>),
-    Classic(ClassicBrdf),
-}
-
-macro_rules! dispatch {
-    ($self:expr, $b:ident => $e:expr) => {
-        match $self {
-            Material::Conductor($b) => $e,
-            Material::Dielectric($b) => $e,
-            Material::Diffuse($b) => $e,
-            Material::Classic($b) => $e,
-        }
-    };
-}
-
-impl Material {
-    pub fn eval(&self, wo: Vec3, wi: Vec3, rng: &mut impl Rng) -> Vec3 {
-        dispatch!(self, b => b.eval(wo, wi, rng).f)
-    }
-    pub fn sample(&self, wo: Vec3, rng: &mut impl Rng) -> Option<microsurface::BsdfSample> {
-        dispatch!(self, b => b.sample(wo, rng))
-    }
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        dispatch!(self, b => b.pdf(wo, wi))
-    }
-}
+/// A material of the scene: any BSDF of the crate, behind the object-safe trait.
+pub type Material = Box<dyn Bsdf>;
 
 #[derive(Debug, Clone, Copy)]
 pub struct Sphere {
@@ -187,8 +164,8 @@ fn sample_light_cone(light: &Light, p: Vec3, rng: &mut impl Rng) -> Option<(Vec3
         return None;
     }
     let cos_max = (1.0 - sin2_max).sqrt();
-    let u1: f32 = rand::RngExt::random(rng);
-    let u2: f32 = rand::RngExt::random(rng);
+    let u1: f32 = rng.random();
+    let u2: f32 = rng.random();
     let cos_t = 1.0 - u1 * (1.0 - cos_max);
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
     let frame = ShadingFrame::from_normal(to_center)?;
@@ -227,18 +204,24 @@ fn add_finite(acc: &mut Vec3, c: Vec3, stats: &RenderStats) {
 }
 
 /// Radiance along the ray (o, d): path tracing with next-event estimation towards the light,
-/// BSDF sampling, MIS (power heuristic) between the two, and Russian roulette.
+/// BSDF sampling, MIS (power heuristic) between the two, and Russian roulette on the
+/// throughput with the η² of the refractions taken out (pbrt's `etaScale`). `key` identifies
+/// the path (pixel and sample); the BSDFs' stochastic estimates mix it with the depth into
+/// their seeds.
 pub fn radiance(
     scene: &Scene,
     mut o: Vec3,
     mut d: Vec3,
     max_depth: u32,
+    key: u64,
     rng: &mut impl Rng,
     stats: &RenderStats,
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
-    let mut bsdf_pdf_prev: Option<f32> = None; // None: the previous vertex was the camera
+    // the product of the η² of the refractions: radiance is scaled by 1/η² entering glass
+    let mut eta_scale = 1.0f32;
+    let mut bsdf_pdf_prev: Option<f32> = None; // None: camera or specular vertex, no MIS
     for depth in 0..max_depth {
         let Some(hit) = scene.intersect(o, d) else {
             add_finite(&mut sum, throughput * scene.environment.radiance(d), stats);
@@ -257,22 +240,23 @@ pub fn radiance(
             Hit::Surface { point, normal, material, .. } => (point, normal, material),
         };
         let Some(frame) = ShadingFrame::from_normal(normal) else { break };
-        let material = &scene.materials[material];
+        let bsdf: &dyn Bsdf = scene.materials[material].as_ref();
         let wo = frame.to_local(-d).normalize();
+        let vertex_key = key.wrapping_mul(64).wrapping_add(u64::from(depth));
 
-        // next-event estimation
-        if let Some(light) = &scene.light {
+        // next-event estimation (useless on a Dirac lobe)
+        if let Some(light) = scene.light.as_ref().filter(|_| bsdf.flags().has_non_specular()) {
             let origin = point + normal * RAY_EPSILON * normal.dot(-d).signum();
             if let Some((wi_world, p_light)) = sample_light_cone(light, origin, rng) {
                 let wi = frame.to_local(wi_world).normalize();
-                let f = material.eval(wo, wi, rng);
-                if f != Vec3::ZERO {
+                let (f, p_bsdf) = bsdf.eval_with_pdf_keyed(wo, wi, vertex_key);
+                if f.f != Vec3::ZERO {
                     let shadow_origin = point + normal * RAY_EPSILON * wi.z.signum();
                     if matches!(scene.intersect(shadow_origin, wi_world), Some(Hit::Light { .. })) {
-                        let w = power_heuristic(p_light, material.pdf(wo, wi));
+                        let w = power_heuristic(p_light, p_bsdf);
                         add_finite(
                             &mut sum,
-                            throughput * f * wi.z.abs() * light.radiance * (w / p_light),
+                            throughput * f.f * wi.z.abs() * light.radiance * (w / p_light),
                             stats,
                         );
                     }
@@ -280,19 +264,23 @@ pub fn radiance(
             }
         }
 
-        // BSDF sampling
-        let Some(s) = material.sample(wo, rng) else { break };
+        // BSDF sampling, driven by the tracer's uniforms
+        let (uc, u) = (rng.random::<f32>(), Vec2::new(rng.random(), rng.random()));
+        let Some(s) = bsdf.sample_keyed(wo, uc, u, vertex_key) else { break };
         throughput *= s.weight;
         if !throughput.is_finite() {
             stats.rejected.fetch_add(1, Ordering::Relaxed);
             break;
         }
-        bsdf_pdf_prev = Some(s.pdf);
+        if s.flags.transmission {
+            eta_scale *= s.eta * s.eta;
+        }
+        bsdf_pdf_prev = (!s.flags.specular).then_some(s.pdf);
         d = frame.to_world(s.wi).normalize();
         o = point + normal * RAY_EPSILON * s.wi.z.signum();
         if depth >= ROULETTE_DEPTH {
-            let q = throughput.max_element().min(ROULETTE_MAX_SURVIVAL);
-            if rand::RngExt::random::<f32>(rng) >= q {
+            let q = (throughput.max_element() * eta_scale).min(ROULETTE_MAX_SURVIVAL);
+            if rng.random::<f32>() >= q {
                 break;
             }
             throughput /= q;
@@ -328,11 +316,15 @@ pub fn render(
                         let mut row_err = Vec::with_capacity(width as usize);
                         for x in 0..width {
                             let (mut s, mut s2) = (glam::DVec3::ZERO, 0.0f64);
-                            for _ in 0..spp {
-                                let jx: f32 = rand::RngExt::random(&mut rng);
-                                let jy: f32 = rand::RngExt::random(&mut rng);
+                            for i in 0..spp {
+                                let jx: f32 = rng.random();
+                                let jy: f32 = rng.random();
                                 let d = camera.ray(x as f32 + jx, y as f32 + jy, width, height);
-                                let l = radiance(scene, camera.origin, d, 64, &mut rng, stats).as_dvec3();
+                                let path = (u64::from(y as u32) * u64::from(width) + u64::from(x))
+                                    * u64::from(spp)
+                                    + u64::from(i);
+                                let l =
+                                    radiance(scene, camera.origin, d, 64, path, &mut rng, stats).as_dvec3();
                                 s += l;
                                 let m = l.element_sum() / 3.0;
                                 s2 += m * m;
@@ -366,25 +358,25 @@ const SHOWCASE_ALPHA: f32 = 0.5;
 
 fn conductor(technique: Technique, ior: Option<ComplexIor>) -> Material {
     let c = ior.map_or_else(Conductor::perfect, Conductor::new);
-    Material::Conductor(
-        MicrofacetBsdf::new(UniformHeight, Ggx::isotropic(SHOWCASE_ALPHA).expect("valid α"), c)
-            .with_technique(technique),
-    )
+    let alpha = Ggx::isotropic(SHOWCASE_ALPHA).expect("valid α");
+    Box::new(MicrofacetBsdf::new(alpha, c).expect("α ≤ MAX_WALK_ALPHA").with_technique(technique))
 }
 
 fn dielectric(technique: Technique) -> Material {
     let d = Dielectric::new(1.5).expect("valid η");
-    Material::Dielectric(
-        MicrofacetBsdf::new(UniformHeight, Ggx::isotropic(SHOWCASE_ALPHA).expect("valid α"), d)
-            .with_technique(technique),
-    )
+    let alpha = Ggx::isotropic(SHOWCASE_ALPHA).expect("valid α");
+    Box::new(MicrofacetBsdf::new(alpha, d).expect("α ≤ MAX_WALK_ALPHA").with_technique(technique))
 }
 
 fn diffuse(technique: Technique, albedo: Vec3) -> Material {
     let d = Diffuse::new(albedo).expect("valid albedo");
-    Material::Diffuse(
-        MicrofacetBsdf::new(UniformHeight, Ggx::isotropic(1.0).expect("valid α"), d)
-            .with_technique(technique),
+    let alpha = Ggx::isotropic(1.0).expect("valid α");
+    Box::new(MicrofacetBsdf::new(alpha, d).expect("α ≤ MAX_WALK_ALPHA").with_technique(technique))
+}
+
+fn classic(kd: Vec3, ks: Vec3, alpha: f32) -> Material {
+    Box::new(
+        ClassicBrdf::new(kd, ks, ClassicNdf::Ggx(alpha), ClassicMasking::Exact).expect("valid parameters"),
     )
 }
 
@@ -402,7 +394,7 @@ pub const SHOWCASE_LABELS: [&str; 8] = [
     "glass, random walk",
     "glass, position-free BDPT",
     "diffuse, random walk",
-    "classic CS500 GGX",
+    "classic GGX + Lambert",
 ];
 
 /// The x coordinate of showcase sphere i.
@@ -424,15 +416,7 @@ pub fn showcase_scene(furnace: bool) -> (Scene, Camera) {
         dielectric(Technique::RandomWalk),
         dielectric(BDPT),
         diffuse(Technique::RandomWalk, albedo),
-        Material::Classic(
-            ClassicBrdf::new(
-                Vec3::new(0.1, 0.3, 0.6),
-                Vec3::splat(0.04),
-                ClassicNdf::Ggx(0.2),
-                ClassicMasking::Exact,
-            )
-            .expect("valid parameters"),
-        ),
+        classic(Vec3::new(0.1, 0.3, 0.6), Vec3::splat(0.04), 0.2),
     ];
     let count = if furnace { 7 } else { 8 };
     let mut spheres: Vec<Sphere> = (0..count)
@@ -441,10 +425,7 @@ pub fn showcase_scene(furnace: bool) -> (Scene, Camera) {
     let (light, environment) = if furnace {
         (None, Environment::Constant(Vec3::ONE))
     } else {
-        materials.push(Material::Classic(
-            ClassicBrdf::new(Vec3::splat(0.5), Vec3::ZERO, ClassicNdf::Ggx(1.0), ClassicMasking::Exact)
-                .expect("valid parameters"),
-        ));
+        materials.push(classic(Vec3::splat(0.5), Vec3::ZERO, 1.0));
         spheres.push(Sphere {
             center: Vec3::new(0.0, -1000.0, 0.0),
             radius: 1000.0,

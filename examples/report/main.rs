@@ -1,22 +1,28 @@
 //! The crate's main job: a report of every estimator's accuracy against run time, the lobes
 //! and energy per scattering order, and the cost of every model, measured on this machine.
 //!
-//! `cargo run --release --example report -- [--quick] [--out DIR]` writes CSV files, PNG
-//! plots and `summary.md` into DIR (default `target/report`) and prints the summary.
+//! `cargo run --release --example report -- [--quick] [--out DIR]` writes CSV files, SVG
+//! figures, `summary.md` and the page `index.html` into DIR (default `target/report`) and
+//! prints the summary. The stages, one file each: `configure` (what and how much), `measure`
+//! (per-sample values, timings, references, energy, lobes, cost), `reduce` (errors against
+//! time, efficiency ratios with confidence intervals, lobe panels), `plot` (SVG figures) and
+//! `write` (CSV, Markdown, HTML); `pipeline` runs them in order.
 
+mod configure;
+mod measure;
+mod pipeline;
 mod plot;
-#[path = "../path_tracer/png.rs"]
-mod png;
-mod run;
+mod reduce;
+mod write;
 
 const USAGE: &str = "usage: cargo run --release --example report -- [--quick] [--out DIR]
 
-  --quick    a small run (seconds instead of a minute)
+  --quick    a small run (seconds instead of minutes)
   --out DIR  output directory (default target/report)
   --help     print this message
 
-Writes CSV files, PNG plots and summary.md into DIR and prints the summary. A progress bar
-goes to stderr when it is a terminal.";
+Writes CSV files, SVG figures, summary.md and index.html into DIR and prints the summary. A
+progress bar goes to stderr when it is a terminal.";
 
 /// Prints the usage and the problem to stderr and exits with status 2.
 fn usage_error(problem: &str) -> ! {
@@ -24,12 +30,13 @@ fn usage_error(problem: &str) -> ! {
     std::process::exit(2)
 }
 
-fn main() -> std::io::Result<()> {
+/// Stage 1 (configure) from the command line.
+fn options() -> Option<configure::Options> {
     use std::io::IsTerminal;
     let mut args = std::env::args().skip(1);
-    let mut opts = run::Options {
+    let mut opts = configure::Options {
         quick: false,
-        out_dir: run::default_out_dir(),
+        out_dir: configure::default_out_dir(),
         threads: std::thread::available_parallelism().map_or(2, |n| n.get()),
         progress: std::io::stderr().is_terminal(),
     };
@@ -41,19 +48,24 @@ fn main() -> std::io::Result<()> {
             }
             "-h" | "--help" => {
                 println!("{USAGE}");
-                return Ok(());
+                return None;
             }
             other => usage_error(&format!("unknown argument {other}")),
         }
     }
-    let start = std::time::Instant::now();
-    let summary = run::run(&opts)?;
-    println!("{}", summary.markdown);
+    Some(opts)
+}
+
+fn main() -> std::io::Result<()> {
+    let Some(opts) = options() else { return Ok(()) };
+    let report = pipeline::run(&opts)?;
+    println!("{}", report.markdown);
     println!(
-        "wrote {} files into {} in {:.1} s",
-        summary.files.len(),
+        "wrote {} files into {} in {:.1} s (open {})",
+        report.files.len(),
         opts.out_dir.display(),
-        start.elapsed().as_secs_f64()
+        report.seconds,
+        opts.out_dir.join("index.html").display()
     );
     Ok(())
 }

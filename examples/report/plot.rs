@@ -1,199 +1,357 @@
-//! A small raster plotter for the report: log–log line charts and polar lobe plots, with an
-//! 8×8 bitmap font (`font8x8`), written to PNG. No system fonts needed.
+//! Stage 4, plot: the report's figures as SVG with `plotters` (its SVG backend writes text as
+//! SVG `<text>`, so no font files are needed): error against run time as small multiples over
+//! every (θi, ωo), and the lobes per order of the walk and both position-free models.
 
-use font8x8::legacy::BASIC_LEGACY;
+use super::configure::{Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, THETAS};
+use super::reduce::{LobePanel, Results};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-pub type Rgb = [u8; 3];
+/// A rendered figure: its file name, its SVG text and a caption for the HTML page.
+pub struct Figure {
+    pub file: String,
+    pub svg: String,
+    pub title: String,
+}
 
-pub const WHITE: Rgb = [255, 255, 255];
-pub const BLACK: Rgb = [0, 0, 0];
-pub const GRID: Rgb = [225, 225, 225];
-/// A palette that stays distinguishable in print.
-pub const PALETTE: [Rgb; 7] = [
-    [31, 119, 180],
-    [255, 127, 14],
-    [44, 160, 44],
-    [214, 39, 40],
-    [148, 103, 189],
-    [140, 86, 75],
-    [23, 190, 207],
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+type PlotResult<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// A palette that stays distinguishable in print (the first six of Tableau 10).
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
 ];
+const GRAY: RGBColor = RGBColor(110, 110, 110);
+const LIGHT: RGBColor = RGBColor(215, 215, 215);
+const FONT: &str = "sans-serif";
 
-pub struct Canvas {
-    pub width: u32,
-    pub height: u32,
-    pixels: Vec<Rgb>,
-}
-
-impl Canvas {
-    pub fn new(width: u32, height: u32) -> Self {
-        Self { width, height, pixels: vec![WHITE; (width * height) as usize] }
-    }
-
-    pub fn set(&mut self, x: i32, y: i32, c: Rgb) {
-        if x >= 0 && y >= 0 && (x as u32) < self.width && (y as u32) < self.height {
-            self.pixels[(y as u32 * self.width + x as u32) as usize] = c;
-        }
-    }
-
-    /// A line of the given thickness (Bresenham with a square brush).
-    pub fn line(&mut self, (x0, y0): (f32, f32), (x1, y1): (f32, f32), c: Rgb, thickness: i32) {
-        if !(x0.is_finite() && y0.is_finite() && x1.is_finite() && y1.is_finite()) {
-            return;
-        }
-        let steps = ((x1 - x0).abs().max((y1 - y0).abs()).ceil() as i32).clamp(1, 10_000);
-        for s in 0..=steps {
-            let t = s as f32 / steps as f32;
-            let (x, y) = ((x0 + t * (x1 - x0)).round() as i32, (y0 + t * (y1 - y0)).round() as i32);
-            for dx in 0..thickness {
-                for dy in 0..thickness {
-                    self.set(x + dx - thickness / 2, y + dy - thickness / 2, c);
-                }
-            }
-        }
-    }
-
-    /// Text with the 8×8 font, top-left at (x, y), scaled by an integer factor.
-    pub fn text(&mut self, x: i32, y: i32, s: &str, c: Rgb, scale: i32) {
-        for (i, ch) in s.chars().enumerate() {
-            let glyph = BASIC_LEGACY.get(ch as usize).copied().unwrap_or(BASIC_LEGACY[b'?' as usize]);
-            for (row, bits) in glyph.iter().enumerate() {
-                for col in 0..8 {
-                    if bits & (1 << col) != 0 {
-                        for sy in 0..scale {
-                            for sx in 0..scale {
-                                self.set(
-                                    x + (i as i32 * 8 + col) * scale + sx,
-                                    y + row as i32 * scale + sy,
-                                    c,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    /// Copies `other` with its top-left corner at (x, y).
-    pub fn blit(&mut self, other: &Canvas, x: i32, y: i32) {
-        for oy in 0..other.height {
-            for ox in 0..other.width {
-                self.set(x + ox as i32, y + oy as i32, other.pixels[(oy * other.width + ox) as usize]);
-            }
-        }
-    }
-
-    pub fn text_width(s: &str, scale: i32) -> i32 {
-        s.chars().count() as i32 * 8 * scale
-    }
-
-    pub fn save(&self, path: &std::path::Path) -> std::io::Result<()> {
-        let bytes: Vec<u8> = self.pixels.iter().flatten().copied().collect();
-        super::png::write_rgb8(path, self.width, self.height, &bytes)
+fn est_color(est: Est) -> RGBColor {
+    match est {
+        Est::Single => GRAY,
+        Est::Walk => PALETTE[0],
+        Est::PtUncorrelated => PALETTE[1],
+        Est::PtCorrelated => PALETTE[2],
+        Est::BdptUncorrelated => PALETTE[3],
+        Est::BdptCorrelated => PALETTE[4],
     }
 }
 
-/// A named series of points.
-pub struct Series {
-    pub label: String,
-    pub points: Vec<(f64, f64)>,
-    pub color: Rgb,
+/// 10 to an integer power, with superscript digits.
+fn power_of_ten(v: f64) -> String {
+    let e = v.log10().round() as i32;
+    let sup: String = e
+        .to_string()
+        .chars()
+        .map(|c| match c {
+            '-' => '⁻',
+            d => ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'][d.to_digit(10).unwrap_or(0) as usize],
+        })
+        .collect();
+    format!("10{sup}")
 }
 
-/// A log–log line chart with decade grid lines and a legend.
-pub fn loglog_chart(canvas: &mut Canvas, title: &str, x_label: &str, y_label: &str, series: &[Series]) {
-    let (w, h) = (canvas.width as f32, canvas.height as f32);
-    let (left, right, top, bottom) = (58.0, w - 12.0, 26.0, h - 34.0);
-    let finite = |v: f64| v.is_finite() && v > 0.0;
-    let pts = series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(x, y)| finite(x) && finite(y));
+/// Text lines at (x, y), `size` px, `gap` px apart.
+fn text_lines(area: &Area, lines: &[String], (x, y): (i32, i32), size: u32, gap: i32) -> PlotResult<()> {
+    for (i, line) in lines.iter().enumerate() {
+        area.draw(&Text::new(line.clone(), (x, y + i as i32 * gap), (FONT, size).into_font()))?;
+    }
+    Ok(())
+}
+
+/// A legend entry: a line sample and its label, at (x, y).
+fn legend_entry(
+    area: &Area,
+    (x, y): (i32, i32),
+    color: RGBColor,
+    dashed: bool,
+    label: &str,
+) -> PlotResult<()> {
+    if dashed {
+        for k in 0..3 {
+            area.draw(&PathElement::new(
+                vec![(x + 10 * k, y + 7), (x + 10 * k + 6, y + 7)],
+                color.stroke_width(3),
+            ))?;
+        }
+    } else {
+        area.draw(&PathElement::new(vec![(x, y + 7), (x + 26, y + 7)], color.stroke_width(3)))?;
+    }
+    area.draw(&Text::new(label.to_string(), (x + 34, y - 1), (FONT, 15).into_font()))?;
+    Ok(())
+}
+
+/// Every figure of the report.
+pub fn figures(results: &Results, budget: &Budget) -> PlotResult<Vec<Figure>> {
+    let mut figures = Vec::new();
+    for config in Config::ALL {
+        figures.push(error_vs_time(results, config, budget)?);
+    }
+    for material in LOBE_MATERIALS {
+        figures.push(lobes(results, material, budget)?);
+    }
+    Ok(figures)
+}
+
+/// Relative RMSE against single-thread time, one panel per (θi, ωo).
+fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResult<Figure> {
+    let (w, h) = (1080u32, 1000u32);
+    let mut svg = String::new();
+    let cases = Case::all(config);
+    let rows: Vec<_> = results.efficiency.iter().filter(|r| r.case.config == config).collect();
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    let pts =
+        rows.iter().flat_map(|r| r.curve.iter()).filter(|p| positive(p.seconds) && positive(p.rel_rmse));
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for (x, y) in pts {
-        (x0, x1, y0, y1) = (x0.min(x.log10()), x1.max(x.log10()), y0.min(y.log10()), y1.max(y.log10()));
+    for p in pts {
+        (x0, x1, y0, y1) = (x0.min(p.seconds), x1.max(p.seconds), y0.min(p.rel_rmse), y1.max(p.rel_rmse));
     }
     if x0 > x1 {
-        return;
+        (x0, x1, y0, y1) = (1e-7, 1e-3, 1e-3, 1.0);
     }
-    let (x0, x1, y0, y1) =
-        (x0.floor(), x1.ceil().max(x0.floor() + 1.0), y0.floor(), y1.ceil().max(y0.floor() + 1.0));
-    let px = |x: f64| left + ((x.log10() - x0) / (x1 - x0)) as f32 * (right - left);
-    let py = |y: f64| bottom - ((y.log10() - y0) / (y1 - y0)) as f32 * (bottom - top);
-    for d in (x0 as i32)..=(x1 as i32) {
-        let x = px(10f64.powi(d));
-        canvas.line((x, top), (x, bottom), GRID, 1);
-        let label = format!("1e{d}");
-        canvas.text(x as i32 - Canvas::text_width(&label, 1) / 2, bottom as i32 + 6, &label, BLACK, 1);
-    }
-    for d in (y0 as i32)..=(y1 as i32) {
-        let y = py(10f64.powi(d));
-        canvas.line((left, y), (right, y), GRID, 1);
-        let label = format!("1e{d}");
-        canvas.text(left as i32 - Canvas::text_width(&label, 1) - 4, y as i32 - 4, &label, BLACK, 1);
-    }
-    canvas.line((left, bottom), (right, bottom), BLACK, 1);
-    canvas.line((left, top), (left, bottom), BLACK, 1);
-    canvas.text(left as i32, 6, title, BLACK, 1);
-    canvas.text((right as i32) - Canvas::text_width(x_label, 1), h as i32 - 14, x_label, BLACK, 1);
-    canvas.text(4, top as i32 - 14, y_label, BLACK, 1);
-    for (i, s) in series.iter().enumerate() {
-        let pts: Vec<(f32, f32)> =
-            s.points.iter().filter(|&&(x, y)| finite(x) && finite(y)).map(|&(x, y)| (px(x), py(y))).collect();
-        for pair in pts.windows(2) {
-            canvas.line(pair[0], pair[1], s.color, 2);
+    let decade = |v: f64, up: bool| 10f64.powf(if up { v.log10().ceil() } else { v.log10().floor() });
+    // a hair beyond the decades, so that the end labels are drawn
+    let (x0, x1, y0, y1) = (
+        decade(x0, false) * 0.98,
+        decade(x1, true) * 1.02,
+        decade(y0, false) * 0.98,
+        decade(y1, true) * 1.02,
+    );
+    let title = format!("Relative RMSE against single-thread run time: {}", config.label());
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (header, grid) = root.split_vertically(176);
+        text_lines(
+            &header,
+            &[
+                title.clone(),
+                format!(
+                    "Each curve: the RMSE of the mean of n evaluations (disjoint batches of one run of {} evaluations) against its model's",
+                    budget.samples
+                ),
+                format!(
+                    "converged reference ({}× the samples, from the model's lowest-variance estimator), divided by that reference; log–log axes.",
+                    budget.reference_factor
+                ),
+            ],
+            (12, 8),
+            15,
+            22,
+        )?;
+        for (k, est) in Est::ALL.iter().enumerate() {
+            let (col, row) = (k % 2, k / 2);
+            let at = (12 + col as i32 * 530, 80 + row as i32 * 22);
+            legend_entry(&header, at, est_color(*est), *est == Est::Single, est.label())?;
         }
-        let ly = top as i32 + 4 + 11 * i as i32;
-        let lx = right as i32 - 8 * 18;
-        canvas.line((lx as f32, ly as f32 + 4.0), (lx as f32 + 14.0, ly as f32 + 4.0), s.color, 3);
-        canvas.text(lx + 18, ly, &s.label, BLACK, 1);
+        legend_entry(
+            &header,
+            (12, 80 + 3 * 22),
+            BLACK,
+            true,
+            "slope −½ (the Monte Carlo rate), through the walk's first point",
+        )?;
+        let panels = grid.split_evenly((THETAS.len(), 3));
+        for (panel, case) in panels.iter().zip(&cases) {
+            let caption = format!("θi = {}, ωo: {}", case.theta_i(), case.wo.name());
+            let mut chart = ChartBuilder::on(panel)
+                .caption(caption, (FONT, 17))
+                .margin(6)
+                .margin_right(14)
+                .x_label_area_size(42)
+                .y_label_area_size(62)
+                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s, one thread)")
+                .y_desc("relative RMSE")
+                .x_labels(6)
+                .y_labels(6)
+                .x_label_formatter(&|v| power_of_ten(*v))
+                .y_label_formatter(&|v| power_of_ten(*v))
+                .label_style((FONT, 14))
+                .axis_desc_style((FONT, 15))
+                .light_line_style(WHITE)
+                .bold_line_style(LIGHT)
+                .draw()?;
+            // the Monte Carlo rate: slope −½ through the walk's first point
+            if let Some(first) = results.row(*case, Est::Walk).and_then(|r| r.curve.first()) {
+                let line = [x0, x1].map(|t| (t, first.rel_rmse * (t / first.seconds).powf(-0.5)));
+                chart.draw_series(DashedLineSeries::new(line, 3, 5, BLACK.stroke_width(1)))?;
+            }
+            for est in Est::ALL {
+                let Some(row) = results.row(*case, est) else { continue };
+                let points: Vec<(f64, f64)> = row
+                    .curve
+                    .iter()
+                    .filter(|p| positive(p.seconds) && positive(p.rel_rmse))
+                    .map(|p| (p.seconds, p.rel_rmse))
+                    .collect();
+                let style = est_color(est).stroke_width(2);
+                if est == Est::Single {
+                    chart.draw_series(DashedLineSeries::new(points, 6, 4, style))?;
+                } else {
+                    chart.draw_series(LineSeries::new(points, style))?;
+                }
+            }
+        }
+        root.present()?;
     }
+    Ok(Figure { file: format!("error_vs_time_{}.svg", config.name()), svg, title })
 }
 
-/// A polar plot of lobes in the incidence plane: each series holds (θ, r) with θ measured
-/// from the normal (positive towards +x, |θ| > π/2 below the surface). The radius scale is
-/// shared by all series; `notes` are printed under the title.
-pub fn polar_chart(canvas: &mut Canvas, title: &str, notes: &[String], series: &[Series], incident: f64) {
-    let (w, h) = (canvas.width as f32, canvas.height as f32);
-    let below = series
-        .iter()
-        .any(|s| s.points.iter().any(|&(t, r)| t.abs() > std::f64::consts::FRAC_PI_2 && r > 0.0));
-    let (cx, cy) = (w * 0.5, if below { h * 0.55 } else { h * 0.85 });
-    let radius = if below { (h * 0.38).min(w * 0.42) } else { (h * 0.7).min(w * 0.45) };
-    let r_max =
-        series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).fold(0.0f64, |a, b| a.max(b)).max(1e-12);
-    for k in 1..=4 {
-        let r = radius * k as f32 / 4.0;
-        let mut prev = None;
-        for i in 0..=180 {
-            let t = std::f32::consts::PI * (i as f32 / 180.0) * if below { 2.0 } else { 1.0 }
-                - std::f32::consts::FRAC_PI_2;
-            let p = (cx + r * t.sin(), cy - r * t.cos());
-            if let Some(q) = prev {
-                canvas.line(q, p, GRID, 1);
+/// A round step for the radial scale: the smallest 1, 2, 2.5 or 5 × 10^k of at least a quarter
+/// of `r` (two to four labelled circles).
+fn radial_step(r: f64) -> f64 {
+    let raw = r / 4.0;
+    let p = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 2.5, 5.0, 10.0].into_iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p)
+}
+
+/// Lobes per order: rows θi, columns the three models.
+fn lobes(results: &Results, material: MaterialKind, budget: &Budget) -> PlotResult<Figure> {
+    let full_circle = material == MaterialKind::Dielectric;
+    let (pw, ph) = (360u32, if full_circle { 430u32 } else { 300u32 });
+    let header_h = 110u32;
+    let (w, h) = (3 * pw, header_h + THETAS.len() as u32 * ph);
+    let panels: Vec<&LobePanel> = results.lobes.iter().filter(|p| p.material == material).collect();
+    let worst = panels.iter().map(|p| p.max_rel_se).fold(0.0, f64::max);
+    let what = match material {
+        MaterialKind::Conductor => "conductor (F = 1)",
+        MaterialKind::Dielectric => "dielectric (η = 1.5)",
+        MaterialKind::Diffuse => "diffuse",
+    };
+    let title = format!("Lobes per scattering order, {what}, GGX α = 1");
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (header, grid) = root.split_vertically(header_h);
+        text_lines(
+            &header,
+            &[
+                title.clone(),
+                format!(
+                    "f·|cos θo| (sr⁻¹) in the plane of incidence, against θo; ωi is the gray ray (on the right), the mirror direction on the left{}.",
+                    if full_circle { ", transmission below the horizon" } else { "" }
+                ),
+                "Radial circles in sr⁻¹, one scale per row; legends: the albedo of each order (from sampled scatterings of the same model).".to_string(),
+                format!(
+                    "Walk: its eval; position-free: PT. {}–{} evaluations per order and angle, until the SE of the total is ≤ {} % of the panel's peak in a pilot run; largest SE: {:.2} % of the peak.",
+                    panels.iter().map(|p| p.samples.0).min().unwrap_or(0),
+                    panels.iter().map(|p| p.samples.1).max().unwrap_or(0),
+                    100.0 * budget.lobe_rel_se,
+                    100.0 * worst
+                ),
+            ],
+            (12, 8),
+            15,
+            24,
+        )?;
+        let cells = grid.split_evenly((THETAS.len(), Model::ALL.len()));
+        for (k, theta_i) in THETAS.into_iter().enumerate() {
+            let row: Vec<&&LobePanel> = panels.iter().filter(|p| p.theta_i == theta_i).collect();
+            let r_max = row.iter().map(|p| p.peak).fold(1e-12, f64::max) * 1.04;
+            for (j, model) in Model::ALL.into_iter().enumerate() {
+                let Some(panel) = row.iter().find(|p| p.model == model) else { continue };
+                lobe_panel(&cells[k * Model::ALL.len() + j], panel, r_max, full_circle)?;
             }
-            prev = Some(p);
         }
+        root.present()?;
     }
-    canvas.line((cx - radius, cy), (cx + radius, cy), BLACK, 1);
-    let (si, ci) = (incident.sin() as f32, incident.cos() as f32);
-    canvas.line((cx, cy), (cx - radius * si, cy - radius * ci), [120, 120, 120], 1);
-    canvas.text(8, 6, title, BLACK, 1);
-    for (i, n) in notes.iter().enumerate() {
-        canvas.text(8, 18 + 10 * i as i32, n, BLACK, 1);
-    }
-    for (i, s) in series.iter().enumerate() {
-        let pts: Vec<(f32, f32)> = s
-            .points
-            .iter()
-            .map(|&(t, r)| {
-                let rr = radius * (r / r_max) as f32;
-                (cx + rr * t.sin() as f32, cy - rr * t.cos() as f32)
+    Ok(Figure { file: format!("lobes_{}.svg", material.name()), svg, title })
+}
+
+/// A labelled curve in data coordinates.
+struct Curve {
+    label: String,
+    color: RGBColor,
+    points: Vec<(f64, f64)>,
+}
+
+/// One polar panel: the orders 1, 2, 3+ and their total.
+fn lobe_panel(area: &Area, panel: &LobePanel, r_max: f64, full_circle: bool) -> PlotResult<()> {
+    let (title_h, legend_h) = (24u32, 44u32);
+    let (top, rest) = area.split_vertically(title_h);
+    let (_, ah) = rest.dim_in_pixel();
+    let (plot, legend) = rest.split_vertically(ah.saturating_sub(legend_h));
+    top.draw(&Text::new(
+        format!("{}, θi = {}", panel.model.label(), panel.theta_i),
+        (10, 4),
+        (FONT, 16).into_font(),
+    ))?;
+    let (y_lo, y_hi) =
+        if full_circle { (-1.04 * r_max, 1.04 * r_max) } else { (-0.08 * r_max, 1.04 * r_max) };
+    let (pw, ph) = plot.dim_in_pixel();
+    let half_w = ((y_hi - y_lo) * f64::from(pw) / f64::from(ph.max(1)) / 2.0).max(1.06 * r_max);
+    let mut chart = ChartBuilder::on(&plot).margin(4).build_cartesian_2d(-half_w..half_w, y_lo..y_hi)?;
+    let step = radial_step(r_max);
+    let circle_end = if full_circle { std::f64::consts::TAU } else { std::f64::consts::PI };
+    let circles: Vec<f64> = (1..).map(|k| f64::from(k) * step).take_while(|r| *r <= r_max * 1.0001).collect();
+    for &r in &circles {
+        let circle: Vec<(f64, f64)> = (0..=180)
+            .map(|i| {
+                let a = circle_end * f64::from(i) / 180.0;
+                (r * a.cos(), r * a.sin())
             })
             .collect();
-        for pair in pts.windows(2) {
-            canvas.line(pair[0], pair[1], s.color, 2);
-        }
-        let ly = h as i32 - 12 - 11 * (series.len() - 1 - i) as i32;
-        canvas.line((8.0, ly as f32 + 4.0), (22.0, ly as f32 + 4.0), s.color, 3);
-        canvas.text(26, ly, &s.label, BLACK, 1);
+        chart.draw_series(LineSeries::new(circle, LIGHT.stroke_width(1)))?;
+        chart.draw_series(std::iter::once(Text::new(
+            format!("{}", (r * 1e6).round() / 1e6),
+            (r, 0.0),
+            (FONT, 13).into_font().color(&GRAY).pos(Pos::new(HPos::Right, VPos::Top)),
+        )))?;
     }
+    chart.draw_series(LineSeries::new([(-half_w, 0.0), (half_w, 0.0)], GRAY.stroke_width(1)))?;
+    let (si, ci) = (panel.theta_i.sin(), panel.theta_i.cos());
+    chart.draw_series(LineSeries::new([(0.0, 0.0), (r_max * si, r_max * ci)], GRAY.stroke_width(2)))?;
+    chart.draw_series(std::iter::once(Text::new(
+        "ωi".to_string(),
+        (r_max * si * 0.9 + 0.03 * r_max, r_max * ci * 0.9),
+        (FONT, 14).into_font().color(&GRAY),
+    )))?;
+    let polar = |t: f64, v: f64| (-v * t.sin(), v * t.cos());
+    let mut series: Vec<Curve> = Vec::new();
+    let energy = |k: usize| panel.energy.map(|e| if k < 2 { e[k] } else { e[2] + e[3] });
+    for (k, name) in ["order 1", "order 2", "orders 3+"].into_iter().enumerate() {
+        let pts = panel.points.iter().map(|p| polar(p.theta_o, p.orders[k].mean)).collect();
+        let label = match energy(k) {
+            Some(e) => format!("{name}: {e:.3}"),
+            None => name.to_string(),
+        };
+        series.push(Curve { label, color: PALETTE[k], points: pts });
+    }
+    let total_pts = panel.points.iter().map(|p| polar(p.theta_o, p.total().mean)).collect();
+    let total_label = match panel.energy {
+        Some(e) => format!("total: {:.3}", e.iter().sum::<f64>()),
+        None => "total".to_string(),
+    };
+    series.push(Curve { label: total_label, color: BLACK, points: total_pts });
+    for Curve { color, points, .. } in &series {
+        let mut pts = points.clone();
+        if full_circle {
+            if let Some(&p) = pts.first() {
+                pts.push(p);
+            }
+        }
+        chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))?;
+    }
+    for (i, Curve { label, color, .. }) in series.iter().enumerate() {
+        let (col, row) = (i % 2, i / 2);
+        legend.draw(&PathElement::new(
+            vec![(10 + col as i32 * 175, 9 + row as i32 * 20), (30 + col as i32 * 175, 9 + row as i32 * 20)],
+            color.stroke_width(3),
+        ))?;
+        legend.draw(&Text::new(
+            label.clone(),
+            (36 + col as i32 * 175, 1 + row as i32 * 20),
+            (FONT, 15).into_font(),
+        ))?;
+    }
+    Ok(())
 }

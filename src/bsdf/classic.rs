@@ -1,20 +1,20 @@
-//! The classic renderer BRDF of the CS500 project: a Lambertian lobe plus a single-scattering
-//! microfacet lobe with Phong, Beckmann or GGX normals, Smith masking and Schlick's Fresnel.
+//! The classic real-time/offline renderer BRDF: a Lambertian lobe plus a single-scattering
+//! Cook–Torrance microfacet lobe with Blinn–Phong, Beckmann or GGX normals, separable Smith
+//! masking and Schlick's Fresnel (Cook and Torrance 1982; Walter et al. 2007; Schlick 1994).
 
-use super::{Bsdf, BsdfSample, BsdfValue, SampleFlags, is_direction};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::error::Error;
 use crate::frame::sample_cosine_hemisphere;
 use crate::fresnel::fresnel_schlick;
-use crate::rng::uniform;
+use crate::rng::cut_tails;
 use crate::special::erfc64;
 use core::f32::consts::{FRAC_1_PI, TAU};
-use glam::Vec3;
-use rand::Rng;
+use glam::{Vec2, Vec3};
 
-/// Above this `a` = 1/(α tan θ) the CS500 rational approximation of the Beckmann G1 is 1.
+/// Above this `a` = 1/(α tan θ) Walter et al.'s rational approximation of the Beckmann G1 is 1.
 const RATIONAL_G1_CUTOFF: f32 = 1.6;
 
-/// The normal distribution of the classic BRDF's specular lobe (CS500, "D factor").
+/// The normal distribution of the classic BRDF's specular lobe.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ClassicNdf {
     /// D = (αp + 2)/(2π) cos^αp θm, αp ≥ 0 (larger is smoother).
@@ -31,18 +31,34 @@ pub enum ClassicMasking {
     /// Exact Smith G1 = 1/(1 + Λ) (for Phong, the Beckmann Λ with αb = √(2/(αp + 2))).
     #[default]
     Exact,
-    /// The CS500 rational approximation for Beckmann and Phong,
+    /// The rational approximation of Walter et al. 2007 (eq. 27) for Beckmann and Phong,
     /// (3.535a + 2.181a²)/(1 + 2.276a + 2.577a²) for a < 1.6, else 1 (a = 1/(αb tan θ), or
     /// √(αp/2 + 1)/tan θ for Phong); GGX keeps its exact G1. Relative error below 0.5 %
     /// (Walter et al. 2007).
     Rational,
 }
 
-/// The CS500 BRDF: K_d/π + D G F/(4 |cos θi| |cos θo|), with Schlick's F (F0 = K_s), sampled
+/// The classic BRDF: K_d/π + D G F/(4 |cos θi| |cos θo|), with Schlick's F (F0 = K_s), sampled
 /// by choosing the diffuse lobe with probability ‖K_d‖/(‖K_d‖ + ‖K_s‖) (cosine sampling) and
 /// the specular lobe otherwise (sampling D(m) cos θm and reflecting); the pdf is the mixture of
 /// both lobes' densities, so `sample`'s weight is exactly f·cos θi/pdf. Reflection only, in
-/// the upper hemisphere of the shading frame.
+/// the upper hemisphere of the shading frame. `sample`'s `uc` chooses the lobe and `u` the
+/// direction: the caller's sampler drives it completely.
+///
+/// # Examples
+///
+/// ```
+/// use microsurface::glam::{Vec2, Vec3};
+/// use microsurface::{Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf};
+///
+/// let plastic =
+///     ClassicBrdf::new(Vec3::new(0.5, 0.1, 0.1), Vec3::splat(0.04), ClassicNdf::Ggx(0.2), ClassicMasking::Exact)?;
+/// let wo = Vec3::new(0.0, 0.6, 0.8);
+/// let s = plastic.sample(wo, 0.9, Vec2::new(0.3, 0.7)).expect("a direction above the surface");
+/// let (f, pdf) = plastic.eval_with_pdf(wo, s.wi);
+/// assert!((s.weight - f.f * s.wi.z / pdf).abs().max_element() < 1e-5 && pdf == s.pdf);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClassicBrdf {
     kd: Vec3,
@@ -139,11 +155,13 @@ impl ClassicBrdf {
         }
     }
 
-    /// cos θm of a normal sampled from D(m) cos θm (CS500, "Sampling a BRDF").
+    /// cos θm of a normal sampled from D(m) cos θm (Walter et al. 2007, eqs. 28, 30, 35), with
+    /// the tails cut at 2⁻²⁴ (the crate's tail policy: u = 0 would give Phong's horizon normal).
     fn sample_cos_theta_m(&self, u: f32) -> f32 {
+        let u = cut_tails(u);
         match self.ndf {
             // D(m) cos θm ∝ cos^(e+1) θm: cos θm = u^(1/(e+2)) (Walter et al. 2007, eq. 30; the
-            // CS500 handout's 1/(e+1) samples cos^e θm instead)
+            // exponent 1/(e+1) found in some course notes samples cos^e θm instead)
             ClassicNdf::Phong(e) => u.powf(1.0 / (e + 2.0)),
             ClassicNdf::Beckmann(a) => 1.0 / (1.0 - a * a * (-u).ln_1p()).sqrt(),
             ClassicNdf::Ggx(a) => {
@@ -152,60 +170,83 @@ impl ClassicBrdf {
             }
         }
     }
+}
 
-    fn pdf_specular(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let m = (wo + wi).normalize_or_zero();
+impl ClassicBrdf {
+    /// f and the pdf at (wo, wi), from one half vector, for valid directions above the
+    /// surface.
+    #[inline]
+    fn eval_and_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let m = (wo + wi).normalize();
+        let d = self.d(m);
+        let specular = d * self.g1(wi) * self.g1(wo) / (4.0 * wi.z * wo.z);
+        let f = self.kd * FRAC_1_PI + fresnel_schlick(wi.dot(m), self.ks) * specular;
         let cos_im = wi.dot(m);
-        if m.z <= 0.0 || cos_im <= 0.0 { 0.0 } else { self.d(m) * m.z / (4.0 * cos_im) }
+        let pdf_specular = if m.z <= 0.0 || cos_im <= 0.0 { 0.0 } else { d * m.z / (4.0 * cos_im) };
+        let pdf = self.p_diffuse * wi.z * FRAC_1_PI + (1.0 - self.p_diffuse) * pdf_specular;
+        (if f.is_finite() { f } else { Vec3::ZERO }, if pdf.is_finite() { pdf } else { 0.0 })
     }
 }
 
 impl Bsdf for ClassicBrdf {
-    fn eval(&self, wo: Vec3, wi: Vec3, _rng: &mut impl Rng) -> BsdfValue {
-        if !is_direction(wo) || !is_direction(wi) || wo.z <= 0.0 || wi.z <= 0.0 {
-            return BsdfValue { f: Vec3::ZERO, exact: true };
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags {
+            reflection: true,
+            transmission: false,
+            glossy: self.p_diffuse < 1.0,
+            diffuse: self.p_diffuse > 0.0,
+            specular: false,
         }
-        let m = (wo + wi).normalize();
-        let specular = self.d(m) * self.g1(wi) * self.g1(wo) / (4.0 * wi.z * wo.z);
-        let f = self.kd * FRAC_1_PI + fresnel_schlick(wi.dot(m), self.ks) * specular;
-        BsdfValue { f: if f.is_finite() { f } else { Vec3::ZERO }, exact: true }
     }
 
-    fn sample(&self, wo: Vec3, rng: &mut impl Rng) -> Option<BsdfSample> {
-        if !is_direction(wo) || wo.z <= 0.0 {
+    /// Deterministic: the key is ignored.
+    fn eval_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> BsdfValue {
+        self.eval_with_pdf_keyed(wo, wi, 0).0
+    }
+
+    /// `uc` chooses the lobe, `u` the direction within it (exact: no other random number).
+    fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, _key: u64) -> Option<BsdfSample> {
+        if !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z <= 0.0 {
             return None;
         }
-        let (u0, u1, u2) = (uniform(rng), uniform(rng), uniform(rng));
-        let wi = if u0 < self.p_diffuse {
-            sample_cosine_hemisphere(u1, u2)
+        let wi = if uc < self.p_diffuse {
+            sample_cosine_hemisphere(u.x, u.y)
         } else {
-            let cos_m = self.sample_cos_theta_m(u1);
+            let cos_m = self.sample_cos_theta_m(u.x);
             let sin_m = (1.0 - cos_m * cos_m).max(0.0).sqrt();
-            let (s, c) = (TAU * u2).sin_cos();
+            let (s, c) = (TAU * u.y).sin_cos();
             let m = Vec3::new(sin_m * c, sin_m * s, cos_m);
-            // a normal facing away from ωo reflects nothing (the CS500 listing's |ωo·m| would
+            // a normal facing away from ωo reflects nothing (taking |ωo·m| instead would
             // produce directions whose density is not the one `pdf` returns)
             let cos_om = wo.dot(m);
             if cos_om <= 0.0 {
                 return None;
             }
-            2.0 * cos_om * m - wo
+            (2.0 * cos_om * m - wo).normalize()
         };
-        let pdf = self.pdf(wo, wi);
-        if wi.z <= 0.0 || pdf <= 0.0 {
+        if wi.z <= 0.0 {
             return None;
         }
-        let f = self.eval(wo, wi, rng).f;
+        let (f, pdf) = self.eval_and_pdf(wo, wi);
+        if pdf <= 0.0 {
+            return None;
+        }
         let weight = f * (wi.z / pdf);
         let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
-        weight.is_finite().then_some(BsdfSample { wi, weight, pdf, flags })
+        weight.is_finite().then_some(BsdfSample { wi, weight, pdf, eta: 1.0, flags })
     }
 
     /// p_d cos θi/π + p_r D(m) cos θm/(4 |ωi·m|).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !is_direction(wo) || !is_direction(wi) || wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
+        self.eval_with_pdf_keyed(wo, wi, 0).1
+    }
+
+    /// One half vector and one D for both.
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> (BsdfValue, f32) {
+        if !valid_direction(wo) || !valid_direction(wi) || wo.z <= 0.0 || wi.z <= 0.0 {
+            return (BsdfValue::ZERO, 0.0);
         }
-        self.p_diffuse * wi.z * FRAC_1_PI + (1.0 - self.p_diffuse) * self.pdf_specular(wo, wi)
+        let (f, pdf) = self.eval_and_pdf(wo, wi);
+        (BsdfValue { f, exact: true }, pdf)
     }
 }

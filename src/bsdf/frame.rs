@@ -5,6 +5,20 @@ use glam::Vec3;
 
 /// An orthonormal frame (t, b, n) built from a shading normal n, to move directions between
 /// world space and the local frame the BSDFs work in (z = n).
+///
+/// # Examples
+///
+/// ```
+/// use microsurface::ShadingFrame;
+/// use microsurface::glam::Vec3;
+///
+/// let frame = ShadingFrame::from_normal(Vec3::new(0.0, 2.0, 0.0)).expect("a non-zero normal");
+/// let to_viewer = Vec3::new(0.6, 0.8, 0.0);
+/// let wo = frame.to_local(to_viewer);
+/// assert!((wo.z - 0.8).abs() < 1e-6); // z is the cosine with the normal
+/// assert!((frame.to_world(wo) - to_viewer).length() < 1e-6);
+/// assert!(ShadingFrame::from_normal(Vec3::ZERO).is_none());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadingFrame {
     t: Vec3,

@@ -1,26 +1,57 @@
 //! The renderer-facing BSDF of a microsurface, with a choice of technique.
 
-use super::{Bsdf, BsdfSample, BsdfValue, SampleFlags, Transport, is_direction};
-use crate::height::MicrosurfaceHeight;
+use super::seed::{Hasher, PrimedRng};
+use super::specular::SpecularLimit;
+use super::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
+};
+use crate::error::Error;
+use crate::height::UniformHeight;
 use crate::material::Material;
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
 use crate::position_free::{Estimator, PositionFree, Shadowing};
 use crate::slope::MicrosurfaceSlope;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rand::Rng;
 
 /// Orders tabulated separately by [`EnergyByOrder`].
 const TABULATED_ORDERS: usize = 8;
+
+/// Below this roughness (max(αx, αy) < 10⁻³, pbrt-v4's `EffectivelySmooth` threshold) a
+/// conductor or dielectric [`MicrofacetBsdf`] is treated as perfectly smooth: a Dirac lobe
+/// (the mirror and refraction directions with Fresnel weights), `eval` and `pdf` are 0 and
+/// `flags().specular` is set. The lobes of α < 10⁻³ are narrower than 0.06° and the energy
+/// of the higher orders vanishes with α, so the Dirac lobe is the limit every technique
+/// converges to; a density that narrow is useless to an integrator (NEE and MIS never hit
+/// it) and f32 cannot resolve it. Diffuse facets have no specular limit and are unaffected.
+pub const SMOOTH_ALPHA: f32 = 1e-3;
+
+/// The largest roughness [`MicrofacetBsdf::new`] accepts: max(αx, αy) ≤ 10.
+///
+/// A walk's length grows linearly with α: for a perfect GGX conductor seen at normal
+/// incidence the mean number of bounces was measured at 2.3 (α = 1), 9.2 (α = 4), 26 (α = 10)
+/// and 305 (α = 100), i.e. about 2.7α, and a sample's cost with it (≈ 2.6 µs at α = 10 on the
+/// development machine). From α ≈ 300 on walks reach the bounce cap [`crate::MAX_BOUNCES`]
+/// and lose their energy (at α = 10⁶ every walk does: 0.33 ms per sample and no light).
+/// Roughnesses above 10 describe no real surface, so the renderer layer rejects them rather
+/// than let a scene's cost explode; the research layer ([`Microsurface`], [`PositionFree`])
+/// still accepts them.
+pub const MAX_WALK_ALPHA: f32 = 10.0;
 
 /// How a [`MicrofacetBsdf`] evaluates and samples its microsurface: the choice that lets a
 /// renderer pay only for what its scene needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Technique {
     /// The classic single-scattering microfacet BSDF (Cook–Torrance / Walter) with
-    /// height-correlated Smith masking-shadowing: exact eval, pdf and sample; loses the
+    /// height-correlated Smith masking-shadowing: exact eval, pdf and sample (the caller's
+    /// uniforms drive the visible-normal sample and the Fresnel event directly); loses the
     /// energy of higher orders. Valid for backfacing view directions (normal mapping): the
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
-    /// whole sphere (Tokuyoshi), so estimates stay unbiased.
+    /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
+    /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term) for every
+    /// roughness; samples whose pdf or f would be subnormal are not returned (at most
+    /// 4π·`f32::MIN_POSITIVE` of probability). See `PositionFree::sample_single` for the f32
+    /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
     /// weights, approximate pdf.
@@ -61,32 +92,95 @@ impl EnergyByOrder {
     }
 }
 
-/// The BSDF of a microsurface with height distribution `H`, slope distribution `S` and
-/// material `M`, evaluated with a chosen [`Technique`] and truncated to a chosen
-/// [`ScatteringOrder`]; statically dispatched.
+/// The renderer-facing BSDF of a microsurface with slope distribution `S` and material `M`,
+/// evaluated with a chosen [`Technique`] and truncated to a chosen [`ScatteringOrder`].
 ///
-/// It uses the adjoint orientation of the models (they are evaluated and sampled starting
-/// from `wo`), with the (η_wo/η_wi)² factor of radiance transport for dielectrics. For the
-/// non-reciprocal height-correlated position-free model this is the model with the roles of
-/// the two directions exchanged, which keeps `eval`, `sample` and `pdf` consistent with one
-/// another.
+/// The microsurface BSDF does not depend on the height distribution (Heitz et al. 2016,
+/// §3.2: the walk is invariant under a monotonic change of heights), so there is none to
+/// choose here; the height distribution matters only to the geometry queries of the research
+/// layer ([`crate::MicrosurfaceGeometry`]).
+///
+/// Orientation: the research-layer models are evaluated and sampled *from the viewer* — the
+/// walk enters along the renderer's `wo` and leaves along `wi` (the adjoint orientation), with
+/// the (η_wo/η_wi)² factor of radiance transport for dielectrics. For the non-reciprocal
+/// height-correlated position-free model this is the model with the roles of the two
+/// directions exchanged, which keeps `eval`, `sample` and `pdf` consistent with one another.
+///
+/// Randomness: every method is a pure function of its arguments, the BSDF's seed
+/// ([`MicrofacetBsdf::with_seed`]) and the caller's key (the `_keyed` methods of [`Bsdf`]):
+/// a stochastic `eval` seeds a PCG generator with a hash of the bits of (seed, key, wo, wi);
+/// `sample` gives the caller's uniforms to the first bounce (u to the visible normal, uc to
+/// the next decision: the Fresnel event of a dielectric, the exit test of a conductor) and
+/// draws the rest from a generator seeded with a hash of (seed, key, wo, uc, u).
+///
+/// # Examples
+///
+/// ```
+/// use microsurface::glam::{Vec2, Vec3};
+/// use microsurface::{Bsdf, ComplexIor, Conductor, Ggx, MicrofacetBsdf, Technique};
+///
+/// // gold with multiple scattering (the random walk, all orders)
+/// let gold = MicrofacetBsdf::new(Ggx::isotropic(0.5)?, Conductor::new(ComplexIor::GOLD))?;
+/// let wo = Vec3::new(0.5, 0.0, 0.866); // towards the viewer, shading frame
+/// let s = gold.sample(wo, 0.3, Vec2::new(0.6, 0.1)).expect("gold reflects");
+/// assert!(s.flags.reflection && !s.flags.specular && s.eta == 1.0);
+/// let (f, pdf) = gold.eval_with_pdf(wo, s.wi);
+/// assert!(f.f.is_finite() && pdf > 0.0);
+/// // the same BSDF for one pixel of a renderer that decorrelates its pixels
+/// let f_pixel = gold.eval_keyed(wo, s.wi, 1234).f;
+/// assert!(f_pixel.is_finite());
+/// // single scattering is exact and cheaper, and loses the higher orders
+/// let single = gold.with_technique(Technique::SingleScattering);
+/// assert!(single.eval(wo, s.wi).exact);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MicrofacetBsdf<H, S, M> {
-    surface: Microsurface<H, S, M>,
+pub struct MicrofacetBsdf<S, M> {
+    surface: Microsurface<UniformHeight, S, M>,
     technique: Technique,
     order: ScatteringOrder,
     transport: Transport,
+    seed: u64,
+    specular: bool,
 }
 
-impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> MicrofacetBsdf<H, S, M> {
-    /// A BSDF with the random-walk technique, all orders, radiance transport.
-    pub fn new(height: H, slope: S, material: M) -> Self {
-        Self {
-            surface: Microsurface::new(height, slope, material),
+impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
+    /// A BSDF with the random-walk technique (all orders of multiple scattering), radiance
+    /// transport and seed 0. Effectively smooth surfaces (max(αx, αy) < [`SMOOTH_ALPHA`]) of
+    /// conductors and dielectrics, and dielectrics of η = 1 at any roughness, are Dirac lobes.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`"alpha"`) if max(αx, αy) > [`MAX_WALK_ALPHA`], where walks
+    /// stop being bounded in time.
+    pub fn new(slope: S, material: M) -> Result<Self, Error> {
+        let alpha = slope.alpha_x().max(slope.alpha_y());
+        // a slope's roughness is finite and > 0 (its constructor checks it)
+        if alpha > MAX_WALK_ALPHA {
+            return Err(Error::InvalidParameter {
+                name: "alpha",
+                value: alpha,
+                expected: "at most 10 (MAX_WALK_ALPHA)",
+            });
+        }
+        let specular = material.always_specular() || (M::SMOOTH_IS_SPECULAR && alpha < SMOOTH_ALPHA);
+        Ok(Self {
+            surface: Microsurface::new(UniformHeight, slope, material),
             technique: Technique::default(),
             order: ScatteringOrder::All,
             transport: Transport::default(),
-        }
+            seed: 0,
+            specular,
+        })
+    }
+
+    /// The same BSDF evaluated as a rough microfacet lobe however smooth it is: the Dirac limit
+    /// below [`SMOOTH_ALPHA`] is not applied (a dielectric of η = 1, which has no rough lobe,
+    /// stays a Dirac lobe). For references and tests below α = 10⁻³, where the lobe is valid
+    /// but too narrow for an integrator to use.
+    #[must_use]
+    pub fn without_smooth_limit(self) -> Self {
+        let specular = self.surface.material().always_specular();
+        Self { specular, ..self }
     }
 
     /// The same BSDF evaluated with another technique.
@@ -104,14 +198,31 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> MicrofacetBsdf<H,
         Self { transport, ..self }
     }
 
-    /// The underlying microsurface.
-    pub fn surface(&self) -> &Microsurface<H, S, M> {
+    /// The same BSDF with another seed for the private generators of its stochastic
+    /// techniques (pbrt's `--seed`): two BSDFs that differ only by their seed give
+    /// independent estimates. Deterministic techniques ignore it.
+    pub fn with_seed(self, seed: u64) -> Self {
+        Self { seed, ..self }
+    }
+
+    /// The seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The underlying microsurface (uniform heights: see the type's documentation).
+    pub fn surface(&self) -> &Microsurface<UniformHeight, S, M> {
         &self.surface
     }
 
     /// The technique.
     pub fn technique(&self) -> Technique {
         self.technique
+    }
+
+    /// Whether the BSDF is a Dirac lobe (effectively smooth, or an index-matched dielectric).
+    pub fn is_specular(&self) -> bool {
+        self.specular
     }
 
     /// The position-free model with the given shadowing over the same slope and material.
@@ -124,19 +235,38 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> MicrofacetBsdf<H,
     #[inline(always)]
     fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self.transport {
+            // the research layer's relative_eta_sq(light from, light to): light goes wi → wo
             Transport::Radiance => self.surface.material().relative_eta_sq(wi.z > 0.0, wo.z > 0.0),
             Transport::Importance => 1.0,
         }
+    }
+
+    /// η_wi/η_wo: the relative index of a transmission from wo's side to wi's side.
+    #[inline(always)]
+    fn relative_eta(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if (wi.z > 0.0) == (wo.z > 0.0) {
+            1.0
+        } else {
+            // relative_eta_sq(a, b) = (η_b/η_a)²
+            self.surface.material().relative_eta_sq(wo.z > 0.0, wi.z > 0.0).sqrt()
+        }
+    }
+
+    /// Whether `eval` is exact (not a stochastic estimate).
+    #[inline(always)]
+    fn exact_eval(&self) -> bool {
+        self.specular || (self.technique == Technique::SingleScattering && M::EXACT_PHASE_PDF)
     }
 
     /// The energy per scattering order for the view direction `wo`, from `walks` sampled
     /// walks of this BSDF's technique (single scattering uses the random walk): what a
     /// truncation to n orders would leave out is [`EnergyByOrder::left_out`]. The energies are
     /// albedos (importance transport): the radiance factor (η_wo/η_wi)² of a dielectric is not
-    /// applied.
+    /// applied. An analysis tool, not a renderer call: it takes a generator.
     pub fn energy_by_order(&self, wo: Vec3, walks: usize, rng: &mut impl Rng) -> EnergyByOrder {
         let mut table = EnergyByOrder { walks, ..EnergyByOrder::default() };
         for _ in 0..walks {
+            // the walk enters along the view direction
             let sample = match self.technique {
                 Technique::PositionFree { shadowing, .. } => self.position_free(shadowing).sample(wo, rng),
                 _ => self.surface.sample(wo, rng),
@@ -152,71 +282,164 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> MicrofacetBsdf<H,
         table
     }
 
-    /// f(wo → wi)·|cos θi| in the model's own orientation (light from `wo`).
-    #[inline]
-    fn adjoint_eval(&self, wo: Vec3, wi: Vec3, rng: &mut impl Rng) -> Vec3 {
+    /// f·|cos| of the research layer for light entering along `walk_in` and leaving along
+    /// `walk_out` (its `eval(wi, wo)` = f·|cos θo|): called with the renderer's (wo, wi).
+    #[inline(always)]
+    fn research_f_cos_out(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut impl Rng) -> Vec3 {
         match self.technique {
             Technique::SingleScattering => {
-                self.position_free(Shadowing::Correlated).eval_single_backfacing(wo, wi, rng)
+                self.position_free(Shadowing::Correlated).eval_single_backfacing(walk_in, walk_out, rng)
             }
-            Technique::RandomWalk => self.surface.eval(wo, wi, self.order, rng),
+            Technique::RandomWalk => self.surface.eval(walk_in, walk_out, self.order, rng),
             Technique::PositionFree { estimator, shadowing } => {
-                self.position_free(shadowing).eval(wo, wi, estimator, self.order, rng)
+                self.position_free(shadowing).eval(walk_in, walk_out, estimator, self.order, rng)
             }
         }
+    }
+
+    /// The research layer's density of the exit direction `walk_out` of a walk entering
+    /// along `walk_in` (exact for single scattering, approximate otherwise).
+    #[inline(always)]
+    fn research_pdf_out(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
+        let pf = self.position_free(Shadowing::Correlated);
+        match self.technique {
+            Technique::SingleScattering => pf.pdf_single(walk_in, walk_out),
+            _ => pf.pdf(walk_in, walk_out),
+        }
+    }
+
+    /// f for valid, non-horizontal directions of a non-specular BSDF: the research layer's
+    /// f·|cos| of the walk entering along wo and leaving along wi, divided by |cos θi|, with
+    /// the transport factor; 0 if not finite.
+    #[inline(always)]
+    fn f_checked(&self, wo: Vec3, wi: Vec3, key: u64) -> Vec3 {
+        let (walk_in, walk_out) = (wo, wi);
+        let seed = self.seed;
+        let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
+        let f_cos_wi = self.research_f_cos_out(walk_in, walk_out, &mut rng);
+        let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
+        if f.is_finite() { f } else { Vec3::ZERO }
+    }
+
+    /// The Dirac lobe's sample.
+    #[inline]
+    fn sample_specular(&self, wo: Vec3, uc: f32) -> Option<BsdfSample> {
+        let e = self.surface.material().sample_specular(wo, uc)?;
+        let weight = e.weight * self.transport_scale(wo, e.wi);
+        let reflection = (e.wi.z > 0.0) == (wo.z > 0.0);
+        let flags = SampleFlags { reflection, transmission: !reflection, specular: true, exact_pdf: true };
+        let eta = self.relative_eta(wo, e.wi);
+        (weight.is_finite() && e.probability > 0.0).then_some(BsdfSample {
+            wi: e.wi,
+            weight,
+            pdf: e.probability,
+            eta,
+            flags,
+        })
     }
 }
 
-impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Bsdf for MicrofacetBsdf<H, S, M> {
-    fn eval(&self, wo: Vec3, wi: Vec3, rng: &mut impl Rng) -> BsdfValue {
-        let exact = self.technique == Technique::SingleScattering && M::EXACT_PHASE_PDF;
-        if !is_direction(wo) || !is_direction(wi) || wi.z == 0.0 {
-            return BsdfValue { f: Vec3::ZERO, exact };
+impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<S, M> {
+    #[inline]
+    fn flags(&self) -> BsdfFlags {
+        let index_matched = self.surface.material().always_specular();
+        BsdfFlags {
+            reflection: !index_matched,
+            transmission: M::TRANSMITS,
+            glossy: !self.specular && M::SMOOTH_IS_SPECULAR,
+            diffuse: !M::SMOOTH_IS_SPECULAR,
+            specular: self.specular,
         }
-        let f = self.adjoint_eval(wo, wi, rng) * (self.transport_scale(wo, wi) / wi.z.abs());
-        BsdfValue { f: if f.is_finite() { f } else { Vec3::ZERO }, exact }
     }
 
-    fn sample(&self, wo: Vec3, rng: &mut impl Rng) -> Option<BsdfSample> {
-        if !is_direction(wo) {
+    #[inline]
+    fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
+        let exact = self.exact_eval();
+        if !valid_direction(wo) || !valid_direction(wi) || wi.z == 0.0 || self.specular {
+            return BsdfValue { f: Vec3::ZERO, exact };
+        }
+        BsdfValue { f: self.f_checked(wo, wi, key), exact }
+    }
+
+    #[inline]
+    fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        if !valid_direction(wo) || !valid_uniforms(uc, u) {
             return None;
         }
-        let (wi, weight, exact_pdf) = match self.technique {
+        if self.specular {
+            return self.sample_specular(wo, uc);
+        }
+        let seed = self.seed;
+        let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
+        let uniforms = [u.x, u.y, uc];
+        let walk_in = wo;
+        let (walk_out, weight, exact_pdf) = match self.technique {
             Technique::SingleScattering => {
-                let (wi, weight) = self.position_free(Shadowing::Correlated).sample_single(wo, rng)?;
-                (wi, weight, M::EXACT_PHASE_PDF)
+                let mut rng = PrimedRng::new(&uniforms, hash);
+                let (out, weight) =
+                    self.position_free(Shadowing::Correlated).sample_single(walk_in, &mut rng)?;
+                (out, weight, M::EXACT_PHASE_PDF)
             }
             Technique::RandomWalk => {
-                let s = self.surface.sample(wo, rng).filter(|s| self.order.includes(s.bounces))?;
+                // the walk draws the height of its first intersection first: from the private
+                // generator, so that the caller's uniforms drive the first visible normal
+                let mut rng = PrimedRng::after_one_private(&uniforms, hash);
+                let s = self.surface.sample(walk_in, &mut rng).filter(|s| self.order.includes(s.bounces))?;
                 (s.wo, s.weight, false)
             }
             Technique::PositionFree { shadowing, .. } => {
+                let mut rng = PrimedRng::new(&uniforms, hash);
                 let s = self
                     .position_free(shadowing)
-                    .sample(wo, rng)
+                    .sample(walk_in, &mut rng)
                     .filter(|s| self.order.includes(s.bounces))?;
                 (s.wo, s.weight, false)
             }
         };
-        let pdf = self.pdf(wo, wi);
+        let wi = walk_out;
+        let pdf = self.research_pdf_out(walk_in, walk_out);
         let weight = weight * self.transport_scale(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite() && weight.is_finite() && is_direction(wi)) || wi.z == 0.0 {
+        // the density and the BSDF value f = weight·pdf/|cos θi| the sample implies must be
+        // normal f32 numbers: a subnormal one has lost its precision, and eval could not
+        // reproduce weight = f·|cos θi|/pdf (deep tails: Beckmann dielectric α = 1 at
+        // cos θo = 1e-3 gave f = 2e-45, 33 % off). Dropping such samples loses at most
+        // 4π·f32::MIN_POSITIVE of probability and π·f32::MIN_POSITIVE of energy.
+        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite() && weight.is_finite() && super::is_direction(wi))
+            || wi.z == 0.0
+        {
+            return None;
+        }
+        let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z.abs());
+        if f_max < f64::from(f32::MIN_POSITIVE) {
             return None;
         }
         let reflection = (wi.z > 0.0) == (wo.z > 0.0);
         let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf };
-        Some(BsdfSample { wi, weight, pdf, flags })
+        Some(BsdfSample { wi, weight, pdf, eta: self.relative_eta(wo, wi), flags })
     }
 
+    /// One validation of the directions for both (the research layer has no combined
+    /// evaluation to share more).
+    #[inline]
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        let exact = self.exact_eval();
+        if !valid_direction(wo) || !valid_direction(wi) || self.specular {
+            return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
+        }
+        let pdf = self.research_pdf_out(wo, wi);
+        let pdf = if pdf.is_finite() { pdf } else { 0.0 };
+        if wi.z == 0.0 {
+            return (BsdfValue { f: Vec3::ZERO, exact }, pdf);
+        }
+        (BsdfValue { f: self.f_checked(wo, wi, key), exact }, pdf)
+    }
+
+    #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !is_direction(wo) || !is_direction(wi) {
+        if !valid_direction(wo) || !valid_direction(wi) || self.specular {
             return 0.0;
         }
-        let pf = self.position_free(Shadowing::Correlated);
-        let pdf = match self.technique {
-            Technique::SingleScattering => pf.pdf_single(wo, wi),
-            _ => pf.pdf(wo, wi),
-        };
+        let pdf = self.research_pdf_out(wo, wi);
         if pdf.is_finite() { pdf } else { 0.0 }
     }
 }

@@ -1,5 +1,6 @@
 //! Fresnel reflectance of a conductor (complex index of refraction), per RGB channel.
 
+use crate::contract::is_cosine;
 use crate::error::Error;
 use glam::Vec3;
 
@@ -46,8 +47,19 @@ impl ComplexIor {
 /// Rs = (a² + b² − 2a cos θ + cos²θ)/(a² + b² + 2a cos θ + cos²θ),
 /// Rp = Rs (cos²θ (a² + b²) − 2a cos θ s² + s⁴)/(cos²θ (a² + b²) + 2a cos θ s² + s⁴),
 /// F = (Rs + Rp)/2 (Born and Wolf, Principles of Optics, §14.2). F ∈ [0, 1]; 1 at grazing.
+///
+/// Invalid input ([policy](crate#invalid-input)): a `cos_theta_i` that is NaN or beyond
+/// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives `Vec3::NAN` (a debug
+/// assertion in debug builds).
 #[inline]
 pub fn fresnel_conductor(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 {
+    require!(is_cosine(cos_theta_i), Vec3::NAN; cos_theta_i);
+    conductor_reflectance(cos_theta_i, ior)
+}
+
+/// [`fresnel_conductor`] without the argument check, for cosines the crate formed itself.
+#[inline(always)]
+pub(crate) fn conductor_reflectance(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 {
     let cos_theta = cos_theta_i.abs().min(1.0);
     if cos_theta == 0.0 {
         // grazing: every interface reflects fully (and the formula would be 0/0 at η = 1, k = 0)

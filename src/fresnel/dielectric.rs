@@ -1,5 +1,7 @@
 //! Fresnel reflectance of a dielectric interface.
 
+use crate::contract::{is_cosine, is_index};
+
 /// Unpolarized Fresnel reflectance of a smooth dielectric interface, with total internal
 /// reflection.
 ///
@@ -8,8 +10,19 @@
 /// sin²θt ≥ 1 (total internal reflection, possible for η < 1), otherwise
 /// F = ½(Rs² + Rp²), Rs = (cos θi − η cos θt)/(cos θi + η cos θt),
 /// Rp = (η cos θi − cos θt)/(η cos θi + cos θt). F = 0 at η = 1; F = 1 at grazing incidence.
+///
+/// Invalid input ([policy](crate#invalid-input)): a `cos_theta_i` that is NaN or beyond
+/// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)), or an `eta` that is not finite
+/// and > 0, gives NaN (a debug assertion in debug builds).
 #[inline]
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
+    require!(is_cosine(cos_theta_i) && is_index(eta), f32::NAN; cos_theta_i, eta);
+    dielectric_reflectance(cos_theta_i, eta)
+}
+
+/// [`fresnel_dielectric`] without the argument check, for the crate's own cosines and indices.
+#[inline(always)]
+pub(crate) fn dielectric_reflectance(cos_theta_i: f32, eta: f32) -> f32 {
     let c = f64::from(cos_theta_i.abs().min(1.0));
     let eta = f64::from(eta);
     // η² cos²θt = c² + (η − 1)(η + 1): no rounding of (1 − c²)/η² to 1 near grazing

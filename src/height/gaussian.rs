@@ -1,6 +1,7 @@
 //! The standard Gaussian height distribution.
 
 use super::MicrosurfaceHeight;
+use crate::contract::is_uniform;
 use crate::special::{erfc64, erfinv_from_both_ends};
 
 /// 1/√(2π).
@@ -30,19 +31,21 @@ impl GaussianHeight {
 impl MicrosurfaceHeight for GaussianHeight {
     #[inline]
     fn p1(&self, h: f32) -> f32 {
+        require!(!h.is_nan(), 0.0; h);
         INV_SQRT_2PI * (-0.5 * h * h).exp()
     }
 
     #[inline]
     fn c1(&self, h: f32) -> f32 {
+        require!(!h.is_nan(), f32::NAN; h);
         (0.5 * erfc64(-f64::from(h) / SQRT_2)) as f32
     }
 
-    /// u outside [0, 1] is a contract violation (debug assertion); release builds saturate
-    /// to ±`H_MAX`.
+    /// u outside [0, 1] (or NaN) is a contract violation: a debug assertion in debug builds,
+    /// NaN in release builds.
     #[inline]
     fn inv_c1(&self, u: f32) -> f32 {
-        debug_assert!((0.0..=1.0).contains(&u), "u = {u} outside [0, 1]");
+        require!(is_uniform(u), f32::NAN; u);
         let u = f64::from(u);
         if u <= 0.0 {
             return -Self::H_MAX;

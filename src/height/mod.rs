@@ -15,6 +15,10 @@ pub use uniform::UniformHeight;
 ///
 /// Heights are in the units of the distribution; `c1` accepts ±∞ (a ray starting above the
 /// whole surface has h = +∞ and C¹(h) = 1).
+///
+/// Invalid input ([policy](crate#invalid-input)): a NaN height or a `u` that is NaN or outside
+/// [0, 1] trips a debug assertion in debug builds; release builds return 0 from `p1` (a
+/// density) and NaN from `c1` and `inv_c1`.
 pub trait MicrosurfaceHeight: Copy + core::fmt::Debug + Send + Sync {
     /// The height density P¹(h).
     fn p1(&self, h: f32) -> f32;

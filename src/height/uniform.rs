@@ -1,6 +1,7 @@
 //! The uniform height distribution on [−1, 1].
 
 use super::MicrosurfaceHeight;
+use crate::contract::is_uniform;
 
 /// Heights uniform on [−1, 1] (Heitz et al. 2016, supplement §1.2).
 ///
@@ -12,19 +13,21 @@ pub struct UniformHeight;
 impl MicrosurfaceHeight for UniformHeight {
     #[inline]
     fn p1(&self, h: f32) -> f32 {
+        require!(!h.is_nan(), 0.0; h);
         if (-1.0..=1.0).contains(&h) { 0.5 } else { 0.0 }
     }
 
     #[inline]
     fn c1(&self, h: f32) -> f32 {
+        require!(!h.is_nan(), f32::NAN; h);
         (0.5 * (h + 1.0)).clamp(0.0, 1.0)
     }
 
-    /// 2u − 1; u outside [0, 1] is a contract violation (debug assertion) and saturates to
-    /// the support in release builds.
+    /// 2u − 1; u outside [0, 1] (or NaN) is a contract violation: a debug assertion in debug
+    /// builds, NaN in release builds.
     #[inline]
     fn inv_c1(&self, u: f32) -> f32 {
-        debug_assert!((0.0..=1.0).contains(&u), "u = {u} outside [0, 1]");
+        require!(is_uniform(u), f32::NAN; u);
         (2.0 * u - 1.0).clamp(-1.0, 1.0)
     }
 }

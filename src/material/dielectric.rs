@@ -1,8 +1,9 @@
 //! Dielectric microfacets.
 
 use super::{Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_half_vector};
+use crate::contract::is_direction;
 use crate::error::Error;
-use crate::fresnel::{fresnel_dielectric, fresnel_dielectric_cosines};
+use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, normalize_fast, renormalize};
 use crate::special::beta;
@@ -110,11 +111,11 @@ impl Dielectric {
     ) -> f32 {
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta) * phase_reflection(slope, wi, wh)
+            dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta) * phase_reflection(slope, wi, wh)
         } else {
             let Some(r) = self.refraction(wi, wo) else { return 0.0 };
             let eta = f64::from(self.eta);
-            (eta * eta * r.transmittance * slope.d_wi64(wi, r.wh) * (-r.cos_oh) / r.denom_sq) as f32
+            (eta * eta * r.transmittance * slope.d_wi64_unchecked(wi, r.wh) * (-r.cos_oh) / r.denom_sq) as f32
         }
     }
 
@@ -126,12 +127,12 @@ impl Dielectric {
         }
         if wo_outside {
             let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta)
-                * (slope.d64(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
+            dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
+                * (slope.d64_unchecked(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
         } else {
             let Some(r) = self.refraction(wi, wo) else { return 0.0 };
             let eta = f64::from(self.eta);
-            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64(r.wh)
+            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64_unchecked(r.wh)
                 / (f64::from(wi.z.abs()) * r.denom_sq)) as f32
         }
     }
@@ -163,10 +164,33 @@ impl Material for Dielectric {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        // the argument check is `pdf_phase`'s
         Vec3::splat(self.pdf_phase(slope, wi, wo, wi_outside, wo_outside))
     }
 
+    #[inline]
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
+        Vec3::splat(self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside))
+    }
+
     const EXACT_PHASE_PDF: bool = true;
+
+    /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not
+    /// transparent: from the denser side a ray below the critical angle, cos θ < √(2|η − 1|),
+    /// is totally reflected, and elsewhere the walk's many crossings do bend it (see
+    /// [`crate::MAX_BOUNCES`]).
+    #[inline]
+    fn is_transparent(&self) -> bool {
+        self.eta == 1.0
+    }
 
     #[inline]
     fn relative_eta_sq(&self, wi_outside: bool, wo_outside: bool) -> f32 {
@@ -180,6 +204,19 @@ impl Material for Dielectric {
     /// The phase function itself (the sample weight is 1).
     #[inline]
     fn pdf_phase<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
+        self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside)
+    }
+
+    #[inline]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
         wi: Vec3,
@@ -205,6 +242,20 @@ impl Material for Dielectric {
         wo_outside: bool,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
+    }
+
+    #[inline]
+    fn vertex_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        _rng: &mut impl Rng,
+    ) -> Vec3 {
         let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
         Vec3::splat(this.vertex_outside(slope, wi, wo, wo_outside))
     }
@@ -220,9 +271,21 @@ impl Material for Dielectric {
         wi_outside: bool,
         rng: &mut impl Rng,
     ) -> PhaseSample {
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: wi_outside }; wi);
+        self.sample_phase_unchecked(slope, wi, wi_outside, rng)
+    }
+
+    #[inline]
+    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
         let (this, wi_local, sign) = if wi_outside { (*self, wi, 1.0) } else { (self.flipped(), -wi, -1.0) };
-        let wm = slope.sample_d_wi(wi_local, uniform(rng), uniform(rng));
-        let f = fresnel_dielectric(wi_local.dot(wm), this.eta);
+        let wm = slope.sample_d_wi_unchecked(wi_local, uniform(rng), uniform(rng));
+        let f = dielectric_reflectance(wi_local.dot(wm), this.eta);
         let (wo_local, crossed) = if uniform(rng) < f {
             (renormalize(reflect(wi_local, wm), wm), false)
         } else {
@@ -242,6 +305,7 @@ impl Material for Dielectric {
         wo: Vec3,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if wi.z < 0.0 {
             return self.flipped().eval_single_scattering(slope, -wi, -wo, rng);
         }
@@ -252,12 +316,12 @@ impl Material for Dielectric {
             let g2 = g2_reflection(slope, wi, wo);
             let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
             fresnel_dielectric(wi.as_dvec3().dot(wh) as f32, self.eta)
-                * (slope.d64(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32
+                * (slope.d64_unchecked(wh) * f64::from(g2) / (4.0 * f64::from(wi.z))) as f32
         } else {
             let Some(r) = self.refraction(wi, wo) else { return Vec3::ZERO };
-            let g2 = beta(1.0 + f64::from(slope.lambda(wi)), 1.0 + f64::from(slope.lambda(-wo)));
+            let g2 = beta(1.0 + slope.lambda64(wi), 1.0 + slope.lambda64(-wo));
             let eta = f64::from(self.eta);
-            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64(r.wh) * g2
+            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64_unchecked(r.wh) * g2
                 / (f64::from(wi.z) * r.denom_sq)) as f32
         };
         Vec3::splat(value)

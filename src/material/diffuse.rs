@@ -1,8 +1,9 @@
 //! Diffuse (Lambertian) microfacets.
 
 use super::{Material, PhaseSample, g2_reflection};
+use crate::contract::is_direction;
 use crate::error::Error;
-use crate::frame::{orthonormal_basis, sample_cosine_hemisphere};
+use crate::frame::{basis, cosine_hemisphere};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
@@ -56,10 +57,24 @@ impl Material for Diffuse {
         wo_outside: bool,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_phase_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    #[inline]
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
         if !(wi_outside && wo_outside) {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0))
     }
 
@@ -70,6 +85,19 @@ impl Material for Diffuse {
     /// sphere, so that MIS weights built on it never exclude a path.
     #[inline]
     fn pdf_phase<S: MicrosurfaceSlope>(
+        &self,
+        _slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+    ) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
+        self.pdf_phase_unchecked(_slope, wi, wo, wi_outside, wo_outside)
+    }
+
+    #[inline]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         _slope: &S,
         _wi: Vec3,
@@ -95,11 +123,25 @@ impl Material for Diffuse {
         wo_outside: bool,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
+    }
+
+    #[inline]
+    fn vertex_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        wi_outside: bool,
+        wo_outside: bool,
+        rng: &mut impl Rng,
+    ) -> Vec3 {
         if !(wi_outside && wo_outside) || wi.z == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * slope.projected_area(wi) / wi.z.abs())
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
     /// ωm from D_ωi, then ωo cosine-distributed about ωm; weight a.
@@ -111,9 +153,21 @@ impl Material for Diffuse {
         _wi_outside: bool,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        let local = sample_cosine_hemisphere(uniform(rng), uniform(rng));
-        let (t, b) = orthonormal_basis(wm);
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
+        self.sample_phase_unchecked(slope, wi, _wi_outside, rng)
+    }
+
+    #[inline]
+    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _wi_outside: bool,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        let local = cosine_hemisphere(uniform(rng), uniform(rng));
+        let (t, b) = basis(wm);
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
         PhaseSample { wo, weight: self.albedo, outside: true }
     }
@@ -129,12 +183,15 @@ impl Material for Diffuse {
         wo: Vec3,
         rng: &mut impl Rng,
     ) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let g2 = g2_reflection(slope, wi, wo);
         if g2 == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi(wi, uniform(rng), uniform(rng));
-        let g2_given_g1 = (1.0 + slope.lambda(wi)) * g2;
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        // (1 + Λi)/(1 + Λi + Λo) in f64: the f32 factors saturate near grazing
+        let k = 1.0 + slope.lambda64(wi);
+        let g2_given_g1 = (k / (k + slope.lambda64(wo))) as f32;
         self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * g2_given_g1)
     }
 }

@@ -7,8 +7,10 @@ mod walk;
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
 pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 
+use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::{Material, PhaseSample};
+use crate::position_free::{PositionFree, Shadowing};
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
@@ -61,8 +63,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// outside, summed over both sides of the interface for a dielectric (reflection and
     /// transmission), as the supplement's wrapper does. Integrates to 1 over the sphere for
     /// non-absorptive materials (test 4.3.1). Stochastic for the diffuse material.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     #[inline]
     pub fn eval_phase(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let slope = self.geometry.slope();
         let reflected = self.material.eval_phase(slope, wi, wo, true, true, rng);
         if M::TRANSMITS {
@@ -73,17 +79,32 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     }
 
     /// Samples the phase function p(ωi, ·) of a ray arriving from outside.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// a sample with a NaN `wo` and a zero weight (a debug assertion in debug builds).
     #[inline]
     pub fn sample_phase(&self, wi: Vec3, rng: &mut impl Rng) -> PhaseSample {
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
         self.material.sample_phase(self.geometry.slope(), wi, true, rng)
     }
 
     /// The single-scattering BSDF times |cos θo| (what `eval` with
-    /// [`ScatteringOrder::Only`]`(1)` estimates). Zero for ωi at or below the horizon, except
-    /// for a dielectric, which is evaluated from inside.
+    /// [`ScatteringOrder::Only`]`(1)` estimates). Zero for ωi or ωo on the horizon and for an
+    /// opaque material's ωo below it. A dielectric lit from below is evaluated from inside; an
+    /// opaque material lit from below the macrosurface (a backfacing view) has the
+    /// full-spherical height-correlated masking G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022,
+    /// eq. 17), the order-1 term of [`Microsurface::eval_from_below`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     #[inline]
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if !M::TRANSMITS && (wi.z <= 0.0 || wo.z <= 0.0) {
+            if wi.z < 0.0 && wo.z > 0.0 {
+                let pf = PositionFree::new(*self.slope(), self.material, Shadowing::Correlated);
+                return pf.eval_single_scattering(wi, wo, rng);
+            }
             return Vec3::ZERO;
         }
         self.material.eval_single_scattering(self.geometry.slope(), wi, wo, rng)

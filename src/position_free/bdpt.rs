@@ -3,6 +3,7 @@
 
 use super::segment::{in_side_frame, inv_g1};
 use super::{Exit, Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
+use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
 use crate::rng::uniform;
@@ -74,7 +75,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The densities are exact for conductors and dielectrics; for diffuse facets the MIS
     /// weights use [`Material::pdf_phase`]'s deterministic approximation, which keeps the
     /// estimator unbiased (the weights still sum to one).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_bdpt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
@@ -123,7 +128,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 // the contribution of the connection with the densities of its direction pair
                 let (contribution, forward, reverse) = if t == 0 {
                     let reverse = if s >= 1 {
-                        f64::from(self.material.pdf_phase(&self.slope, out, at.w, out_outside, at.outside))
+                        f64::from(self.material.pdf_phase_unchecked(
+                            &self.slope,
+                            out,
+                            at.w,
+                            out_outside,
+                            at.outside,
+                        ))
                     } else {
                         0.0
                     };
@@ -138,8 +149,14 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     if factor == 0.0 {
                         continue;
                     }
-                    let (v, forward, reverse) =
-                        self.material.connection(&self.slope, at.w, out, at.outside, out_outside, rng);
+                    let (v, forward, reverse) = self.material.connection_unchecked(
+                        &self.slope,
+                        at.w,
+                        out,
+                        at.outside,
+                        out_outside,
+                        rng,
+                    );
                     (v.as_dvec3() * factor, f64::from(forward), f64::from(reverse))
                 };
                 if contribution == DVec3::ZERO {
@@ -192,9 +209,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             }
             let x = -next.w;
             let pdf_forward =
-                f64::from(self.material.pdf_phase(&self.slope, at.w, x, at.outside, next.outside));
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, at.w, x, at.outside, next.outside));
             let pdf_reverse_prev =
-                f64::from(self.material.pdf_phase(&self.slope, x, at.w, next.outside, at.outside));
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, x, at.w, next.outside, at.outside));
             // the connection of the new vertex to ωo, the (s, 0) strategy's
             let connection = self.connect_known(next, k_next, to_wo, true, rng);
             if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
@@ -225,7 +242,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let (mut b, mut b_outside) = (wo, wo_outside);
         let mut throughput = DVec3::ONE;
         for (i, slot) in out.iter_mut().enumerate().take(max) {
-            let s = self.material.sample_phase(&self.slope, b, b_outside, rng);
+            let s = self.material.sample_phase_unchecked(&self.slope, b, b_outside, rng);
             let a = Incident { w: s.wo, outside: s.outside };
             let k_in = inv_g1(&self.slope, in_side_frame(a.w, a.outside));
             if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
@@ -233,17 +250,18 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             }
             let factor = self.shadowing_factor(a, k_in, self.exit(b, b_outside), i == 0)
                 * f64::from(self.material.relative_eta_sq(a.outside, b_outside))
-                * f64::from(self.slope.projected_area(in_side_frame(b, b_outside)))
+                * f64::from(self.slope.projected_area_unchecked(in_side_frame(b, b_outside)))
                 / f64::from(a.w.z.abs());
             throughput *= s.weight.as_dvec3() * factor;
             if throughput == DVec3::ZERO || !throughput.is_finite() {
                 return i;
             }
-            let pdf_reverse = f64::from(self.material.pdf_phase(&self.slope, b, a.w, b_outside, a.outside));
+            let pdf_reverse =
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, b, a.w, b_outside, a.outside));
             let pdf_forward_out = if i == 0 {
                 0.0
             } else {
-                f64::from(self.material.pdf_phase(&self.slope, a.w, b, a.outside, b_outside))
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, a.w, b, a.outside, b_outside))
             };
             if i as u32 + 1 >= ROULETTE_FROM_BOUNCE {
                 let q = throughput.max_element().min(1.0);

@@ -2,6 +2,7 @@
 
 use super::segment::{in_side_frame, inv_g1};
 use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
+use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
 use crate::rng::uniform;
@@ -20,7 +21,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// G1 of the next incident direction, keeps it unbiased and of finite variance (see
     /// `survival_probability`); the throughput is carried in f64. `order` selects all orders (no
     /// truncation; [`crate::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_pt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let (Some(mut at), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
@@ -73,14 +78,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         if k_in == 0.0 || !k_in.is_finite() {
             return None;
         }
-        let s = self.material.sample_phase(&self.slope, at.w, at.outside, rng);
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
         let out = self.exit(s.wo, s.outside);
-        let middle = self.shadowing_factor(at, k_in, out, false);
+        // k_in·S_middle, exact also where k_in underflows (a backfacing low-roughness vertex)
+        let middle = self.relative_shadowing(at, k_in, out).middle;
         // the next incident direction −ω: below the horizon in its frame where ω can exit, and
         // then 1 + L̃ = Λ(ω)
         let k_next =
             if out.can_exit { out.lambda } else { inv_g1(&self.slope, -in_side_frame(s.wo, s.outside)) };
         let next = Incident { w: -s.wo, outside: s.outside };
-        Some((next, k_next, s.weight.as_dvec3() * (k_in * middle)))
+        Some((next, k_next, s.weight.as_dvec3() * middle))
     }
 }

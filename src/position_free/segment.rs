@@ -27,11 +27,23 @@ pub(crate) fn in_side_frame(w: Vec3, outside: bool) -> Vec3 {
 /// 1 + L̃(ω) = |1 + Λ(ω)| for an incident direction ω in its side frame: the inverse of the
 /// full-spherical masking G1(ω) = 1/|1 + Λ(ω)| (Wang et al. 2022, eq. 10), which exceeds 1
 /// for light arriving from below the macrosurface. Below the horizon |1 + Λ(ω)| = Λ(−ω) is
-/// evaluated directly, without cancellation. In [0, ∞): 0 only straight from below.
+/// evaluated directly, without cancellation, and in f64 ([`MicrosurfaceSlope::lambda64`]):
+/// it is tiny there for small α. In [0, ∞]: 0 straight from below, and also where Λ(−ω)
+/// underflows f64 (Beckmann, |cot θ|/αᵢ > 26.6; the masking ratios of such a vertex are then
+/// formed from ln Λ, see `PositionFree::relative_shadowing`).
+///
+/// Saturates at [`LAMBDA_SATURATION`] (exactly grazing directions, where the exact value is +∞).
 #[inline(always)]
 pub(crate) fn inv_g1<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> f64 {
-    if w.z >= 0.0 { 1.0 + f64::from(slope.lambda(w)) } else { f64::from(slope.lambda(-w)) }
+    let k = if w.z >= 0.0 { 1.0 + slope.lambda64(w) } else { slope.lambda64(-w) };
+    k.min(LAMBDA_SATURATION)
 }
+
+/// The largest Λ and 1 + L̃ the shadowing factors take (`f32::MAX`, as the f32 Λ saturates):
+/// at exactly grazing directions the exact value is +∞, which would turn
+/// ln Γ(1 + k) − ln Γ(1 + k + Λ) into ∞ − ∞. Every factor is 0 or 1 to f64 precision from
+/// far below it on.
+pub(crate) const LAMBDA_SATURATION: f64 = f32::MAX as f64;
 
 /// The shadowing factors of one vertex: `last` when the path leaves through the outgoing
 /// direction, `middle` when it continues (Wang et al. 2022, eqs. 7–8, 12–13 and 17–23,
@@ -49,6 +61,49 @@ pub(crate) struct VertexShadowing {
 }
 
 impl Shadowing {
+    /// The shadowing factors of a vertex relative to its incident masking, k_in × S
+    /// ([`Self::vertex`]), i.e. the factors by which the phase function p = v·k_in (rather
+    /// than the vertex term v) is multiplied. `ratio` = Λo/k_in, which the caller forms
+    /// without underflow.
+    ///
+    /// | | uncorrelated | correlated, reflection | correlated, transmission |
+    /// |---|---|---|---|
+    /// | last | 1/(1 + Λo) | 1/(1 + ratio) | k_in B(k_in, 1 + Λo) |
+    /// | middle, can exit | Λo/(1 + Λo) | 1/(1 + 1/ratio) | 1 − k_in B(k_in, 1 + Λo) |
+    /// | middle, cannot exit | 1 | 1 | 1 |
+    ///
+    /// Unlike k_in × [`Self::vertex`] this stays exact where k_in underflows: for a backfacing
+    /// incident direction of a low-roughness Beckmann surface k_in = Λ(−ωin) and Λo are both
+    /// of order e^{−a²}, and only their ratio matters. ratio = ∞ (k_in = 0 straight from
+    /// below) gives last = 0, middle = 1. Relative error a few f64 ulps.
+    #[inline]
+    pub(crate) fn relative(
+        self,
+        k_in: f64,
+        can_exit: bool,
+        lambda_out: f64,
+        ratio: f64,
+        reflect: bool,
+    ) -> VertexShadowing {
+        if !can_exit {
+            return VertexShadowing { last: 0.0, middle: 1.0 };
+        }
+        match (self, reflect) {
+            (Shadowing::Uncorrelated, _) => {
+                let g1_out = 1.0 / (1.0 + lambda_out);
+                VertexShadowing { last: g1_out, middle: lambda_out * g1_out }
+            }
+            (Shadowing::Correlated, true) => {
+                VertexShadowing { last: 1.0 / (1.0 + ratio), middle: 1.0 / (1.0 + 1.0 / ratio) }
+            }
+            (Shadowing::Correlated, false) => {
+                let ln_kb =
+                    ln_gamma(1.0 + k_in) + ln_gamma(1.0 + lambda_out) - ln_gamma(1.0 + k_in + lambda_out);
+                VertexShadowing { last: ln_kb.exp(), middle: -ln_kb.exp_m1() }
+            }
+        }
+    }
+
     /// The shadowing factors of a vertex. With G1in = 1/k_in and Λo = `lambda_out`:
     ///
     /// | | uncorrelated | correlated, reflection | correlated, transmission |

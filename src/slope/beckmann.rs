@@ -1,7 +1,11 @@
 //! The Beckmann slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, ensure_visible, normal_from_slopes};
+use super::{
+    MicrosurfaceSlope, check_roughness, ensure_visible, is_direction, is_direction64, is_uniform,
+    normal_from_slopes,
+};
 use crate::error::Error;
+use crate::rng::cut_tails64;
 use crate::special::{erfc_inv_f32, erfcx64};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -11,10 +15,6 @@ const SQRT_PI: f64 = 1.772_453_850_905_516;
 const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
 /// 1/π.
 const INV_PI: f64 = core::f64::consts::FRAC_1_PI;
-/// Uniforms are kept at least this far from 0 and 1 before they are inverted through a
-/// Gaussian tail: the quantile of 1e-30 is finite (|x̃| ≈ 8.3 at α = 1) and the probability
-/// mass left out is 1e-30.
-const MIN_TAIL_PROBABILITY: f64 = 1e-30;
 /// From this u = −x̃ on, 1 − m√π erfcx(u) is evaluated by its asymptotic series (which is free
 /// of the cancellation the direct form suffers for large u).
 const PSI_SERIES_FROM: f64 = 8.0;
@@ -96,7 +96,7 @@ impl Beckmann {
 
     /// The projected area in double precision.
     #[inline]
-    fn projected_area64(&self, w: Vec3) -> f64 {
+    fn projected_area_double(&self, w: Vec3) -> f64 {
         let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let root_q = q.sqrt();
         let z = f64::from(w.z);
@@ -138,6 +138,7 @@ impl MicrosurfaceSlope for Beckmann {
 
     #[inline]
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
+        require!(!slope_x.is_nan() && !slope_y.is_nan(), 0.0; slope_x, slope_y);
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
         let (x, y) = (f64::from(slope_x) / ax, f64::from(slope_y) / ay);
         ((-(x * x) - y * y).exp() * INV_PI / (ax * ay)) as f32
@@ -147,26 +148,73 @@ impl MicrosurfaceSlope for Beckmann {
     /// an f32 exponent E grows as E·2⁻²⁴, and m.z⁴ would underflow before the exponential.
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
+        require!(is_direction(wm), 0.0; wm);
         self.d_double(wm.as_dvec3()) as f32
     }
 
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        require!(is_direction64(wm), 0.0; wm);
+        self.d64_unchecked(wm)
+    }
+
+    #[inline]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
         self.d_double(wm)
     }
 
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.lambda_unchecked(w)
+    }
+
+    #[inline]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
+        (self.lambda64(w) as f32).clamp(-f32::MAX, f32::MAX)
+    }
+
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
         let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
         let a = f64::from(w.z.abs()) / q.sqrt();
         let up = lambda_up64(a);
-        let value = if w.z >= 0.0 { up } else { -1.0 - up };
-        (value as f32).clamp(-f32::MAX, f32::MAX)
+        if w.z >= 0.0 { up } else { -1.0 - up }
+    }
+
+    /// ln Λ = −a² + ln r(a) − ln(2a√π) with a = cot θ/αᵢ and r = 1 − √π a erfcx(a)
+    /// (`one_minus_scaled_erfcx`): no exponential, so it stays finite (and relative error
+    /// below 3e-14 of ln Λ's magnitude or 1e-13 absolute) where Λ underflows f64 (a > 26.6).
+    #[inline]
+    fn ln_lambda(&self, w: Vec3) -> f64 {
+        if w.z < 0.0 {
+            return f64::NAN;
+        }
+        let q = projected_roughness_sq64(self.alpha_x, self.alpha_y, w);
+        let a = f64::from(w.z) / q.sqrt();
+        if a == 0.0 {
+            return f64::INFINITY;
+        }
+        if a.is_infinite() {
+            return f64::NEG_INFINITY;
+        }
+        -a * a + (one_minus_scaled_erfcx(a) * (0.5 * INV_SQRT_PI) / a).ln()
     }
 
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
-        self.projected_area64(w) as f32
+        require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w)
+    }
+
+    #[inline]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
+        self.projected_area_double(w) as f32
+    }
+
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        self.projected_area_double(w)
     }
 
     /// Evaluated in double precision; when ωi is so far below the horizon that the
@@ -174,16 +222,23 @@ impl MicrosurfaceSlope for Beckmann {
     /// logarithms ln D − ln A, with ln A = −a² + ln(αᵢ sin θ/(2√π)) + ln(1 − √π a erfcx(a)).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
-        self.d_wi64(wi, wm.as_dvec3()) as f32
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
+        self.d_wi64_unchecked(wi, wm.as_dvec3()) as f32
     }
 
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
+        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
+        self.d_wi64_unchecked(wi, wm)
+    }
+
+    #[inline]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
         let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
-        let area = self.projected_area64(wi);
+        let area = self.projected_area_double(wi);
         if area > AREA_LOG_SPACE_BELOW {
             return cos_im * self.d_double(wm) / area;
         }
@@ -205,6 +260,12 @@ impl MicrosurfaceSlope for Beckmann {
     /// their spread (5 % at |cot θ| = 480).
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+        self.sample_d_wi_unchecked(wi, u1, u2)
+    }
+
+    #[inline]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
         let (sx, sy, z) = (ax * f64::from(wi.x), ay * f64::from(wi.y), f64::from(wi.z));
         let len_xy = (sx * sx + sy * sy).sqrt();
@@ -227,6 +288,11 @@ impl MicrosurfaceSlope for Beckmann {
     /// visible, returns the zero slope.
     #[inline]
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        require!(
+            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
+            Vec2::NAN;
+            cos_theta, sin_theta, u1, u2
+        );
         let (c, s) = (f64::from(cos_theta), f64::from(sin_theta));
         let slope_x = if s > 0.0 {
             visible_slope_x(c / s, f64::from(u1))
@@ -240,11 +306,13 @@ impl MicrosurfaceSlope for Beckmann {
 }
 
 /// The quantile of the slope density exp(−x²)/√π: erf⁻¹(2u − 1), evaluated from the nearer
-/// end of [0, 1] in single precision (relative error below 4e-7, see `erfc_inv_f32`); the
-/// tails are cut at probability 1e-30.
+/// end of [0, 1] in single precision (relative error below 4e-7, see `erfc_inv_f32`). Both
+/// tails are cut at probability 2⁻²⁴ (the crate's tail policy, `rng`): u = 0 gives
+/// x̃ = −3.744, with 2⁻²⁴ of the density below it, and u = 1 − 2⁻²⁴ gives +3.744.
 #[inline]
 pub(crate) fn gaussian_slope(u: f64) -> f64 {
-    let tail = u.min(1.0 - u).max(MIN_TAIL_PROBABILITY);
+    let u = cut_tails64(u);
+    let tail = u.min(1.0 - u);
     let x = f64::from(erfc_inv_f32(tail as f32));
     if u < 0.5 { -x } else { x }
 }
@@ -311,9 +379,12 @@ fn visible_slope_x(kappa: f64, u: f64) -> f64 {
 /// Like [`visible_slope_x`], restricted to x̃ ∈ [`lower`, κ) (`lower` may be −∞): solves
 /// S(x̃) = S(lower) + u (S(κ) − S(lower)) in log space. Used by the V-cavity sampler, whose
 /// unmasked part is the Smith VNDF limited to slopes above 3 cot θ (Tokuyoshi, listing 5).
+///
+/// u is cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy, `rng`): the lowest sample has 2⁻²⁴ of
+/// the visible slopes below it, the highest 2⁻²⁴ between it and κ (where the density vanishes).
 #[inline]
 pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
-    let u = u.clamp(MIN_TAIL_PROBABILITY, 1.0);
+    let u = cut_tails64(u);
     let ln_u = u.ln();
     let ln_s_kappa = ln_s(kappa, kappa).0;
     let (target, mut lo) = if lower > f64::NEG_INFINITY && lower < kappa {

@@ -11,6 +11,7 @@ pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use ggx::Ggx;
 
+pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -20,6 +21,14 @@ use glam::{DVec3, Vec2, Vec3};
 /// Implementors provide the primitives `p22`, `d`, `lambda`, `projected_area` and
 /// `sample_p22_11`; `alpha_i`, `d_wi` and `sample_d_wi` are derived (and may be overridden
 /// with faster or more accurate forms).
+///
+/// Invalid input ([policy](crate#invalid-input)), the same for every method and every
+/// implementation of the crate: a direction argument that is zero, has a NaN or ±∞ component,
+/// or is not unit within [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE), a NaN slope, or
+/// a uniform outside [0, 1] trips a debug assertion in debug builds; release builds return 0
+/// from the densities (`p22`, `d`, `d64`, `d_wi`, `d_wi64`), NaN from `lambda`,
+/// `projected_area` and `alpha_i`, and a NaN vector from the samplers (`sample_p22_11`,
+/// `sample_d_wi`). Grazing and below-horizon unit directions are valid everywhere.
 pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along x.
     fn alpha_x(&self) -> f32;
@@ -37,8 +46,9 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Smith's Λ(ω) on the whole sphere (supplement §2.2–2.3, with the sign of a kept).
     ///
     /// Λ ≥ 0 for ω.z > 0 (0 at the zenith), Λ(−ω) = −1 − Λ(ω) below the horizon (−1 at the
-    /// nadir). At exactly grazing ω.z = ±0 the exact value is +∞; the result saturates to
-    /// `f32::MAX` there (and to −`f32::MAX`−1 below), never leaving the finite numbers.
+    /// nadir). At exactly grazing ω.z = ±0 (both signs of zero are the horizon seen from
+    /// above) the exact value is +∞; the result saturates to `f32::MAX` there (and to
+    /// −`f32::MAX` just below it), never leaving the finite numbers.
     fn lambda(&self, w: Vec3) -> f32;
 
     /// The projected area ∫⟨ω, ωm⟩ D(ωm) dωm = (1 + Λ(ω)) cos θ ≥ 0, for every ω
@@ -46,10 +56,55 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// 0 at the nadir and ½ αᵢ sin θ at the horizon.
     fn projected_area(&self, w: Vec3) -> f32;
 
+    /// Λ(ω) in double precision, unsaturated: ±∞ at exactly grazing ω.z = ±0 (see
+    /// [`Self::lambda`] for the rest of the contract).
+    ///
+    /// Below the horizon the masking of a backfacing direction is G1(ω) = 1/|1 + Λ(ω)| =
+    /// 1/Λ(−ω), and Λ(−ω) is tiny there for small α (Beckmann: e^{−a²}, a = |cot θ|/αᵢ, an
+    /// f32 subnormal from a ≈ 9.6 on); its f32 rounding loses all precision long before it
+    /// reaches 0. The default widens [`Self::lambda`]; [`Ggx`] and [`Beckmann`] evaluate it in
+    /// f64 (GGX's Λ ≥ 1e-106 for every f32 direction and α, so it never underflows; Beckmann's
+    /// underflows f64 from a ≈ 26.6 on, see [`Self::ln_lambda`]).
+    /// A precision primitive of the crate's walks and single scattering: no argument check
+    /// (callers pass unit directions), hence hidden.
+    #[doc(hidden)]
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
+        f64::from(self.lambda_unchecked(w))
+    }
+
+    /// ln Λ(ω) for ω on or above the horizon (ω.z ≥ 0): −∞ at the zenith, +∞ at ω.z = 0;
+    /// NaN below the horizon (outside the domain).
+    ///
+    /// The masking ratio Λ(ω′)/Λ(−ω) of a backfacing vertex (both factors tiny) is formed as
+    /// exp(ln Λ(ω′) − ln Λ(−ω)) where Λ underflows in f64. The default is `lambda64(w).ln()`;
+    /// [`Beckmann`] evaluates −a² + ln(r(a)/(2a√π)) directly, finite for every a > 0.
+    /// A precision primitive of the crate's walks and single scattering: no argument check
+    /// (callers pass unit directions), hence hidden.
+    #[doc(hidden)]
+    #[inline]
+    fn ln_lambda(&self, w: Vec3) -> f64 {
+        if w.z < 0.0 { f64::NAN } else { self.lambda64(w).ln() }
+    }
+
+    /// The projected area in double precision (see [`Self::projected_area`]): below the
+    /// horizon it is Λ(−ω)|cos θ|, which underflows f32 far earlier than f64. The default
+    /// widens [`Self::projected_area`]; [`Ggx`] and [`Beckmann`] evaluate it in f64.
+    /// A precision primitive of the crate's walks and single scattering: no argument check
+    /// (callers pass unit directions), hence hidden.
+    #[doc(hidden)]
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        f64::from(self.projected_area_unchecked(w))
+    }
+
     /// Samples visible slopes of the distribution stretched to α = 1, seen from the direction
     /// (sin θ, 0, cos θ), θ ∈ [0, π] (supplement §2.1, `sampleP22_11`).
     ///
-    /// Takes cos θ and sin θ ≥ 0 rather than θ, and two uniforms in [0, 1).
+    /// Takes cos θ and sin θ ≥ 0 rather than θ (either may be ±0, treated alike), and two
+    /// uniforms in [0, 1). Implementations cut the tails of the quantiles they invert at 2⁻²⁴
+    /// (u is used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴); the crate's tail policy): no sample lies
+    /// beyond the last 2⁻²⁴ of the model.
     fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2;
 
     /// D for a normal given in double precision, evaluated in double precision. The default
@@ -59,24 +114,22 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Beckmann exponent t).
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        require!(is_direction64(wm), 0.0; wm);
         f64::from(self.d(wm.as_vec3()))
     }
 
     /// D_ωi(ωm) in double precision for ωm given in double precision (see [`Self::d64`]).
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
-        let cos_im = wi.as_dvec3().dot(wm);
-        if cos_im <= 0.0 || wm.z <= 0.0 {
-            return 0.0;
-        }
-        let area = f64::from(self.projected_area(wi));
-        if area <= 0.0 { 0.0 } else { cos_im * self.d64(wm) / area }
+        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
+        smith_d_wi64(self, wi, wm)
     }
 
     /// The projected roughness αᵢ = √(cos²φ αx² + sin²φ αy²) in the azimuth of ω
     /// (supplement §2.1). At ω = ±z, where φ is undefined, returns αx.
     #[inline]
     fn alpha_i(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
         // scaled by the larger horizontal component so that x² + y² cannot underflow
         let scale = w.x.abs().max(w.y.abs());
         if scale == 0.0 {
@@ -90,9 +143,15 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// The distribution of visible normals D_ωi(ωm) = ⟨ωi, ωm⟩ D(ωm) / projected_area(ωi)
     /// (supplement §2.1), for any ωi. Zero where ωi sees no microsurface (projected area 0,
     /// i.e. ωi = −z).
+    ///
+    /// ⟨ωi, ωm⟩ is evaluated in f64 from the f32 vectors, the visibility test that the samplers
+    /// guarantee for their normals (`ensure_visible`): in f32 it rounds to ≤ 0 for normals
+    /// within ~1e-7 of grazing, which the samplers do return (at the bottom of the spherical
+    /// cap, u1 = 1 − 2⁻²⁴).
     #[inline]
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
-        let cos_im = wi.dot(wm);
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
+        let cos_im = wi.as_dvec3().dot(wm.as_dvec3());
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
@@ -100,16 +159,17 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         if area <= 0.0 {
             return 0.0;
         }
-        cos_im * self.d(wm) / area
+        cos_im as f32 * self.d(wm) / area
     }
 
     /// Samples a normal ωm from D_ωi exactly, for any ωi on the sphere, from two uniforms in
     /// [0, 1) (supplement §2.1: stretch to α = 1, sample slopes, rotate, unstretch).
     ///
     /// Always returns a unit vector with ωm.z ≥ 0. For ωi = −z, which sees no microsurface,
-    /// returns +z.
+    /// returns +z. Tails are cut at 2⁻²⁴ as in [`Self::sample_p22_11`].
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
         let (ax, ay) = (self.alpha_x(), self.alpha_y());
         let stretched = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         let sin_theta = (stretched.x * stretched.x + stretched.y * stretched.y).sqrt();
@@ -120,6 +180,57 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
         let slope_y = ay * (sin_phi * s.x + cos_phi * s.y);
         ensure_visible(wi, normal_from_slopes(slope_x, slope_y))
     }
+
+    // The same quantities without the argument check, for the crate's walks, which call them
+    // once or more per bounce with directions they produced themselves (unit up to rounding).
+    // Each defaults to the checked method, so that an implementation outside the crate keeps
+    // its own overrides; the crate's slopes override them with the unchecked bodies.
+
+    /// [`Self::lambda`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
+        self.lambda(w)
+    }
+
+    /// [`Self::projected_area`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
+        self.projected_area(w)
+    }
+
+    /// [`Self::d64`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
+        self.d64(wm)
+    }
+
+    /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
+        self.d_wi64(wi, wm)
+    }
+
+    /// [`Self::sample_d_wi`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        self.sample_d_wi(wi, u1, u2)
+    }
+}
+
+/// The default D_ωi(ωm) in double precision, cos⟨ωi, ωm⟩ D(ωm)/A(ωi), without the argument check.
+#[inline(always)]
+pub(crate) fn smith_d_wi64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: DVec3) -> f64 {
+    let cos_im = wi.as_dvec3().dot(wm);
+    if cos_im <= 0.0 || wm.z <= 0.0 {
+        return 0.0;
+    }
+    let area = slope.projected_area64(wi);
+    if area <= 0.0 { 0.0 } else { cos_im * slope.d64_unchecked(wm) / area }
 }
 
 /// An f32 dot product of two unit vectors above this is positive in exact arithmetic too

@@ -2,14 +2,14 @@
 
 use super::VisibleNormalSampler;
 use super::disk::{half_space_band, sample_band};
-use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes};
+use crate::contract::{are_uniform, is_direction};
+use crate::rng::cut_tails64;
+use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope, ensure_visible, gaussian_slope, normal_from_slopes};
 use crate::special::{erf64, erfinv64};
 use glam::Vec3;
 
 /// 1/√π.
 const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
-/// Uniforms are kept at least this far from 0 (as in the exact Beckmann sampler).
-const MIN_TAIL_PROBABILITY: f64 = 1e-30;
 /// Newton steps of [`BeckmannNewton`] stop once a step is below this (in the erf domain).
 const ERF_NEWTON_TOLERANCE: f64 = 1e-7;
 /// At most this many Newton steps in [`BeckmannNewton`].
@@ -24,11 +24,13 @@ pub struct SmithVndf<S>(pub S);
 impl<S: MicrosurfaceSlope> VisibleNormalSampler for SmithVndf<S> {
     #[inline]
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         self.0.sample_d_wi(wi, u[0], u[1])
     }
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
@@ -42,11 +44,13 @@ pub struct GgxSphericalCap(pub Ggx);
 impl VisibleNormalSampler for GgxSphericalCap {
     #[inline]
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         self.0.sample_d_wi(wi, u[0], u[1])
     }
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
@@ -63,6 +67,7 @@ pub struct GgxDisk(pub Ggx);
 impl VisibleNormalSampler for GgxDisk {
     #[inline]
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         let (ax, ay) = (self.0.alpha_x(), self.0.alpha_y());
         let v = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         let len_xy = (v.x * v.x + v.y * v.y).sqrt();
@@ -74,14 +79,22 @@ impl VisibleNormalSampler for GgxDisk {
             (Vec3::Y, Vec3::X * v.z.signum())
         };
         let (lo, hi) = half_space_band(t2_axis.z, v.z, true);
-        let (t1, t2) = sample_band(u[0], u[1], lo, hi);
-        let t3 = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
-        let h = t1 * t1_axis + t2 * t2_axis + t3 * v;
-        Vec3::new(ax * h.x, ay * h.y, h.z.max(0.0)).normalize_or(Vec3::Z)
+        let p = sample_band(u[0], u[1], lo, hi);
+        let mut h = p.t1 * t1_axis + p.t2 * t2_axis + p.t3 * v;
+        // h.z = T2.z t2 + v.z t3 vanishes on the band's lower edge (lo = −v.z, T2.z² + v.z² = 1),
+        // where its two terms cancel: near the rim (u[0] = 1 − 2⁻²⁴) rounding would put the
+        // normal on the horizon (density 0). Exactly, h.z = (t2 − lo ρ)(T2.z t3 − v.z t2 + ρ) /
+        // (t3 + ρ T2.z), a product of non-negative factors
+        let denom = p.t3 + p.rho * t2_axis.z;
+        if denom > 0.0 {
+            h.z = p.above_lo * (t2_axis.z * p.t3 - v.z * p.t2 + p.rho) / denom;
+        }
+        ensure_visible(wi, Vec3::new(ax * h.x, ay * h.y, h.z.max(0.0)).normalize_or(Vec3::Z))
     }
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
@@ -99,6 +112,7 @@ pub struct BeckmannNewton(pub Beckmann);
 
 impl VisibleNormalSampler for BeckmannNewton {
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         let (ax, ay) = (self.0.alpha_x(), self.0.alpha_y());
         let v = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
         if v.z <= 0.0 {
@@ -114,12 +128,14 @@ impl VisibleNormalSampler for BeckmannNewton {
 
     #[inline]
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
     }
 }
 
 /// The visible slope x̃ < cot θ at α = 1 for tan θ ≥ 0: Newton on
-/// C(e) = e + tan θ exp(−x̃²)/√π (e = erf x̃), whose value runs from −1 to C(erf(cot θ)).
+/// C(e) = e + tan θ exp(−x̃²)/√π (e = erf x̃), whose value runs from −1 to C(erf(cot θ)); u is
+/// cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy).
 fn erf_domain_slope(tan_theta: f64, u: f64) -> f64 {
     if tan_theta == 0.0 {
         return gaussian_slope(u);
@@ -127,8 +143,8 @@ fn erf_domain_slope(tan_theta: f64, u: f64) -> f64 {
     let slope_max = 1.0 / tan_theta;
     let e_max = erf64(slope_max);
     let c_max = e_max + INV_SQRT_PI * tan_theta * (-slope_max * slope_max).exp();
-    // u = 0 would put e on −1 (slope −∞): keep it in the exact sampler's tail floor
-    let u = u.clamp(MIN_TAIL_PROBABILITY, 1.0);
+    // u = 0 would put e on −1 (slope −∞): both tails are cut at 2⁻²⁴ (the crate's tail policy)
+    let u = cut_tails64(u);
     let target = u * (c_max + 1.0) - 1.0;
     let mut e = e_max - (1.0 + e_max) * erf64((-u.ln()).sqrt());
     for _ in 0..ERF_NEWTON_MAX_STEPS {

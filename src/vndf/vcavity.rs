@@ -2,6 +2,8 @@
 
 use super::VisibleNormalSampler;
 use super::disk::{half_space_band, sample_band};
+use crate::contract::{are_uniform, is_direction, is_plane_normal};
+use crate::rng::cut_tails64;
 use crate::slope::{
     Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes, one_minus_scaled_erfcx,
     visible_slope_x_above,
@@ -20,6 +22,13 @@ const BOUNDARY_SLOPE_FACTOR: f32 = 3.0;
 
 /// Slope distributions with the closed forms the V-cavity model needs: the hit probability
 /// H(i) and restricted samplers (Tokuyoshi, supplement §2.2–2.3).
+///
+/// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit direction,
+/// a plane normal `k` whose squared length is not a normal finite f32 (zero, NaN, ∞, or so
+/// short or long that it under- or overflows; its length is otherwise free), or a uniform outside
+/// [0, 1] trips a debug assertion in debug builds; release builds return NaN from the
+/// probabilities, −∞ from `ln_d` (the logarithm of the density's nothing, 0) and a NaN normal
+/// from the samplers.
 pub trait VCavitySlope: MicrosurfaceSlope {
     /// The hit probability H(i) = ∫ G(i, m) max(i·m, 0) D(m) dm / |i·n| (§2.2): 1 for
     /// i.z ≥ 0; for i.z < 0 in closed form.
@@ -31,12 +40,14 @@ pub trait VCavitySlope: MicrosurfaceSlope {
 
     /// ln H(i) in double precision (finite where H underflows in f32).
     fn ln_hit_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         f64::from(self.hit_probability(wi)).ln()
     }
 
     /// For a backfacing i: the probability 2 ∫_{x<3cotθ} P2 / H(i) of the branch that samples
     /// D(m) m.z below the boundary slope (Tokuyoshi, eq. 5), in [0, 1].
     fn projected_branch_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         let boundary = Vec3::new(wi.x, wi.y, BOUNDARY_SLOPE_FACTOR * wi.z);
         let h = self.hit_probability(wi);
         if h <= 0.0 {
@@ -48,13 +59,16 @@ pub trait VCavitySlope: MicrosurfaceSlope {
 
     /// ln D(m) in double precision (−∞ where D is 0).
     fn ln_d(&self, wm: Vec3) -> f64 {
+        require!(is_direction(wm), f64::NEG_INFINITY; wm);
         self.d64(wm.as_dvec3()).ln()
     }
 
-    /// A normal distributed as D(m) m.z restricted to m·k > 0 (k = +z: unrestricted).
+    /// A normal distributed as D(m) m.z restricted to m·k > 0 (k = +z: unrestricted), from
+    /// uniforms in [0, 1) whose quantiles' tails are cut at 2⁻²⁴ (the crate's tail policy).
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3;
 
-    /// A normal distributed as the Smith VNDF of ωi restricted to m·k ≤ 0.
+    /// A normal distributed as the Smith VNDF of ωi restricted to m·k ≤ 0, with tails cut at
+    /// 2⁻²⁴ like [`Self::sample_projected`].
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3;
 }
 
@@ -89,6 +103,7 @@ impl VCavitySlope for Ggx {
     /// evaluated without cancellation as q (1/(A + 3|i_z|) + 1/(B + |i_z|))/(A + B) with
     /// A = √(q + 9 i_z²), B = √(q + i_z²).
     fn hit_probability(&self, wi: Vec3) -> f32 {
+        require!(is_direction(wi), f32::NAN; wi);
         if wi.z >= 0.0 {
             return 1.0;
         }
@@ -101,6 +116,7 @@ impl VCavitySlope for Ggx {
 
     /// ½ + k_z / (2√(αx² k_x² + αy² k_y² + k_z²)).
     fn frontfacing_proportion(&self, k: Vec3) -> f32 {
+        require!(is_plane_normal(k), f32::NAN; k);
         let ks = stretch(self, k);
         0.5 + 0.5 * ks.z / ks.length()
     }
@@ -108,11 +124,12 @@ impl VCavitySlope for Ggx {
     /// In the stretched configuration D m.z is uniform on the projected disk; the plane
     /// m·k = 0 cuts it along the azimuth of k (Tokuyoshi, listing 2).
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; k, u1, u2);
         let ks = stretch(self, k).normalize_or(Vec3::Z);
         let (e, f) = azimuth_frame(ks);
         let (lo, hi) = (-ks.z, 1.0);
-        let (w, u) = sample_band(u1, u2, lo, hi);
-        let z = (1.0 - u * u - w * w).max(0.0).sqrt();
+        let p = sample_band(u1, u2, lo, hi);
+        let (w, u, z) = (p.t1, p.t2, p.t3);
         let (x, y) = (u * e.x + w * f.x, u * e.y + w * f.y);
         Vec3::new(self.alpha_x() * x, self.alpha_y() * y, z).normalize_or(Vec3::Z)
     }
@@ -120,6 +137,7 @@ impl VCavitySlope for Ggx {
     /// The disk method of Heitz 2018 with the band limited by both the horizon and the plane
     /// m·k = 0 (Tokuyoshi, listing 3).
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; wi, k, u1, u2);
         let v = stretch(self, wi).normalize_or(Vec3::Z);
         let ks = stretch(self, k).normalize_or(Vec3::Z);
         let len_xy = (v.x * v.x + v.y * v.y).sqrt();
@@ -132,8 +150,8 @@ impl VCavitySlope for Ggx {
         let (lo_h, hi_h) = half_space_band(t2_axis.z, v.z, true);
         let (lo_k, hi_k) = half_space_band(t2_axis.dot(ks), v.dot(ks), false);
         let (lo, hi) = (lo_h.max(lo_k), hi_h.min(hi_k).max(lo_h.max(lo_k)));
-        let (t1, t2) = sample_band(u1, u2, lo, hi);
-        let t3 = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
+        let p = sample_band(u1, u2, lo, hi);
+        let (t1, t2, t3) = (p.t1, p.t2, p.t3);
         let h = t1 * t1_axis + t2 * t2_axis + t3 * v;
         Vec3::new(self.alpha_x() * h.x, self.alpha_y() * h.y, h.z.max(0.0)).normalize_or(Vec3::Z)
     }
@@ -144,6 +162,7 @@ impl VCavitySlope for Beckmann {
     /// u = i_z/√(αx² i_x² + αy² i_y²) (§2.2); evaluated with w = −u > 0 as
     /// (3 erfc(3w) − erfc(w))/2 − e^{−w²} expm1(−8w²)/(2√π w), without cancellation at w → 0.
     fn hit_probability(&self, wi: Vec3) -> f32 {
+        require!(is_direction(wi), f32::NAN; wi);
         if wi.z >= 0.0 {
             return 1.0;
         }
@@ -158,6 +177,7 @@ impl VCavitySlope for Beckmann {
     /// −w² + ln(r(w)/(2√π w) + e^{−8w²}(3 erfcx(3w)/2 − 1/(2√π w))) with
     /// r(w) = 1 − √π w erfcx(w) from its asymptotic series (no underflow, no cancellation).
     fn ln_hit_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         if wi.z >= 0.0 {
             return 0.0;
         }
@@ -178,6 +198,7 @@ impl VCavitySlope for Beckmann {
 
     /// erfc(3w)/H(i) in log space: −9w² + ln erfcx(3w) − ln H.
     fn projected_branch_probability(&self, wi: Vec3) -> f64 {
+        require!(is_direction(wi), f64::NAN; wi);
         let v = stretch64(self, wi);
         let q = v.x * v.x + v.y * v.y;
         if q == 0.0 {
@@ -190,6 +211,7 @@ impl VCavitySlope for Beckmann {
 
     /// −t − ln(π αx αy m.z⁴), t = (m.x²/αx² + m.y²/αy²)/m.z².
     fn ln_d(&self, wm: Vec3) -> f64 {
+        require!(is_direction(wm), f64::NEG_INFINITY; wm);
         if wm.z <= 0.0 {
             return f64::NEG_INFINITY;
         }
@@ -201,6 +223,7 @@ impl VCavitySlope for Beckmann {
 
     /// ½ erfc(−k_z/√(αx² k_x² + αy² k_y²)).
     fn frontfacing_proportion(&self, k: Vec3) -> f32 {
+        require!(is_plane_normal(k), f32::NAN; k);
         let ks = stretch(self, k);
         let len = f64::from(ks.truncate().length());
         if len == 0.0 {
@@ -212,12 +235,14 @@ impl VCavitySlope for Beckmann {
     /// Gaussian slopes, the one along the azimuth of k truncated to x̃ < k_z/|k_xy|
     /// (Tokuyoshi, listing 4), by inversion from the nearer end.
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; k, u1, u2);
         let ks = stretch(self, k);
         let (e, f) = azimuth_frame(ks);
         let len = f64::from(ks.truncate().length());
         // share of N(0, ½) below the boundary, as a complement 2P = erfc(−boundary)
         let two_p = if len == 0.0 { 2.0 } else { erfc64(-f64::from(ks.z) / len) };
-        let q = f64::from(u1) * two_p; // erfc(−x̃) = q
+        // tails cut at 2⁻²⁴ (the crate's tail policy): u1 = 0 would give x̃ = −26.5
+        let q = cut_tails64(f64::from(u1)) * two_p; // erfc(−x̃) = q
         let x = if q <= 1.0 {
             -erfinv_from_both_ends(1.0 - q, q.max(f64::MIN_POSITIVE))
         } else {
@@ -231,6 +256,7 @@ impl VCavitySlope for Beckmann {
     /// The exact visible-slope inversion limited to x̃ ∈ [3 cot θ, cot θ) (Tokuyoshi, listings
     /// 5–6, with the safeguarded log-space solver of [`Beckmann`]).
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; wi, k, u1, u2);
         let v = stretch64(self, wi);
         let ks = stretch64(self, k);
         let (e, f) = azimuth_frame(v.as_vec3());
@@ -259,8 +285,12 @@ pub struct VCavity<S>(pub S);
 
 impl<S: VCavitySlope> VCavity<S> {
     /// The V-cavity masking function G(i, m) (eq. 3).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit
+    /// direction gives NaN (a debug assertion in debug builds).
     #[inline]
     pub fn masking(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), f32::NAN; wi, wm);
         let cos_im = wi.dot(wm);
         if cos_im <= 0.0 {
             return 0.0;
@@ -269,6 +299,9 @@ impl<S: VCavitySlope> VCavity<S> {
     }
 
     /// The hit probability H(i) (§2.2).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// NaN (a debug assertion in debug builds).
     #[inline]
     pub fn hit_probability(&self, wi: Vec3) -> f32 {
         self.0.hit_probability(wi)
@@ -281,6 +314,7 @@ impl<S: VCavitySlope> VisibleNormalSampler for VCavity<S> {
     /// 2 ∫_{x<3cotθ} P2 / H(i) a normal from D(m) m.z limited to slopes below 3 cot θ, otherwise
     /// one from the Smith VNDF limited to [3 cot θ, cot θ) (Tokuyoshi, listing 1).
     fn sample(&self, wi: Vec3, u: [f32; 3]) -> Vec3 {
+        require!(is_direction(wi) && are_uniform(&u), Vec3::NAN; wi, u);
         if wi.z >= 0.0 {
             let m1 = self.0.sample_projected(Vec3::Z, u[0], u[1]);
             let m2 = Vec3::new(-m1.x, -m1.y, m1.z);
@@ -308,6 +342,7 @@ impl<S: VCavitySlope> VisibleNormalSampler for VCavity<S> {
     /// 2 D(m) m.z (i·m)⁺ / ((i·m)⁺ + (i·m′)⁺) with m′ the mirror image of m, which stays finite at
     /// grazing incidence.
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         // the visibility test in f64, like the Smith densities (near the nadir ⟨i, m⟩ is tiny)
         if wi.as_dvec3().dot(wm.as_dvec3()) <= 0.0 || wm.z <= 0.0 {
             return 0.0;

@@ -1,0 +1,245 @@
+//! Benchmarks of the renderer-facing `Bsdf` trait against the research-layer calls it wraps,
+//! for every technique (single scattering, random walk, position-free PT and BDPT) on gold and
+//! glass (GGX, α = 0.5), with static dispatch (the concrete `MicrofacetBsdf`) and dynamic
+//! dispatch (`&dyn Bsdf`) side by side; and single-scattering `Bsdf::sample` of the GGX
+//! conductor against the spherical-cap `sample_d_wi` it is built on.
+//!
+//! One call per iteration. The inputs — `N` view directions uniform on the upper hemisphere,
+//! `N` light directions (upper hemisphere for gold, whole sphere for glass) and `N` triples of
+//! uniforms — are pre-generated from fixed seeds and rotated through with a wrapping counter
+//! behind `std::hint::black_box`. The research calls draw from a `Pcg64Mcg` that runs on
+//! across iterations; the trait calls seed their own generators from the hash of their
+//! arguments (that cost is part of what is measured) and take the counter as key.
+//!
+//! Benchmark ids: `{material}/{technique}/{eval|pdf|sample}/{research|static|dyn}`, and
+//! `gold/single/sample-vs-vndf/{sample_d_wi|static}`.
+
+use core::f32::consts::TAU;
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::{Vec2, Vec3};
+use microsurface::{
+    Bsdf, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
+    MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SpecularLimit, Technique, UniformHeight,
+};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+use std::hint::black_box;
+
+#[path = "common/clock.rs"]
+mod clock;
+use clock::{Clock, config};
+
+/// The number of pre-generated inputs (a power of two).
+const N: usize = 1024;
+/// The roughness of every configuration.
+const ALPHA: f32 = 0.5;
+
+/// The next index of the rotation through the `N` inputs.
+#[inline(always)]
+fn next(i: &mut usize) -> usize {
+    let k = *i & (N - 1);
+    *i = i.wrapping_add(1);
+    k
+}
+
+/// A uniform direction on the upper hemisphere (or the whole sphere), never horizontal.
+fn direction(rng: &mut Pcg64Mcg, sphere: bool) -> Vec3 {
+    let u = 1.0 - rng.random::<f32>(); // (0, 1]
+    let z = if sphere && rng.random::<bool>() { -u } else { u };
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = TAU * rng.random::<f32>();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+struct Inputs {
+    wo: Vec<Vec3>,
+    wi: Vec<Vec3>,
+    uc: Vec<f32>,
+    u: Vec<Vec2>,
+}
+
+fn inputs(transmits: bool, seed: u64) -> Inputs {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let wo = (0..N).map(|_| direction(&mut rng, false)).collect();
+    let wi = (0..N).map(|_| direction(&mut rng, transmits)).collect();
+    let uc = (0..N).map(|_| rng.random::<f32>()).collect();
+    let u = (0..N).map(|_| Vec2::new(rng.random(), rng.random())).collect();
+    Inputs { wo, wi, uc, u }
+}
+
+/// The research-layer calls a technique wraps, in the adjoint orientation of the trait (the
+/// walk enters along the renderer's wo).
+struct Research<S, M> {
+    surface: Microsurface<UniformHeight, S, M>,
+    technique: Technique,
+}
+
+impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
+    fn pf(&self, shadowing: Shadowing) -> PositionFree<S, M> {
+        PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
+    }
+
+    #[inline(always)]
+    fn eval(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
+        match self.technique {
+            Technique::SingleScattering => {
+                self.pf(Shadowing::Correlated).eval_single_scattering(walk_in, walk_out, rng)
+            }
+            Technique::RandomWalk => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
+            Technique::PositionFree { estimator, shadowing } => {
+                self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn pdf(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
+        match self.technique {
+            Technique::SingleScattering => self.pf(Shadowing::Correlated).pdf_single(walk_in, walk_out),
+            _ => self.pf(Shadowing::Correlated).pdf(walk_in, walk_out),
+        }
+    }
+
+    #[inline(always)]
+    fn sample(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<Vec3> {
+        match self.technique {
+            Technique::SingleScattering => {
+                self.pf(Shadowing::Correlated).sample_single(walk_in, rng).map(|s| s.0)
+            }
+            Technique::RandomWalk => self.surface.sample(walk_in, rng).map(|s| s.wo),
+            Technique::PositionFree { shadowing, .. } => {
+                self.pf(shadowing).sample(walk_in, rng).map(|s| s.wo)
+            }
+        }
+    }
+}
+
+const TECHNIQUES: [(&str, Technique); 4] = [
+    ("single", Technique::SingleScattering),
+    ("walk", Technique::RandomWalk),
+    ("pt", Technique::PositionFree { estimator: Estimator::Pt, shadowing: Shadowing::Correlated }),
+    ("bdpt", Technique::PositionFree { estimator: Estimator::Bdpt, shadowing: Shadowing::Correlated }),
+];
+
+fn bench_material<M: Material + SpecularLimit>(c: &mut Criterion<Clock>, name: &str, material: M, seed: u64) {
+    let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
+    let x = inputs(M::TRANSMITS, seed);
+    for (tname, technique) in TECHNIQUES {
+        let bsdf =
+            MicrofacetBsdf::new(slope, material).expect("α ≤ MAX_WALK_ALPHA").with_technique(technique);
+        let dynamic: &dyn Bsdf = &bsdf;
+        let research = Research { surface: Microsurface::new(UniformHeight, slope, material), technique };
+        let mut rng = Pcg64Mcg::seed_from_u64(seed + 1);
+
+        let mut g = c.benchmark_group(format!("{name}/{tname}/eval"));
+        g.bench_function("research", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&research).eval(black_box(x.wo[k]), black_box(x.wi[k]), &mut rng)
+            })
+        });
+        g.bench_function("static", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&bsdf).eval_keyed(black_box(x.wo[k]), black_box(x.wi[k]), i as u64)
+            })
+        });
+        g.bench_function("dyn", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(dynamic).eval_keyed(black_box(x.wo[k]), black_box(x.wi[k]), i as u64)
+            })
+        });
+        g.finish();
+
+        let mut g = c.benchmark_group(format!("{name}/{tname}/pdf"));
+        g.bench_function("research", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&research).pdf(black_box(x.wo[k]), black_box(x.wi[k]))
+            })
+        });
+        g.bench_function("static", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&bsdf).pdf(black_box(x.wo[k]), black_box(x.wi[k]))
+            })
+        });
+        g.bench_function("dyn", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(dynamic).pdf(black_box(x.wo[k]), black_box(x.wi[k]))
+            })
+        });
+        g.finish();
+
+        let mut g = c.benchmark_group(format!("{name}/{tname}/sample"));
+        g.bench_function("research", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&research).sample(black_box(x.wo[k]), &mut rng)
+            })
+        });
+        g.bench_function("static", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(&bsdf).sample(black_box(x.wo[k]), black_box(x.uc[k]), black_box(x.u[k]))
+            })
+        });
+        g.bench_function("dyn", |b| {
+            let mut i = 0;
+            b.iter(|| {
+                let k = next(&mut i);
+                black_box(dynamic).sample(black_box(x.wo[k]), black_box(x.uc[k]), black_box(x.u[k]))
+            })
+        });
+        g.finish();
+    }
+}
+
+/// Single-scattering `Bsdf::sample` of a GGX conductor against the spherical-cap visible-normal
+/// sampler it is built on (the target: at most 2× its cost).
+fn sample_vs_vndf(c: &mut Criterion<Clock>) {
+    let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
+    let gold = MicrofacetBsdf::new(slope, Conductor::new(ComplexIor::GOLD))
+        .expect("α ≤ MAX_WALK_ALPHA")
+        .with_technique(Technique::SingleScattering);
+    let x = inputs(false, 77);
+    let mut g = c.benchmark_group("gold/single/sample-vs-vndf");
+    g.bench_function("sample_d_wi", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            black_box(&slope).sample_d_wi(black_box(x.wo[k]), black_box(x.u[k].x), black_box(x.u[k].y))
+        })
+    });
+    g.bench_function("static", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            black_box(&gold).sample(black_box(x.wo[k]), black_box(x.uc[k]), black_box(x.u[k]))
+        })
+    });
+    g.finish();
+}
+
+fn bsdfs(c: &mut Criterion<Clock>) {
+    sample_vs_vndf(c);
+    bench_material(c, "gold", Conductor::new(ComplexIor::GOLD), 100);
+    bench_material(c, "glass", Dielectric::new(1.5).expect("valid index"), 200);
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = bsdfs
+}
+criterion_main!(benches);

@@ -1,0 +1,598 @@
+//! Stage 2, measure: every estimator's per-sample values and timing in every case of the error
+//! study, the converged references, the energy per order, the lobes per order and the cost.
+//! Nothing here is reduced beyond means and standard errors.
+
+use super::configure::{
+    Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, Models, Options, Rng, SlopeKind, Surface,
+    THETAS, WithModels, dir, with_surface,
+};
+use glam::Vec3;
+use microsurface::{MAX_BOUNCES, Material, MicrosurfaceSlope, ScatteringOrder};
+use rand::SeedableRng;
+use std::hint::black_box;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// A mean with its standard error.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Estimate {
+    pub mean: f64,
+    pub se: f64,
+}
+
+impl Estimate {
+    /// The mean of `values` and its standard error σ̂/√n.
+    pub fn of(values: impl Iterator<Item = f64> + Clone) -> Self {
+        let (n, sum) = values.clone().fold((0usize, 0.0), |(n, s), v| (n + 1, s + v));
+        let n = n.max(1) as f64;
+        let mean = sum / n;
+        let var = values.map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        Self { mean, se: (var / n).sqrt() }
+    }
+}
+
+/// The measured cost of one estimator run: the mean time per sample and its standard error
+/// from `TIMING_CHUNKS` separately timed chunks of the run.
+#[derive(Debug, Clone, Copy)]
+pub struct Timing {
+    pub ns_per_sample: f64,
+    pub ns_se: f64,
+}
+
+/// The number of separately timed chunks of an estimator run (for the SE of its cost).
+pub const TIMING_CHUNKS: usize = 16;
+
+/// Per-sample values of one estimator in one case, with its timing.
+pub struct EstimatorRun {
+    pub case: Case,
+    pub est: Est,
+    pub values: Vec<f32>,
+    pub timing: Timing,
+}
+
+/// The converged reference of one model in one case.
+#[derive(Debug, Clone, Copy)]
+pub struct Reference {
+    pub case: Case,
+    pub model: Model,
+    pub value: Estimate,
+}
+
+/// The energy of one surface, model and θi: albedo split by side and by scattering order
+/// (from sampled scatterings, weight × indicator), and for the walk the white furnace
+/// ∫f cos dωo by Monte Carlo over ωo.
+#[derive(Debug, Clone, Copy)]
+pub struct EnergyRow {
+    pub surface: Surface,
+    pub model: Model,
+    pub theta_i: f64,
+    pub reflected: f64,
+    pub transmitted: f64,
+    /// Orders 1, 2, 3 and 4+.
+    pub orders: [f64; 4],
+    pub mean_bounces: f64,
+    pub furnace: Option<Estimate>,
+}
+
+/// One point of a lobe: f·|cos θo| per order in the plane of incidence.
+#[derive(Debug, Clone, Copy)]
+pub struct LobePoint {
+    pub material: MaterialKind,
+    pub model: Model,
+    pub theta_i: f64,
+    /// Signed angle from the normal, positive on the mirror side (φo = π); |θo| > π/2 below.
+    pub theta_o: f64,
+    /// Orders 1, 2 and 3+.
+    pub orders: [Estimate; 3],
+    /// Evaluations per order.
+    pub samples: usize,
+}
+
+impl LobePoint {
+    /// The total over orders (independent estimates: the SEs add in quadrature).
+    pub fn total(&self) -> Estimate {
+        Estimate {
+            mean: self.orders.iter().map(|e| e.mean).sum(),
+            se: self.orders.iter().map(|e| e.se * e.se).sum::<f64>().sqrt(),
+        }
+    }
+}
+
+/// The cost of one estimator on one surface.
+#[derive(Debug, Clone, Copy)]
+pub struct CostRow {
+    pub surface: Surface,
+    pub est: Est,
+    pub ns_per_eval: f64,
+    /// `None` for single scattering (no sampler of its own).
+    pub ns_per_sample: Option<f64>,
+    pub mean_bounces: Option<f64>,
+}
+
+/// Everything measured.
+pub struct Measurements {
+    pub runs: Vec<EstimatorRun>,
+    pub references: Vec<Reference>,
+    pub energy: Vec<EnergyRow>,
+    pub lobes: Vec<LobePoint>,
+    pub cost: Vec<CostRow>,
+}
+
+/// Runs every measurement.
+pub fn measure(opts: &Options, budget: &Budget) -> Measurements {
+    let (runs, references) = error_study(opts, budget);
+    Measurements {
+        runs,
+        references,
+        energy: energy(opts, budget),
+        lobes: lobes(opts, budget),
+        cost: cost(budget),
+    }
+}
+
+/// Runs `jobs` on `threads` workers, reporting progress on stderr.
+fn parallel<T: Send, R: Send>(
+    label: &str,
+    jobs: Vec<T>,
+    opts: &Options,
+    work: impl Fn(T) -> R + Sync,
+) -> Vec<R> {
+    let total = jobs.len();
+    let queue = Mutex::new(jobs.into_iter().enumerate().collect::<Vec<_>>());
+    let done = AtomicUsize::new(0);
+    let results = Mutex::new(Vec::with_capacity(total));
+    std::thread::scope(|s| {
+        for _ in 0..opts.threads.max(1) {
+            s.spawn(|| {
+                loop {
+                    let Some((i, job)) = queue.lock().expect("queue").pop() else { break };
+                    let r = work(job);
+                    results.lock().expect("results").push((i, r));
+                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if opts.progress {
+                        let bar = 30 * d / total.max(1);
+                        eprint!("\r{label:<22} [{}{}] {d}/{total}", "=".repeat(bar), " ".repeat(30 - bar));
+                    }
+                }
+            });
+        }
+    });
+    if opts.progress {
+        eprintln!();
+    }
+    let mut results = results.into_inner().expect("results");
+    results.sort_by_key(|(i, _)| *i);
+    results.into_iter().map(|(_, r)| r).collect()
+}
+
+/// `n` evaluations of one estimator, single-threaded, timed in `TIMING_CHUNKS` chunks. The
+/// model and both directions pass through `black_box` on every call, so that nothing that
+/// depends on them is hoisted out of the timed loop (the error study estimates one value, so
+/// its inputs cannot rotate; `cost` rotates pre-generated directions).
+struct TimedRun {
+    est: Est,
+    wi: Vec3,
+    wo: Vec3,
+    n: usize,
+    seed: u64,
+}
+
+impl WithModels for TimedRun {
+    type Out = (Vec<f32>, Timing);
+
+    fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
+        let Self { est, wi, wo, n, seed } = self;
+        let mut rng = Rng::seed_from_u64(seed);
+        let mut values = Vec::with_capacity(n);
+        let chunk = n.div_ceil(TIMING_CHUNKS).max(1);
+        let (mut total_ns, mut per_chunk) = (0.0, Vec::with_capacity(TIMING_CHUNKS));
+        while values.len() < n {
+            let len = chunk.min(n - values.len());
+            let start = Instant::now();
+            for _ in 0..len {
+                let v = black_box(&m).eval(est, black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng);
+                values.push(v as f32);
+            }
+            let ns = start.elapsed().as_secs_f64() * 1e9;
+            total_ns += ns;
+            per_chunk.push(ns / len as f64);
+        }
+        let k = per_chunk.len() as f64;
+        let mean_chunk = per_chunk.iter().sum::<f64>() / k;
+        let var_chunk = per_chunk.iter().map(|t| (t - mean_chunk).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
+        (values, Timing { ns_per_sample: total_ns / n as f64, ns_se: (var_chunk / k).sqrt() })
+    }
+}
+
+/// What an error-study job computes.
+#[derive(Clone, Copy)]
+enum Role {
+    /// A run of the error study, `samples` evaluations.
+    Study(Est),
+    /// A model's converged reference, `samples × reference_factor` evaluations.
+    Reference(Model),
+}
+
+/// The error study: every estimator in every case, and every model's reference.
+fn error_study(opts: &Options, budget: &Budget) -> (Vec<EstimatorRun>, Vec<Reference>) {
+    let mut jobs = Vec::new();
+    for config in Config::ALL {
+        for case in Case::all(config) {
+            jobs.extend(Est::ALL.map(|est| (case, Role::Study(est))));
+            jobs.extend(Model::ALL.map(|model| (case, Role::Reference(model))));
+        }
+    }
+    let jobs: Vec<_> = jobs.into_iter().enumerate().collect();
+    let done = parallel("error vs time", jobs, opts, |(i, (case, role))| {
+        let (est, n) = match role {
+            Role::Study(est) => (est, budget.samples),
+            Role::Reference(model) => (model.reference_estimator(), budget.samples * budget.reference_factor),
+        };
+        let task = TimedRun { est, wi: case.wi(), wo: case.wo_dir(), n, seed: 0x5EED_0000 + i as u64 };
+        (case, role, with_surface(case.config.surface(), task))
+    });
+    let (mut runs, mut references) = (Vec::new(), Vec::new());
+    for (case, role, (values, timing)) in done {
+        match role {
+            Role::Study(est) => runs.push(EstimatorRun { case, est, values, timing }),
+            Role::Reference(model) => references.push(Reference {
+                case,
+                model,
+                value: Estimate::of(values.iter().map(|&v| f64::from(v))),
+            }),
+        }
+    }
+    (runs, references)
+}
+
+/// Albedo per order from sampled scatterings and (for the walk) the white furnace.
+struct EnergyTask {
+    surface: Surface,
+    model: Model,
+    theta_i: f64,
+    walks: usize,
+    furnace: usize,
+    seed: u64,
+}
+
+impl WithModels for EnergyTask {
+    type Out = EnergyRow;
+
+    fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
+        let mut rng = Rng::seed_from_u64(self.seed);
+        let wi = dir(self.theta_i, 0.0);
+        let mut row = EnergyRow {
+            surface: self.surface,
+            model: self.model,
+            theta_i: self.theta_i,
+            reflected: 0.0,
+            transmitted: 0.0,
+            orders: [0.0; 4],
+            mean_bounces: 0.0,
+            furnace: None,
+        };
+        let n = self.walks as f64;
+        for _ in 0..self.walks {
+            if let Some(s) = m.sample(self.model, wi, &mut rng) {
+                let w = s.weight / n;
+                if s.reflected {
+                    row.reflected += w
+                } else {
+                    row.transmitted += w
+                }
+                row.orders[(s.bounces as usize).clamp(1, 4) - 1] += w;
+                row.mean_bounces += f64::from(s.bounces) / n;
+            }
+        }
+        if self.model != Model::Walk {
+            return row;
+        }
+        // ωo from a mixture of the uniform sphere and (when its density is exact) the
+        // first-bounce phase function, so that sharp lobes (α = 0.1) are found
+        let walk = &m.walk;
+        let phase_share = if M::EXACT_PHASE_PDF { 0.5 } else { 0.0 };
+        let furnace: Vec<f64> = (0..self.furnace)
+            .map(|_| {
+                let u0: f64 = rand::RngExt::random(&mut rng);
+                let wo = if u0 < phase_share {
+                    walk.sample_phase(wi, &mut rng).wo
+                } else {
+                    let u1: f64 = rand::RngExt::random(&mut rng);
+                    let u2: f64 = rand::RngExt::random(&mut rng);
+                    dir((1.0 - 2.0 * u1).acos(), std::f64::consts::TAU * u2)
+                };
+                let phase =
+                    if phase_share > 0.0 { f64::from(walk.eval_phase(wi, wo, &mut rng).x) } else { 0.0 };
+                let density = (1.0 - phase_share) / (4.0 * std::f64::consts::PI) + phase_share * phase;
+                f64::from(walk.eval(wi, wo, ScatteringOrder::All, &mut rng).x) / density
+            })
+            .collect();
+        row.furnace = Some(Estimate::of(furnace.iter().copied()));
+        row
+    }
+}
+
+/// The energy table: the walk on every surface, and the position-free models on the lobe
+/// surfaces (GGX α = 1, conductor and dielectric).
+fn energy(opts: &Options, budget: &Budget) -> Vec<EnergyRow> {
+    let mut jobs = Vec::new();
+    for surface in Surface::all() {
+        let lobe_surface = surface.slope == SlopeKind::Ggx
+            && surface.alpha == 1.0
+            && LOBE_MATERIALS.contains(&surface.material);
+        let models: &[Model] = if lobe_surface { &Model::ALL } else { &[Model::Walk] };
+        for &model in models {
+            for theta_i in THETAS {
+                jobs.push((surface, model, theta_i));
+            }
+        }
+    }
+    parallel("energy per order", jobs, opts, |(surface, model, theta_i)| {
+        let seed = (surface.alpha * 1e3) as u64
+            ^ ((theta_i * 1e3) as u64) << 16
+            ^ (surface.material as u64 + 1) << 32
+            ^ (surface.slope as u64 + 1) << 40
+            ^ (model as u64) << 48;
+        let (walks, furnace) = (budget.energy_walks, budget.furnace_samples);
+        with_surface(surface, EnergyTask { surface, model, theta_i, walks, furnace, seed })
+    })
+}
+
+/// The continuation probability q of the random order of `orders_from_3`.
+const ORDER3_CONTINUE: f64 = 0.75;
+
+/// An unbiased estimate of the orders 3 and up of f·|cos θo| from one term: the order
+/// k = 3 + G, G geometric (P(G = g) = (1 − q) q^g, q = `ORDER3_CONTINUE`), capped at
+/// `MAX_BOUNCES` (which then takes the remaining mass q^{cap − 3}), evaluated with
+/// `ScatteringOrder::only(k)` and divided by P(k). Every term is ≥ 0 for non-negative
+/// models, unlike the difference total − order 1 − order 2. Its variance is finite when the
+/// order-k contributions fall faster than √q^k; it costs a walk of 3 + q/(1 − q) = 6 bounces
+/// on average.
+fn orders_from_3(eval: &impl Fn(ScatteringOrder, &mut Rng) -> f64, rng: &mut Rng) -> f64 {
+    let (mut k, mut p) = (3u32, 1.0 - ORDER3_CONTINUE);
+    while k < MAX_BOUNCES {
+        if rand::RngExt::random::<f64>(rng) >= ORDER3_CONTINUE {
+            break;
+        }
+        k += 1;
+        p *= ORDER3_CONTINUE;
+    }
+    if k == MAX_BOUNCES {
+        p *= 1.0 / (1.0 - ORDER3_CONTINUE);
+    }
+    eval(ScatteringOrder::only(k).expect("k ≥ 3"), rng) / p
+}
+
+/// The estimator of a model's lobes: the walk's `eval` and the position-free PT.
+fn lobe_estimator(model: Model) -> Est {
+    match model {
+        Model::Walk => Est::Walk,
+        Model::Uncorrelated => Est::PtUncorrelated,
+        Model::Correlated => Est::PtCorrelated,
+    }
+}
+
+/// The lobe angles: the midpoints of `n` equal steps over the upper half plane (−π/2, π/2),
+/// and for the dielectric of `2n` steps over the whole circle; never horizontal, where f·cos
+/// vanishes and the estimators' weights are least stable.
+pub fn lobe_angles(material: MaterialKind, n: usize) -> Vec<f64> {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let count = if material == MaterialKind::Dielectric { 2 * n } else { n };
+    (0..count).map(|k| -FRAC_PI_2 + PI * (k as f64 + 0.5) / n as f64).collect()
+}
+
+/// Running sums of one estimated quantity.
+#[derive(Debug, Clone, Copy, Default)]
+struct Sums {
+    n: usize,
+    sum: f64,
+    sum2: f64,
+}
+
+impl Sums {
+    fn add(&mut self, v: f64) {
+        self.n += 1;
+        self.sum += v;
+        self.sum2 += v * v;
+    }
+
+    fn estimate(&self) -> Estimate {
+        let n = self.n.max(1) as f64;
+        let mean = self.sum / n;
+        let var = ((self.sum2 - n * mean * mean) / (n - 1.0).max(1.0)).max(0.0);
+        Estimate { mean, se: (var / n).sqrt() }
+    }
+}
+
+/// The standard error of the total of three independent estimates.
+fn total_se(sums: &[Sums; 3]) -> f64 {
+    sums.iter().map(|s| s.estimate().se.powi(2)).sum::<f64>().sqrt()
+}
+
+/// More evaluations of orders 1, 2 and 3+ at one point of a lobe, in rounds of `round`
+/// samples, until the SE of the total is at most `target_se` or `max_samples` are reached.
+struct LobeTask {
+    est: Est,
+    wi: Vec3,
+    wo: Vec3,
+    sums: [Sums; 3],
+    round: usize,
+    target_se: f64,
+    max_samples: usize,
+    seed: u64,
+}
+
+impl WithModels for LobeTask {
+    type Out = [Sums; 3];
+
+    fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
+        let mut rng = Rng::seed_from_u64(self.seed);
+        let mut sums = self.sums;
+        let eval = |order: ScatteringOrder, rng: &mut Rng| m.eval(self.est, self.wi, self.wo, order, rng);
+        let (first, second) =
+            (ScatteringOrder::only(1).expect("n > 0"), ScatteringOrder::only(2).expect("n > 0"));
+        loop {
+            for _ in 0..self.round {
+                sums[0].add(eval(first, &mut rng));
+                sums[1].add(eval(second, &mut rng));
+                sums[2].add(orders_from_3(&eval, &mut rng));
+            }
+            if total_se(&sums) <= self.target_se || sums[0].n >= self.max_samples {
+                break sums;
+            }
+        }
+    }
+}
+
+/// The lobes per order of the walk and both position-free models (GGX α = 1), in two passes:
+/// a pilot of `lobe_samples` evaluations per point gives each panel's peak, then every point
+/// gets more evaluations until the SE of its total is at most `lobe_rel_se` × its panel's
+/// peak (or `lobe_max_samples` are reached; the report states the SE it reached).
+fn lobes(opts: &Options, budget: &Budget) -> Vec<LobePoint> {
+    let mut points = Vec::new();
+    for material in LOBE_MATERIALS {
+        for model in Model::ALL {
+            for theta_i in THETAS {
+                for theta_o in lobe_angles(material, budget.lobe_angles) {
+                    points.push((material, model, theta_i, theta_o));
+                }
+            }
+        }
+    }
+    let task = |&(material, model, theta_i, theta_o): &(MaterialKind, Model, f64, f64),
+                sums: [Sums; 3],
+                target_se: f64,
+                pass: u64| {
+        let surface = Surface { material, slope: SlopeKind::Ggx, alpha: 1.0 };
+        let seed = ((material as u64) << 40)
+            ^ ((model as u64) << 36)
+            ^ ((theta_i * 1e3) as u64) << 20
+            ^ ((theta_o + 4.0) * 1e5) as u64
+            ^ pass << 56;
+        let task = LobeTask {
+            est: lobe_estimator(model),
+            wi: dir(theta_i, 0.0),
+            wo: Vec3::new(-(theta_o.sin()) as f32, 0.0, theta_o.cos() as f32),
+            sums,
+            round: budget.lobe_samples,
+            target_se,
+            max_samples: budget.lobe_max_samples,
+            seed,
+        };
+        with_surface(surface, task)
+    };
+    let pilot =
+        parallel("lobes (pilot)", points.clone(), opts, |p| task(&p, [Sums::default(); 3], f64::INFINITY, 0));
+    let panel = |p: &(MaterialKind, Model, f64, f64)| (p.0, p.1, p.2.to_bits());
+    let mut peaks: std::collections::HashMap<(MaterialKind, Model, u64), f64> = Default::default();
+    for (p, sums) in points.iter().zip(&pilot) {
+        let total: f64 = sums.iter().map(|s| s.estimate().mean).sum();
+        let peak = peaks.entry(panel(p)).or_insert(0.0);
+        *peak = peak.max(total);
+    }
+    let jobs: Vec<_> = points.iter().copied().zip(pilot).collect();
+    let refined = parallel("lobes per order", jobs, opts, |(p, sums)| {
+        let target = budget.lobe_rel_se * peaks[&panel(&p)];
+        if total_se(&sums) <= target { sums } else { task(&p, sums, target, 1) }
+    });
+    points
+        .into_iter()
+        .zip(refined)
+        .map(|((material, model, theta_i, theta_o), sums)| LobePoint {
+            material,
+            model,
+            theta_i,
+            theta_o,
+            orders: sums.map(|s| s.estimate()),
+            samples: sums[0].n,
+        })
+        .collect()
+}
+
+/// The number of pre-generated outgoing directions the cost loops rotate through (a power of
+/// two).
+const COST_DIRECTIONS: usize = 1024;
+
+/// `COST_DIRECTIONS` outgoing directions from a fixed seed, uniform on the upper hemisphere
+/// (on the whole sphere when `transmits`), never horizontal.
+fn cost_directions(transmits: bool) -> Vec<Vec3> {
+    let mut rng = Rng::seed_from_u64(0xC057);
+    (0..COST_DIRECTIONS)
+        .map(|_| {
+            loop {
+                let u: f64 = rand::RngExt::random(&mut rng);
+                let v: f64 = rand::RngExt::random(&mut rng);
+                let z = if transmits { 1.0 - 2.0 * u } else { 1.0 - u };
+                if z != 0.0 {
+                    break dir(z.acos(), std::f64::consts::TAU * v);
+                }
+            }
+        })
+        .collect()
+}
+
+/// The incident angle of the cost table.
+pub const COST_THETA_I: f64 = 0.5;
+
+/// The surfaces of the cost table.
+pub fn cost_surfaces() -> [Surface; 4] {
+    let s = |material, slope| Surface { material, slope, alpha: 0.5 };
+    [
+        s(MaterialKind::Conductor, SlopeKind::Ggx),
+        s(MaterialKind::Conductor, SlopeKind::Beckmann),
+        s(MaterialKind::Dielectric, SlopeKind::Ggx),
+        s(MaterialKind::Diffuse, SlopeKind::Ggx),
+    ]
+}
+
+/// Single-threaded cost per call of every estimator on one surface, like the criterion
+/// benches: ωi fixed, the ωo of `eval` rotated through `COST_DIRECTIONS` pre-generated
+/// directions, the model and every input behind `black_box`.
+struct CostTask {
+    surface: Surface,
+    n: usize,
+}
+
+impl WithModels for CostTask {
+    type Out = Vec<CostRow>;
+
+    fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
+        let (wi, n) = (dir(COST_THETA_I, 0.0), self.n);
+        let wos = cost_directions(M::TRANSMITS);
+        let mut rng = Rng::seed_from_u64(99);
+        let mut rows = Vec::new();
+        for est in Est::ALL {
+            let start = Instant::now();
+            let mut acc = 0.0;
+            for i in 0..n {
+                let wo = wos[i & (COST_DIRECTIONS - 1)];
+                acc += black_box(&m).eval(est, black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng);
+            }
+            let ns_per_eval = start.elapsed().as_secs_f64() * 1e9 / n as f64;
+            black_box(acc);
+            let (ns_per_sample, mean_bounces) = if est == Est::Single {
+                (None, None)
+            } else {
+                let start = Instant::now();
+                let mut bounces = 0.0;
+                for _ in 0..n {
+                    let s = black_box(&m).sample(est.model(), black_box(wi), &mut rng);
+                    bounces += s.map_or(0.0, |s| f64::from(s.bounces));
+                }
+                black_box(bounces);
+                (Some(start.elapsed().as_secs_f64() * 1e9 / n as f64), Some(bounces / n as f64))
+            };
+            rows.push(CostRow { surface: self.surface, est, ns_per_eval, ns_per_sample, mean_bounces });
+        }
+        rows
+    }
+}
+
+/// The cost table (single thread, sequential, so that the timings do not compete).
+fn cost(budget: &Budget) -> Vec<CostRow> {
+    cost_surfaces()
+        .into_iter()
+        .flat_map(|surface| with_surface(surface, CostTask { surface, n: budget.cost_calls }))
+        .collect()
+}

@@ -6,10 +6,12 @@
 
 mod beckmann;
 mod ggx;
+mod tabulated;
 
 pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use ggx::Ggx;
+pub use tabulated::{MAX_RINGS, TabulatedSlope};
 
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};

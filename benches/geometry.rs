@@ -15,7 +15,8 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::{
-    Beckmann, GaussianHeight, Ggx, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, UniformHeight,
+    Beckmann, GaussianHeight, Ggx, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope,
+    TabulatedSlope, UniformHeight,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -142,6 +143,12 @@ fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion<Clock>, name: &str, make:
 fn slopes(c: &mut Criterion<Clock>) {
     bench_slope(c, "ggx", |a| Ggx::isotropic(a).expect("valid roughness"));
     bench_slope(c, "beckmann", |a| Beckmann::isotropic(a).expect("valid roughness"));
+    // GGX tabulated on 256 rings at s = α (the table size of tests/tabulated_slope.rs); the
+    // tables are leaked: the trait is implemented for `&TabulatedSlope`
+    bench_slope(c, "tabulated_ggx256", |a| {
+        let ggx = Ggx::isotropic(a).expect("valid roughness");
+        &*Box::leak(Box::new(TabulatedSlope::from_slope(&ggx, a, 256).expect("valid table")))
+    });
 }
 
 /// `sample_height` at α = 0.5: a ray arriving from above the surface (h0 = +∞, θ = 2.2 below

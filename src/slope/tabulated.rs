@@ -24,10 +24,10 @@ const EXACT_RINGS: usize = 24;
 const GL8: [(f64, f64); 8] = [
     (-0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
     (-0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
-    (-0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
-    (-0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
-    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
+    (-0.183_434_642_495_649_8, 0.362_683_783_378_362),
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
     (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
     (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
 ];
@@ -351,7 +351,7 @@ impl TabulatedSlope {
 
     /// The radial density P²² at slope radius `r` ≥ 0 (f64).
     pub fn p22_radial(&self, r: f64) -> f64 {
-        if !(r >= 0.0) {
+        if r.is_nan() || r < 0.0 {
             return 0.0;
         }
         self.ring_of(r, 1.0).map_or(0.0, |k| self.p22[k])
@@ -364,7 +364,7 @@ impl TabulatedSlope {
         let w = w.as_dvec3();
         let h = (w.x * w.x + w.y * w.y).sqrt();
         let len = (h * h + w.z * w.z).sqrt();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return 0.0;
         }
         self.area_exact(w.z / len, h / len)
@@ -434,7 +434,7 @@ impl TabulatedSlope {
             total += self.p22[k] * (next - prev);
             prev = next;
         }
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return None;
         }
         let target = u1 * total;
@@ -513,7 +513,7 @@ impl TabulatedSlope {
         let w = wi.as_dvec3();
         let h = (w.x * w.x + w.y * w.y).sqrt();
         let len = (h * h + w.z * w.z).sqrt();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return Vec3::Z;
         }
         let (cos_phi, sin_phi) = if h > 0.0 { (w.x / h, w.y / h) } else { (1.0, 0.0) };
@@ -528,7 +528,7 @@ impl TabulatedSlope {
     /// D in f64 for a normal with horizontal length `h` and height `z`.
     #[inline]
     fn d_from(&self, h: f64, z: f64) -> f64 {
-        if !(z > 0.0) {
+        if z.is_nan() || z <= 0.0 {
             return 0.0;
         }
         let Some(k) = self.ring_of(h, z) else { return 0.0 };
@@ -612,7 +612,7 @@ impl MicrosurfaceSlope for &TabulatedSlope {
         let a = f64::from(self.alpha);
         let (sx, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));
         let len = (sx * sx + z * z).sqrt();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return Vec2::ZERO;
         }
         match self.sample_slopes(z / len, sx / len, f64::from(u1), f64::from(u2)) {

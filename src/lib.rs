@@ -59,7 +59,10 @@ pub use microsurface::{
 pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
-pub use slope::{Beckmann, Ggx, MAX_RINGS, MicrosurfaceSlope, TabulatedSlope};
+pub use slope::{
+    BackscatterShadowing, Beckmann, Extraction, Ggx, MAX_RINGS, MicrosurfaceSlope, TabulatedSlope,
+    extract_fresnel, extract_isotropic, extract_isotropic_fn,
+};
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{
     BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,

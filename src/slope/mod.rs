@@ -5,11 +5,15 @@
 //! frame (z up). Λ is the signed Smith function, with Λ(−ω) = −1 − Λ(ω).
 
 mod beckmann;
+mod extract;
 mod ggx;
 mod tabulated;
 
 pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
+pub use extract::{
+    BackscatterShadowing, Extraction, extract_fresnel, extract_isotropic, extract_isotropic_fn,
+};
 pub use ggx::Ggx;
 pub use tabulated::{MAX_RINGS, TabulatedSlope};
 

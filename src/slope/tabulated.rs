@@ -122,7 +122,7 @@ impl core::fmt::Debug for TabulatedSlope {
 /// The projected area of the uniform slope disk r < R (of density 1) seen from
 /// ω = (sin θ, 0, cos θ): ∫_{r<R} (cos θ − x̃ sin θ)₊ dx̃ dỹ, in closed form.
 #[inline]
-fn disk_area(radius: f64, cos_t: f64, sin_t: f64) -> f64 {
+pub(super) fn disk_area(radius: f64, cos_t: f64, sin_t: f64) -> f64 {
     if radius <= 0.0 {
         return 0.0;
     }
@@ -256,7 +256,11 @@ impl TabulatedSlope {
         Self::from_radial_fn(scale, rings, |r| f64::from(slope.p22(r as f32, 0.0)))
     }
 
-    fn from_ring_values(scale: f32, mut values: Vec<f64>, input_mass: Option<f64>) -> Result<Self, Error> {
+    pub(super) fn from_ring_values(
+        scale: f32,
+        mut values: Vec<f64>,
+        input_mass: Option<f64>,
+    ) -> Result<Self, Error> {
         let s = f64::from(Error::check_positive("scale", scale)?);
         let n = values.len();
         check_ring_count(n)?;
@@ -338,6 +342,28 @@ impl TabulatedSlope {
     /// same projected area at grazing incidence. Reported by `alpha_x`/`alpha_y`.
     pub fn alpha(&self) -> f32 {
         self.alpha
+    }
+
+    /// The Beckmann roughness with the same second moment, α = √E[x̃² + ỹ²] (E[r²] = α² for
+    /// Beckmann), computed exactly from the rings: E[r²] = Σₖ pₖ π(Rₖ₊₁⁴ − Rₖ⁴)/2 (Dupuy 2015,
+    /// Listing 4.4, which converts a radial table to Beckmann roughness by its second moment).
+    pub fn beckmann_alpha(&self) -> f32 {
+        let m2: f64 = self
+            .p22
+            .iter()
+            .zip(self.radii.windows(2))
+            .map(|(p, r)| {
+                let (a, b) = (r[0] * r[0], r[1] * r[1]);
+                p * 0.5 * PI * (b - a) * (b + a)
+            })
+            .sum();
+        m2.sqrt() as f32
+    }
+
+    /// The normal angle θₖ = atan(s·tan θ′) of the centre of ring k (θ′ the stretched angle at
+    /// k + ½): where [`crate::extract_isotropic`] collocates the backscattering samples.
+    pub fn ring_centre_angle(scale: f32, rings: usize, k: usize) -> f64 {
+        (f64::from(scale) * grid_angle(k as f64 + 0.5, rings).tan()).atan()
     }
 
     /// The ring holding the slope radius r = `horizontal`/`z`, from the stretched angle.
@@ -541,12 +567,12 @@ impl TabulatedSlope {
 
 /// The stretched angle θ′ = (π/2)(1 − (1 − k/(N+1))²) of the (fractional) ring boundary `k` of
 /// a grid of N = `rings` rings.
-fn grid_angle(k: f64, rings: usize) -> f64 {
+pub(super) fn grid_angle(k: f64, rings: usize) -> f64 {
     let v = 1.0 - k / (rings as f64 + 1.0);
     FRAC_PI_2 * (1.0 - v * v)
 }
 
-fn check_ring_count(rings: usize) -> Result<(), Error> {
+pub(super) fn check_ring_count(rings: usize) -> Result<(), Error> {
     if rings == 0 || rings > MAX_RINGS {
         return Err(Error::InvalidParameter {
             name: "values.len()",

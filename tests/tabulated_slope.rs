@@ -237,48 +237,44 @@ fn sampler_chi2() {
     ];
     let tests = cases.len() + 2;
     let alpha = sidak(1e-3, tests);
-    let mut g = rng(0x7ab);
     let n = 60_000;
     // D jumps at every ring boundary: the adaptive quadrature of the expected counts stops at
     // depth 8, within 1e-6 of the mass per cell (≈ 0.06 count against ≈ 300 expected per cell)
     let grid = Chi2Grid { quad_tol: 1e-6, max_depth: 8, ..Chi2Grid::sphere(12, 16) };
-    for (label, t, theta) in cases {
-        {
-            let wi = dir(theta, 0.9);
-            let out = chi2_test(
-                &format!("tabulated {label} θi = {theta}"),
-                grid,
-                |m| f64::from(t.d_wi(wi, m)),
-                || Some(t.sample_d_wi(wi, uniform32(&mut g), uniform32(&mut g))),
-                n,
-                alpha,
-                1.0,
-            );
-            assert!(out.failures == 0);
-        }
-    }
-    // the stretched primitive, composed as the trait's default sample_d_wi
-    let t = &coarse;
-    for theta in [0.8, 2.4] {
-        let wi = dir(theta, 2.0);
+    // the last two: the stretched primitive sample_p22_11, composed as the trait's default
+    // sample_d_wi composes it
+    let mut jobs: Vec<(&str, &TabulatedSlope, f64, bool)> =
+        cases.iter().map(|&(l, t, th)| (l, t, th, false)).collect();
+    jobs.push(("12 rings, sample_p22_11", &coarse, 0.8, true));
+    jobs.push(("12 rings, sample_p22_11", &coarse, 2.4, true));
+    common::par_map(&jobs, |k, &(label, t, theta, stretched)| {
+        let mut g = rng(0x7ab + k as u64);
+        let wi = dir(theta, if stretched { 2.0 } else { 0.9 });
         let a = t.alpha_x();
         let st = Vec3::new(a * wi.x, a * wi.y, wi.z).normalize();
         let sin_t = (st.x * st.x + st.y * st.y).sqrt();
         let (c, s) = (st.x / sin_t, st.y / sin_t);
-        chi2_test(
-            &format!("sample_p22_11 θi = {theta}"),
+        let out = chi2_test(
+            &format!("tabulated {label} θi = {theta}"),
             grid,
             |m| f64::from(t.d_wi(wi, m)),
             || {
-                let p = t.sample_p22_11(st.z, sin_t, uniform32(&mut g), uniform32(&mut g));
-                let (x, y) = (a * (c * p.x - s * p.y), a * (s * p.x + c * p.y));
-                Some(Vec3::new(-x, -y, 1.0).normalize())
+                let (u1, u2) = (uniform32(&mut g), uniform32(&mut g));
+                if stretched {
+                    let p = t.sample_p22_11(st.z, sin_t, u1, u2);
+                    let (x, y) = (a * (c * p.x - s * p.y), a * (s * p.x + c * p.y));
+                    Some(Vec3::new(-x, -y, 1.0).normalize())
+                } else {
+                    Some(t.sample_d_wi(wi, u1, u2))
+                }
             },
             n,
             alpha,
             1.0,
         );
-    }
+        assert!(out.failures == 0);
+    });
+    let t = &coarse;
     // ωi = −z sees nothing: +z
     assert_eq!(t.sample_d_wi(-Vec3::Z, 0.3, 0.7), Vec3::Z);
     assert_eq!(t.d_wi(-Vec3::Z, Vec3::Z), 0.0);

@@ -211,3 +211,82 @@ fn extraction_cost() {
     println!("N = 256, 4 iterations: {:.2} ms, F0 = {:.5}", start.elapsed().as_secs_f64() * 1e3, e.f0);
     assert!(e.f0.is_finite());
 }
+
+/// Beyond the thesis: extraction from a BRDF with multiple scattering (the crate's walk on a
+/// conductor F = 1 with GGX α = 1, where single scattering keeps about 69 % of the energy at
+/// normal incidence... and the rest leaves after two or more bounces). Measured: the thesis'
+/// single-scattering inversion of the walk's backscattering, and an inversion that models
+/// multiple scattering by iterating the extraction on f_walk − (higher orders of the walk on the
+/// current estimate), each against the true GGX (F0, fitted α, max |ΔG1|, max relative P error).
+///
+/// Asserted: the single-scattering inversion is biased (its F0 exceeds 1 by more than 5σ of
+/// the data's noise: backscattered multiple scattering is read as extra specular energy), and
+/// eight rounds of the multiple-scattering-aware inversion bring F0 back within 4σ + 2e-3 of 1
+/// and the fitted α closer to the truth. Measured (4000 walks per angle, 48 angles): the
+/// single-scattering inversion gives F0 = 2.47, α = 0.63, max |ΔG1| = 0.16; rounds 1–8 of the
+/// corrected inversion give F0 = 1.57, 1.28, 1.17, 1.13, 1.11, 1.10, 1.09, 1.08 and α = 0.79,
+/// 0.86, 0.90, 0.91, 0.92, 0.935, 0.939, 0.939 (max |ΔG1| 0.021 after 8): the error halves in
+/// the first rounds, then the progress slows to a few per cent per round (not converged after
+/// eight; the per-ring P stays noisy, 30–50 % relative at θ′ ≤ 60°, from the data's noise).
+#[test]
+fn multiple_scattering_inversion() {
+    use microsurface::ScatteringOrder;
+    let alpha = 1.0f32;
+    let rings = 48;
+    let samples = 4000;
+    let ggx = Ggx::isotropic(alpha).unwrap();
+    let truth = TabulatedSlope::from_slope(&ggx, alpha, rings).unwrap();
+    let angles: Vec<f64> = (0..rings).map(|i| TabulatedSlope::ring_centre_angle(alpha, rings, i)).collect();
+    // the walk's backscattering (all orders) and its standard error, per angle; and the higher
+    // orders (all minus the exact single scattering) of the walk on a given slope
+    let backscatter = |slope: &TabulatedSlope, seed: u64| -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
+        let rows = common::par_map(&angles, |i, &theta| {
+            let o = dir(theta, 0.0);
+            let mut g = common::rng(seed + i as u64);
+            let mut st = common::Stats::default();
+            for _ in 0..samples {
+                st.push(f64::from(surface.eval(o, o, ScatteringOrder::All, &mut g).x) / f64::from(o.z));
+            }
+            let single = f64::from(surface.eval_single_scattering(o, o, &mut g).x) / f64::from(o.z);
+            (st.mean(), st.se(), st.mean() - single)
+        });
+        (
+            rows.iter().map(|r| r.0).collect(),
+            rows.iter().map(|r| r.1).collect(),
+            rows.iter().map(|r| r.2).collect(),
+        )
+    };
+    // the data: the walk on the (tabulated) truth, so that the table is the exact answer
+    let (data, data_se, _) = backscatter(&truth, 1000);
+    let summary = |label: &str, e: &microsurface::Extraction| {
+        let (p, g1) = compare(&e.slope, &ggx, &truth);
+        println!(
+            "{label}: F0 = {:.4}, fitted α = {:.4}, max |ΔG1| = {g1:.3e}, max P rel. error (θ′ ≤ 60°) = {p:.3e}",
+            e.f0,
+            e.slope.alpha()
+        );
+    };
+    let hc = BackscatterShadowing::HeightCorrelated;
+    let single = extract_isotropic(alpha, &data, 8, hc).unwrap();
+    summary("single-scattering inversion", &single);
+    // the noise of F0: the eigenvalue is a weighted mean of the data ratios; bound its SE by
+    // the largest relative SE of the data
+    let rel_se = data.iter().zip(&data_se).map(|(d, s)| s / d).fold(0.0f64, f64::max);
+    println!("largest relative SE of the data: {rel_se:.2e} ({samples} walks per angle, {rings} angles)");
+    assert!(single.f0 - 1.0 > 5.0 * rel_se, "single-scattering inversion F0 = {}", single.f0);
+    let mut estimate = single.clone();
+    for round in 1..=8 {
+        let (_, _, higher) = backscatter(&estimate.slope, 2000 * round);
+        let corrected: Vec<f64> = data.iter().zip(&higher).map(|(d, h)| (d - h).max(0.0)).collect();
+        estimate = extract_isotropic(alpha, &corrected, 8, hc).unwrap();
+        summary(&format!("multiple-scattering-aware inversion, round {round}"), &estimate);
+    }
+    assert!((estimate.f0 - 1.0).abs() <= 4.0 * rel_se + 2e-3, "corrected F0 = {}", estimate.f0);
+    assert!(
+        (estimate.slope.alpha() - alpha).abs() < (single.slope.alpha() - alpha).abs(),
+        "the corrected fit is not closer: {} vs {}",
+        estimate.slope.alpha(),
+        single.slope.alpha()
+    );
+}

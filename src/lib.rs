@@ -34,6 +34,7 @@ mod frame;
 mod fresnel;
 mod height;
 mod material;
+mod merl;
 mod microsurface;
 mod position_free;
 mod rng;
@@ -53,6 +54,7 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
 pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
+pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
 pub use microsurface::{
     HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
 };

@@ -344,8 +344,8 @@ impl TabulatedSlope {
         self.alpha
     }
 
-    /// The Beckmann roughness with the same second moment, α = √E[x̃² + ỹ²] (E[r²] = α² for
-    /// Beckmann), computed exactly from the rings: E[r²] = Σₖ pₖ π(Rₖ₊₁⁴ − Rₖ⁴)/2 (Dupuy 2015,
+    /// The Beckmann roughness with the same second moment, α = √E[x̃² + ỹ²] (E\[r²\] = α² for
+    /// Beckmann), computed exactly from the rings: E\[r²\] = Σₖ pₖ π(Rₖ₊₁⁴ − Rₖ⁴)/2 (Dupuy 2015,
     /// Listing 4.4, which converts a radial table to Beckmann roughness by its second moment).
     pub fn beckmann_alpha(&self) -> f32 {
         let m2: f64 = self

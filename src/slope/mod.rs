@@ -15,7 +15,7 @@ pub use extract::{
     BackscatterShadowing, Extraction, extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use ggx::Ggx;
-pub use tabulated::{MAX_RINGS, TabulatedSlope};
+pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
 
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};

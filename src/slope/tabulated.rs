@@ -554,7 +554,7 @@ impl TabulatedSlope {
     /// D in f64 for a normal with horizontal length `h` and height `z`.
     #[inline]
     fn d_from(&self, h: f64, z: f64) -> f64 {
-        if z.is_nan() || z <= 0.0 {
+        if z.is_nan() || z <= 0.0 || !h.is_finite() {
             return 0.0;
         }
         let Some(k) = self.ring_of(h, z) else { return 0.0 };
@@ -607,24 +607,39 @@ impl MicrosurfaceSlope for &TabulatedSlope {
         self.d64(wm.as_dvec3()) as f32
     }
 
+    /// As `d`; 0 for a non-finite normal (a debug assertion in debug builds).
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
+        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
+        if !wm.is_finite() {
+            return 0.0;
+        }
         self.d_from((wm.x * wm.x + wm.y * wm.y).sqrt(), wm.z)
     }
 
     /// B(cos θ)/cos θ above the horizon and −1 − B(|cos θ|)/|cos θ| below, B interpolated
-    /// from the table (see the type's documentation); saturates to ±`f32::MAX` at ±0.
+    /// from the table (see the type's documentation); saturates to ±`f32::MAX` at ±0. For a
+    /// NaN ω.z (invalid): 0, after a debug assertion.
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
+        debug_assert!(!w.z.is_nan(), "lambda: NaN direction {w}");
+        if w.z.is_nan() {
+            return 0.0;
+        }
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         let lambda = (b / z.abs()).min(f64::from(f32::MAX)) as f32;
         if w.z >= 0.0 { lambda } else { -1.0 - lambda }
     }
 
-    /// cos θ + B(cos θ) above the horizon, B(|cos θ|) below (B interpolated).
+    /// cos θ + B(cos θ) above the horizon, B(|cos θ|) below (B interpolated). For a NaN ω.z
+    /// (invalid): 0, after a debug assertion.
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
+        debug_assert!(!w.z.is_nan(), "projected_area: NaN direction {w}");
+        if w.z.is_nan() {
+            return 0.0;
+        }
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         (if w.z >= 0.0 { z + b } else { b }) as f32
@@ -647,9 +662,144 @@ impl MicrosurfaceSlope for &TabulatedSlope {
         }
     }
 
-    /// Exact for every ωi (see the type's documentation); +z for ωi = −z.
+    /// Exact for every ωi (see the type's documentation); +z for ωi = −z and for a
+    /// non-finite ωi (invalid, a debug assertion).
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        debug_assert!(wi.is_finite(), "sample_d_wi: non-finite direction {wi}");
+        debug_assert!(
+            (0.0..1.0).contains(&u1) && (0.0..1.0).contains(&u2),
+            "sample_d_wi: uniforms {u1}, {u2}"
+        );
+        if !wi.is_finite() {
+            return Vec3::Z;
+        }
         self.sample_normal(wi, u1, u2)
+    }
+}
+
+/// An anisotropic slope distribution made by stretching a [`TabulatedSlope`] by (sx, sy):
+/// P²²(x̃, ỹ) = P²²_table(√((x̃/sx)² + (ỹ/sy)²))/(sx sy), i.e. a tabulated profile with
+/// elliptic level sets (the way the analytic GGX and Beckmann become anisotropic; not a general
+/// 2D table).
+///
+/// Everything follows from the table by the stretch (Heitz et al. 2016, supplement §2.1):
+/// with ω_s = (sx ω.x, sy ω.y, ω.z), Λ(ω) = Λ_table(ω_s/‖ω_s‖) and the projected area is
+/// ‖ω_s‖·area_table(ω_s/‖ω_s‖); visible normals are sampled exactly by sampling the table's
+/// visible slopes from ω_s/‖ω_s‖ and scaling them by (sx, sy), since
+/// (ω.z − x̃ω.x − ỹω.y)₊ dx̃ dỹ becomes ‖ω_s‖(ŝ.z − uŝ.x − vŝ.y)₊ du dv. `alpha_x` and
+/// `alpha_y` report sx·α and sy·α (α = [`TabulatedSlope::alpha`]).
+#[derive(Debug, Clone, Copy)]
+pub struct StretchedTabulated<'a> {
+    table: &'a TabulatedSlope,
+    sx: f32,
+    sy: f32,
+}
+
+impl TabulatedSlope {
+    /// The table stretched by (`sx`, `sy`) into an anisotropic distribution.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if `sx` or `sy` is not finite and > 0.
+    pub fn stretched(&self, sx: f32, sy: f32) -> Result<StretchedTabulated<'_>, Error> {
+        Ok(StretchedTabulated {
+            table: self,
+            sx: Error::check_positive("sx", sx)?,
+            sy: Error::check_positive("sy", sy)?,
+        })
+    }
+}
+
+impl StretchedTabulated<'_> {
+    /// ω_s/‖ω_s‖ and ‖ω_s‖ for ω_s = (sx ω.x, sy ω.y, ω.z), in f64.
+    #[inline]
+    fn stretch(&self, w: Vec3) -> (Vec3, f64) {
+        let s = DVec3::new(
+            f64::from(self.sx) * f64::from(w.x),
+            f64::from(self.sy) * f64::from(w.y),
+            f64::from(w.z),
+        );
+        let len = s.length();
+        if len.is_nan() || len <= 0.0 {
+            return (Vec3::Z, 0.0);
+        }
+        ((s / len).as_vec3(), len)
+    }
+}
+
+impl MicrosurfaceSlope for StretchedTabulated<'_> {
+    #[inline]
+    fn alpha_x(&self) -> f32 {
+        self.sx * self.table.alpha
+    }
+
+    #[inline]
+    fn alpha_y(&self) -> f32 {
+        self.sy * self.table.alpha
+    }
+
+    #[inline]
+    fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
+        let (x, y) = (f64::from(slope_x) / f64::from(self.sx), f64::from(slope_y) / f64::from(self.sy));
+        (self.table.p22_radial((x * x + y * y).sqrt()) / (f64::from(self.sx) * f64::from(self.sy))) as f32
+    }
+
+    #[inline]
+    fn d(&self, wm: Vec3) -> f32 {
+        self.d64(wm.as_dvec3()) as f32
+    }
+
+    /// P²²(x̃, ỹ)/cos⁴θm in f64; 0 for ωm.z ≤ 0, beyond the table and for a non-finite normal
+    /// (a debug assertion).
+    #[inline]
+    fn d64(&self, wm: DVec3) -> f64 {
+        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
+        if !wm.is_finite() || wm.z <= 0.0 {
+            return 0.0;
+        }
+        let (sx, sy) = (f64::from(self.sx), f64::from(self.sy));
+        // the stretched normal (m.x/sx, m.y/sy, m.z) has the stretched slopes; D transforms
+        // with cos⁴: D(m) = D_table(m′) (cos θm′/cos θm)⁴ /(sx sy) for unit m, m′
+        let m = DVec3::new(wm.x / sx, wm.y / sy, wm.z);
+        let (lm, lw) = (m.length(), wm.length());
+        let d_table = self.table.d_from((m.x * m.x + m.y * m.y).sqrt(), m.z);
+        let ratio = (m.z / lm) / (wm.z / lw);
+        d_table * ratio.powi(4) / (sx * sy)
+    }
+
+    #[inline]
+    fn lambda(&self, w: Vec3) -> f32 {
+        let (s, _) = self.stretch(w);
+        (&self.table).lambda(s)
+    }
+
+    #[inline]
+    fn projected_area(&self, w: Vec3) -> f32 {
+        let (s, len) = self.stretch(w);
+        (len * f64::from((&self.table).projected_area(s))) as f32
+    }
+
+    /// The table's `sample_p22_11` (the stretched space of α = 1 is the same).
+    #[inline]
+    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        (&self.table).sample_p22_11(cos_theta, sin_theta, u1, u2)
+    }
+
+    /// Exact for every ωi: the table's visible slopes from ω_s/‖ω_s‖, scaled by (sx, sy); +z
+    /// for ωi = −z and for a non-finite ωi (a debug assertion).
+    #[inline]
+    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        debug_assert!(wi.is_finite(), "sample_d_wi: non-finite direction {wi}");
+        if !wi.is_finite() {
+            return Vec3::Z;
+        }
+        let (s, len) = self.stretch(wi);
+        if len <= 0.0 {
+            return Vec3::Z;
+        }
+        let m = (&self.table).sample_d_wi(s, u1, u2);
+        // the table's normal m ∝ (−u, −v, 1): the slopes scale by (sx, sy)
+        let stretched = Vec3::new(m.x * self.sx, m.y * self.sy, m.z);
+        ensure_visible(wi, super::normalize_scaled(stretched, Vec3::Z))
     }
 }

@@ -7,6 +7,7 @@
 mod beckmann;
 mod extract;
 mod ggx;
+mod grid;
 mod tabulated;
 
 pub use beckmann::Beckmann;
@@ -15,6 +16,7 @@ pub use extract::{
     BackscatterShadowing, Extraction, extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use ggx::Ggx;
+pub use grid::GridSlope;
 pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
 
 use crate::error::Error;

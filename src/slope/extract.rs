@@ -2,6 +2,7 @@
 //! thesis §4.2: the backscattering eigenproblem solved by power iteration, Algorithms 1–3).
 
 use super::MicrosurfaceSlope;
+use super::grid::{GridSlope, boundaries};
 use super::tabulated::{TabulatedSlope, check_ring_count, disk_area};
 use crate::error::Error;
 use core::f64::consts::PI;
@@ -99,35 +100,7 @@ pub fn extract_isotropic(
             kernel[i * n + j] = row_scale * entry;
         }
     }
-    let multiply = |p: &[f64], out: &mut [f64]| {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = kernel[i * n..(i + 1) * n].iter().zip(p).map(|(k, p)| k * p).sum();
-        }
-    };
-    let mut p = vec![1.0f64; n];
-    let mut kp = vec![0.0f64; n];
-    let mut residuals = Vec::with_capacity(iterations);
-    let mut lambda = 0.0;
-    for _ in 0..iterations {
-        multiply(&p, &mut kp);
-        let norm = kp.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if norm.is_nan() || norm <= 0.0 || norm.is_infinite() {
-            return Err(Error::InvalidParameter {
-                name: "total mass",
-                value: norm as f32,
-                expected: "finite and > 0 (backscattering data with some energy)",
-            });
-        }
-        for (pi, k) in p.iter_mut().zip(&kp) {
-            *pi = k / norm;
-        }
-        // the Rayleigh quotient and the residual of the new (unit) iterate
-        multiply(&p, &mut kp);
-        lambda = p.iter().zip(&kp).map(|(a, b)| a * b).sum::<f64>();
-        let kp_norm = kp.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let res = p.iter().zip(&kp).map(|(a, b)| (b - lambda * a).powi(2)).sum::<f64>().sqrt();
-        residuals.push(if kp_norm > 0.0 { res / kp_norm } else { 0.0 });
-    }
+    let (p, lambda, residuals) = power_iteration(&kernel, n, iterations)?;
     let slope = TabulatedSlope::from_ring_values(scale, p, None)?;
     Ok(Extraction { slope, f0: lambda, residuals })
 }
@@ -212,4 +185,168 @@ pub fn extract_fresnel(
             (count > 0).then(|| sum / count as f64)
         })
         .collect()
+}
+
+/// ∫∫ over [x0, x1] × [y0, y1] of (ω.z − x̃ω.x − ỹω.y)₊ (`absolute` = false) or of its absolute
+/// value: for fixed ỹ the x̃ integral is a closed form, a quadratic in ỹ between the ỹ where the
+/// zero line crosses x = x0 or x = x1, integrated exactly by Simpson's rule on each piece.
+fn cell_weight(w: DVec3, x0: f64, x1: f64, y0: f64, y1: f64, absolute: bool) -> f64 {
+    let row = |y: f64| -> f64 {
+        let c = w.z - y * w.y;
+        // ∫_{x0}^{x1} (c − x ω.x)₊ dx (and the same of the negative part)
+        let lin = |x: f64| c * x - 0.5 * w.x * x * x;
+        let full = lin(x1) - lin(x0);
+        if w.x == 0.0 {
+            return if absolute { full.abs() } else { full.max(0.0) };
+        }
+        let t = (c / w.x).clamp(x0, x1);
+        let (left, right) = (lin(t) - lin(x0), lin(x1) - lin(t));
+        // the positive part lies left of t when ω.x > 0, right of it otherwise
+        let (pos, neg) = if w.x > 0.0 { (left, -right) } else { (right, -left) };
+        if absolute { pos.max(0.0) + neg.max(0.0) } else { pos.max(0.0) }
+    };
+    let mut cuts = [y0, y1, y1, y1];
+    if w.y != 0.0 {
+        for (k, x) in [x0, x1].into_iter().enumerate() {
+            let y = (w.z - x * w.x) / w.y;
+            cuts[k + 1] = if y > y0 && y < y1 { y } else { y1 };
+        }
+    }
+    cuts[1..3].sort_by(f64::total_cmp);
+    let mut total = 0.0;
+    for k in 0..3 {
+        let (a, b) = (cuts[k], cuts[k + 1]);
+        if b > a {
+            total += (b - a) / 6.0 * (row(a) + 4.0 * row(0.5 * (a + b)) + row(b));
+        }
+    }
+    total
+}
+
+/// The result of [`extract_anisotropic`].
+#[derive(Debug, Clone)]
+pub struct GridExtraction {
+    /// The extracted slope distribution (normalized).
+    pub slope: GridSlope,
+    /// The Perron eigenvalue λ = F0.
+    pub f0: f64,
+    /// The relative residual after each power iteration (as [`Extraction::residuals`]).
+    pub residuals: Vec<f64>,
+}
+
+/// Extracts an anisotropic slope distribution on the 2D grid of [`GridSlope`] from
+/// backscattering samples by power iteration (Dupuy 2015, §4.2, eqs. 4.5–4.9 and Algorithm 1).
+///
+/// `backscatter[k]` is f_r(oₖ, oₖ) at the direction oₖ =
+/// [`GridSlope::cell_centre_direction`]`(scale_x, scale_y, half_cells, i, j)`, k = j·2N + i.
+/// The kernel is collocated at the cell centres with the cell integrals done exactly:
+/// Kₖₗ = 4 f_r(oₖ, oₖ) cos⁵θₖ ∫_cell l (oₖ.z − x̃oₖ.x − ỹoₖ.y)₊ dx̃ dỹ (monostatic G1) or with
+/// |·| (height-correlated G2), as [`extract_isotropic`]. Cost: (2N)⁴ kernel entries.
+///
+/// # Errors
+/// As [`extract_isotropic`], with `values.len()` ≠ (2N)² also an error, and N above 64.
+pub fn extract_anisotropic(
+    scale_x: f32,
+    scale_y: f32,
+    half_cells: usize,
+    backscatter: &[f64],
+    iterations: usize,
+    shadowing: BackscatterShadowing,
+) -> Result<GridExtraction, Error> {
+    let sx = f64::from(Error::check_positive("scale_x", scale_x)?);
+    let sy = f64::from(Error::check_positive("scale_y", scale_y)?);
+    check_ring_count(half_cells)?;
+    let m = 2 * half_cells;
+    if half_cells > 64 || backscatter.len() != m * m {
+        return Err(Error::InvalidParameter {
+            name: "values.len()",
+            value: backscatter.len() as f32,
+            expected: "(2·half_cells)², half_cells ≤ 64",
+        });
+    }
+    if iterations == 0 {
+        return Err(Error::InvalidParameter { name: "iterations", value: 0.0, expected: "at least 1" });
+    }
+    if let Some(&bad) = backscatter.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+        return Err(Error::InvalidParameter {
+            name: "backscatter[i]",
+            value: bad as f32,
+            expected: "finite and >= 0",
+        });
+    }
+    let (xs, ys) = (boundaries(sx, half_cells), boundaries(sy, half_cells));
+    let n = m * m;
+    let absolute = shadowing == BackscatterShadowing::HeightCorrelated;
+    let mut kernel = vec![0.0f64; n * n];
+    for k in 0..n {
+        let (i, j) = (k % m, k / m);
+        let o = GridSlope::cell_centre_direction(scale_x, scale_y, half_cells, i, j).as_dvec3().normalize();
+        let row_scale = 4.0 * backscatter[k] * o.z.powi(5);
+        if row_scale == 0.0 {
+            continue;
+        }
+        for l in 0..n {
+            let (a, b) = (l % m, l / m);
+            kernel[k * n + l] = row_scale * cell_weight(o, xs[a], xs[a + 1], ys[b], ys[b + 1], absolute);
+        }
+    }
+    let (p, lambda, residuals) = power_iteration(&kernel, n, iterations)?;
+    let slope = GridSlope::from_p22(scale_x, scale_y, half_cells, &p)?;
+    Ok(GridExtraction { slope, f0: lambda, residuals })
+}
+
+/// [`extract_anisotropic`] from a backscattering function `f_r(o)` (the BRDF at ωi = ωo = o).
+///
+/// # Errors
+/// As [`extract_anisotropic`].
+pub fn extract_anisotropic_fn(
+    scale_x: f32,
+    scale_y: f32,
+    half_cells: usize,
+    iterations: usize,
+    shadowing: BackscatterShadowing,
+    backscatter: impl Fn(Vec3) -> f64,
+) -> Result<GridExtraction, Error> {
+    Error::check_positive("scale_x", scale_x)?;
+    Error::check_positive("scale_y", scale_y)?;
+    check_ring_count(half_cells)?;
+    let m = 2 * half_cells;
+    let values: Vec<f64> = (0..m * m)
+        .map(|k| backscatter(GridSlope::cell_centre_direction(scale_x, scale_y, half_cells, k % m, k / m)))
+        .collect();
+    extract_anisotropic(scale_x, scale_y, half_cells, &values, iterations, shadowing)
+}
+
+/// Power iteration from (1, …, 1): the normalized iterate, its Rayleigh quotient and the
+/// relative residual after each multiplication.
+fn power_iteration(kernel: &[f64], n: usize, iterations: usize) -> Result<(Vec<f64>, f64, Vec<f64>), Error> {
+    let multiply = |p: &[f64], out: &mut [f64]| {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = kernel[i * n..(i + 1) * n].iter().zip(p).map(|(k, p)| k * p).sum();
+        }
+    };
+    let mut p = vec![1.0f64; n];
+    let mut kp = vec![0.0f64; n];
+    let mut residuals = Vec::with_capacity(iterations);
+    let mut lambda = 0.0;
+    for _ in 0..iterations {
+        multiply(&p, &mut kp);
+        let norm = kp.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if norm.is_nan() || norm <= 0.0 || norm.is_infinite() {
+            return Err(Error::InvalidParameter {
+                name: "total mass",
+                value: norm as f32,
+                expected: "finite and > 0 (backscattering data with some energy)",
+            });
+        }
+        for (pi, k) in p.iter_mut().zip(&kp) {
+            *pi = k / norm;
+        }
+        multiply(&p, &mut kp);
+        lambda = p.iter().zip(&kp).map(|(a, b)| a * b).sum::<f64>();
+        let kp_norm = kp.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let res = p.iter().zip(&kp).map(|(a, b)| (b - lambda * a).powi(2)).sum::<f64>().sqrt();
+        residuals.push(if kp_norm > 0.0 { res / kp_norm } else { 0.0 });
+    }
+    Ok((p, lambda, residuals))
 }

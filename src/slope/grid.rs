@@ -71,7 +71,7 @@ impl core::fmt::Debug for GridSlope {
 }
 
 /// The symmetric boundaries ±s·tan θ′ₖ of a grid with N cells per half axis.
-fn boundaries(scale: f64, n: usize) -> Vec<f64> {
+pub(super) fn boundaries(scale: f64, n: usize) -> Vec<f64> {
     let half: Vec<f64> =
         (0..=n).map(|k| if k == 0 { 0.0 } else { scale * grid_angle(k as f64, n).tan() }).collect();
     half.iter().rev().map(|v| -v).chain(half[1..].iter().copied()).collect()
@@ -238,6 +238,25 @@ impl GridSlope {
             }
         }
         Self::from_p22(scale_x, scale_y, half_cells, &values)
+    }
+
+    /// The backscattering direction of the centre of cell (column `i`, row `j`) of the grid of
+    /// `half_cells` per half axis: the unit normal whose slopes are the cell centre (in the
+    /// stretched angles, as the ring centres of [`super::TabulatedSlope`]), where
+    /// [`crate::extract_anisotropic`] collocates its samples. Cell k = j·2N + i.
+    pub fn cell_centre_direction(scale_x: f32, scale_y: f32, half_cells: usize, i: usize, j: usize) -> Vec3 {
+        let n = half_cells;
+        // the centre of the cell in the stretched angle (wide tail cells are collocated where
+        // their angular extent is halved, not at their slope midpoint)
+        let centre = |k: usize, s: f64| {
+            if k >= n {
+                s * grid_angle((k - n) as f64 + 0.5, n).tan()
+            } else {
+                -s * grid_angle((n - 1 - k) as f64 + 0.5, n).tan()
+            }
+        };
+        let (x, y) = (centre(i, f64::from(scale_x)), centre(j, f64::from(scale_y)));
+        DVec3::new(-x, -y, 1.0).normalize().as_vec3()
     }
 
     /// S0 and S1 of row j at t: ∫_{x<t} P and ∫_{x<t} xP along the row.

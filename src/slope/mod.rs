@@ -13,7 +13,8 @@ mod tabulated;
 pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
 pub use extract::{
-    BackscatterShadowing, Extraction, extract_fresnel, extract_isotropic, extract_isotropic_fn,
+    BackscatterShadowing, Extraction, GridExtraction, extract_anisotropic, extract_anisotropic_fn,
+    extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use ggx::Ggx;
 pub use grid::GridSlope;

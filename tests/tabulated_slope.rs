@@ -567,3 +567,32 @@ fn stretched_anisotropic() {
     }
     assert_mean("stretched white furnace", &stats, 1.0, family_z(1e-3, 1), 1e-2, 0.0);
 }
+
+/// White furnace of the dielectric walk (η = 1.5, no absorption) on the two-lobe mixture:
+/// reflection plus transmission integrate to 1, estimated with ωo cosine-distributed in a
+/// hemisphere chosen with probability ½.
+#[test]
+fn dielectric_white_furnace_on_mixture() {
+    let t = mixture(64);
+    let surface = Microsurface::new(UniformHeight, &t, Dielectric::new(1.5).unwrap());
+    let thetas = [0.4, 1.2];
+    let z = family_z(1e-3, thetas.len());
+    let mut g = rng(21);
+    for theta in thetas {
+        let wi = dir(theta, 0.3);
+        let mut stats = Stats::default();
+        for _ in 0..1_000_000 {
+            let mut wo = microsurface::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
+            if uniform32(&mut g) < 0.5 {
+                wo.z = -wo.z;
+            }
+            let pdf = 0.5 * f64::from(wo.z.abs()) / PI;
+            stats.push(if pdf > 0.0 {
+                f64::from(surface.eval(wi, wo, ScatteringOrder::All, &mut g).x) / pdf
+            } else {
+                0.0
+            });
+        }
+        assert_mean(&format!("dielectric white furnace θi = {theta}"), &stats, 1.0, z, 1e-2, 0.0);
+    }
+}

@@ -12,6 +12,8 @@ use glam::{DVec3, Vec2, Vec3};
 const AREA_U: usize = 512;
 /// Intervals of the back-face area table over φ ∈ [0, 2π).
 const AREA_PHI: usize = 128;
+/// The most rows a grid has (2 × the largest `half_cells`, 512).
+const MAX_ROWS: usize = 1024;
 /// Newton–bisection tolerance (relative to the interval) and iteration cap of the sampler.
 const SOLVE_TOLERANCE: f64 = 1e-13;
 const SOLVE_ITERATIONS: usize = 100;
@@ -377,8 +379,13 @@ impl GridSlope {
     /// Samples visible slopes exactly for a unit ω; `None` if ω sees nothing.
     fn sample_slopes(&self, w: DVec3, u1: f64, u2: f64) -> Option<(f64, f64)> {
         let m = self.ys.len() - 1;
-        // first pass: the total
-        let total = self.area(w);
+        // first pass: the row masses (on the stack: at most MAX_ROWS rows) and the total
+        let mut masses = [0.0f64; MAX_ROWS];
+        let mut total = 0.0;
+        for (j, mass) in masses.iter_mut().enumerate().take(m) {
+            *mass = self.row_mass(j, w, self.ys[j], self.ys[j + 1]);
+            total += *mass;
+        }
         if total.is_nan() || total <= 0.0 {
             return None;
         }
@@ -387,8 +394,7 @@ impl GridSlope {
         let mut acc = 0.0;
         let mut chosen = None;
         let mut last = None;
-        for j in 0..m {
-            let mass = self.row_mass(j, w, self.ys[j], self.ys[j + 1]);
+        for (j, &mass) in masses.iter().enumerate().take(m) {
             if mass > 0.0 {
                 last = Some(j);
                 if target < acc + mass {
@@ -400,7 +406,7 @@ impl GridSlope {
         }
         let (j, rest) = chosen.or_else(|| last.map(|j| (j, f64::INFINITY)))?;
         let (y0, y1) = (self.ys[j], self.ys[j + 1]);
-        let row_total = self.row_mass(j, w, y0, y1);
+        let row_total = masses[j];
         let rest = rest.min(row_total);
         // the piece of the row holding the target, then Newton on the cubic CDF in it
         let mut acc = 0.0;

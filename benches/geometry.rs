@@ -15,7 +15,8 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::{
-    Beckmann, GaussianHeight, Ggx, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, UniformHeight,
+    Beckmann, GaussianHeight, Ggx, GridSlope, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope,
+    TabulatedSlope, UniformHeight,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -142,6 +143,21 @@ fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion<Clock>, name: &str, make:
 fn slopes(c: &mut Criterion<Clock>) {
     bench_slope(c, "ggx", |a| Ggx::isotropic(a).expect("valid roughness"));
     bench_slope(c, "beckmann", |a| Beckmann::isotropic(a).expect("valid roughness"));
+    // GGX tabulated on 256 rings at s = α (the table size of tests/tabulated_slope.rs); the
+    // tables are leaked: the trait is implemented for `&TabulatedSlope`
+    bench_slope(c, "tabulated_ggx256", |a| {
+        let ggx = Ggx::isotropic(a).expect("valid roughness");
+        &*Box::leak(Box::new(TabulatedSlope::from_slope(&ggx, a, 256).expect("valid table")))
+    });
+    // GGX on a 2D grid of 2 × 32 cells per axis
+    bench_slope(c, "grid_ggx32", |a| {
+        let a64 = f64::from(a);
+        let ggx = move |x: f64, y: f64| {
+            let t = 1.0 + (x * x + y * y) / (a64 * a64);
+            1.0 / (core::f64::consts::PI * a64 * a64 * t * t)
+        };
+        &*Box::leak(Box::new(GridSlope::from_fn(a, a, 32, ggx).expect("valid table")))
+    });
 }
 
 /// `sample_height` at α = 0.5: a ray arriving from above the surface (h0 = +∞, θ = 2.2 below

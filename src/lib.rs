@@ -114,6 +114,7 @@ mod frame;
 mod fresnel;
 mod height;
 mod material;
+mod merl;
 mod microsurface;
 mod position_free;
 mod rng;
@@ -136,13 +137,18 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
 pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
+pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
 pub use microsurface::{
     HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
 };
 pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
-pub use slope::{Beckmann, Ggx, MicrosurfaceSlope};
+pub use slope::{
+    BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
+    StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,
+    extract_isotropic, extract_isotropic_fn,
+};
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{
     BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,

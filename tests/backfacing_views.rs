@@ -583,9 +583,9 @@ fn bsdf_white_furnace_with_tilted_shading_normals() {
                 let s =
                     b.sample(wo, uniform32(&mut rng), Vec2::new(uniform32(&mut rng), uniform32(&mut rng)));
                 let s = s.unwrap_or_else(|| panic!("{label}: no sample for a backfacing view"));
-                // (the flags follow their documented shading-frame convention: wi on the other
-                // side of the shading plane than wo reads `transmission`)
                 assert!(s.wi.z > 0.0, "{label}: sample {s:?} below the shading hemisphere");
+                // light does not cross an opaque surface: a reflection, whatever the shading frame
+                assert!(s.flags.reflection && !s.flags.transmission && s.eta == 1.0, "{label}: {s:?}");
                 assert!((s.weight - Vec3::ONE).abs().max_element() < 1e-6, "{label}: weight {}", s.weight);
                 assert!(s.pdf > 0.0 && s.pdf.is_finite(), "{label}: pdf {}", s.pdf);
                 single_stats.push(b_weight(single.sample(

@@ -222,7 +222,9 @@ fn weight_stats<B: Bsdf>(
                     s.wi
                 );
                 assert!((s.pdf - p).abs() <= 1e-5 * p, "{label}: sample pdf {} ≠ pdf() {p}", s.pdf);
-                let reflection = (s.wi.z > 0.0) == (wo.z > 0.0);
+                // an opaque BSDF reflects even where a normal map puts wi and wo on opposite
+                // sides of the shading plane
+                let reflection = !b.flags().transmission || (s.wi.z > 0.0) == (wo.z > 0.0);
                 assert_eq!(
                     s.flags.reflection, reflection,
                     "{label}: flags {:?} for wo {wo} wi {}",

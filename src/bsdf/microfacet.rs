@@ -54,11 +54,14 @@ pub enum Technique {
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
-    /// weights, approximate pdf.
+    /// weights, approximate pdf. Valid for backfacing views of opaque materials (normal
+    /// mapping): the walk starts with the full-spherical first intersection
+    /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there.
     #[default]
     RandomWalk,
     /// The position-free estimators of Wang et al. 2022: stochastic eval, exact sample
-    /// weights, approximate pdf.
+    /// weights, approximate pdf. Valid for backfacing views of opaque materials, whose first
+    /// vertex is a vertex reached from below (DESIGN.md).
     PositionFree {
         /// PT or BDPT.
         estimator: Estimator,
@@ -413,7 +416,9 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         if f_max < f64::from(f32::MIN_POSITIVE) {
             return None;
         }
-        let reflection = (wi.z > 0.0) == (wo.z > 0.0);
+        // light never crosses an opaque surface: under a normal map wo and wi may lie on
+        // opposite sides of the shading plane, and that is still a reflection
+        let reflection = !M::TRANSMITS || (wi.z > 0.0) == (wo.z > 0.0);
         let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf };
         Some(BsdfSample { wi, weight, pdf, eta: self.relative_eta(wo, wi), flags })
     }

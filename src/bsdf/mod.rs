@@ -68,9 +68,11 @@ impl BsdfFlags {
 /// What kind of scattering a sample represents.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SampleFlags {
-    /// `wi` is on the same side of the surface as `wo`.
+    /// The light did not cross the surface: `wi` is on the same side of the shading plane as
+    /// `wo`, or the material is opaque (under a normal map a reflection off an opaque surface
+    /// can leave `wi` and `wo` on opposite sides of the shading plane).
     pub reflection: bool,
-    /// `wi` crossed the surface.
+    /// `wi` crossed the surface of a transmissive material.
     pub transmission: bool,
     /// The sample comes from a Dirac lobe: `pdf` is the discrete probability of the event
     /// (not a density), and `eval`/`pdf` at `wi` are 0. Skip MIS for such a bounce.

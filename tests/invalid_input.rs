@@ -391,6 +391,15 @@ fn check_vcavity_slope<S: VCavitySlope>(r: &mut Report, name: &str, s: S) {
             || s.projected_branch_probability(b),
             nan64,
         );
+        // defined for backfacing directions (and the horizon) only: above it, the nothing
+        // (the Beckmann form evaluated erfcx outside its domain and panicked there)
+        for above in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8)] {
+            r.expect_nothing(
+                &format!("{name}: projected_branch_probability({above})"),
+                || s.projected_branch_probability(above),
+                nan64,
+            );
+        }
         r.expect_nothing(&format!("{l}: ln_d"), || s.ln_d(b), |x| *x == f64::NEG_INFINITY);
         r.expect_nothing(&format!("{l}: masking(bad, good)"), || vc.masking(b, good()), nan32);
         r.expect_nothing(&format!("{l}: masking(good, bad)"), || vc.masking(good(), b), nan32);

@@ -46,8 +46,12 @@ pub trait VCavitySlope: MicrosurfaceSlope {
 
     /// For a backfacing i: the probability 2 ∫_{x<3cotθ} P2 / H(i) of the branch that samples
     /// D(m) m.z below the boundary slope (Tokuyoshi, eq. 5), in [0, 1].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction, or
+    /// is above the horizon (wi.z > 0, where the sampler has no such branch), gives NaN (a debug
+    /// assertion in debug builds).
     fn projected_branch_probability(&self, wi: Vec3) -> f64 {
-        require!(is_direction(wi), f64::NAN; wi);
+        require!(is_direction(wi) && wi.z <= 0.0, f64::NAN; wi);
         let boundary = Vec3::new(wi.x, wi.y, BOUNDARY_SLOPE_FACTOR * wi.z);
         let h = self.hit_probability(wi);
         if h <= 0.0 {
@@ -198,7 +202,8 @@ impl VCavitySlope for Beckmann {
 
     /// erfc(3w)/H(i) in log space: −9w² + ln erfcx(3w) − ln H.
     fn projected_branch_probability(&self, wi: Vec3) -> f64 {
-        require!(is_direction(wi), f64::NAN; wi);
+        // w = −v.z/√q ≥ 0 on and below the horizon: erfcx64 is evaluated on its domain u ≥ 0
+        require!(is_direction(wi) && wi.z <= 0.0, f64::NAN; wi);
         let v = stretch64(self, wi);
         let q = v.x * v.x + v.y * v.y;
         if q == 0.0 {

@@ -224,6 +224,44 @@ fn near_index_matched_dielectrics_terminate() {
 /// η = 1 exactly is transparent: every walk leaves along −ωi with weight 1 as one event, also
 /// at cos θi = 1e-8 where walking the ~Λ(ωi) = 5e7 crossings would reach any cap, and the BSDF
 /// (a Dirac) evaluates to 0.
+/// The position-free walk on nearly index-matched dielectrics at grazing incidence: its
+/// paths grow as |η − 1| → 0 (see `PositionFree::sample`), but down to |η − 1| = 1e-5 none of
+/// `N` walks per configuration may reach the cap (Clopper–Pearson bound below 1 %, Šidák over
+/// the configurations), for both shadowing models; nor at η = 1 ± 1.2e-7 away from grazing
+/// (cos θi = 0.1).
+#[test]
+fn position_free_near_index_matched_dielectrics_terminate() {
+    use microsurface::{PositionFree, Shadowing};
+    const N: usize = 1_000;
+    const BOUND: f64 = 1e-2;
+    let mut cases: Vec<(Shadowing, f32, f32)> = Vec::new();
+    for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
+        for eta in [1.0 + 1e-5, 1.0 - 1e-5, 1.0 + 1e-4, 1.0 - 1e-4] {
+            for cos in [1e-3, 1e-2] {
+                cases.push((shadowing, eta, cos));
+            }
+        }
+        // within f32 ulps of 1 the grazing paths are lost (documented); away from grazing not
+        for eta in [1.0 + 1.2e-7, 1.0 - 1.2e-7] {
+            cases.push((shadowing, eta, 0.1));
+        }
+    }
+    let level = common::sidak(0.01, cases.len());
+    let results = common::par_map(&cases, |k, &(shadowing, eta, cos)| {
+        let mut rng = common::rng(9300 + k as u64);
+        let wi = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+        let pf = PositionFree::new(Ggx::isotropic(1.0).unwrap(), Dielectric::new(eta).unwrap(), shadowing);
+        (0..N).filter(|_| pf.sample(wi, &mut rng).is_none()).count()
+    });
+    for (&(shadowing, eta, cos), &capped) in cases.iter().zip(&results) {
+        let bound = upper_bound(capped, N, level);
+        assert!(
+            bound < BOUND,
+            "{shadowing:?} η = {eta}, cos θi = {cos}: {capped} of {N} lost, bound {bound:.2e}"
+        );
+    }
+}
+
 #[test]
 fn index_matched_dielectric_is_transparent() {
     use microsurface::{Estimator, PositionFree, ScatteringOrder, Shadowing};

@@ -175,6 +175,17 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// the material (on the horizon, or at the nadir of an opaque material, where no facet
     /// faces it), or the walk reached [`crate::MAX_BOUNCES`].
     ///
+    /// Nearly index-matched dielectrics at grazing incidence: a refraction through an
+    /// interface with η ≈ 1 barely turns the ray, and this model's exit probability per vertex
+    /// then falls to about 2^−Λ (it forgets the height a vertex was reached at, which the
+    /// height-tracing walk keeps), so its paths grow as |η − 1| → 0. Measured for GGX α = 1
+    /// with correlated shadowing: mean path lengths of 150 (|η − 1| = 1e-3), 1 100 (1e-4),
+    /// 8 500 (1e-5) and 36 000 bounces (2e-6, 3.5 ms per sample) at cos θi = 1e-3, none
+    /// capped; within one or two f32 ulps of 1 (η = 1 ± 1.2e-7) 98–100 % of such paths reach
+    /// [`crate::MAX_BOUNCES`] and are lost, at 6 ms each (at cos θi = 0.1 none is). η = 1
+    /// itself is transparent ([`crate::Material::is_transparent`]). `tests/walk_cap.rs` checks
+    /// the no-loss range down to |η − 1| = 1e-5.
+    ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {

@@ -23,7 +23,10 @@ const TABULATED_ORDERS: usize = 8;
 /// `flags().specular` is set. The lobes of α < 10⁻³ are narrower than 0.06° and the energy
 /// of the higher orders vanishes with α, so the Dirac lobe is the limit every technique
 /// converges to; a density that narrow is useless to an integrator (NEE and MIS never hit
-/// it) and f32 cannot resolve it. Diffuse facets have no specular limit and are unaffected.
+/// it). Diffuse facets have no specular limit and are unaffected. One exception: an opaque
+/// surface seen from below its shading hemisphere (a normal map) sees only the tails of its
+/// distribution, whose lobe does not shrink to a direction as α → 0; those views keep the
+/// rough technique at every roughness.
 pub const SMOOTH_ALPHA: f32 = 1e-3;
 
 /// The largest roughness [`MicrofacetBsdf::new`] accepts: max(αx, αy) ≤ 10.
@@ -56,12 +59,16 @@ pub enum Technique {
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
     /// weights, approximate pdf. Valid for backfacing views of opaque materials (normal
     /// mapping): the walk starts with the full-spherical first intersection
-    /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there.
+    /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there, except
+    /// for smooth Beckmann surfaces seen from well below (|cot θo|/α ≳ 9.6), where the walk's
+    /// f32 Λ underflows and it returns nothing (see `Microsurface::eval_from_below`).
     #[default]
     RandomWalk,
     /// The position-free estimators of Wang et al. 2022: stochastic eval, exact sample
     /// weights, approximate pdf. Valid for backfacing views of opaque materials, whose first
-    /// vertex is a vertex reached from below (DESIGN.md).
+    /// vertex is a vertex reached from below (DESIGN.md); for Beckmann seen from so far below
+    /// that Λ underflows f64 (|cot θo|/α ≳ 26.6) `sample` returns nothing and eval keeps only
+    /// the first order.
     PositionFree {
         /// PT or BDPT.
         estimator: Estimator,
@@ -224,6 +231,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 
     /// Whether the BSDF is a Dirac lobe (effectively smooth, or an index-matched dielectric).
+    /// An effectively smooth opaque BSDF seen from below its shading hemisphere (a normal map)
+    /// still answers with its rough lobe, which does not shrink to a direction as α → 0.
     pub fn is_specular(&self) -> bool {
         self.specular
     }
@@ -255,10 +264,20 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         }
     }
 
-    /// Whether `eval` is exact (not a stochastic estimate).
+    /// Whether the Dirac lobe answers for the view `wo`: for an effectively smooth BSDF,
+    /// except an opaque one seen from below the shading hemisphere (a normal map), whose
+    /// visible facets are the tails of the distribution: that lobe does not shrink to a
+    /// direction as α → 0 (GGX gold at θo = 100°: walk albedo 0.942 at α = 1.01e-3), so the
+    /// rough technique serves it at every roughness.
     #[inline(always)]
-    fn exact_eval(&self) -> bool {
-        self.specular || (self.technique == Technique::SingleScattering && M::EXACT_PHASE_PDF)
+    fn dirac(&self, wo: Vec3) -> bool {
+        self.specular && (M::TRANSMITS || wo.z > 0.0)
+    }
+
+    /// Whether `eval` is exact (not a stochastic estimate) for the view `wo`.
+    #[inline(always)]
+    fn exact_eval(&self, wo: Vec3) -> bool {
+        self.dirac(wo) || (self.technique == Technique::SingleScattering && M::EXACT_PHASE_PDF)
     }
 
     /// The energy per scattering order for the view direction `wo`, from `walks` sampled
@@ -357,8 +376,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        let exact = self.exact_eval();
-        if !valid_direction(wo) || !valid_direction(wi) || wi.z == 0.0 || self.specular {
+        let exact = self.exact_eval(wo);
+        if !valid_direction(wo) || !valid_direction(wi) || wi.z == 0.0 || self.dirac(wo) {
             return BsdfValue { f: Vec3::ZERO, exact };
         }
         BsdfValue { f: self.f_checked(wo, wi, key), exact }
@@ -369,7 +388,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         if !valid_direction(wo) || !valid_uniforms(uc, u) {
             return None;
         }
-        if self.specular {
+        if self.dirac(wo) {
             return self.sample_specular(wo, uc);
         }
         let seed = self.seed;
@@ -427,8 +446,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
     /// evaluation to share more).
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        let exact = self.exact_eval();
-        if !valid_direction(wo) || !valid_direction(wi) || self.specular {
+        let exact = self.exact_eval(wo);
+        if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
             return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
         }
         let pdf = self.research_pdf_out(wo, wi);
@@ -441,7 +460,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !valid_direction(wo) || !valid_direction(wi) || self.specular {
+        if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
             return 0.0;
         }
         let pdf = self.research_pdf_out(wo, wi);

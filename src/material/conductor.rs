@@ -236,7 +236,7 @@ impl Material for Conductor {
             }
             _ => c,
         };
-        PhaseSample { wo, weight: self.fresnel(cos), outside: true }
+        PhaseSample { wo, weight: self.reflectance(cos), outside: true }
     }
 
     /// F(ωi·ωh) D(ωh) G2(ωi, ωo) / (4 cos θi) (the Cook–Torrance BRDF times cos θo).

@@ -122,10 +122,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
     /// distribution that resolves its tail (Gaussian); the C¹-space walk carries ln C¹ and has
     /// no such floor.
     ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction or a
+    /// uniform outside [0, 1] gives `None` (a debug assertion in debug builds).
+    ///
     /// [`Microsurface::eval_from_below`]: crate::Microsurface::eval_from_below
     #[inline]
     pub fn sample_height_from_below(&self, wi: Vec3, u: f32) -> Option<f32> {
-        if wi.z.is_nan() || wi.z >= 0.0 {
+        require!(is_direction(wi) && is_uniform(u), None; wi, u);
+        if wi.z >= 0.0 {
             return None;
         }
         let ln_c1 = first_ln_c1_from_below(self.slope.lambda(-wi), u)?;
@@ -223,8 +227,9 @@ pub(crate) fn first_ln_c1_from_below(lambda_up: f32, u: f32) -> Option<f32> {
     if lambda_up.is_nan() || lambda_up <= 0.0 {
         return None;
     }
-    // 1 − u: see `next_c1`
-    let ln_1mu = (1.0 - u).ln();
+    // 1 − u: see `next_c1`; the tails cut at 2⁻²⁴ like every quantile (u = 0 would put the
+    // first hit at the very top, ln C¹ = −MIN_HIT_DEPTH)
+    let ln_1mu = (1.0 - cut_tails(u)).ln();
     Some((ln_1mu / lambda_up).clamp(f32::MIN, -MIN_HIT_DEPTH))
 }
 

@@ -230,6 +230,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// 0 when ωo is at or below the horizon, or when Λ(−ωi) = 0 (ωi at the nadir sees no
     /// microsurface). Stochastic and unbiased, consistent with
     /// [`Microsurface::sample_from_below`] (the same walk).
+    ///
+    /// Known limit: the walk carries Λ in f32. For Beckmann, Λ(−ωi) ≈ e^{−a²} (a = |cot θi|/αᵢ)
+    /// underflows f32 from a ≈ 9.6 on (α = 0.01 at θi = 96°, 0.05 at 120°, 0.1 at 150°), and
+    /// the walk then returns nothing although the model's albedo is that of single scattering
+    /// and more (≈ 0.92 there for F = 1); single scattering, which forms this masking in f64 and
+    /// in log space, does not share the limit. GGX's Λ stays above 1e-106 and is unaffected.
     pub fn eval_from_below(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         if M::TRANSMITS || !(wi.z < 0.0 && wo.z > 0.0) {
             return Vec3::ZERO;
@@ -276,6 +282,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     ///
     /// `None` if ωi is not below the horizon, the material transmits, Λ(−ωi) = 0, the path was
     /// absorbed, or it reached [`MAX_BOUNCES`].
+    ///
+    /// Known limit: the walk carries Λ in f32. For Beckmann, Λ(−ωi) ≈ e^{−a²} (a = |cot θi|/αᵢ)
+    /// underflows f32 from a ≈ 9.6 on (α = 0.01 at θi = 96°, 0.05 at 120°, 0.1 at 150°), and
+    /// the walk then returns `None` although the model's albedo is that of single scattering
+    /// and more (≈ 0.92 there for F = 1); single scattering, which forms this masking in f64 and
+    /// in log space, does not share the limit. GGX's Λ stays above 1e-106 and is unaffected.
     pub fn sample_from_below(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         if M::TRANSMITS || wi.z.is_nan() || wi.z >= 0.0 {
             return None;

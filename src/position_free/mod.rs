@@ -346,7 +346,8 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             if factor == 0.0 {
                 return DVec3::ZERO;
             }
-            let phase = self.material.eval_phase(&self.slope, at.w, out.w, at.outside, out.outside, rng);
+            let phase =
+                self.material.eval_phase_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng);
             return phase.as_dvec3() * factor;
         }
         let factor = self.shadowing_factor(at, k_in, out, last);

@@ -264,7 +264,8 @@ fn cap_near_opposite(v: Vec3, u1: f32, u2: f32) -> Option<Vec3> {
     }
     let s = s_sq.sqrt();
     let len = (s_sq + vz * vz).sqrt();
-    let top = len + vz;
+    // as in the f32 form: len + v.z = |v_xy|²/(len − v.z) below the horizon, without cancellation
+    let top = if vz >= 0.0 { len + vz } else { s_sq / (len - vz) };
     let h_z = (1.0 - u1) * top;
     let z = h_z - vz;
     let r = (u1 * top * (len + z)).max(0.0).sqrt();

@@ -343,11 +343,11 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let pdf_ss = self.single.pdf(wo, wi);
-        if self.scheme == Compensation::Turquin
-            || self.single.is_specular()
-            || !valid_direction(wo)
-            || !valid_direction(wi)
-        {
+        // Turquin samples the single-scattering lobe (which validates the directions)
+        if self.scheme == Compensation::Turquin {
+            return pdf_ss;
+        }
+        if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
             return pdf_ss;
         }
         let c_o = self.view_complement(wo);

@@ -143,6 +143,7 @@ fn white_furnace_within_table_error() {
     let z = family_z(0.01, 64);
     let n = 80_000;
     let mut worst: f64 = 0.0;
+    #[allow(clippy::too_many_arguments)]
     fn run<S: TabulatedSlope>(
         slope: S,
         table: AlbedoTable,
@@ -313,5 +314,38 @@ fn backfacing_views_are_single_scattering() {
         assert_eq!(b.sample(wo, uc, u), ss.sample(wo, uc, u));
         let wi = dir(f64::from(uniform32(&mut rng)) * 1.5, 2.0);
         assert_eq!(b.eval_with_pdf(wo, wi), ss.eval_with_pdf(wo, wi));
+    }
+}
+
+/// Invalid arguments (NaN, non-unit or zero directions; uniforms outside [0, 1)) trip the debug
+/// assertion in debug builds and give the documented nothing in release builds: f = 0, pdf = 0,
+/// `None`.
+#[test]
+fn invalid_input_gives_nothing() {
+    let ok = dir(0.5, 0.2);
+    let bad = [Vec3::NAN, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0)];
+    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
+        let b = CompensatedConductor::new(ggx(0.4), gold(), scheme).unwrap();
+        let check = |label: &str, call: &dyn Fn() -> bool| {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(call));
+            if cfg!(debug_assertions) {
+                assert!(r.is_err(), "{scheme:?} {label}: no debug assertion");
+            } else {
+                assert!(r.expect("no panic in release"), "{scheme:?} {label}: not nothing");
+            }
+        };
+        for w in bad {
+            check("eval(bad, ok)", &|| b.eval(w, ok).f == Vec3::ZERO);
+            check("eval(ok, bad)", &|| b.eval(ok, w).f == Vec3::ZERO);
+            check("pdf(bad, ok)", &|| b.pdf(w, ok) == 0.0);
+            check("pdf(ok, bad)", &|| b.pdf(ok, w) == 0.0);
+            check("eval_with_pdf(ok, bad)", &|| {
+                b.eval_with_pdf(ok, w) == (microsurface::BsdfValue::ZERO, 0.0)
+            });
+            check("sample(bad)", &|| b.sample(w, 0.5, Vec2::splat(0.5)).is_none());
+        }
+        for (uc, u) in [(1.0, Vec2::splat(0.5)), (0.5, Vec2::new(f32::NAN, 0.2)), (-0.1, Vec2::splat(0.5))] {
+            check("sample(uniforms)", &|| b.sample(ok, uc, u).is_none());
+        }
     }
 }

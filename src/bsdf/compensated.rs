@@ -154,7 +154,8 @@ impl<S: TabulatedSlope> CompensatedConductor<S> {
     /// tables' range: there is no albedo to compensate with beyond it.
     pub fn new(slope: S, conductor: Conductor, scheme: Compensation) -> Result<Self, Error> {
         let alpha = (slope.alpha_x() * slope.alpha_y()).sqrt();
-        if !(alpha <= MAX_TABULATED_ALPHA) {
+        // the slope's roughnesses are finite and > 0; their product may overflow to ∞ (rejected)
+        if alpha > MAX_TABULATED_ALPHA {
             return Err(Error::InvalidParameter {
                 name: "alpha",
                 value: alpha,
@@ -162,8 +163,13 @@ impl<S: TabulatedSlope> CompensatedConductor<S> {
             });
         }
         let single = MicrofacetBsdf::new(slope, conductor)?.with_technique(Technique::SingleScattering);
-        let complement = blended_complement(&S::ALBEDO, alpha);
-        let complement_average = average_of_complement(&complement, f64::from(alpha));
+        // a Dirac mirror is not compensated (and √(αx αy) may underflow to 0 there)
+        let (complement, complement_average) = if single.is_specular() {
+            ([0.0; ALBEDO_TABLE_SIZE], 0.0)
+        } else {
+            let c = blended_complement(&S::ALBEDO, alpha);
+            (c, average_of_complement(&c, f64::from(alpha)))
+        };
         let fresnel_average = fresnel_average(&conductor);
         let fresnel_normal = conductor.fresnel(1.0);
         let e_avg = 1.0 - complement_average;

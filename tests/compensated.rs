@@ -47,19 +47,20 @@ fn draw<B: Bsdf + ?Sized>(b: &B, wo: Vec3, rng: &mut common::TestRng) -> Option<
 /// The chi-square cases: (label, BSDF, θo).
 fn chi2_cases() -> Vec<(String, Box<dyn Bsdf>, f64)> {
     let mut v: Vec<(String, Box<dyn Bsdf>, f64)> = vec![];
-    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
-        for (a, theta) in [(0.3f32, 0.5f64), (1.0, 1.3)] {
-            v.push((
-                format!("{scheme:?} GGX gold α = {a} θo = {theta}"),
-                Box::new(CompensatedConductor::new(ggx(a), gold(), scheme).unwrap()),
-                theta,
-            ));
-            v.push((
-                format!("{scheme:?} Beckmann gold α = {a} θo = {theta}"),
-                Box::new(CompensatedConductor::new(beckmann(a), gold(), scheme).unwrap()),
-                theta,
-            ));
-        }
+    let kc = Compensation::KullaConty;
+    for (a, theta, scheme) in [(0.3f32, 0.5f64, kc), (1.0, 1.3, Compensation::Turquin)] {
+        v.push((
+            format!("{scheme:?} GGX gold α = {a} θo = {theta}"),
+            Box::new(CompensatedConductor::new(ggx(a), gold(), scheme).unwrap()),
+            theta,
+        ));
+    }
+    for (a, theta) in [(0.08f32, 1.4f64), (1.0, 0.3)] {
+        v.push((
+            format!("KullaConty Beckmann gold α = {a} θo = {theta}"),
+            Box::new(CompensatedConductor::new(beckmann(a), gold(), kc).unwrap()),
+            theta,
+        ));
     }
     // anisotropic slopes (the tables at √(αx αy)): the sampler is still exact
     v.push((
@@ -72,7 +73,7 @@ fn chi2_cases() -> Vec<(String, Box<dyn Bsdf>, f64)> {
     v
 }
 
-/// `sample` against `pdf` (chi-square, 20 × 40 cells of the sphere, 200 000 samples, family-wise
+/// `sample` against `pdf` (chi-square, 20 × 40 cells of the sphere, 100 000 samples, family-wise
 /// level 1 % over the cases); every sample has an exact pdf equal to `pdf(wo, wi)` and a weight
 /// equal to eval·cos θi/pdf (relative 1e-4); the sampler refuses (reflections below the
 /// horizon) exactly the mass 1 − ∫pdf (binomial, z·SE + the quadrature's 1e-3).
@@ -81,16 +82,16 @@ fn sample_matches_pdf_and_weights_match_eval() {
     let cases = chi2_cases();
     let alpha = sidak(0.01, cases.len());
     let z = family_z(0.01, cases.len());
-    let n = 200_000;
+    let n = 100_000;
     for (k, (label, b, theta)) in cases.iter().enumerate() {
         let wo = dir(*theta, 0.4);
         // the single-scattering lobe's reflections below the horizon are refused: ∫pdf < 1
-        let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 16, 32, false, 1e-5, 7);
+        let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 8, 16, false, 1e-4, 6);
         assert!(mass <= 1.0 + 1e-3, "{label}: ∫pdf = {mass} > 1");
         let mut rng = common::rng(1600 + k as u64);
         let out = chi2_test(
             label,
-            Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(20, 40) },
+            Chi2Grid { quad_tol: 1e-4, max_depth: 6, ..Chi2Grid::sphere(20, 40) },
             |w| f64::from(b.pdf(wo, w)),
             || {
                 let s = draw(b.as_ref(), wo, &mut rng)?;
@@ -135,7 +136,7 @@ fn sample_matches_pdf_and_weights_match_eval() {
 /// the chi-square and weight tests) is 1 within z·SE plus the table's interpolation error ε
 /// (Kulla–Conty: albedo − 1 = E_exact(μo) − E_table(μo); Turquin: E_exact/E_table − 1, so
 /// ε/E_table(μo)), for α ∈ {0.05, 0.2, 0.5, 1} and μo ∈ {0.1, 0.4, 0.7, 1}, both families and
-/// both schemes (64 cases, family-wise level 1 %; each asserts SE ≤ 5e-3, N = 80 000: the cosine lobe samples the Kulla–Conty lobe poorly at grazing views of α ≲ 0.1, where its weights reach F_ms max(1 − E)/(1 − E_avg)).
+/// both schemes (64 cases, family-wise level 1 %; each asserts SE ≤ 2e-3 for Kulla–Conty (its σ̂ ≈ 0.45 comes from the refused single-scattering samples below the horizon) and 5e-3 for Turquin, N = 80 000).
 #[test]
 fn white_furnace_within_table_error() {
     let alphas = [0.05f32, 0.2, 0.5, 1.0];
@@ -169,7 +170,9 @@ fn white_furnace_within_table_error() {
                 Compensation::Turquin => eps / e_table,
             };
             let label = format!("white furnace {} {scheme:?} α = {alpha} μo = {mu}", table.name());
-            assert_mean(&label, &stats, 1.0, z, 5e-3, tol);
+            // Turquin's weights are the single-scattering weights over E(μo) (up to 3.3 at α = 1)
+            let max_se = if scheme == Compensation::KullaConty { 2e-3 } else { 5e-3 };
+            assert_mean(&label, &stats, 1.0, z, max_se, tol);
             println!("{label}: mean {:.5}, SE {:.1e}, tol {tol:.1e}", stats.mean(), stats.se());
             *worst = worst.max((stats.mean() - 1.0).abs());
         }
@@ -186,7 +189,7 @@ fn white_furnace_within_table_error() {
 }
 
 /// The Kulla–Conty lobe f_KC − f_ss integrates to F_ms (1 − E(μo)) over the hemisphere (by
-/// adaptive quadrature, to 2e-5 relative; the E_avg it is normalized by is the exact average
+/// adaptive quadrature, to 2e-5 relative + 1e-6; the E_avg it is normalized by is the exact average
 /// of the interpolated E), for gold (coloured F_ms) and F = 1 (F_ms = 1).
 #[test]
 fn kulla_conty_lobe_is_normalized() {
@@ -195,30 +198,25 @@ fn kulla_conty_lobe_is_normalized() {
             let b = CompensatedConductor::new(ggx(a), conductor, Compensation::KullaConty).unwrap();
             let ss = *b.single_scattering();
             let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-            let mut lobe = [0.0f64; 3];
-            for (c, slot) in lobe.iter_mut().enumerate() {
-                *slot = integrate_sphere(
-                    &mut |w| f64::from((b.eval(wo, w).f - ss.eval(wo, w).f)[c] * w.z),
-                    8,
-                    16,
-                    true,
-                    1e-7,
-                    7,
-                );
-            }
+            // the channels' sum (each channel's F_ms comes from the same formula)
+            let lobe = integrate_sphere(
+                &mut |w| f64::from((b.eval(wo, w).f - ss.eval(wo, w).f).element_sum() * w.z),
+                8,
+                16,
+                true,
+                1e-6,
+                6,
+            );
             let c_o = 1.0 - f64::from(b.directional_albedo(mu).unwrap());
             let fms = b.fresnel_multiple_scattering();
             if name == "F = 1" {
                 assert!((fms - Vec3::ONE).abs().max_element() < 1e-6, "F_ms = {fms} for F = 1");
             }
-            for c in 0..3 {
-                let expected = f64::from(fms[c]) * c_o;
-                assert!(
-                    (lobe[c] - expected).abs() <= 2e-5 * expected + 1e-8,
-                    "{name} α = {a} μo = {mu} channel {c}: ∫ f_ms cos = {:.7e}, F_ms (1 − E) = {expected:.7e}",
-                    lobe[c]
-                );
-            }
+            let expected = f64::from(fms.element_sum()) * c_o;
+            assert!(
+                (lobe - expected).abs() <= 2e-5 * expected + 1e-6,
+                "{name} α = {a} μo = {mu}: ∫ Σ f_ms cos = {lobe:.7e}, Σ F_ms (1 − E) = {expected:.7e}"
+            );
         }
     }
 }

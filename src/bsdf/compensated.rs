@@ -6,9 +6,9 @@ use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
 use crate::error::Error;
-use crate::frame::cosine_hemisphere;
 use crate::material::Conductor;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+use crate::special::sin_cos_turns;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -95,8 +95,11 @@ pub enum Compensation {
 ///
 /// **Sampling** (Kulla–Conty): with probability p = E(μo) (the energies of the two lobes for
 /// F = 1) the caller's uniforms drive the exact visible-normal sample of the single-scattering
-/// lobe (uc rescaled to uc/p), otherwise u draws a cosine-distributed direction; the density is
-/// the mixture pdf = p pdf_ss + (1 − p) cos θi/π, exact. Turquin samples and has the density of
+/// lobe (uc rescaled to uc/p), otherwise u samples the added lobe's profile (1 − E(μi)) μi
+/// tabulated per cell of the direction axis (a cell by its mass, μi² uniform in it, φ uniform:
+/// density d_cell μi/π); the density is the mixture pdf = p pdf_ss + (1 − p) d_cell μi/π, exact
+/// (the cell of a returned direction is recomputed from its f32 cosine, which moves at most a
+/// few ulps of μ² of probability between neighbouring cells). Turquin samples and has the density of
 /// the single-scattering lobe.
 ///
 /// **Special cases.** Effectively smooth surfaces (max(αx, αy) < [`super::SMOOTH_ALPHA`]) are
@@ -136,6 +139,8 @@ pub struct CompensatedConductor<S> {
     complement: [f32; ALBEDO_TABLE_SIZE],
     /// 1 − E_avg of the interpolated E.
     complement_average: f64,
+    /// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi.
+    profile: Profile,
     /// F_avg per channel.
     fresnel_average: Vec3,
     /// F0 per channel.
@@ -164,11 +169,12 @@ impl<S: TabulatedSlope> CompensatedConductor<S> {
         }
         let single = MicrofacetBsdf::new(slope, conductor)?.with_technique(Technique::SingleScattering);
         // a Dirac mirror is not compensated (and √(αx αy) may underflow to 0 there)
-        let (complement, complement_average) = if single.is_specular() {
-            ([0.0; ALBEDO_TABLE_SIZE], 0.0)
+        let (complement, complement_average, profile) = if single.is_specular() {
+            ([0.0; ALBEDO_TABLE_SIZE], 0.0, Profile::EMPTY)
         } else {
             let c = blended_complement(&S::ALBEDO, alpha);
-            (c, average_of_complement(&c, f64::from(alpha)))
+            let (average, profile) = average_of_complement(&c, f64::from(alpha));
+            (c, average, profile)
         };
         let fresnel_average = fresnel_average(&conductor);
         let fresnel_normal = conductor.fresnel(1.0);
@@ -190,6 +196,7 @@ impl<S: TabulatedSlope> CompensatedConductor<S> {
             alpha,
             complement,
             complement_average,
+            profile,
             fresnel_average,
             fresnel_normal,
             fresnel_ms,
@@ -245,12 +252,42 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// axis x = √(μ (1 + α)/(μ + α)). Branch-free.
     #[inline(always)]
     fn complement_at(&self, mu: f32) -> f32 {
+        let (i, f) = self.cell(mu);
+        let (a, b) = (self.complement[i], self.complement[i + 1]);
+        a + f * (b - a)
+    }
+
+    /// The cell i ∈ [0, 30] of the direction axis that holds μ, and the fraction within it.
+    #[inline(always)]
+    fn cell(&self, mu: f32) -> (usize, f32) {
         let x = (mu * (1.0 + self.alpha) / (mu + self.alpha)).min(1.0).sqrt();
         let t = x * LAST;
         let i = (t as usize).min(ALBEDO_TABLE_SIZE - 2);
-        let f = t - i as f32;
-        let (a, b) = (self.complement[i], self.complement[i + 1]);
-        a + f * (b - a)
+        (i, t - i as f32)
+    }
+
+    /// The density of the Kulla–Conty lobe's sampler at wi (upper hemisphere):
+    /// d_i μi/π with d_i the cell's probability over its Δμ² (see [`Profile`]).
+    #[inline(always)]
+    fn profile_pdf(&self, wi: Vec3) -> f32 {
+        if wi.z > 0.0 { self.profile.density[self.cell(wi.z).0] * wi.z * FRAC_1_PI } else { 0.0 }
+    }
+
+    /// Samples the Kulla–Conty lobe's sampler from u ∈ [0, 1)²: a cell by its probability,
+    /// μ² uniform in the cell, φ uniform. `None` on the horizon.
+    #[inline(always)]
+    fn sample_profile(&self, u: Vec2) -> Option<Vec3> {
+        let cdf = &self.profile.cdf;
+        // the first cell whose cumulative probability exceeds u.x
+        let i = cdf[1..].partition_point(|&c| c <= u.x).min(ALBEDO_TABLE_SIZE - 2);
+        let width = cdf[i + 1] - cdf[i];
+        let v = if width > 0.0 { ((u.x - cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
+        let (m0, m1) = (self.profile.mu_sq[i], self.profile.mu_sq[i + 1]);
+        let mu_sq = m0 + v * (m1 - m0);
+        let mu = mu_sq.sqrt();
+        let sin_theta = (1.0 - mu_sq).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+        (mu > 0.0).then(|| Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, mu))
     }
 
     /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
@@ -273,9 +310,8 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
 
     /// The Kulla–Conty mixture density for the probability `p` of the single-scattering lobe.
     #[inline(always)]
-    fn mixture_pdf(p: f32, pdf_ss: f32, wi: Vec3) -> f32 {
-        let cosine = if wi.z > 0.0 { wi.z * FRAC_1_PI } else { 0.0 };
-        p * pdf_ss + (1.0 - p) * cosine
+    fn mixture_pdf(&self, p: f32, pdf_ss: f32, wi: Vec3) -> f32 {
+        p * pdf_ss + (1.0 - p) * self.profile_pdf(wi)
     }
 
     /// A sample from the weight-times-density `f_cos` (f·cos θi) and density `pdf` at `wi`,
@@ -332,15 +368,12 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
                 if uc < p {
                     let s = self.single.sample_keyed(wo, (uc / p).min(ONE_MINUS_ULP), u, key)?;
                     let f_cos = s.weight * s.pdf + self.kc_lobe(c_o, s.wi) * s.wi.z.abs();
-                    Self::finish(wo, s.wi, f_cos, Self::mixture_pdf(p, s.pdf, s.wi))
+                    Self::finish(wo, s.wi, f_cos, self.mixture_pdf(p, s.pdf, s.wi))
                 } else {
-                    let wi = cosine_hemisphere(u.x, u.y);
-                    if wi.z <= 0.0 {
-                        return None;
-                    }
+                    let wi = self.sample_profile(u)?;
                     let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
                     let f_cos = (v.f + self.kc_lobe(c_o, wi)) * wi.z;
-                    Self::finish(wo, wi, f_cos, Self::mixture_pdf(p, pdf_ss, wi))
+                    Self::finish(wo, wi, f_cos, self.mixture_pdf(p, pdf_ss, wi))
                 }
             }
         }
@@ -357,7 +390,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             return pdf_ss;
         }
         let c_o = self.view_complement(wo);
-        if c_o == 0.0 { pdf_ss } else { Self::mixture_pdf(1.0 - c_o, pdf_ss, wi) }
+        if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) }
     }
 
     #[inline]
@@ -370,7 +403,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         match self.scheme {
             Compensation::KullaConty => {
                 let f = v.f + self.kc_lobe(c_o, wi);
-                let pdf = if c_o == 0.0 { pdf_ss } else { Self::mixture_pdf(1.0 - c_o, pdf_ss, wi) };
+                let pdf = if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) };
                 (BsdfValue { f, exact: true }, pdf)
             }
             Compensation::Turquin => (BsdfValue { f: v.f * self.turquin_factor(c_o), exact: true }, pdf_ss),
@@ -395,34 +428,81 @@ fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZ
     out
 }
 
-/// ∫₀¹ c(μ) 2μ dμ for c linear in x on each cell [i/31, (i+1)/31] of the direction axis
-/// x = √(μ (1 + α)/(μ + α)), i.e. μ = α x²/(1 + α − x²), in closed form:
+/// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi: cell i of the direction
+/// axis is chosen with probability M_i/c̄ (M_i = ∫_cell (1 − E) d(μ²), c̄ = Σ M_i = 1 − E_avg),
+/// and μ² is uniform within it, so its density in solid angle is d_i μ/π with
+/// d_i = P_i/Δμ²_i: the lobe's profile with 1 − E replaced by its mean over the cell, and the
+/// sample weight of the lobe is F_ms (1 − E(μo)) times (1 − E(μi)) over that mean (between 0
+/// and 2 for a linear 1 − E).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Profile {
+    /// Cumulative probabilities of the cells (0 first, 1 last).
+    cdf: [f32; ALBEDO_TABLE_SIZE],
+    /// μ² at the direction nodes.
+    mu_sq: [f32; ALBEDO_TABLE_SIZE],
+    /// d_i per cell.
+    density: [f32; ALBEDO_TABLE_SIZE - 1],
+}
+
+impl Profile {
+    /// No lobe (a Dirac mirror).
+    const EMPTY: Profile = Profile {
+        cdf: [0.0; ALBEDO_TABLE_SIZE],
+        mu_sq: [0.0; ALBEDO_TABLE_SIZE],
+        density: [0.0; ALBEDO_TABLE_SIZE - 1],
+    };
+}
+
+/// c̄ = ∫₀¹ c(μ) 2μ dμ for c linear in x on each cell [i/31, (i+1)/31] of the direction axis
+/// x = √(μ (1 + α)/(μ + α)), i.e. μ = α x²/(1 + α − x²), in closed form, and the sampler of
+/// c(μ) μ built from the cells' masses:
 ///
 /// ∫ (a + b x) d(μ²) = a Δμ² + b Δ(x μ²) − b α² ΔP,   P(x) = ∫ x⁴/(k − x²)² dx
 ///                   = x + k x / (2 (k − x²)) − (3√k/2) atanh(x/√k),   k = 1 + α.
 ///
 /// In f64; the differences of P across a cell lose at most log₂(1/α) bits (1e-13 at
 /// α = 1e-3).
-fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f64) -> f64 {
+fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f64) -> (f64, Profile) {
     let k = 1.0 + alpha;
     let sk = k.sqrt();
     let mu_sq = |x: f64| {
+        if x >= 1.0 {
+            return 1.0;
+        }
         let m = alpha * x * x / (k - x * x);
         m * m
     };
     let p = |x: f64| x + k * x / (2.0 * (k - x * x)) - 1.5 * sk * (x / sk).atanh();
     let h = 1.0 / f64::from(LAST);
-    let mut sum = 0.0;
-    for i in 0..ALBEDO_TABLE_SIZE - 1 {
-        let (x0, x1) = (i as f64 * h, (i + 1) as f64 * h);
-        let x1 = if i == ALBEDO_TABLE_SIZE - 2 { 1.0 } else { x1 };
+    let mut masses = [0.0f64; ALBEDO_TABLE_SIZE - 1];
+    for (i, mass) in masses.iter_mut().enumerate() {
+        let (x0, x1) = (i as f64 * h, if i == ALBEDO_TABLE_SIZE - 2 { 1.0 } else { (i + 1) as f64 * h });
         let (c0, c1) = (f64::from(c[i]), f64::from(c[i + 1]));
         let b = (c1 - c0) / h;
         let a = c0 - b * x0;
         let (m0, m1) = (mu_sq(x0), mu_sq(x1));
-        sum += a * (m1 - m0) + b * (x1 * m1 - x0 * m0) - b * alpha * alpha * (p(x1) - p(x0));
+        // ≥ 0 for c ≥ 0; rounding can leave −1e-20 in a cell of c = 0
+        *mass = (a * (m1 - m0) + b * (x1 * m1 - x0 * m0) - b * alpha * alpha * (p(x1) - p(x0))).max(0.0);
     }
-    sum
+    let total: f64 = masses.iter().sum();
+    let mut profile = Profile::EMPTY;
+    if total > 0.0 {
+        let mut acc = 0.0;
+        for i in 0..ALBEDO_TABLE_SIZE {
+            profile.mu_sq[i] = mu_sq(if i == ALBEDO_TABLE_SIZE - 1 { 1.0 } else { i as f64 * h }) as f32;
+            profile.cdf[i] = (acc / total) as f32;
+            if let Some(m) = masses.get(i) {
+                acc += m;
+            }
+        }
+        profile.cdf[ALBEDO_TABLE_SIZE - 1] = 1.0;
+        for i in 0..ALBEDO_TABLE_SIZE - 1 {
+            let prob = f64::from(profile.cdf[i + 1]) - f64::from(profile.cdf[i]);
+            let width = f64::from(profile.mu_sq[i + 1]) - f64::from(profile.mu_sq[i]);
+            profile.density[i] = if width > 0.0 { (prob / width) as f32 } else { 0.0 };
+        }
+    }
+    (total, profile)
 }
 
 /// F_avg = 2∫₀¹ F(μ) μ dμ per channel, by composite Gauss–Legendre.
@@ -473,6 +553,10 @@ mod tests {
                 })
                 .sum();
             let exact = b.complement_average;
+            let cdf = b.profile.cdf;
+            assert!(
+                cdf[0] == 0.0 && cdf[ALBEDO_TABLE_SIZE - 1] == 1.0 && cdf.windows(2).all(|w| w[0] <= w[1])
+            );
             assert!(
                 (sum - exact).abs() <= 1e-7 * exact,
                 "α = {alpha}: quadrature {sum:e}, closed form {exact:e}"

@@ -379,7 +379,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let pdf_ss = self.single.pdf(wo, wi);
         // Turquin samples the single-scattering lobe (which validates the directions)

@@ -302,6 +302,20 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         if wi.z > 0.0 && c_o > 0.0 { self.scale * (c_o * self.complement_at(wi.z)) } else { Vec3::ZERO }
     }
 
+    /// The Kulla–Conty lobe f_ms and the mixture density at wi from one table lookup (the same
+    /// arithmetic as [`Self::kc_lobe`] and [`Self::mixture_pdf`], bit for bit).
+    #[inline(always)]
+    fn kc_lobe_and_pdf(&self, c_o: f32, p: f32, pdf_ss: f32, wi: Vec3) -> (Vec3, f32) {
+        if wi.z <= 0.0 {
+            return (Vec3::ZERO, p * pdf_ss + (1.0 - p) * 0.0);
+        }
+        let (i, f) = self.cell(wi.z);
+        let (a, b) = (self.complement[i], self.complement[i + 1]);
+        let c_i = a + f * (b - a);
+        let lobe = if c_o > 0.0 { self.scale * (c_o * c_i) } else { Vec3::ZERO };
+        (lobe, p * pdf_ss + (1.0 - p) * (self.profile.density[i] * wi.z * FRAC_1_PI))
+    }
+
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
     #[inline(always)]
     fn turquin_factor(&self, c_o: f32) -> Vec3 {
@@ -367,13 +381,13 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
                 let p = 1.0 - c_o;
                 if uc < p {
                     let s = self.single.sample_keyed(wo, (uc / p).min(ONE_MINUS_ULP), u, key)?;
-                    let f_cos = s.weight * s.pdf + self.kc_lobe(c_o, s.wi) * s.wi.z.abs();
-                    Self::finish(wo, s.wi, f_cos, self.mixture_pdf(p, s.pdf, s.wi))
+                    let (lobe, pdf) = self.kc_lobe_and_pdf(c_o, p, s.pdf, s.wi);
+                    Self::finish(wo, s.wi, s.weight * s.pdf + lobe * s.wi.z.abs(), pdf)
                 } else {
                     let wi = self.sample_profile(u)?;
                     let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-                    let f_cos = (v.f + self.kc_lobe(c_o, wi)) * wi.z;
-                    Self::finish(wo, wi, f_cos, self.mixture_pdf(p, pdf_ss, wi))
+                    let (lobe, pdf) = self.kc_lobe_and_pdf(c_o, p, pdf_ss, wi);
+                    Self::finish(wo, wi, (v.f + lobe) * wi.z, pdf)
                 }
             }
         }

@@ -6,7 +6,8 @@
 //!   grid of μ and α, for F = 1, gold, copper and aluminium;
 //! * lobe-shape error: relative L1 distance of the binned f·cos θi over the hemisphere,
 //!   Σ|h − h_walk| / Σ h_walk (F = 1), per α ∈ {0.1, 0.3, 0.6, 1} and θo ∈ {0, 1, 1.4}, with
-//!   the noise floor of the estimate (the same distance between two independent walk runs).
+//!   the noise floor of the estimate (the same distance between two independent walk runs);
+//! * the albedo error of anisotropic GGX (F = 1) compensated at α = √(αx αy).
 //!
 //! Every estimate is the mean of sample weights (unbiased for each technique), with its
 //! standard error. Writes `target/compensation/albedo.csv`, `lobes.csv` and `table.md`.
@@ -20,7 +21,7 @@ use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::{RngExt, SeedableRng};
 use microsurface::{
     Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Ggx, MicrofacetBsdf, Microsurface,
-    Technique, UniformHeight,
+    MicrosurfaceSlope, Technique, UniformHeight,
 };
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -102,8 +103,22 @@ struct AlbedoCell {
 }
 
 fn albedo_cell(material: &'static str, c: Conductor, alpha: f32, mu: f32, n: usize, seed: u64) -> AlbedoCell {
-    let slope = Ggx::isotropic(alpha).unwrap();
-    let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    albedo_cell_of(material, c, Ggx::isotropic(alpha).unwrap(), mu, 0.0, n, seed)
+}
+
+/// [`albedo_cell`] for any GGX slopes and view azimuth φo.
+fn albedo_cell_of(
+    material: &'static str,
+    c: Conductor,
+    slope: Ggx,
+    mu: f32,
+    phi: f32,
+    n: usize,
+    seed: u64,
+) -> AlbedoCell {
+    let alpha = slope.alpha_x();
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let wo = Vec3::new(s * phi.cos(), s * phi.sin(), mu);
     let surface = Microsurface::new(UniformHeight, slope, c);
     let mut rng = Pcg::seed_from_u64(seed);
     let walk = estimate(n, || surface.sample(wo, &mut rng).map(|s| s.weight));
@@ -235,6 +250,22 @@ fn main() -> std::io::Result<()> {
         let (m, a, mu) = jobs[i];
         albedo_cell(mats[m].0, mats[m].1, a, mu, s.albedo_samples, 16_000 + 8 * i as u64)
     });
+    // anisotropic slopes, compensated at α = √(αx αy): F = 1, φo ∈ {0, π/4, π/2}
+    let anisotropic = [(0.1f32, 0.4f32), (0.2, 0.8), (0.5, 1.0)];
+    let mut aniso_jobs = vec![];
+    for (k, &(ax, ay)) in anisotropic.iter().enumerate() {
+        for phi in [0.0f32, core::f32::consts::FRAC_PI_4, core::f32::consts::FRAC_PI_2] {
+            for &mu in &s.mus {
+                aniso_jobs.push((k, ax, ay, phi, mu));
+            }
+        }
+    }
+    eprintln!("anisotropic albedo: {} cells × {} samples × 4 models", aniso_jobs.len(), s.albedo_samples);
+    let aniso_cells = par_map(aniso_jobs.len(), |i| {
+        let (_, ax, ay, phi, mu) = aniso_jobs[i];
+        let slope = Ggx::new(ax, ay).unwrap();
+        albedo_cell_of("F = 1", Conductor::perfect(), slope, mu, phi, s.albedo_samples, 18_000 + 8 * i as u64)
+    });
     let lobe_jobs: Vec<(f32, f32)> =
         [0.1f32, 0.3, 0.6, 1.0].iter().flat_map(|&a| [0.0f32, 1.0, 1.4].map(|t| (a, t))).collect();
     eprintln!("lobes: {} cases × {} samples × 5 runs", lobe_jobs.len(), s.lobe_samples);
@@ -302,6 +333,29 @@ fn main() -> std::io::Result<()> {
                 .iter()
                 .filter(|c| c.material == *name)
                 .flat_map(|c| (0..3).map(move |ch| c.techniques[k].mean[ch] - c.walk.mean[ch]))
+                .collect();
+            let max = errs.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+            let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+            write!(md, " {max:.4} | {rms:.4} |").unwrap();
+        }
+        md.push('\n');
+    }
+    writeln!(
+        md,
+        "\nAnisotropic GGX, F = 1, compensated at α = √(αx αy): albedo error over μo (as above) and \
+         φo ∈ {{0, π/4, π/2}}:\n"
+    )
+    .unwrap();
+    writeln!(md, "| αx, αy | single: max | RMS | Kulla–Conty: max | RMS | Turquin: max | RMS |").unwrap();
+    writeln!(md, "|---|---|---|---|---|---|---|").unwrap();
+    for (k, (ax, ay)) in anisotropic.iter().enumerate() {
+        write!(md, "| {ax}, {ay} |").unwrap();
+        for t in 0..TECHNIQUES.len() {
+            let errs: Vec<f64> = aniso_jobs
+                .iter()
+                .zip(&aniso_cells)
+                .filter(|(j, _)| j.0 == k)
+                .map(|(_, c)| c.techniques[t].mean[0] - c.walk.mean[0])
                 .collect();
             let max = errs.iter().fold(0.0f64, |m, e| m.max(e.abs()));
             let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();

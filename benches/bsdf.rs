@@ -18,8 +18,9 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use microsurface::{
-    Bsdf, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
-    MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SpecularLimit, Technique, UniformHeight,
+    Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material,
+    MicrofacetBsdf, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SpecularLimit,
+    Technique, UniformHeight,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -231,7 +232,51 @@ fn sample_vs_vndf(c: &mut Criterion<Clock>) {
     g.finish();
 }
 
+/// The energy-compensated gold (`CompensatedConductor`, Kulla–Conty and Turquin) against the
+/// single-scattering gold it is built on, static dispatch (the target: at most 1.3× its cost).
+/// Ids `gold/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin}`.
+fn compensated(c: &mut Criterion<Clock>) {
+    let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
+    let gold = Conductor::new(ComplexIor::GOLD);
+    let single = MicrofacetBsdf::new(slope, gold)
+        .expect("α ≤ MAX_WALK_ALPHA")
+        .with_technique(Technique::SingleScattering);
+    let kc = CompensatedConductor::new(slope, gold, Compensation::KullaConty).expect("α ≤ 1");
+    let turquin = CompensatedConductor::new(slope, gold, Compensation::Turquin).expect("α ≤ 1");
+    let x = inputs(false, 300);
+    macro_rules! bench {
+        ($g:expr, $name:expr, $model:expr, $call:ident) => {
+            $g.bench_function($name, |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    bench!(@call black_box($model), $call, k)
+                })
+            });
+        };
+        (@call $m:expr, eval, $k:expr) => { $m.eval(black_box(x.wo[$k]), black_box(x.wi[$k])) };
+        (@call $m:expr, pdf, $k:expr) => { $m.pdf(black_box(x.wo[$k]), black_box(x.wi[$k])) };
+        (@call $m:expr, sample, $k:expr) => { $m.sample(black_box(x.wo[$k]), black_box(x.uc[$k]), black_box(x.u[$k])) };
+    }
+    let mut g = c.benchmark_group("gold/compensated/eval");
+    bench!(g, "single", &single, eval);
+    bench!(g, "kulla-conty", &kc, eval);
+    bench!(g, "turquin", &turquin, eval);
+    g.finish();
+    let mut g = c.benchmark_group("gold/compensated/pdf");
+    bench!(g, "single", &single, pdf);
+    bench!(g, "kulla-conty", &kc, pdf);
+    bench!(g, "turquin", &turquin, pdf);
+    g.finish();
+    let mut g = c.benchmark_group("gold/compensated/sample");
+    bench!(g, "single", &single, sample);
+    bench!(g, "kulla-conty", &kc, sample);
+    bench!(g, "turquin", &turquin, sample);
+    g.finish();
+}
+
 fn bsdfs(c: &mut Criterion<Clock>) {
+    compensated(c);
     sample_vs_vndf(c);
     bench_material(c, "gold", Conductor::new(ComplexIor::GOLD), 100);
     bench_material(c, "glass", Dielectric::new(1.5).expect("valid index"), 200);

@@ -18,12 +18,14 @@
 //! f·|cos θo|, and `&mut impl Rng` arguments.)
 
 mod classic;
+mod compensated;
 mod frame;
 mod microfacet;
 mod seed;
 mod specular;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
+pub use compensated::{CompensatedConductor, Compensation, TabulatedSlope};
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
 pub use specular::{SpecularEvent, SpecularLimit};

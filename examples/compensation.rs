@@ -1,0 +1,399 @@
+//! Measures the error of the energy-compensated conductors (`CompensatedConductor`:
+//! Kulla–Conty and Turquin) and of plain single scattering against the exact multiple-scattering
+//! model (the random walk of Heitz et al. 2016), GGX:
+//!
+//! * directional albedo error A_technique(μ) − A_walk(μ) per RGB channel, max and RMS over a
+//!   grid of μ and α, for F = 1, gold, copper and aluminium;
+//! * lobe-shape error: relative L1 distance of the binned f·cos θi over the hemisphere,
+//!   Σ|h − h_walk| / Σ h_walk (F = 1), per α ∈ {0.1, 0.3, 0.6, 1} and θo ∈ {0, 1, 1.4}, with
+//!   the noise floor of the estimate (the same distance between two independent walk runs);
+//! * the albedo error of anisotropic GGX (F = 1) compensated at α = √(αx αy).
+//!
+//! Every estimate is the mean of sample weights (unbiased for each technique), with its
+//! standard error. Writes `target/compensation/albedo.csv`, `lobes.csv` and `table.md`.
+//!
+//! ```sh
+//! cargo run --release --example compensation            # the published numbers
+//! cargo run --release --example compensation -- --quick # a smaller run (CI)
+//! ```
+
+use microsurface::glam::{Vec2, Vec3};
+use microsurface::rand::{RngExt, SeedableRng};
+use microsurface::{
+    Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Ggx, MicrofacetBsdf, Microsurface,
+    MicrosurfaceSlope, Technique, UniformHeight,
+};
+use std::fmt::Write as _;
+use std::time::Instant;
+
+type Pcg = rand_pcg::Pcg64Mcg;
+
+/// The techniques compared with the walk.
+const TECHNIQUES: [&str; 3] = ["single", "kulla-conty", "turquin"];
+
+/// Lobe bins: equal-area cells in (cos θ, φ) over the upper hemisphere.
+const LOBE_NZ: usize = 16;
+const LOBE_NPHI: usize = 32;
+
+struct Settings {
+    alphas: Vec<f32>,
+    mus: Vec<f32>,
+    albedo_samples: usize,
+    lobe_samples: usize,
+}
+
+fn materials() -> Vec<(&'static str, Conductor)> {
+    vec![
+        ("F = 1", Conductor::perfect()),
+        ("gold", Conductor::new(ComplexIor::GOLD)),
+        ("copper", Conductor::new(ComplexIor::COPPER)),
+        ("aluminium", Conductor::new(ComplexIor::ALUMINIUM)),
+    ]
+}
+
+/// The renderer-layer BSDF of a technique.
+fn technique(name: &str, slope: Ggx, c: Conductor) -> Box<dyn Bsdf> {
+    match name {
+        "single" => {
+            Box::new(MicrofacetBsdf::new(slope, c).unwrap().with_technique(Technique::SingleScattering))
+        }
+        "kulla-conty" => Box::new(CompensatedConductor::new(slope, c, Compensation::KullaConty).unwrap()),
+        "turquin" => Box::new(CompensatedConductor::new(slope, c, Compensation::Turquin).unwrap()),
+        _ => unreachable!(),
+    }
+}
+
+/// Mean and standard error per channel of `n` weights, and the time per sample (ns).
+struct Estimate {
+    mean: [f64; 3],
+    se: [f64; 3],
+    ns: f64,
+}
+
+fn estimate(n: usize, mut draw: impl FnMut() -> Option<Vec3>) -> Estimate {
+    let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
+    let t = Instant::now();
+    for _ in 0..n {
+        if let Some(w) = draw() {
+            for c in 0..3 {
+                let x = f64::from(w[c]);
+                s[c] += x;
+                s2[c] += x * x;
+            }
+        }
+    }
+    let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
+    let nf = n as f64;
+    let mean = s.map(|v| v / nf);
+    let se = core::array::from_fn(|c| ((s2[c] / nf - mean[c] * mean[c]).max(0.0) / (nf - 1.0)).sqrt());
+    Estimate { mean, se, ns }
+}
+
+fn uniforms(rng: &mut Pcg) -> (f32, Vec2) {
+    (rng.random::<f32>(), Vec2::new(rng.random::<f32>(), rng.random::<f32>()))
+}
+
+/// One albedo cell: the walk and each technique at (material, α, μ).
+struct AlbedoCell {
+    material: &'static str,
+    alpha: f32,
+    mu: f32,
+    walk: Estimate,
+    techniques: Vec<Estimate>,
+}
+
+fn albedo_cell(material: &'static str, c: Conductor, alpha: f32, mu: f32, n: usize, seed: u64) -> AlbedoCell {
+    albedo_cell_of(material, c, Ggx::isotropic(alpha).unwrap(), mu, 0.0, n, seed)
+}
+
+/// [`albedo_cell`] for any GGX slopes and view azimuth φo.
+fn albedo_cell_of(
+    material: &'static str,
+    c: Conductor,
+    slope: Ggx,
+    mu: f32,
+    phi: f32,
+    n: usize,
+    seed: u64,
+) -> AlbedoCell {
+    let alpha = slope.alpha_x();
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let wo = Vec3::new(s * phi.cos(), s * phi.sin(), mu);
+    let surface = Microsurface::new(UniformHeight, slope, c);
+    let mut rng = Pcg::seed_from_u64(seed);
+    let walk = estimate(n, || surface.sample(wo, &mut rng).map(|s| s.weight));
+    let techniques = TECHNIQUES
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let b = technique(name, slope, c);
+            let mut rng = Pcg::seed_from_u64(seed + 1 + k as u64);
+            estimate(n, || {
+                let (uc, u) = uniforms(&mut rng);
+                b.sample(wo, uc, u).map(|s| s.weight)
+            })
+        })
+        .collect();
+    AlbedoCell { material, alpha, mu, walk, techniques }
+}
+
+/// The binned f·cos θi (F = 1, channel 0) of `n` samples, normalized by n: an estimate of
+/// ∫_bin f cos dω per bin.
+fn lobe(n: usize, mut draw: impl FnMut() -> Option<(Vec3, f32)>) -> Vec<f64> {
+    let mut h = vec![0.0; LOBE_NZ * LOBE_NPHI];
+    for _ in 0..n {
+        if let Some((w, weight)) = draw() {
+            if w.z <= 0.0 {
+                continue;
+            }
+            let iz = ((w.z * LOBE_NZ as f32) as usize).min(LOBE_NZ - 1);
+            let phi = w.y.atan2(w.x).rem_euclid(core::f32::consts::TAU);
+            let ip = ((phi / core::f32::consts::TAU * LOBE_NPHI as f32) as usize).min(LOBE_NPHI - 1);
+            h[iz * LOBE_NPHI + ip] += f64::from(weight) / n as f64;
+        }
+    }
+    h
+}
+
+fn l1(a: &[f64], reference: &[f64]) -> f64 {
+    let d: f64 = a.iter().zip(reference).map(|(x, y)| (x - y).abs()).sum();
+    d / reference.iter().sum::<f64>()
+}
+
+/// One lobe case: L1 of each technique against the walk, and the walk-vs-walk noise floor.
+struct LobeCell {
+    alpha: f32,
+    theta: f32,
+    floor: f64,
+    errors: Vec<f64>,
+}
+
+fn lobe_cell(alpha: f32, theta: f32, n: usize, seed: u64) -> LobeCell {
+    let slope = Ggx::isotropic(alpha).unwrap();
+    let c = Conductor::perfect();
+    let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+    let surface = Microsurface::new(UniformHeight, slope, c);
+    let walk_lobe = |seed: u64| {
+        let mut rng = Pcg::seed_from_u64(seed);
+        lobe(n, || surface.sample(wo, &mut rng).map(|s| (s.wo, s.weight.x)))
+    };
+    let (walk, walk_b) = (walk_lobe(seed), walk_lobe(seed + 1));
+    let errors = TECHNIQUES
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let b = technique(name, slope, c);
+            let mut rng = Pcg::seed_from_u64(seed + 2 + k as u64);
+            let h = lobe(n, || {
+                let (uc, u) = uniforms(&mut rng);
+                b.sample(wo, uc, u).map(|s| (s.wi, s.weight.x))
+            });
+            l1(&h, &walk)
+        })
+        .collect();
+    LobeCell { alpha, theta, floor: l1(&walk_b, &walk), errors }
+}
+
+/// Runs `f` over `0..n` on all cores, results in order.
+fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let next = AtomicUsize::new(0);
+    let out: Mutex<Vec<Option<T>>> = Mutex::new((0..n).map(|_| None).collect());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= n {
+                        break;
+                    }
+                    let r = f(i);
+                    out.lock().unwrap()[i] = Some(r);
+                }
+            });
+        }
+    });
+    out.into_inner().unwrap().into_iter().map(Option::unwrap).collect()
+}
+
+fn main() -> std::io::Result<()> {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let s = if quick {
+        Settings {
+            alphas: vec![0.1, 0.5, 1.0],
+            mus: vec![0.1, 0.5, 1.0],
+            albedo_samples: 20_000,
+            lobe_samples: 100_000,
+        }
+    } else {
+        Settings {
+            alphas: vec![0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0],
+            mus: vec![0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9, 1.0],
+            albedo_samples: 100_000,
+            lobe_samples: 1_000_000,
+        }
+    };
+    let start = Instant::now();
+    let mats = materials();
+    let mut jobs: Vec<(usize, f32, f32)> = vec![];
+    for m in 0..mats.len() {
+        for &a in &s.alphas {
+            for &mu in &s.mus {
+                jobs.push((m, a, mu));
+            }
+        }
+    }
+    eprintln!("albedo: {} cells × {} samples × 4 models", jobs.len(), s.albedo_samples);
+    let cells = par_map(jobs.len(), |i| {
+        let (m, a, mu) = jobs[i];
+        albedo_cell(mats[m].0, mats[m].1, a, mu, s.albedo_samples, 16_000 + 8 * i as u64)
+    });
+    // anisotropic slopes, compensated at α = √(αx αy): F = 1, φo ∈ {0, π/4, π/2}
+    let anisotropic = [(0.1f32, 0.4f32), (0.2, 0.8), (0.5, 1.0)];
+    let mut aniso_jobs = vec![];
+    for (k, &(ax, ay)) in anisotropic.iter().enumerate() {
+        for phi in [0.0f32, core::f32::consts::FRAC_PI_4, core::f32::consts::FRAC_PI_2] {
+            for &mu in &s.mus {
+                aniso_jobs.push((k, ax, ay, phi, mu));
+            }
+        }
+    }
+    eprintln!("anisotropic albedo: {} cells × {} samples × 4 models", aniso_jobs.len(), s.albedo_samples);
+    let aniso_cells = par_map(aniso_jobs.len(), |i| {
+        let (_, ax, ay, phi, mu) = aniso_jobs[i];
+        let slope = Ggx::new(ax, ay).unwrap();
+        albedo_cell_of("F = 1", Conductor::perfect(), slope, mu, phi, s.albedo_samples, 18_000 + 8 * i as u64)
+    });
+    let lobe_jobs: Vec<(f32, f32)> =
+        [0.1f32, 0.3, 0.6, 1.0].iter().flat_map(|&a| [0.0f32, 1.0, 1.4].map(|t| (a, t))).collect();
+    eprintln!("lobes: {} cases × {} samples × 5 runs", lobe_jobs.len(), s.lobe_samples);
+    let lobes = par_map(lobe_jobs.len(), |i| {
+        lobe_cell(lobe_jobs[i].0, lobe_jobs[i].1, s.lobe_samples, 17_000 + 8 * i as u64)
+    });
+
+    let dir = std::path::Path::new("target/compensation");
+    std::fs::create_dir_all(dir)?;
+    let mut csv = String::from("material,alpha,mu,channel,walk,walk_se");
+    for t in TECHNIQUES {
+        write!(csv, ",{t},{t}_se").unwrap();
+    }
+    csv.push('\n');
+    for cell in &cells {
+        for c in 0..3 {
+            write!(
+                csv,
+                "{},{},{},{c},{:.6},{:.2e}",
+                cell.material, cell.alpha, cell.mu, cell.walk.mean[c], cell.walk.se[c]
+            )
+            .unwrap();
+            for e in &cell.techniques {
+                write!(csv, ",{:.6},{:.2e}", e.mean[c], e.se[c]).unwrap();
+            }
+            csv.push('\n');
+        }
+    }
+    std::fs::write(dir.join("albedo.csv"), csv)?;
+    let mut csv = String::from("alpha,theta_o,walk_noise_floor");
+    for t in TECHNIQUES {
+        write!(csv, ",{t}").unwrap();
+    }
+    csv.push('\n');
+    for l in &lobes {
+        write!(csv, "{},{},{:.4}", l.alpha, l.theta, l.floor).unwrap();
+        for e in &l.errors {
+            write!(csv, ",{e:.4}").unwrap();
+        }
+        csv.push('\n');
+    }
+    std::fs::write(dir.join("lobes.csv"), csv)?;
+
+    // the markdown tables
+    let mut md = String::new();
+    writeln!(
+        md,
+        "Directional albedo error against the walk (GGX, α ∈ {:?}, μo ∈ {:?}, {} samples per model and cell; \
+         max |A − A_walk| and RMS over cells and RGB channels; largest standard error of a difference {:.1e}):\n",
+        s.alphas,
+        s.mus,
+        s.albedo_samples,
+        cells
+            .iter()
+            .flat_map(|c| c.techniques.iter().flat_map(|e| (0..3).map(|ch| e.se[ch].hypot(c.walk.se[ch]))))
+            .fold(0.0, f64::max)
+    )
+    .unwrap();
+    writeln!(md, "| material | single: max | RMS | Kulla–Conty: max | RMS | Turquin: max | RMS |").unwrap();
+    writeln!(md, "|---|---|---|---|---|---|---|").unwrap();
+    for (name, _) in &mats {
+        write!(md, "| {name} |").unwrap();
+        for k in 0..TECHNIQUES.len() {
+            let errs: Vec<f64> = cells
+                .iter()
+                .filter(|c| c.material == *name)
+                .flat_map(|c| (0..3).map(move |ch| c.techniques[k].mean[ch] - c.walk.mean[ch]))
+                .collect();
+            let max = errs.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+            let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+            write!(md, " {max:.4} | {rms:.4} |").unwrap();
+        }
+        md.push('\n');
+    }
+    writeln!(
+        md,
+        "\nAnisotropic GGX, F = 1, compensated at α = √(αx αy): albedo error over μo (as above) and \
+         φo ∈ {{0, π/4, π/2}}:\n"
+    )
+    .unwrap();
+    writeln!(md, "| αx, αy | single: max | RMS | Kulla–Conty: max | RMS | Turquin: max | RMS |").unwrap();
+    writeln!(md, "|---|---|---|---|---|---|---|").unwrap();
+    for (k, (ax, ay)) in anisotropic.iter().enumerate() {
+        write!(md, "| {ax}, {ay} |").unwrap();
+        for t in 0..TECHNIQUES.len() {
+            let errs: Vec<f64> = aniso_jobs
+                .iter()
+                .zip(&aniso_cells)
+                .filter(|(j, _)| j.0 == k)
+                .map(|(_, c)| c.techniques[t].mean[0] - c.walk.mean[0])
+                .collect();
+            let max = errs.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+            let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+            write!(md, " {max:.4} | {rms:.4} |").unwrap();
+        }
+        md.push('\n');
+    }
+    writeln!(
+        md,
+        "\nLobe-shape error against the walk (F = 1, relative L1 of f·cos θi binned in {LOBE_NZ} × {LOBE_NPHI} \
+         equal-area cells of the hemisphere, {} samples per run; the floor is the L1 distance between two \
+         independent walk runs, the noise in every entry):\n",
+        s.lobe_samples
+    )
+    .unwrap();
+    writeln!(md, "| α | θo | floor | single | Kulla–Conty | Turquin |").unwrap();
+    writeln!(md, "|---|---|---|---|---|---|").unwrap();
+    for l in &lobes {
+        write!(md, "| {} | {} | {:.3} |", l.alpha, l.theta, l.floor).unwrap();
+        for e in &l.errors {
+            write!(md, " {e:.3} |").unwrap();
+        }
+        md.push('\n');
+    }
+    // cost per sample, as measured in this run (one thread of the run's pool)
+    let mean_ns = |f: &dyn Fn(&AlbedoCell) -> f64| cells.iter().map(f).sum::<f64>() / cells.len() as f64;
+    writeln!(
+        md,
+        "\nMean time per sample in this run (all cells, one thread each): walk {:.0} ns, single {:.0} ns, \
+         Kulla–Conty {:.0} ns, Turquin {:.0} ns.",
+        mean_ns(&|c| c.walk.ns),
+        mean_ns(&|c| c.techniques[0].ns),
+        mean_ns(&|c| c.techniques[1].ns),
+        mean_ns(&|c| c.techniques[2].ns)
+    )
+    .unwrap();
+    std::fs::write(dir.join("table.md"), &md)?;
+    println!("{md}");
+    eprintln!("wrote {} in {:.1} s", dir.display(), start.elapsed().as_secs_f64());
+    Ok(())
+}

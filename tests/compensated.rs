@@ -1,0 +1,349 @@
+//! Energy-compensated conductors (`CompensatedConductor`): the sampler against its density
+//! (chi-square), the sample weights against eval·cos/pdf, the white furnace (F = 1) within the
+//! albedo tables' interpolation error, the normalization of the Kulla–Conty lobe, its
+//! reciprocity, and the constructor's range.
+
+mod common;
+
+use common::chi2::{Chi2Grid, chi2_test};
+use common::quadrature::integrate_sphere;
+use common::{Stats, assert_mean, dir, family_z, sidak, uniform32};
+use microsurface::glam::{Vec2, Vec3};
+use microsurface::{
+    AlbedoTable, Beckmann, Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Ggx,
+    TabulatedSlope,
+};
+
+/// The tables' largest interpolation error of E (measured by the generator, `AlbedoTable`).
+const TABLE_ERROR_GGX: f64 = 1.2e-3;
+const TABLE_ERROR_BECKMANN: f64 = 3.7e-3;
+
+fn ggx(a: f32) -> Ggx {
+    Ggx::isotropic(a).unwrap()
+}
+
+fn beckmann(a: f32) -> Beckmann {
+    Beckmann::isotropic(a).unwrap()
+}
+
+fn gold() -> Conductor {
+    Conductor::new(ComplexIor::GOLD)
+}
+
+/// |a − b| ≤ rel·max(|a|, |b|), or both below the normal f32 range (subnormal values carry
+/// no relative precision).
+fn rel_close(a: Vec3, b: Vec3, rel: f32) -> bool {
+    let scale = a.abs().max(b.abs()).max_element();
+    (a - b).abs().max_element() <= rel * scale || scale < f32::MIN_POSITIVE
+}
+
+/// A sample from fresh uniforms.
+fn draw<B: Bsdf + ?Sized>(b: &B, wo: Vec3, rng: &mut common::TestRng) -> Option<microsurface::BsdfSample> {
+    let uc = uniform32(rng);
+    let u = Vec2::new(uniform32(rng), uniform32(rng));
+    b.sample(wo, uc, u)
+}
+
+/// The chi-square cases: (label, BSDF, θo).
+fn chi2_cases() -> Vec<(String, Box<dyn Bsdf>, f64)> {
+    let mut v: Vec<(String, Box<dyn Bsdf>, f64)> = vec![];
+    let kc = Compensation::KullaConty;
+    for (a, theta, scheme) in [(0.3f32, 0.5f64, kc), (1.0, 1.3, Compensation::Turquin)] {
+        v.push((
+            format!("{scheme:?} GGX gold α = {a} θo = {theta}"),
+            Box::new(CompensatedConductor::new(ggx(a), gold(), scheme).unwrap()),
+            theta,
+        ));
+    }
+    for (a, theta) in [(0.08f32, 1.4f64), (1.0, 0.3)] {
+        v.push((
+            format!("KullaConty Beckmann gold α = {a} θo = {theta}"),
+            Box::new(CompensatedConductor::new(beckmann(a), gold(), kc).unwrap()),
+            theta,
+        ));
+    }
+    // anisotropic slopes (the tables at √(αx αy)): the sampler is still exact
+    v.push((
+        "KullaConty GGX gold αx = 0.2, αy = 0.8".into(),
+        Box::new(
+            CompensatedConductor::new(Ggx::new(0.2, 0.8).unwrap(), gold(), Compensation::KullaConty).unwrap(),
+        ),
+        0.9,
+    ));
+    v
+}
+
+/// `sample` against `pdf` (chi-square, 20 × 40 cells of the sphere, 100 000 samples, family-wise
+/// level 1 % over the cases); every sample has an exact pdf equal to `pdf(wo, wi)` and a weight
+/// equal to eval·cos θi/pdf (relative 1e-4); the sampler refuses (reflections below the
+/// horizon) exactly the mass 1 − ∫pdf (binomial, z·SE + the quadrature's 1e-3).
+#[test]
+fn sample_matches_pdf_and_weights_match_eval() {
+    let cases = chi2_cases();
+    let alpha = sidak(0.01, cases.len());
+    let z = family_z(0.01, cases.len());
+    let n = 100_000;
+    for (k, (label, b, theta)) in cases.iter().enumerate() {
+        let wo = dir(*theta, 0.4);
+        // the single-scattering lobe's reflections below the horizon are refused: ∫pdf < 1
+        let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 8, 16, false, 1e-4, 6);
+        assert!(mass <= 1.0 + 1e-3, "{label}: ∫pdf = {mass} > 1");
+        let mut rng = common::rng(1600 + k as u64);
+        let out = chi2_test(
+            label,
+            Chi2Grid { quad_tol: 1e-4, max_depth: 6, ..Chi2Grid::sphere(20, 40) },
+            |w| f64::from(b.pdf(wo, w)),
+            || {
+                let s = draw(b.as_ref(), wo, &mut rng)?;
+                assert!(
+                    s.flags.exact_pdf && s.flags.reflection && !s.flags.specular,
+                    "{label}: flags {:?}",
+                    s.flags
+                );
+                let (v, pdf) = b.eval_with_pdf(wo, s.wi);
+                assert!(v.exact, "{label}: eval not exact");
+                assert!((pdf - s.pdf).abs() <= 1e-6 * pdf, "{label}: pdf {pdf} ≠ sample's {}", s.pdf);
+                assert_eq!(pdf, b.pdf(wo, s.wi), "{label}: eval_with_pdf and pdf disagree");
+                assert_eq!(v, b.eval(wo, s.wi), "{label}: eval_with_pdf and eval disagree");
+                let expected = v.f * (s.wi.z / s.pdf);
+                assert!(
+                    rel_close(s.weight, expected, 1e-4),
+                    "{label}: weight {} ≠ eval·cos/pdf = {expected} at wi = {}",
+                    s.weight,
+                    s.wi
+                );
+                Some(s.wi)
+            },
+            n,
+            alpha,
+            mass,
+        );
+        let p_none = (1.0 - mass).clamp(0.0, 1.0);
+        let se = (p_none * (1.0 - p_none) / n as f64).sqrt();
+        let frac = out.failures as f64 / n as f64;
+        assert!(
+            (frac - p_none).abs() <= z * se + 1e-3,
+            "{label}: sample refused {frac:.5} of the time, 1 − ∫pdf = {p_none:.5} (N = {n}, SE = {se:.2e}, z = {z:.2})"
+        );
+        println!(
+            "{label}: χ² = {:.1}, dof = {}, p = {:.4}, ∫pdf = {mass:.5}",
+            out.statistic, out.dof, out.p_value
+        );
+    }
+}
+
+/// The white furnace: with F = 1 the mean sample weight (the albedo ∫ f cos dωi, unbiased given
+/// the chi-square and weight tests) is 1 within z·SE plus the table's interpolation error ε
+/// (Kulla–Conty: albedo − 1 = E_exact(μo) − E_table(μo); Turquin: E_exact/E_table − 1, so
+/// ε/E_table(μo)), for α ∈ {0.05, 0.2, 0.5, 1} and μo ∈ {0.1, 0.4, 0.7, 1}, both families and
+/// both schemes (64 cases, family-wise level 1 %; each asserts SE ≤ 2e-3 for Kulla–Conty (its σ̂ ≈ 0.45 comes from the refused single-scattering samples below the horizon) and 5e-3 for Turquin, N = 80 000).
+#[test]
+fn white_furnace_within_table_error() {
+    let alphas = [0.05f32, 0.2, 0.5, 1.0];
+    let mus = [0.1f32, 0.4, 0.7, 1.0];
+    let z = family_z(0.01, 64);
+    let n = 80_000;
+    let mut worst: f64 = 0.0;
+    #[allow(clippy::too_many_arguments)]
+    fn run<S: TabulatedSlope>(
+        slope: S,
+        table: AlbedoTable,
+        eps: f64,
+        mu: f32,
+        n: usize,
+        z: f64,
+        seed: u64,
+        worst: &mut f64,
+    ) {
+        let alpha = slope.alpha_x();
+        for scheme in [Compensation::KullaConty, Compensation::Turquin] {
+            let b = CompensatedConductor::new(slope, Conductor::perfect(), scheme).unwrap();
+            let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+            let mut rng = common::rng(seed + scheme as u64);
+            let mut stats = Stats::default();
+            for _ in 0..n {
+                stats.push(draw(&b, wo, &mut rng).map_or(0.0, |s| f64::from(s.weight.x)));
+            }
+            let e_table = f64::from(table.directional(mu, alpha).unwrap());
+            let tol = match scheme {
+                Compensation::KullaConty => eps,
+                Compensation::Turquin => eps / e_table,
+            };
+            let label = format!("white furnace {} {scheme:?} α = {alpha} μo = {mu}", table.name());
+            // Turquin's weights are the single-scattering weights over E(μo) (up to 3.3 at α = 1)
+            let max_se = if scheme == Compensation::KullaConty { 2e-3 } else { 5e-3 };
+            assert_mean(&label, &stats, 1.0, z, max_se, tol);
+            println!("{label}: mean {:.5}, SE {:.1e}, tol {tol:.1e}", stats.mean(), stats.se());
+            *worst = worst.max((stats.mean() - 1.0).abs());
+        }
+    }
+    let mut seed = 1700;
+    for &a in &alphas {
+        for &mu in &mus {
+            run(ggx(a), AlbedoTable::GGX, TABLE_ERROR_GGX, mu, n, z, seed, &mut worst);
+            run(beckmann(a), AlbedoTable::BECKMANN, TABLE_ERROR_BECKMANN, mu, n, z, seed + 2, &mut worst);
+            seed += 4;
+        }
+    }
+    println!("white furnace: largest |albedo − 1| = {worst:.2e} (N = {n} per case, z = {z:.2})");
+}
+
+/// The Kulla–Conty lobe f_KC − f_ss integrates to F_ms (1 − E(μo)) over the hemisphere (by
+/// adaptive quadrature, to 2e-5 relative + 1e-6; the E_avg it is normalized by is the exact average
+/// of the interpolated E), for gold (coloured F_ms) and F = 1 (F_ms = 1).
+#[test]
+fn kulla_conty_lobe_is_normalized() {
+    for (a, mu) in [(0.1f32, 0.3f32), (0.5, 0.8), (1.0, 0.05), (1.0, 1.0)] {
+        for (name, conductor) in [("gold", gold()), ("F = 1", Conductor::perfect())] {
+            let b = CompensatedConductor::new(ggx(a), conductor, Compensation::KullaConty).unwrap();
+            let ss = *b.single_scattering();
+            let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+            // the channels' sum (each channel's F_ms comes from the same formula)
+            let lobe = integrate_sphere(
+                &mut |w| f64::from((b.eval(wo, w).f - ss.eval(wo, w).f).element_sum() * w.z),
+                8,
+                16,
+                true,
+                1e-6,
+                6,
+            );
+            let c_o = 1.0 - f64::from(b.directional_albedo(mu).unwrap());
+            let fms = b.fresnel_multiple_scattering();
+            if name == "F = 1" {
+                assert!((fms - Vec3::ONE).abs().max_element() < 1e-6, "F_ms = {fms} for F = 1");
+            }
+            let expected = f64::from(fms.element_sum()) * c_o;
+            assert!(
+                (lobe - expected).abs() <= 2e-5 * expected + 1e-6,
+                "{name} α = {a} μo = {mu}: ∫ Σ f_ms cos = {lobe:.7e}, Σ F_ms (1 − E) = {expected:.7e}"
+            );
+        }
+    }
+}
+
+/// F_avg by the constructor's 4 panels of Gauss–Legendre equals a 2000-panel midpoint rule to
+/// 1e-6 for the metal presets.
+#[test]
+fn fresnel_average_is_accurate() {
+    for ior in [ComplexIor::GOLD, ComplexIor::COPPER, ComplexIor::ALUMINIUM, ComplexIor::SILVER] {
+        let c = Conductor::new(ior);
+        let b = CompensatedConductor::new(ggx(0.5), c, Compensation::KullaConty).unwrap();
+        let n = 20_000;
+        let mut reference = [0.0f64; 3];
+        for k in 0..n {
+            let mu = (k as f64 + 0.5) / n as f64;
+            let f = c.fresnel(mu as f32);
+            for (ch, r) in reference.iter_mut().enumerate() {
+                *r += 2.0 * f64::from(f[ch]) * mu / n as f64;
+            }
+        }
+        let got = b.fresnel_average();
+        for ch in 0..3 {
+            assert!(
+                (f64::from(got[ch]) - reference[ch]).abs() < 1e-6,
+                "{ior:?}: F_avg {got} vs {reference:?}"
+            );
+        }
+    }
+}
+
+/// Kulla–Conty is reciprocal: f(ωo, ωi) = f(ωi, ωo) (relative 1e-4, the single-scattering
+/// lobe's f32 rounding), on 2000 random pairs of upper-hemisphere directions per case.
+#[test]
+fn kulla_conty_is_reciprocal() {
+    let mut rng = common::rng(1800);
+    for a in [0.05f32, 0.3, 1.0] {
+        let b = CompensatedConductor::new(beckmann(a), gold(), Compensation::KullaConty).unwrap();
+        for _ in 0..2000 {
+            let mut d = || {
+                let z = uniform32(&mut rng);
+                let phi = std::f64::consts::TAU * f64::from(uniform32(&mut rng));
+                dir(f64::from(z).acos(), phi)
+            };
+            let (wo, wi) = (d(), d());
+            if wo.z <= 0.0 || wi.z <= 0.0 {
+                continue;
+            }
+            let (f, g) = (b.eval(wo, wi).f, b.eval(wi, wo).f);
+            assert!(
+                rel_close(f, g, 1e-4),
+                "α = {a}: f(wo, wi) = {f}, f(wi, wo) = {g} at wo = {wo}, wi = {wi}"
+            );
+        }
+    }
+}
+
+/// The constructor rejects √(αx αy) > 1 (beyond the tables), accepts the range's end and an
+/// anisotropic surface inside it; smooth surfaces are the single-scattering Dirac mirror.
+#[test]
+fn constructor_range_and_smooth_limit() {
+    for (ax, ay) in [(1.01f32, 1.01f32), (2.0, 0.6), (5.0, 5.0)] {
+        let r = CompensatedConductor::new(Ggx::new(ax, ay).unwrap(), gold(), Compensation::KullaConty);
+        assert!(
+            matches!(r, Err(microsurface::Error::InvalidParameter { name: "alpha", .. })),
+            "αx = {ax}, αy = {ay}: {r:?}"
+        );
+    }
+    assert!(CompensatedConductor::new(ggx(1.0), gold(), Compensation::Turquin).is_ok());
+    let aniso =
+        CompensatedConductor::new(Ggx::new(2.0, 0.25).unwrap(), gold(), Compensation::KullaConty).unwrap();
+    assert!((aniso.table_alpha() - 0.5f32.sqrt()).abs() < 1e-6);
+    let smooth = CompensatedConductor::new(ggx(1e-4), gold(), Compensation::KullaConty).unwrap();
+    assert!(smooth.flags().specular);
+    let wo = dir(0.5, 0.0);
+    assert_eq!(
+        smooth.sample(wo, 0.3, Vec2::new(0.2, 0.7)),
+        smooth.single_scattering().sample(wo, 0.3, Vec2::new(0.2, 0.7))
+    );
+    assert_eq!(smooth.pdf(wo, Vec3::Z), 0.0);
+}
+
+/// Backfacing views (a shading normal turned away) have no table: the lobe is the
+/// single-scattering lobe, bit for bit.
+#[test]
+fn backfacing_views_are_single_scattering() {
+    let b = CompensatedConductor::new(ggx(0.4), gold(), Compensation::KullaConty).unwrap();
+    let ss = *b.single_scattering();
+    let wo = dir(1.8, 0.3);
+    let mut rng = common::rng(1900);
+    for _ in 0..200 {
+        let uc = uniform32(&mut rng);
+        let u = Vec2::new(uniform32(&mut rng), uniform32(&mut rng));
+        assert_eq!(b.sample(wo, uc, u), ss.sample(wo, uc, u));
+        let wi = dir(f64::from(uniform32(&mut rng)) * 1.5, 2.0);
+        assert_eq!(b.eval_with_pdf(wo, wi), ss.eval_with_pdf(wo, wi));
+    }
+}
+
+/// Invalid arguments (NaN, non-unit or zero directions; uniforms outside [0, 1)) trip the debug
+/// assertion in debug builds and give the documented nothing in release builds: f = 0, pdf = 0,
+/// `None`.
+#[test]
+fn invalid_input_gives_nothing() {
+    let ok = dir(0.5, 0.2);
+    let bad = [Vec3::NAN, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0)];
+    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
+        let b = CompensatedConductor::new(ggx(0.4), gold(), scheme).unwrap();
+        let check = |label: &str, call: &dyn Fn() -> bool| {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(call));
+            if cfg!(debug_assertions) {
+                assert!(r.is_err(), "{scheme:?} {label}: no debug assertion");
+            } else {
+                assert!(r.expect("no panic in release"), "{scheme:?} {label}: not nothing");
+            }
+        };
+        for w in bad {
+            check("eval(bad, ok)", &|| b.eval(w, ok).f == Vec3::ZERO);
+            check("eval(ok, bad)", &|| b.eval(ok, w).f == Vec3::ZERO);
+            check("pdf(bad, ok)", &|| b.pdf(w, ok) == 0.0);
+            check("pdf(ok, bad)", &|| b.pdf(ok, w) == 0.0);
+            check("eval_with_pdf(ok, bad)", &|| {
+                b.eval_with_pdf(ok, w) == (microsurface::BsdfValue::ZERO, 0.0)
+            });
+            check("sample(bad)", &|| b.sample(w, 0.5, Vec2::splat(0.5)).is_none());
+        }
+        for (uc, u) in [(1.0, Vec2::splat(0.5)), (0.5, Vec2::new(f32::NAN, 0.2)), (-0.1, Vec2::splat(0.5))] {
+            check("sample(uniforms)", &|| b.sample(ok, uc, u).is_none());
+        }
+    }
+}

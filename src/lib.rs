@@ -124,9 +124,9 @@ mod vndf;
 
 pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
 pub use bsdf::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, CompensatedConductor,
-    Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame,
-    SpecularEvent, SpecularLimit, TabulatedSlope, Technique, Transport,
+    AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
+    CompensatedConductor, Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA,
+    SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport,
 };
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;

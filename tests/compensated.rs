@@ -10,8 +10,8 @@ use common::quadrature::integrate_sphere;
 use common::{Stats, assert_mean, dir, family_z, sidak, uniform32};
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    AlbedoTable, Beckmann, Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Ggx,
-    TabulatedSlope,
+    AlbedoTable, AlbedoTabulated, Beckmann, Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor,
+    Ggx,
 };
 
 /// The tables' largest interpolation error of E (measured by the generator, `AlbedoTable`).
@@ -145,7 +145,7 @@ fn white_furnace_within_table_error() {
     let n = 80_000;
     let mut worst: f64 = 0.0;
     #[allow(clippy::too_many_arguments)]
-    fn run<S: TabulatedSlope>(
+    fn run<S: AlbedoTabulated>(
         slope: S,
         table: AlbedoTable,
         eps: f64,

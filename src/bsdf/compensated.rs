@@ -37,16 +37,16 @@ const FRESNEL_PANELS: usize = 4;
 
 /// A slope family with single-scattering albedo tables: the families a
 /// [`CompensatedConductor`] can be built on.
-pub trait TabulatedSlope: MicrosurfaceSlope {
+pub trait AlbedoTabulated: MicrosurfaceSlope {
     /// The family's tables.
     const ALBEDO: AlbedoTable;
 }
 
-impl TabulatedSlope for Ggx {
+impl AlbedoTabulated for Ggx {
     const ALBEDO: AlbedoTable = AlbedoTable::GGX;
 }
 
-impl TabulatedSlope for Beckmann {
+impl AlbedoTabulated for Beckmann {
     const ALBEDO: AlbedoTable = AlbedoTable::BECKMANN;
 }
 
@@ -153,7 +153,7 @@ pub struct CompensatedConductor<S> {
     scale: Vec3,
 }
 
-impl<S: TabulatedSlope> CompensatedConductor<S> {
+impl<S: AlbedoTabulated> CompensatedConductor<S> {
     /// The compensated BRDF of a conductor on the given slopes.
     ///
     /// # Errors

@@ -25,7 +25,7 @@ mod seed;
 mod specular;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
-pub use compensated::{CompensatedConductor, Compensation, TabulatedSlope};
+pub use compensated::{AlbedoTabulated, CompensatedConductor, Compensation};
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
 pub use specular::{SpecularEvent, SpecularLimit};

@@ -6,7 +6,14 @@
 # Usage: benches/compare-listing.sh [path/to/heitz2016-listing]
 set -e
 cd "$(dirname "$0")/.."
-listing_dir=${1:-../shared/bench/heitz2016-listing}
+# default: the shared directory beside the main checkout (../shared) or beside a worktree of it
+listing_dir=${1:-}
+if [ -z "$listing_dir" ]; then
+  for d in ../shared/bench/heitz2016-listing ../../shared/bench/heitz2016-listing; do
+    if [ -x "$d/run.sh" ]; then listing_dir=$d; break; fi
+  done
+fi
+[ -n "$listing_dir" ] || { echo "heitz2016-listing not found; pass its path" >&2; exit 2; }
 out=${TMPDIR:-/tmp}/compare-listing.$$
 "$listing_dir/run.sh" >"$out.listing"
 MICROSURFACE_BENCH_CLOCK=cpu cargo bench --bench walk -- '^listing/' \

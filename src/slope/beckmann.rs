@@ -368,19 +368,21 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64, f64) {
 /// cot θ = κ (any sign), by solving ln S(x̃) − ln S(κ) = ln u.
 ///
 /// A tabulated initial guess ([`GuessTable`], bilinear in (|κ|/(1 + |κ|), u)) followed by one
-/// Halley step on g = ln(S(x̃)/(u S(κ))), written with a single logarithm (the Gaussian factors
-/// of S(x̃) and S(κ) cancel analytically: κ² − x̃² = (κ − x̃)(κ + x̃)). The step is accepted when
-/// its a-posteriori error estimate, `ERROR_ESTIMATE_SAFETY`·(g″/g′)²·|step|³ for Halley's
-/// step (the cubic term of its error, e₁ ≈ (A² − B)e₀³ with A = g″/2g′; B ≈ 0 where ln S is
-/// locally quadratic) or the Newton estimate of [`visible_slope_x_above`], is below
-/// `NEWTON_TOLERANCE`·(1 + |x̃|), the f32 resolution of x̃; otherwise (the outer cells of the
-/// u axis, a few per cent of the samples) the safeguarded iteration of [`visible_slope_x_above`]
-/// continues from it. So the result meets the same tolerance as that iteration; the sampled
-/// CDF F differs from u by less than 2e-7 for |κ| ≤ 64 (measured 9.0e-8 over a grid of 2·321
-/// κ by 251 u) and less than 1e-5 for |κ| ≤ 400 (measured 4.8e-6 at κ = −199.5; the iteration
-/// alone: 8.8e-6), where the f32 resolution of x̃ that the tolerance follows dominates (the unit
-/// test `fast_visible_slope_meets_its_cdf_bound` asserts both). 4.3 % of the grid's samples
-/// take the fallback. The tails are cut as in [`visible_slope_x_above`].
+/// Halley step on the residual g. Below the horizon g = ln(S(x̃)/(u S(κ))), written with a single
+/// logarithm (the Gaussian factors of S(x̃) and S(κ) cancel analytically:
+/// κ² − x̃² = (κ − x̃)(κ + x̃)); above it (κ ≥ 0, where F cannot underflow) g = F(x̃)/u − 1, with
+/// no logarithm. Both have g′ ≈ d ln F/dx̃ at the root. The step is accepted when its
+/// a-posteriori error estimate, `ERROR_ESTIMATE_SAFETY`·(g″/g′)²·|step|³ for Halley's step (the
+/// cubic term of its error, e₁ ≈ (A² − B)e₀³ with A = g″/2g′, B ≈ 0 where g is locally
+/// quadratic) or ½·`ERROR_ESTIMATE_SAFETY`·|g″/g′|·step² for Newton's, times g′ (the error of
+/// ln F) is below `FAST_LN_CDF_TOLERANCE`; otherwise (the outer cells of the u axis: 5.4 % of a
+/// uniform grid of u) the safeguarded iteration of [`visible_slope_x_above`] continues from it
+/// within the bracket the evaluation established. The sampled CDF F differs from u by less
+/// than 2e-7 for |κ| ≤ 64 (measured 9.0e-8 over a grid of 2·321 κ by 251 u, at κ = −56, from
+/// the fallback's tolerance) and less than 1e-5 for |κ| ≤ 400 (measured 4.8e-6 at κ = −199.5;
+/// the iteration alone: 8.8e-6), where the f32 resolution of x̃ that the iteration's tolerance
+/// follows dominates (the unit test `fast_visible_slope_meets_its_cdf_bound` asserts both).
+/// The tails are cut as in [`visible_slope_x_above`].
 #[inline]
 fn visible_slope_x(kappa: f64, u: f64) -> f64 {
     let u = cut_tails64(u);
@@ -406,27 +408,33 @@ fn visible_slope_x(kappa: f64, u: f64) -> f64 {
         tests::FALLBACKS.with(|n| n.set(n.get() + 1));
         return visible_slope_x_above(kappa, f64::NEG_INFINITY, u);
     }
-    let (g, derivative, over_gap) = if kappa < 0.0 {
+    let (g, derivative, second) = if kappa < 0.0 {
         // x̃ < κ < 0: g = (κ − x̃)(κ + x̃) + ln(ψ(−x̃)/(u ψ(−κ)))
         let psi_x = psi(kappa, -x0);
         let over_gap = 2.0 / psi_x;
-        ((kappa - x0) * (kappa + x0) + (psi_x * scale).ln(), (kappa - x0) * over_gap, over_gap)
+        let derivative = (kappa - x0) * over_gap;
+        // g″ = −g′/(κ − x̃) − g′(2x̃ + g′) (see `refine`)
+        let second = -over_gap - derivative * (2.0 * x0 + derivative);
+        ((kappa - x0) * (kappa + x0) + (psi_x * scale).ln(), derivative, second)
     } else {
-        // κ ≥ 0: S(x̃) = e^{−x̃²}ψ(−x̃)/2 for x̃ < 0, κ(√π/2)(2 − e^{−x̃²}erfcx(x̃)) + e^{−x̃²}/2
-        // for x̃ ≥ 0, both with one erfcx(|x̃|) and one exponential (which cannot underflow:
-        // x̃ > −4.1 above the cut tail), selected without a branch (the sign of x̃ is a coin
-        // flip near the mode)
+        // κ ≥ 0: F(x̃)/u − 1 in linear space (no logarithm; F ≥ 2⁻²⁴ e^{…} never underflows
+        // here), with S(x̃) = e^{−x̃²}ψ(−x̃)/2 for x̃ < 0 and κ(√π/2)(2 − e^{−x̃²}erfcx(x̃)) +
+        // e^{−x̃²}/2 for x̃ ≥ 0, both with one erfcx(|x̃|) and one exponential (which cannot
+        // underflow: x̃ > −4.1 above the cut tail), selected without a branch (the sign of x̃ is
+        // a coin flip near the mode). Its derivative is p(x̃)/u, which near the root is g′ of
+        // the logarithmic form, so the acceptance test below reads the same.
         let gauss = (-x0 * x0).exp();
         let e = SQRT_PI * erfcx64(x0.abs());
         let below = 0.5 * gauss * (1.0 + kappa * e);
         let above = kappa * 0.5 * (2.0 * SQRT_PI - gauss * e) + 0.5 * gauss;
         let s_x = if x0 < 0.0 { below } else { above };
-        let over_gap = gauss / s_x;
-        ((s_x * scale).ln(), (kappa - x0) * over_gap, over_gap)
+        let derivative = (kappa - x0) * gauss * scale;
+        // p′/p = −1/(κ − x̃) − 2x̃
+        let second = derivative * (-1.0 / (kappa - x0) - 2.0 * x0);
+        (s_x * scale - 1.0, derivative, second)
     };
     let (lo, hi) = if g > 0.0 { (f64::NEG_INFINITY, x0) } else { (x0, kappa) };
     // the step of `refine`: Halley's where its correction is small, else Newton's
-    let second = -over_gap - derivative * (2.0 * x0 + derivative);
     let d2 = derivative * derivative;
     let halley = (g * second).abs() <= 2.0 * HALLEY_MAX_CORRECTION * d2;
     let next = if halley { x0 - g * derivative / (d2 - 0.5 * g * second) } else { x0 - g / derivative };

@@ -403,7 +403,7 @@ fn visible_slope_x(kappa: f64, u: f64) -> f64 {
         let target = ln_s(kappa, kappa).0 + u.ln();
         refine(kappa, target, x, lo, hi)
     };
-    if !(x0 < kappa) {
+    if x0.is_nan() || x0 >= kappa {
         #[cfg(test)]
         tests::FALLBACKS.with(|n| n.set(n.get() + 1));
         return visible_slope_x_above(kappa, f64::NEG_INFINITY, u);

@@ -12,7 +12,9 @@
 //! `BOUNCE_WALKS` walks is printed to stderr (outside the timed loops): the walk's cost is
 //! about that many times the cost of one bounce.
 //!
-//! Benchmark ids: `{material}/{slope}/{eval|sample|single}/a{α}/t{θi}` (θi in radians).
+//! Benchmark ids: `{material}/{slope}/{eval|sample|single}/a{α}/t{θi}` (θi in radians), and
+//! `listing/{material}/{slope}/{eval|sample}` for the fixed directions of the supplement's
+//! listing timing (`../shared/bench/heitz2016-listing`; `benches/compare-listing.sh`).
 
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -125,6 +127,45 @@ fn bench_material<S: MicrosurfaceSlope, M: Material>(
     }
 }
 
+/// The unit direction with polar angle `theta` and azimuth `phi` (computed in double precision and
+/// rounded, as the listing's timing driver does).
+fn spherical(theta: f64, phi: f64) -> Vec3 {
+    Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32)
+}
+
+/// The configuration of `../shared/bench/heitz2016-listing` exactly: uniform heights, α = 0.5,
+/// ωi at θ = 0.5 (φ = 0), ωo at θ = 0.8, φ = 3.5, both fixed; one call per iteration.
+fn bench_listing<S: MicrosurfaceSlope, M: Material>(
+    c: &mut Criterion<Clock>,
+    material_name: &str,
+    material: M,
+    slope_name: &str,
+    slope: S,
+) {
+    let surface = Microsurface::new(UniformHeight, slope, material);
+    let (wi, wo) = (spherical(0.5, 0.0), spherical(0.8, 3.5));
+    let mut rng = Pcg64Mcg::seed_from_u64(6000);
+    let mut group = c.benchmark_group(format!("listing/{material_name}/{slope_name}"));
+    group.bench_function("eval", |b| {
+        b.iter(|| black_box(&surface).eval(black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng))
+    });
+    group.bench_function("sample", |b| b.iter(|| black_box(&surface).sample(black_box(wi), &mut rng)));
+    group.finish();
+}
+
+/// The listing's six configurations (`benches/compare-listing.sh` prints the ratios).
+fn listing(c: &mut Criterion<Clock>) {
+    let ggx = Ggx::isotropic(0.5).expect("valid roughness");
+    let beckmann = Beckmann::isotropic(0.5).expect("valid roughness");
+    let dielectric = Dielectric::new(1.5).expect("valid index");
+    bench_listing(c, "conductor", Conductor::perfect(), "ggx", ggx);
+    bench_listing(c, "diffuse", Diffuse::white(), "ggx", ggx);
+    bench_listing(c, "dielectric", dielectric, "ggx", ggx);
+    bench_listing(c, "conductor", Conductor::perfect(), "beckmann", beckmann);
+    bench_listing(c, "diffuse", Diffuse::white(), "beckmann", beckmann);
+    bench_listing(c, "dielectric", dielectric, "beckmann", beckmann);
+}
+
 fn walks(c: &mut Criterion<Clock>) {
     let ggx = |a| Ggx::isotropic(a).expect("valid roughness");
     let beckmann = |a| Beckmann::isotropic(a).expect("valid roughness");
@@ -140,6 +181,6 @@ fn walks(c: &mut Criterion<Clock>) {
 criterion_group! {
     name = benches;
     config = config();
-    targets = walks
+    targets = listing, walks
 }
 criterion_main!(benches);

@@ -531,3 +531,61 @@ fn chi2_rejects_wrong_samplers() {
         "the chi-square harness accepted GGX visible normals against the Beckmann D_ωi (α = 0.3, θi = 1.2)"
     );
 }
+
+/// Beckmann cases for the tabulated-guess sampler (issue 17) beyond the 60 above: α down to
+/// 0.01 and ωi far below the horizon (κ = cot θ/α from 0.01·… to −72.6 and −8.1).
+fn beckmann_deep_cases(full: bool) -> Vec<Case> {
+    let configs: &[(f32, f64)] = if full {
+        &[(0.01, 0.3), (0.01, 1.4), (0.01, 1.6), (0.01, 2.2), (0.5, 0.3), (0.5, 1.4), (0.5, 2.2), (0.5, 2.9)]
+    } else {
+        &[(0.01, 0.3), (0.01, 1.6), (0.01, 2.2), (0.5, 2.9)]
+    };
+    configs
+        .iter()
+        .enumerate()
+        .map(|(i, &(a, theta))| Case {
+            label: format!("beckmann α = {a}, θi = {theta}"),
+            slope: Box::new(Beckmann::isotropic(a).unwrap()),
+            wi: common::dir(theta, 0.3),
+            seed: 0x5eed_1700 + i as u64 + if full { 100 } else { 0 },
+        })
+        .collect()
+}
+
+/// The chi-square test in slope space (`slope_chi2`) of `n` Beckmann samples per case, at the
+/// Šidák level of the family; panics listing the failures.
+fn beckmann_deep_chi2(cases: &[Case], n: usize) {
+    let alpha = common::sidak(FAMILY_ALPHA, cases.len());
+    let mut failures = Vec::new();
+    for c in cases {
+        let mut rng = common::rng(c.seed);
+        let (wi, slope) = (c.wi, &c.slope);
+        let r = slope_chi2(
+            c,
+            || slope.sample(wi, rand::RngExt::random::<f32>(&mut rng), rand::RngExt::random::<f32>(&mut rng)),
+            n,
+            alpha,
+        );
+        match r {
+            Ok(o) => println!(
+                "{}: N = {n}, χ² = {:.1}, dof = {}, p = {:.4}, ∫D_ωi = {:.7}",
+                c.label, o.0, o.1, o.2, o.3
+            ),
+            Err(e) => failures.push(e),
+        }
+    }
+    assert!(failures.is_empty(), "{} Beckmann cases failed:\n{}", failures.len(), failures.join("\n"));
+}
+
+/// The Beckmann sampler at α = 0.01 and far below the horizon, 10⁶ samples per case.
+#[test]
+fn beckmann_vndf_small_roughness_and_deep_views() {
+    beckmann_deep_chi2(&beckmann_deep_cases(false), N);
+}
+
+/// The same at 10⁷ samples per case and 8 cases (about 20 s in release on two threads).
+#[test]
+#[ignore = "10⁷ samples per case: minutes in release; run with --ignored"]
+fn beckmann_vndf_small_roughness_and_deep_views_1e7() {
+    beckmann_deep_chi2(&beckmann_deep_cases(true), 10_000_000);
+}

@@ -599,3 +599,34 @@ fn dielectric_white_furnace_on_mixture() {
         assert_mean(&format!("dielectric white furnace θi = {theta}"), &stats, 1.0, z, 1e-2, 0.0);
     }
 }
+
+/// Invalid input follows the crate's policy (`crate#invalid-input`) for the tabulated
+/// distributions as for the analytic ones: Λ and the projected area of a non-unit direction
+/// are NaN, and so is a visible normal sampled for one (or from a uniform outside [0, 1]),
+/// never a plausible value (they used to give 0 and +z).
+#[test]
+fn invalid_input_gives_the_documented_nothing() {
+    use microsurface::GridSlope;
+    let table = TabulatedSlope::from_slope(&Ggx::isotropic(0.5).unwrap(), 0.5, 32).unwrap();
+    let stretched = table.stretched(0.3, 0.8).unwrap();
+    let grid = GridSlope::from_p22(1.0, 1.0, 2, &[1.0; 16]).unwrap();
+    let bad =
+        [Vec3::NAN, Vec3::new(f32::NAN, 0.0, 1.0), Vec3::ZERO, Vec3::new(0.0, 0.0, 2.0), Vec3::INFINITY];
+    fn check<S: MicrosurfaceSlope>(name: &str, s: S, bad: &[Vec3]) {
+        for &w in bad {
+            if cfg!(debug_assertions) {
+                continue; // the debug assertion fires instead (tests/invalid_input.rs checks the mode)
+            }
+            assert!(s.lambda(w).is_nan(), "{name}: lambda({w})");
+            assert!(s.projected_area(w).is_nan(), "{name}: projected_area({w})");
+            assert!(s.sample_d_wi(w, 0.3, 0.6).is_nan(), "{name}: sample_d_wi({w})");
+        }
+        if !cfg!(debug_assertions) {
+            assert!(s.sample_d_wi(Vec3::Z, f32::NAN, 0.5).is_nan(), "{name}: NaN uniform");
+            assert!(s.sample_d_wi(Vec3::Z, 0.5, 1.5).is_nan(), "{name}: uniform above 1");
+        }
+    }
+    check("tabulated", &table, &bad);
+    check("stretched", stretched, &bad);
+    check("grid", &grid, &bad);
+}

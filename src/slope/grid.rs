@@ -4,6 +4,7 @@
 
 use super::tabulated::{check_ring_count, grid_angle};
 use super::{MicrosurfaceSlope, ensure_visible, normal_from_slopes};
+use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -514,25 +515,20 @@ impl MicrosurfaceSlope for &GridSlope {
     }
 
     /// B/cos θ above the horizon, −1 − B/|cos θ| below (B interpolated); ±`f32::MAX` at ±0;
-    /// 0 for a NaN direction (a debug assertion).
+    /// invalid input ([policy](crate#invalid-input)): NaN.
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
-        debug_assert!(!w.is_nan(), "lambda: NaN direction {w}");
-        if w.is_nan() {
-            return 0.0;
-        }
+        require!(is_direction(w), f32::NAN; w);
         let b = self.backface_of(w);
         let l = (b / f64::from(w.z).abs()).min(f64::from(f32::MAX)) as f32;
         if w.z >= 0.0 { l } else { -1.0 - l }
     }
 
-    /// cos θ + B above the horizon, B below (B interpolated); 0 for a NaN direction.
+    /// cos θ + B above the horizon, B below (B interpolated); invalid input
+    /// ([policy](crate#invalid-input)): NaN.
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
-        debug_assert!(!w.is_nan(), "projected_area: NaN direction {w}");
-        if w.is_nan() {
-            return 0.0;
-        }
+        require!(is_direction(w), f32::NAN; w);
         let b = self.backface_of(w);
         (if w.z >= 0.0 { f64::from(w.z) + b } else { b }) as f32
     }
@@ -551,9 +547,10 @@ impl MicrosurfaceSlope for &GridSlope {
         }
     }
 
-    /// Exact for every ωi; +z for ωi = −z and for a non-finite ωi (a debug assertion).
+    /// Exact for every ωi; +z for ωi = −z. Invalid input ([policy](crate#invalid-input)): a
+    /// non-unit ωi or a uniform outside [0, 1] gives NaN.
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        debug_assert!(wi.is_finite(), "sample_d_wi: non-finite direction {wi}");
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
         let Some(w) = wi.as_dvec3().try_normalize() else { return Vec3::Z };
         match self.sample_slopes(w, f64::from(u1), f64::from(u2)) {
             Some((x, y)) => ensure_visible(wi, normal_from_slopes(x as f32, y as f32)),

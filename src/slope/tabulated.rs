@@ -2,6 +2,7 @@
 //! microsurfaces), with exact visible-normal sampling on the whole sphere.
 
 use super::{MicrosurfaceSlope, ensure_visible, normal_from_slopes};
+use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
@@ -618,28 +619,22 @@ impl MicrosurfaceSlope for &TabulatedSlope {
     }
 
     /// B(cos θ)/cos θ above the horizon and −1 − B(|cos θ|)/|cos θ| below, B interpolated
-    /// from the table (see the type's documentation); saturates to ±`f32::MAX` at ±0. For a
-    /// NaN ω.z (invalid): 0, after a debug assertion.
+    /// from the table (see the type's documentation); saturates to ±`f32::MAX` at ±0. Invalid input
+    /// ([policy](crate#invalid-input)): a `w` that is not a unit direction gives NaN.
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
-        debug_assert!(!w.z.is_nan(), "lambda: NaN direction {w}");
-        if w.z.is_nan() {
-            return 0.0;
-        }
+        require!(is_direction(w), f32::NAN; w);
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         let lambda = (b / z.abs()).min(f64::from(f32::MAX)) as f32;
         if w.z >= 0.0 { lambda } else { -1.0 - lambda }
     }
 
-    /// cos θ + B(cos θ) above the horizon, B(|cos θ|) below (B interpolated). For a NaN ω.z
-    /// (invalid): 0, after a debug assertion.
+    /// cos θ + B(cos θ) above the horizon, B(|cos θ|) below (B interpolated). Invalid input
+    /// ([policy](crate#invalid-input)): a `w` that is not a unit direction gives NaN.
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
-        debug_assert!(!w.z.is_nan(), "projected_area: NaN direction {w}");
-        if w.z.is_nan() {
-            return 0.0;
-        }
+        require!(is_direction(w), f32::NAN; w);
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         (if w.z >= 0.0 { z + b } else { b }) as f32
@@ -662,18 +657,11 @@ impl MicrosurfaceSlope for &TabulatedSlope {
         }
     }
 
-    /// Exact for every ωi (see the type's documentation); +z for ωi = −z and for a
-    /// non-finite ωi (invalid, a debug assertion).
+    /// Exact for every ωi (see the type's documentation); +z for ωi = −z. Invalid
+    /// input ([policy](crate#invalid-input)): a non-unit ωi or a uniform outside [0, 1] gives NaN.
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        debug_assert!(wi.is_finite(), "sample_d_wi: non-finite direction {wi}");
-        debug_assert!(
-            (0.0..1.0).contains(&u1) && (0.0..1.0).contains(&u2),
-            "sample_d_wi: uniforms {u1}, {u2}"
-        );
-        if !wi.is_finite() {
-            return Vec3::Z;
-        }
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
         self.sample_normal(wi, u1, u2)
     }
 }
@@ -769,12 +757,14 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
 
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
         let (s, _) = self.stretch(w);
         (&self.table).lambda(s)
     }
 
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
         let (s, len) = self.stretch(w);
         (len * f64::from((&self.table).projected_area(s))) as f32
     }
@@ -786,13 +776,11 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
     }
 
     /// Exact for every ωi: the table's visible slopes from ω_s/‖ω_s‖, scaled by (sx, sy); +z
-    /// for ωi = −z and for a non-finite ωi (a debug assertion).
+    /// for ωi = −z. Invalid input ([policy](crate#invalid-input)): a non-unit ωi or a uniform
+    /// outside [0, 1] gives NaN.
     #[inline]
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        debug_assert!(wi.is_finite(), "sample_d_wi: non-finite direction {wi}");
-        if !wi.is_finite() {
-            return Vec3::Z;
-        }
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
         let (s, len) = self.stretch(wi);
         if len <= 0.0 {
             return Vec3::Z;

@@ -109,6 +109,7 @@
 mod contract;
 mod albedo;
 mod bsdf;
+mod constants;
 mod error;
 mod frame;
 mod fresnel;
@@ -120,6 +121,7 @@ mod position_free;
 mod rng;
 mod slope;
 mod special;
+mod vector;
 mod vndf;
 
 pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};

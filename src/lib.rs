@@ -103,7 +103,14 @@
 //! without a neutral value (Λ, G1, projected areas, Fresnel terms, heights). Grazing, exactly
 //! horizontal and below-horizon unit directions are valid input.
 
-#![warn(missing_docs)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+// One allowance for the fitted coefficient tables of src/special (the erfcx pieces, the
+// Gaussian-quantile fits, the azimuth polynomials) and their reference values: they are written
+// as their generators in scripts/ print them (the f32 fits with ten significant digits), so
+// that a diff against a generator's output checks them; excessive_precision would have the
+// f32 literals cut to the digits an f32 holds.
+#![allow(clippy::excessive_precision)]
 
 #[macro_use]
 mod contract;
@@ -119,6 +126,7 @@ mod merl;
 mod microsurface;
 mod position_free;
 mod rng;
+mod sealed;
 mod slope;
 mod special;
 mod vector;

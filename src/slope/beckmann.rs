@@ -103,6 +103,8 @@ fn lambda_up64(a: f64) -> f64 {
     0.5 * INV_SQRT_PI * (-a * a).exp() * one_minus_scaled_erfcx(a) / a
 }
 
+impl crate::sealed::Sealed for Beckmann {}
+
 impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn alpha_x(&self) -> f32 {

@@ -18,7 +18,6 @@ const PIECES_PER_Y: f64 = PIECE_COUNT as f64 / (1.0 - Y_FROM);
 /// s = y − (centre of piece k) that interpolates erfcx(4/y − 4) at the 8 Chebyshev nodes of
 /// the piece (computed with 40-digit mpmath; the variable y = 4/(4 + u) follows S. G. Johnson's
 /// Faddeeva package, which makes erfcx smooth and bounded on all of [0, ∞)).
-#[allow(clippy::excessive_precision)]
 const PIECES: [[f64; 8]; 32] = [
     [
         0.02513968901713899,
@@ -395,7 +394,6 @@ mod tests {
 
     /// (u, erfcx(u)) from mpmath with 40 digits, rounded to 20; including both sides of every
     /// joint between pieces and of the switch to the series.
-    #[allow(clippy::excessive_precision)]
     const REFERENCE: [(f64, f64); 41] = [
         (0.0, 1.0),
         (1e-08, 0.99999998871620842904),

@@ -78,7 +78,6 @@ const TAIL_BELOW: f32 = 25.0;
 const FAR_TAIL_UNTIL: f32 = 72.0;
 
 /// erfinv(y)/y as a polynomial in w − 3.125, for w = −ln(1 − y²) ∈ [0, 6.25].
-#[allow(clippy::excessive_precision)]
 const CENTRAL: [f32; 10] = [
     1.653654646e+00,
     2.401580613e-01,
@@ -92,7 +91,6 @@ const CENTRAL: [f32; 10] = [
     -5.114583298e-09,
 ];
 /// erfinv(y)/y as a polynomial in √w − 3.75, for w ∈ [6.25, 25].
-#[allow(clippy::excessive_precision)]
 const TAIL: [f32; 9] = [
     3.587504144e+00,
     1.008678372e+00,
@@ -105,7 +103,6 @@ const TAIL: [f32; 9] = [
     3.940828422e-05,
 ];
 /// erfinv(y)/y as a polynomial in √w − 6.6, for w ∈ [25, 72].
-#[allow(clippy::excessive_precision)]
 const FAR_TAIL: [f32; 9] = [
     6.465499149e+00,
     1.009006988e+00,

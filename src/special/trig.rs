@@ -4,7 +4,6 @@
 const SIN: [f32; 5] =
     [core::f32::consts::FRAC_PI_2, -0.645_964_1, 0.079_692_63, -0.004_681_754, 0.000_160_441_18];
 /// Taylor coefficients of cos(π f / 2) in f² for |f| ≤ ½ (truncation error ≤ 2e-10).
-#[allow(clippy::excessive_precision)]
 const COS: [f32; 6] = [1.0, -1.233_700_6, 0.253_669_5, -0.020_863_481, 0.000_919_260_3, -2.520_204_2e-5];
 
 /// (sin 2πu, cos 2πu) for u ∈ [0, 1]: the azimuth of a uniform sample, without a library

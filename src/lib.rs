@@ -118,7 +118,6 @@ mod albedo;
 mod bsdf;
 mod constants;
 mod error;
-mod frame;
 mod fresnel;
 mod height;
 mod material;
@@ -126,6 +125,7 @@ mod merl;
 mod microsurface;
 mod position_free;
 mod rng;
+mod sampling;
 mod sealed;
 mod slope;
 mod special;
@@ -140,7 +140,6 @@ pub use bsdf::{
 };
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
-pub use frame::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
 pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 /// The vector library of the public API, re-exported so that users on another `glam` version
 /// can name the crate's types.
@@ -154,6 +153,7 @@ pub use microsurface::{
 pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
+pub use sampling::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
 pub use slope::{
     BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
     StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,

@@ -115,6 +115,7 @@
 #[macro_use]
 mod contract;
 mod albedo;
+mod basis;
 mod bsdf;
 mod constants;
 mod error;
@@ -133,6 +134,7 @@ mod vector;
 mod vndf;
 
 pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
+pub use basis::orthonormal_basis;
 pub use bsdf::{
     AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
     CompensatedConductor, Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA,
@@ -153,7 +155,7 @@ pub use microsurface::{
 pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
-pub use sampling::{concentric_disk, orthonormal_basis, sample_cosine_hemisphere};
+pub use sampling::{concentric_disk, sample_cosine_hemisphere};
 pub use slope::{
     BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
     StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,

@@ -370,8 +370,9 @@ pub(crate) fn erfcx64(u: f64) -> f64 {
     INV_SQRT_PI / u * series
 }
 
-/// From this u = −x̃ on, 1 − m√π erfcx(u) is evaluated by its asymptotic series (which is free
-/// of the cancellation the direct form suffers for large u).
+/// From this u on, r(u) = 1 − √π u erfcx(u) ([`one_minus_scaled_erfcx`]) is evaluated by its
+/// asymptotic series, free of the cancellation of the direct form (the Beckmann sampler's
+/// ψ(u) = 1 + κ√π erfcx(u) switches to r at the same point, u = −x̃).
 pub(crate) const PSI_SERIES_FROM: f64 = 8.0;
 
 /// r(u) = 1 − √π u erfcx(u) for u ≥ 0 (the ratio of the Gaussian tail's two terms; r(0) = 1,

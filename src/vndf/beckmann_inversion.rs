@@ -12,11 +12,11 @@ use crate::special::{PSI_SERIES_FROM, erfc_inv_f32, erfcx64, one_minus_scaled_er
 use crate::vector::ensure_visible;
 use glam::Vec3;
 
-/// The iteration stops once its step is below this fraction of 1 + |x̃| (about the f32 resolution
-/// of x̃). The error after that step is of order C·step² or less, where C, the inverse of the
-/// lobe's width, reaches |cot θ| far below the horizon: a looser stop (3e-5 was tried with
-/// Newton steps) biases those thin lobes measurably.
-const NEWTON_TOLERANCE: f64 = 1e-7;
+/// The Halley–bisection iteration stops once its step is below this fraction of 1 + |x̃| (about
+/// the f32 resolution of x̃). The error after that step is of order C·step² or less, where C, the
+/// inverse of the lobe's width, reaches |cot θ| far below the horizon (see DESIGN.md for why not
+/// looser).
+const HALLEY_TOLERANCE: f64 = 1e-7;
 /// Halley's step n/(1 − c) is taken only for |c| up to this (else Newton's step n): it then
 /// differs from Newton's by a factor in [2/3, 2].
 const HALLEY_MAX_CORRECTION: f64 = 0.5;
@@ -345,7 +345,7 @@ fn refine(kappa: f64, target: f64, mut x: f64, mut lo: f64, mut hi: f64) -> f64 
         }
         let step = next - x;
         x = next;
-        let tolerance = NEWTON_TOLERANCE * (1.0 + x.abs());
+        let tolerance = HALLEY_TOLERANCE * (1.0 + x.abs());
         // a Newton or Halley step from error e leaves about |g″/(2g′)| e² or less: stop when
         // that estimate (with a safety factor) is below the tolerance, one evaluation early
         if step.abs() <= tolerance
@@ -397,7 +397,7 @@ mod tests {
     /// The documented bound of the fast sampler's CDF error for |κ| ≤ 64.
     const FAST_CDF_MAX_ERROR: f64 = 2e-7;
     /// Its bound for |κ| ≤ 400, where the f32 rounding of x̃ (tolerance of the fallback
-    /// iteration, `NEWTON_TOLERANCE`·(1 + |x̃|)) dominates: below that of the iteration alone.
+    /// iteration, `HALLEY_TOLERANCE`·(1 + |x̃|)) dominates: below that of the iteration alone.
     const FAST_CDF_MAX_ERROR_FAR: f64 = 1e-5;
     /// The largest fraction of the grid's samples allowed to take the fallback iteration.
     const FAST_MAX_FALLBACK_FRACTION: f64 = 0.06;

@@ -5,7 +5,7 @@ use super::Microsurface;
 use super::geometry::{first_ln_c1_from_below, flip_ln_c1, next_ln_c1};
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
-use crate::material::Material;
+use crate::material::{Interaction, Material, Side};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use core::num::NonZeroU32;
@@ -94,14 +94,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// if the ordinary walk cannot start there (an opaque material lit from below starts in
     /// [`Microsurface::eval_from_below`] / [`Microsurface::sample_from_below`] instead).
     #[inline(always)]
-    fn starting_side(wi: Vec3) -> Option<bool> {
-        if wi.z > 0.0 {
-            Some(true)
-        } else if M::TRANSMITS && wi.z < 0.0 {
-            Some(false)
-        } else {
-            None
-        }
+    fn starting_side(wi: Vec3) -> Option<Side> {
+        Side::of(wi.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
     }
 
     /// Evaluates the multiple-scattering BSDF times |cos θo| by a random walk with next-event
@@ -119,7 +113,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let Some(mut outside) = Self::starting_side(wi) else {
+        let Some(mut side) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 {
                 self.eval_from_below(wi, wo, order, rng)
             } else {
@@ -131,9 +125,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             return Vec3::ZERO;
         }
         let slope = self.geometry.slope();
-        let wo_outside = wo.z > 0.0;
+        let wo_side = Side::above_or_inside(wo.z);
         // Λ of ωo seen from its own side, constant along the walk
-        let lambda_o = slope.lambda_unchecked(if wo_outside { wo } else { -wo });
+        let lambda_o = slope.lambda_unchecked(wo_side.frame(wo));
         let last = order.last();
 
         let mut wr = -wi;
@@ -142,24 +136,25 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut throughput = Vec3::ONE;
         let mut sum = Vec3::ZERO;
         for bounce in 1..=last {
-            let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else { break };
-            ln_c1 = next;
+            let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else { break };
+            ln_c1 = hit.ln_c1;
             if order.includes(bounce) {
-                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, outside, wo_outside, rng);
+                let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
+                let phase = self.material.eval_phase_unchecked(slope, &it, rng);
                 if phase != Vec3::ZERO {
-                    let ln_c1_o = if outside == wo_outside { ln_c1 } else { flip_ln_c1(ln_c1) };
+                    let ln_c1_o = if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) };
                     sum += throughput * phase * (lambda_o * ln_c1_o).exp();
                 }
             }
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
-            if s.outside != outside {
+            let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
+            if s.side != side {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
             wr = s.wo;
-            outside = s.outside;
+            side = s.side;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {
                 break;
@@ -185,7 +180,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         require!(is_direction(wi), None; wi);
-        let Some(mut outside) = Self::starting_side(wi) else {
+        let Some(mut side) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 { self.sample_from_below(wi, rng) } else { None };
         };
         if self.material.is_transparent() {
@@ -196,16 +191,16 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut ln_c1 = 0.0;
         let mut weight = Vec3::ONE;
         for bounces in 0..MAX_BOUNCES {
-            let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else {
+            let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else {
                 return Some(WalkSample { wo: wr, weight, bounces });
             };
-            ln_c1 = next;
-            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
-            if s.outside != outside {
+            ln_c1 = hit.ln_c1;
+            let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
+            if s.side != side {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
             wr = s.wo;
-            outside = s.outside;
+            side = s.side;
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
@@ -250,9 +245,13 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut throughput = Vec3::ONE;
         let mut sum = Vec3::ZERO;
         let mut bounce = 1;
+        // A(ωi) of the current vertex where the height step knows it (not at the first one,
+        // which ωi reaches from below)
+        let mut incident_area = None;
         loop {
             if order.includes(bounce) {
-                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, true, true, rng);
+                let it = Interaction::reflection(-wr, wo).with_incident_area(incident_area);
+                let phase = self.material.eval_phase_unchecked(slope, &it, rng);
                 if phase != Vec3::ZERO {
                     sum += throughput * phase * (lambda_o * ln_c1).exp();
                 }
@@ -260,14 +259,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase_unchecked(slope, -wr, true, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng);
             wr = s.wo;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {
                 break;
             }
-            let Some(next) = self.next_ln_c1(wr, ln_c1, true, rng) else { break };
-            ln_c1 = next;
+            let Some(hit) = self.next_hit(wr, ln_c1, Side::Outside, rng) else { break };
+            (ln_c1, incident_area) = (hit.ln_c1, hit.incident_area);
             bounce += 1;
         }
         sum
@@ -297,26 +296,50 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut ln_c1 = first_ln_c1_from_below(slope.lambda(wr), uniform(rng))?;
         let mut weight = Vec3::ONE;
         for bounces in 1..=MAX_BOUNCES {
-            let s = self.material.sample_phase_unchecked(slope, -wr, true, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng);
             wr = s.wo;
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
             }
-            match self.next_ln_c1(wr, ln_c1, true, rng) {
-                Some(next) => ln_c1 = next,
+            match self.next_hit(wr, ln_c1, Side::Outside, rng) {
+                Some(hit) => ln_c1 = hit.ln_c1,
                 None => return Some(WalkSample { wo: wr, weight, bounces }),
             }
         }
         None
     }
 
-    /// ln C¹ of the next intersection of the ray ωr leaving a point with ln C¹ = `ln_c1` on
-    /// side `outside`, or `None` if it escapes. Both are in the frame of that side: inside a
-    /// dielectric the configuration is flipped vertically (supplement §3.4).
+    /// The next intersection of the ray ωr leaving a point with ln C¹ = `ln_c1` on `side`,
+    /// or `None` if it escapes. Both are in the frame of that side: inside a dielectric the
+    /// configuration is flipped vertically (supplement §3.4). One Λ per bounce: the Λ(ωr) of
+    /// the height step also gives the projected area of the next vertex's incident direction
+    /// ([`incident_area`]).
     #[inline(always)]
-    fn next_ln_c1(&self, wr: Vec3, ln_c1: f32, outside: bool, rng: &mut impl Rng) -> Option<f32> {
-        let w = if outside { wr } else { -wr };
-        next_ln_c1(w.z, self.geometry.slope().lambda_unchecked(w), ln_c1, uniform(rng))
+    fn next_hit(&self, wr: Vec3, ln_c1: f32, side: Side, rng: &mut impl Rng) -> Option<Hit> {
+        let w = side.frame(wr);
+        let lambda = self.geometry.slope().lambda_unchecked(w);
+        let ln_c1 = next_ln_c1(w.z, lambda, ln_c1, uniform(rng))?;
+        Some(Hit { ln_c1, incident_area: incident_area(w.z, lambda) })
     }
+}
+
+/// An intersection of the walk's ray with the microsurface.
+#[derive(Debug, Clone, Copy)]
+struct Hit {
+    /// ln C¹ of its height, in the frame of the ray's side.
+    ln_c1: f32,
+    /// A(ωi) of the incident direction ωi = −ωr there, in the same frame, where known.
+    incident_area: Option<f32>,
+}
+
+/// The projected area A(ωi) = (1 + Λ(ωi)) cos θi (supplement §2.2) of the incident direction
+/// ωi = −ω of a vertex that the ray ω with z-component `z` and Λ(ω) = `lambda` reached going
+/// down: with Λ(ω) = −1 − Λ(ωi), A(ωi) = Λ(ω)·ω.z, one f32 product (relative error below
+/// 2⁻²³ beyond that of Λ). `None` for a ray going up or horizontally (ωi backfacing or
+/// grazing, whose density the materials form in f64 instead) and where Λ saturated at
+/// −`f32::MAX` (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
+#[inline(always)]
+fn incident_area(z: f32, lambda: f32) -> Option<f32> {
+    (z < 0.0 && lambda > -f32::MAX).then_some(lambda * z)
 }

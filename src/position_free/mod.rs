@@ -15,14 +15,14 @@ mod segment;
 pub use segment::Shadowing;
 
 use crate::contract::is_direction;
-use crate::material::Material;
+use crate::material::{Event, Interaction, Material, Side};
 use crate::microsurface::WalkSample;
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec3};
 use rand::Rng;
-use segment::{LAMBDA_SATURATION, VertexShadowing, in_side_frame, inv_g1};
+use segment::{LAMBDA_SATURATION, VertexRole, VertexShadowing, inv_g1};
 
 /// Russian roulette starts after this many sampled bounces (it is unbiased at any depth).
 const ROULETTE_FROM_BOUNCE: u32 = 3;
@@ -83,18 +83,45 @@ pub(crate) struct Exit {
     /// The direction.
     pub(crate) w: Vec3,
     /// Its side of the interface.
-    pub(crate) outside: bool,
-    /// Whether it points up in its side frame.
-    pub(crate) can_exit: bool,
-    /// Λ in its side frame where it can exit, else 0.
-    pub(crate) lambda: f64,
+    pub(crate) side: Side,
+    /// Λ in its side frame where it can leave the surface (points up there); `None` where it
+    /// cannot.
+    pub(crate) lambda: Option<f64>,
 }
 
 /// The incident state at a vertex: the direction towards the previous vertex and its side.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Incident {
     pub(crate) w: Vec3,
-    pub(crate) outside: bool,
+    pub(crate) side: Side,
+}
+
+impl Incident {
+    /// The incident direction in the frame of its side.
+    #[inline(always)]
+    pub(crate) fn in_frame(self) -> Vec3 {
+        self.side.frame(self.w)
+    }
+
+    /// The event from this incident direction to `w` on `side`.
+    #[inline(always)]
+    pub(crate) fn to(self, w: Vec3, side: Side) -> Interaction {
+        Interaction::new(self.w, w, self.side, side)
+    }
+
+    /// The event from this incident direction to the outgoing one.
+    #[inline(always)]
+    pub(crate) fn towards(self, out: Exit) -> Interaction {
+        self.to(out.w, out.side)
+    }
+}
+
+impl Exit {
+    /// Whether the direction can leave the surface.
+    #[inline(always)]
+    pub(crate) fn can_exit(self) -> bool {
+        self.lambda.is_some()
+    }
 }
 
 impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
@@ -149,20 +176,20 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
-        self.connect(start, wo, wo_outside, true, rng).as_vec3()
+        self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
     }
 
     /// [`PositionFree::eval_single_scattering`], which accepts ωi below the horizon for an
     /// opaque material (a backfacing view under normal mapping), like every estimator of this
     /// model (kept for the renderer adapter).
     pub(crate) fn eval_single_backfacing(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
-        self.connect(start, wo, wo_outside, true, rng).as_vec3()
+        self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
     }
 
     /// Samples an outgoing direction with the position-free random walk (Wang et al. 2022,
@@ -195,26 +222,26 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             // the Dirac ωo = −ωi of an interface that does not interact (see `Material`)
             return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 1 });
         }
-        if wi.z < 0.0 && inv_g1(&self.slope, in_side_frame(at.w, at.outside)) == 0.0 {
+        if wi.z < 0.0 && inv_g1(&self.slope, at.in_frame()) == 0.0 {
             // ωi at the nadir of an opaque material: no facet faces it (projected area 0)
             return None;
         }
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
-            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
+            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
             }
-            let out = self.exit(s.wo, s.outside);
-            if out.can_exit {
-                let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+            let out = self.exit(s.wo, s.side);
+            if out.can_exit() {
+                let k_in = inv_g1(&self.slope, at.in_frame());
                 // P(exit) = S_last/(S_last + S_middle) = S_last/G1(ωin)
                 if f64::from(uniform(rng)) < self.relative_shadowing(at, k_in, out).last {
                     return Some(WalkSample { wo: s.wo, weight, bounces });
                 }
             }
-            at = Incident { w: -s.wo, outside: s.outside };
+            at = Incident { w: -s.wo, side: s.side };
         }
         None
     }
@@ -240,9 +267,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
         require!(is_direction(wi), None; wi);
         let at = Self::incident(wi)?;
-        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
-        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        let last = self.relative_shadowing(at, k_in, self.exit(s.wo, s.outside)).last;
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
+        let k_in = inv_g1(&self.slope, at.in_frame());
+        let last = self.relative_shadowing(at, k_in, self.exit(s.wo, s.side)).last;
         let weight = s.weight * last as f32;
         (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
     }
@@ -254,10 +281,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside)
+        self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side))
     }
 
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
@@ -270,10 +297,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        let single = self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside);
+        let single = self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side));
         let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
         (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
     }
@@ -290,40 +317,29 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// the macrosurface”.
     #[inline(always)]
     pub(crate) fn incident(wi: Vec3) -> Option<Incident> {
-        if wi.z > 0.0 || (!M::TRANSMITS && wi.z < 0.0) {
-            Some(Incident { w: wi, outside: true })
-        } else if M::TRANSMITS && wi.z < 0.0 {
-            Some(Incident { w: wi, outside: false })
-        } else {
-            None
-        }
+        let side = Side::of(wi.z)?;
+        Some(Incident { w: wi, side: if M::TRANSMITS { side } else { Side::Outside } })
     }
 
     /// The side of the macro direction ωo, or `None` if light cannot leave there.
     #[inline(always)]
-    pub(crate) fn exit_side(wo: Vec3) -> Option<bool> {
-        if wo.z > 0.0 {
-            Some(true)
-        } else if M::TRANSMITS && wo.z < 0.0 {
-            Some(false)
-        } else {
-            None
-        }
+    pub(crate) fn exit_side(wo: Vec3) -> Option<Side> {
+        Side::of(wo.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
     }
 
-    /// The forward contribution of one vertex, v(ωin, ωout)·S, where S is the last-vertex
-    /// factor if `last` and the continuing factor otherwise.
+    /// The forward contribution of one vertex in the given role, v(ωin, ωout)·S (S the
+    /// last-vertex or the continuing factor).
     #[inline]
     pub(crate) fn connect(
         &self,
         at: Incident,
         wo: Vec3,
-        wo_outside: bool,
-        last: bool,
+        wo_side: Side,
+        role: VertexRole,
         rng: &mut impl Rng,
     ) -> DVec3 {
-        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        self.connect_known(at, k_in, self.exit(wo, wo_outside), last, rng)
+        let k_in = inv_g1(&self.slope, at.in_frame());
+        self.connect_known(at, k_in, self.exit(wo, wo_side), role, rng)
     }
 
     /// [`Self::connect`] with the incident 1 + L̃ = `k_in` and the outgoing direction's exit
@@ -334,28 +350,25 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         at: Incident,
         k_in: f64,
         out: Exit,
-        last: bool,
+        role: VertexRole,
         rng: &mut impl Rng,
     ) -> DVec3 {
         if k_in < 1.0 {
             // a backfacing incident direction (below the horizon in its side frame): v·S =
             // p·(k_in S), with the phase function p and the relative factor both free of the
             // tiny k_in = Λ(−ωin), which v = p·k_in and S ∝ 1/k_in would underflow and overflow
-            let v = self.relative_shadowing(at, k_in, out);
-            let factor = if last { v.last } else { v.middle };
+            let factor = self.relative_shadowing(at, k_in, out).factor(role);
             if factor == 0.0 {
                 return DVec3::ZERO;
             }
-            let phase =
-                self.material.eval_phase_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng);
+            let phase = self.material.eval_phase_unchecked(&self.slope, &at.towards(out), rng);
             return phase.as_dvec3() * factor;
         }
-        let factor = self.shadowing_factor(at, k_in, out, last);
+        let factor = self.shadowing_factor(at, k_in, out, role);
         if factor == 0.0 {
             return DVec3::ZERO;
         }
-        self.material.vertex_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3()
-            * factor
+        self.material.vertex_unchecked(&self.slope, &at.towards(out), rng).as_dvec3() * factor
     }
 
     /// The shadowing factors of a vertex relative to its incident masking, k_in·S
@@ -365,44 +378,46 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// Beckmann surfaces): exact to a few f64 ulps down to the smallest α.
     #[inline]
     pub(crate) fn relative_shadowing(&self, at: Incident, k_in: f64, out: Exit) -> VertexShadowing {
-        let reflect = at.outside == out.outside;
-        let ratio = if !(out.can_exit && reflect && self.shadowing == Shadowing::Correlated) {
-            0.0
-        } else if k_in >= LAMBDA_RATIO_LOG_BELOW {
-            out.lambda / k_in
-        } else {
-            // k_in = Λ(−ωin) of a backfacing incident direction, in its side frame
-            let ln_k = self.slope.ln_lambda(-in_side_frame(at.w, at.outside));
-            if ln_k == f64::NEG_INFINITY {
-                f64::INFINITY
-            } else {
-                (self.slope.ln_lambda(in_side_frame(out.w, out.outside)) - ln_k).exp()
+        let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
+        let ratio = match out.lambda {
+            Some(lambda) if event == Event::Reflection && self.shadowing == Shadowing::Correlated => {
+                if k_in >= LAMBDA_RATIO_LOG_BELOW {
+                    lambda / k_in
+                } else {
+                    // k_in = Λ(−ωin) of a backfacing incident direction, in its side frame
+                    let ln_k = self.slope.ln_lambda(-at.in_frame());
+                    if ln_k == f64::NEG_INFINITY {
+                        f64::INFINITY
+                    } else {
+                        (self.slope.ln_lambda(out.side.frame(out.w)) - ln_k).exp()
+                    }
+                }
             }
+            _ => 0.0,
         };
-        self.shadowing.relative(k_in, out.can_exit, out.lambda, ratio, reflect)
+        self.shadowing.relative(k_in, out.lambda, ratio, event)
     }
 
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
     /// leave the surface) and then its Λ there (0 otherwise).
     #[inline]
-    pub(crate) fn exit(&self, w: Vec3, outside: bool) -> Exit {
-        let frame = in_side_frame(w, outside);
-        let can_exit = frame.z > 0.0;
-        let lambda = if can_exit { self.slope.lambda64(frame).min(LAMBDA_SATURATION) } else { 0.0 };
-        Exit { w, outside, can_exit, lambda }
+    pub(crate) fn exit(&self, w: Vec3, side: Side) -> Exit {
+        let frame = side.frame(w);
+        let lambda = (frame.z > 0.0).then(|| self.slope.lambda64(frame).min(LAMBDA_SATURATION));
+        Exit { w, side, lambda }
     }
 
-    /// The last (`last`) or continuing shadowing factor of a vertex with incident state `at`
+    /// The shadowing factor of a vertex in the given role with incident state `at`
     /// (1 + L̃ = `k_in`) and outgoing direction `out`; 0 where `at` sees no microsurface and
     /// where k_in < `LAMBDA_RATIO_LOG_BELOW` (S would overflow: use [`Self::relative_shadowing`]).
     #[inline(always)]
-    pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, last: bool) -> f64 {
+    pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, role: VertexRole) -> f64 {
         // S ∝ G1in = 1/k_in overflows for a subnormal f64 k_in; its product with a vertex term
         // (∝ k_in) is formed by `relative_shadowing` instead, where callers need it
         if k_in < LAMBDA_RATIO_LOG_BELOW {
             return 0.0;
         }
-        let v = self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside);
-        if last { v.last } else { v.middle }
+        let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
+        self.shadowing.vertex(k_in, out.lambda, event).factor(role)
     }
 }

@@ -32,15 +32,11 @@ const ROULETTE_FROM_BOUNCE: u32 = 3;
 ///
 /// The shadowing factors of a vertex are at most G1 of its incident direction (exactly so for
 /// the correlated transmission and the uncorrelated model, where B(k, ·) and G1·G1out grow as
-/// 1/k). A bounce that sends the path almost straight up carries a factor Λ(ω) → 0 in its
-/// throughput, which the next vertex's G1 = 1/Λ(ω) cancels. A survival probability from the
-/// throughput alone divides the small factor away and keeps the large one: contributions of
-/// size 1/Λ with probability Λ, an infinite variance (measured for conductor GGX α = 1,
-/// θi = 1, ωo = +z: outliers of 4e4 against a mean of 0.32, σ̂ = 54; with G1 in the
-/// probability σ̂ = 0.16). A surviving path's next contributions are then bounded by its
-/// vertex terms. The price: where Λ stays tiny over several bounces (Beckmann, steep
-/// directions) paths live longer (conductor Beckmann α = 0.5, θi = 1, ωo = +z: 10 bounces
-/// instead of 3).
+/// 1/k), so a surviving path's next contributions are bounded by its vertex terms: the
+/// estimator's variance stays finite where a bounce sends the path almost straight up (a
+/// throughput factor Λ(ω) → 0 that the next G1 = 1/Λ(ω) cancels). Why the throughput alone
+/// does not do, with the measured variances: DESIGN.md, “Russian roulette with the next
+/// vertex's masking”.
 #[inline(always)]
 pub(crate) fn survival_probability(throughput: DVec3, k_next: f64) -> f64 {
     (throughput.max_element() * (1.0 / k_next).max(1.0)).min(1.0)
@@ -205,13 +201,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// Nearly index-matched dielectrics at grazing incidence: a refraction through an
     /// interface with η ≈ 1 barely turns the ray, and this model's exit probability per vertex
     /// then falls to about 2^−Λ (it forgets the height a vertex was reached at, which the
-    /// height-tracing walk keeps), so its paths grow as |η − 1| → 0. Measured for GGX α = 1
-    /// with correlated shadowing: mean path lengths of 150 (|η − 1| = 1e-3), 1 100 (1e-4),
-    /// 8 500 (1e-5) and 36 000 bounces (2e-6, 3.5 ms per sample) at cos θi = 1e-3, none
-    /// capped; within one or two f32 ulps of 1 (η = 1 ± 1.2e-7) 98–100 % of such paths reach
-    /// [`crate::MAX_BOUNCES`] and are lost, at 6 ms each (at cos θi = 0.1 none is). η = 1
-    /// itself is transparent ([`crate::Material::is_transparent`]). `tests/walk_cap.rs` checks
-    /// the no-loss range down to |η − 1| = 1e-5.
+    /// height-tracing walk keeps), so its paths grow as |η − 1| → 0: no path is lost to
+    /// [`crate::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk_cap.rs`), while within one or
+    /// two f32 ulps of 1 nearly all grazing paths are (path lengths measured in DESIGN.md,
+    /// “The bounce cap”). η = 1 itself is transparent ([`crate::Material::is_transparent`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).

@@ -2,7 +2,9 @@
 //! per-strategy path densities and the balance heuristic.
 
 use super::segment::{VertexRole, inv_g1};
-use super::{Exit, Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
+use super::{
+    Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability,
+};
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::microsurface::ScatteringOrder;
@@ -151,6 +153,20 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 ),
             };
             Connection { contribution, forward: 0.0, reverse }
+        } else if k_at < LAMBDA_RATIO_LOG_BELOW {
+            // a backfacing camera end whose Λ(−ωin) is below f64's range: v·S = p·(k_in S)
+            // with the relative factor (see `connect_known`); the densities separately
+            let factor = self.relative_shadowing(at, k_at, out).middle;
+            if factor == 0.0 {
+                return None;
+            }
+            let it = at.towards(out);
+            let phase = self.material.eval_phase_unchecked(&self.slope, &it, rng);
+            Connection {
+                contribution: phase.as_dvec3() * factor,
+                forward: f64::from(self.material.pdf_phase_unchecked(&self.slope, &it)),
+                reverse: f64::from(self.material.pdf_phase_unchecked(&self.slope, &it.reversed())),
+            }
         } else {
             let factor = self.shadowing_factor(at, k_at, out, VertexRole::Middle);
             if factor == 0.0 {

@@ -215,7 +215,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             // the Dirac ωo = −ωi of an interface that does not interact (see `Material`)
             return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 1 });
         }
-        if wi.z < 0.0 && inv_g1(&self.slope, at.in_frame()) == 0.0 {
+        if wi.z < 0.0 && self.sees_nothing(at, inv_g1(&self.slope, at.in_frame())) {
             // ωi at the nadir of an opaque material: no facet faces it (projected area 0)
             return None;
         }
@@ -391,6 +391,14 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         self.shadowing.relative(k_in, out.lambda, ratio, event)
     }
 
+    /// Whether the incident state `at` with 1 + L̃ = `k_in` sees no microsurface: Λ(−ωin) = 0
+    /// exactly (straight from below), told apart from a Λ(−ωin) that only underflows f64
+    /// (Beckmann, |cot θ|/αᵢ > 26.6) by ln Λ (−∞ only in the first case).
+    #[inline]
+    pub(crate) fn sees_nothing(&self, at: Incident, k_in: f64) -> bool {
+        k_in == 0.0 && self.slope.ln_lambda(-at.in_frame()) == f64::NEG_INFINITY
+    }
+
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
     /// leave the surface) and then its Λ there (0 otherwise).
     #[inline]
@@ -412,5 +420,84 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         }
         let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
         self.shadowing.vertex(k_in, out.lambda, event).factor(role)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::cosine_hemisphere;
+    use crate::material::Conductor;
+    use crate::microsurface::ScatteringOrder;
+    use crate::slope::Beckmann;
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    /// θi = 120°: with Beckmann α = 0.02, a = |cot θi|/αᵢ = 28.9 and Λ(−ωi) ≈ e^{−a²}
+    /// underflows f64.
+    fn from_below() -> Vec3 {
+        let t = 120f32.to_radians();
+        Vec3::new(t.sin(), 0.0, t.cos())
+    }
+
+    fn smooth_mirror(shadowing: Shadowing) -> PositionFree<Beckmann, Conductor> {
+        PositionFree::new(
+            Beckmann::isotropic(0.02).expect("valid roughness"),
+            Conductor::perfect(),
+            shadowing,
+        )
+    }
+
+    /// Smooth Beckmann seen from below where Λ(−ωi) underflows f64: the position-free walk of
+    /// a perfect mirror returns every path, upwards, with weight 1 (energy is conserved), for
+    /// both shadowing models. Before, the nadir test took the underflowed Λ(−ωi) = 0 for “no
+    /// facet faces ωi” and returned `None` for all of them.
+    #[test]
+    fn sample_from_below_sees_smooth_beckmann() {
+        for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
+            let pf = smooth_mirror(shadowing);
+            let mut rng = Pcg64Mcg::seed_from_u64(41);
+            for k in 0..2000 {
+                let s = pf
+                    .sample(from_below(), &mut rng)
+                    .unwrap_or_else(|| panic!("{shadowing:?}: path {k} lost"));
+                assert!(s.weight == Vec3::ONE && s.wo.z > 0.0, "{shadowing:?}: {s:?}");
+            }
+        }
+    }
+
+    /// The same surface: path tracing's albedo ∫ f·cos dωo is 1 for a perfect mirror.
+    /// Estimated as the mean of eval_pt/pdf over N = 20 000 directions drawn from the mixture
+    /// whose density is [`PositionFree::pdf`] (0.8 phase sampling, 0.2 cosine), within z σ̂/√N,
+    /// z = 3.29 (Šidák, family-wise 1e-3 over the two shadowing models), resolving 1 %. Before,
+    /// the path stopped after the first vertex (its incident 1 + L̃ underflowed to 0) and the
+    /// multiple scattering was lost (mean 0.915, 25 σ̂/√N below 1).
+    #[test]
+    fn pt_from_below_conserves_energy_for_smooth_beckmann() {
+        const N: usize = 20_000;
+        const Z: f64 = 3.29;
+        let wi = from_below();
+        for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
+            let pf = smooth_mirror(shadowing);
+            let mut rng = Pcg64Mcg::seed_from_u64(43);
+            let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+            for _ in 0..N {
+                let wo = if uniform(&mut rng) < 1.0 - PDF_COSINE_SHARE {
+                    pf.material.sample_phase(&pf.slope, wi, Side::Outside, &mut rng).wo
+                } else {
+                    cosine_hemisphere(uniform(&mut rng), uniform(&mut rng))
+                };
+                let pdf = f64::from(pf.pdf(wi, wo));
+                let f = f64::from(pf.eval_pt(wi, wo, ScatteringOrder::All, &mut rng).x);
+                let x = if pdf > 0.0 { f / pdf } else { 0.0 };
+                (sum, sum_sq) = (sum + x, sum_sq + x * x);
+            }
+            let mean = sum / N as f64;
+            let sd = (sum_sq / N as f64 - mean * mean).max(0.0).sqrt();
+            let se = sd / (N as f64).sqrt();
+            let report = format!("{shadowing:?}: N = {N}, mean {mean}, σ̂ {sd}, z = {Z}");
+            assert!(se <= 0.01, "not resolved: {report}");
+            assert!((mean - 1.0).abs() <= Z * se, "{report}");
+        }
     }
 }

@@ -76,7 +76,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         k_in: f64,
         rng: &mut impl Rng,
     ) -> Option<(Incident, f64, DVec3)> {
-        if k_in == 0.0 || !k_in.is_finite() {
+        if !k_in.is_finite() || self.sees_nothing(at, k_in) {
             return None;
         }
         let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);

@@ -147,7 +147,7 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 /// can name the crate's types.
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
-pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
+pub use material::{Conductor, Dielectric, Diffuse, Event, Interaction, Material, PhaseSample, Side};
 pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
 pub use microsurface::{
     HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,

@@ -34,6 +34,7 @@ use microsurface::{
     Beckmann, Bsdf, ComplexIor, Conductor, Diffuse, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
     MicrosurfaceSlope, PositionFree, ScatteringOrder, ShadingFrame, Shadowing, Technique, UniformHeight,
 };
+use microsurface::{Interaction, Side};
 use std::f64::consts::{PI, TAU};
 
 /// z of the incident directions below the horizon.
@@ -180,11 +181,11 @@ fn importance<S: MicrosurfaceSlope, M: Material>(
     let w = if common::uniform64(rng) < 0.5 {
         // the phase function's sampler (exact density `pdf_phase`; a direction below the
         // horizon, where every integrand here is 0, is kept with its density)
-        pf.material().sample_phase(pf.slope(), wi, true, rng).wo
+        pf.material().sample_phase(pf.slope(), wi, Side::Outside, rng).wo
     } else {
         microsurface::sample_cosine_hemisphere(common::uniform32(rng), common::uniform32(rng))
     };
-    let phase = f64::from(pf.material().pdf_phase(pf.slope(), wi, w, true, true));
+    let phase = f64::from(pf.material().pdf_phase(pf.slope(), &Interaction::reflection(wi, w)));
     (w, 0.5 * phase + 0.5 * cosine(w))
 }
 
@@ -758,7 +759,7 @@ fn height_space_walk_from_below_matches_the_c1_walk() {
                 };
                 let (mut wr, mut weight) = (-wi, Vec3::ONE);
                 for bounces in 1..=microsurface::MAX_BOUNCES {
-                    let p = material.sample_phase(&s, -wr, true, rng);
+                    let p = material.sample_phase(&s, -wr, Side::Outside, rng);
                     wr = p.wo;
                     weight *= p.weight;
                     let u = common::uniform32(rng);
@@ -814,7 +815,7 @@ fn position_free_pt_equals_bdpt_pointwise() {
             let wi = wi_below(-0.3);
             let mut rng = common::rng(3000 + i as u64);
             let wo = loop {
-                let w = pf.material().sample_phase(pf.slope(), wi, true, &mut rng).wo;
+                let w = pf.material().sample_phase(pf.slope(), wi, Side::Outside, &mut rng).wo;
                 if w.z > 0.05 {
                     break w;
                 }

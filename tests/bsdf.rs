@@ -30,6 +30,7 @@ use microsurface::{
     Conductor, Dielectric, Diffuse, Estimator, Ggx, Material, MicrofacetBsdf, MicrosurfaceSlope,
     ScatteringOrder, ShadingFrame, Shadowing, SpecularLimit, Technique, Transport, sample_cosine_hemisphere,
 };
+use microsurface::{Interaction, Side};
 use std::f64::consts::PI;
 
 const ETA: f32 = 1.5;
@@ -146,7 +147,7 @@ fn proposal_sample<S: MicrosurfaceSlope, M: Material + SpecularLimit>(
         // wo.z < 0 for an opaque material is a backfacing view (normal mapping): its phase
         // function is still the reflection about a visible normal
         let outside = wo.z > 0.0 || !M::TRANSMITS;
-        return m.sample_phase(s, wo, outside, rng).wo;
+        return m.sample_phase(s, wo, side(outside), rng).wo;
     }
     let w = sample_cosine_hemisphere(uniform32(rng), uniform32(rng));
     if M::TRANSMITS && uniform64(rng) < 0.5 { -w } else { w }
@@ -160,9 +161,9 @@ fn proposal_pdf<S: MicrosurfaceSlope, M: Material + SpecularLimit>(b: &Mf<S, M>,
         return cosine;
     }
     let out = wo.z > 0.0 || !M::TRANSMITS;
-    let mut phase = f64::from(m.pdf_phase(s, wo, w, out, out));
+    let mut phase = f64::from(m.pdf_phase(s, &Interaction::new(wo, w, side(out), side(out))));
     if M::TRANSMITS {
-        phase += f64::from(m.pdf_phase(s, wo, w, out, !out));
+        phase += f64::from(m.pdf_phase(s, &Interaction::new(wo, w, side(out), side(!out))));
     }
     PHASE_SHARE * phase + (1.0 - PHASE_SHARE) * cosine
 }
@@ -1793,4 +1794,9 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
         }
     }
     assert!(reflections > 50 && refractions > 500, "{reflections} reflections, {refractions} refractions");
+}
+
+/// The side of the interface for the test tables' `outside` flags.
+fn side(outside: bool) -> Side {
+    if outside { Side::Outside } else { Side::Inside }
 }

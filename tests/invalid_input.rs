@@ -19,6 +19,7 @@ use microsurface::{
     fresnel_conductor, fresnel_dielectric, fresnel_schlick, orthonormal_basis, sample_cosine_hemisphere,
     smith_normalization,
 };
+use microsurface::{Interaction, Side};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::fmt::Debug;
@@ -267,14 +268,22 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
                 let l = format!("{l} sides ({io}, {oo})");
                 r.expect_nothing(
                     &format!("{l}: eval_phase"),
-                    || m.eval_phase(&s, wi, wo, io, oo, &mut rng),
+                    || m.eval_phase(&s, &Interaction::new(wi, wo, side(io), side(oo)), &mut rng),
                     zero,
                 );
-                r.expect_nothing(&format!("{l}: pdf_phase"), || m.pdf_phase(&s, wi, wo, io, oo), zero32);
-                r.expect_nothing(&format!("{l}: vertex"), || m.vertex(&s, wi, wo, io, oo, &mut rng), zero);
+                r.expect_nothing(
+                    &format!("{l}: pdf_phase"),
+                    || m.pdf_phase(&s, &Interaction::new(wi, wo, side(io), side(oo))),
+                    zero32,
+                );
+                r.expect_nothing(
+                    &format!("{l}: vertex"),
+                    || m.vertex(&s, &Interaction::new(wi, wo, side(io), side(oo)), &mut rng),
+                    zero,
+                );
                 r.expect_nothing(
                     &format!("{l}: connection"),
-                    || m.connection(&s, wi, wo, io, oo, &mut rng),
+                    || m.connection(&s, &Interaction::new(wi, wo, side(io), side(oo)), &mut rng),
                     |c| *c == (Vec3::ZERO, 0.0, 0.0),
                 );
             }
@@ -327,7 +336,7 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
             }
             r.expect_nothing(
                 &format!("{l}: sample_phase({outside})"),
-                || m.sample_phase(&s, b, outside, &mut rng),
+                || m.sample_phase(&s, b, side(outside), &mut rng),
                 no_phase_sample,
             );
         }
@@ -687,4 +696,9 @@ fn valid_edge_directions_pass_the_checks() {
         |v| exact > 0.0 && ((v - exact) / exact).abs() < 1e-2,
     );
     r.finish("valid_edge_directions_pass_the_checks", 400);
+}
+
+/// The side of the interface for the test tables' `outside` flags.
+fn side(outside: bool) -> Side {
+    if outside { Side::Outside } else { Side::Inside }
 }

@@ -18,6 +18,7 @@ use microsurface::{
     MicrosurfaceGeometry, MicrosurfaceSlope, SmithVndf, UniformHeight, VCavity, VCavitySlope,
     VisibleNormalSampler, orthonormal_basis, smith_normalization,
 };
+use microsurface::{Interaction, Side};
 use rand::SeedableRng;
 
 type Rng = rand_pcg::Pcg64Mcg;
@@ -216,16 +217,17 @@ fn check_materials<S: MicrosurfaceSlope>(c: &mut Checker, name: &str, slope: S, 
             for (wi_out, wo_out) in [(true, true), (true, false), (false, true), (false, false)] {
                 let rng = || Rng::seed_from_u64(3);
                 c.scalar2(&format!("{name}.eval_phase[{wi_out},{wo_out}]"), w, wo, |a, b| {
-                    m.eval_phase(&slope, a, b, wi_out, wo_out, &mut rng()).x
+                    m.eval_phase(&slope, &Interaction::new(a, b, side(wi_out), side(wo_out)), &mut rng()).x
                 });
                 c.scalar2(&format!("{name}.pdf_phase[{wi_out},{wo_out}]"), w, wo, |a, b| {
-                    m.pdf_phase(&slope, a, b, wi_out, wo_out)
+                    m.pdf_phase(&slope, &Interaction::new(a, b, side(wi_out), side(wo_out)))
                 });
                 c.scalar2(&format!("{name}.vertex[{wi_out},{wo_out}]"), w, wo, |a, b| {
-                    m.vertex(&slope, a, b, wi_out, wo_out, &mut rng()).x
+                    m.vertex(&slope, &Interaction::new(a, b, side(wi_out), side(wo_out)), &mut rng()).x
                 });
                 c.scalar2(&format!("{name}.connection[{wi_out},{wo_out}]"), w, wo, |a, b| {
-                    let (v, p, q) = m.connection(&slope, a, b, wi_out, wo_out, &mut rng());
+                    let (v, p, q) =
+                        m.connection(&slope, &Interaction::new(a, b, side(wi_out), side(wo_out)), &mut rng());
                     v.x + 2.0 * p + 3.0 * q
                 });
             }
@@ -236,10 +238,10 @@ fn check_materials<S: MicrosurfaceSlope>(c: &mut Checker, name: &str, slope: S, 
         for outside in [true, false] {
             for seed in 0..4 {
                 c.vector1(&format!("{name}.sample_phase[{outside}] seed {seed}"), w, |a| {
-                    let s = m.sample_phase(&slope, a, outside, &mut Rng::seed_from_u64(seed));
+                    let s = m.sample_phase(&slope, a, side(outside), &mut Rng::seed_from_u64(seed));
                     let mut v = s.wo.to_array().to_vec();
                     v.extend(s.weight.to_array());
-                    v.push(f32::from(u8::from(s.outside)));
+                    v.push(f32::from(u8::from(s.side == Side::Outside)));
                     v
                 });
             }
@@ -301,4 +303,9 @@ fn named_samplers_treat_negative_zero_like_positive_zero() {
         });
     }
     c.finish();
+}
+
+/// The side of the interface for the test tables' `outside` flags.
+fn side(outside: bool) -> Side {
+    if outside { Side::Outside } else { Side::Inside }
 }

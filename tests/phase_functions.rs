@@ -25,6 +25,7 @@ use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope,
     PhaseSample, UniformHeight,
 };
+use microsurface::{Interaction, Side};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::{PI, TAU};
 
@@ -84,10 +85,15 @@ impl<S: MicrosurfaceSlope, M: Material> Phase for Surface<S, M> {
         self.kind
     }
     fn sided(&self, wi: Vec3, wo: Vec3, wi_out: bool, wo_out: bool, rng: &mut TestRng) -> f64 {
-        f64::from(self.surface.material().eval_phase(self.surface.slope(), wi, wo, wi_out, wo_out, rng).x)
+        f64::from(
+            self.surface
+                .material()
+                .eval_phase(self.surface.slope(), &Interaction::new(wi, wo, side(wi_out), side(wo_out)), rng)
+                .x,
+        )
     }
     fn sample_sided(&self, wi: Vec3, wi_out: bool, rng: &mut TestRng) -> PhaseSample {
-        self.surface.material().sample_phase(self.surface.slope(), wi, wi_out, rng)
+        self.surface.material().sample_phase(self.surface.slope(), wi, side(wi_out), rng)
     }
     fn eval(&self, wi: Vec3, wo: Vec3, rng: &mut TestRng) -> f64 {
         f64::from(self.surface.eval_phase(wi, wo, rng).x)
@@ -373,7 +379,7 @@ fn sampling_chi2_exact() {
                 };
                 assert_eq!(s.weight, Vec3::ONE, "{label}: non-absorptive weight");
                 assert!(s.wo.is_normalized(), "{label}: ωo = {} not unit", s.wo);
-                same_side += usize::from(s.outside == wi_out);
+                same_side += usize::from(s.side == side(wi_out));
                 Some(s.wo)
             },
             CHI2_N,
@@ -428,7 +434,7 @@ fn sampling_chi2_diffuse_stochastic_density() {
             &mut || {
                 let s = surface.sample(wi, &mut rng);
                 assert_eq!(s.weight, Vec3::ONE, "{label}: white diffuse weight");
-                assert!(s.outside);
+                assert_eq!(s.side, Side::Outside);
                 s.wo
             },
             DIFFUSE_CHI2_N,
@@ -555,11 +561,12 @@ fn connection_equals_vertex_and_both_densities() {
         for _ in 0..20_000 {
             let (wi, wo) = (uniform_sphere(rng), uniform_sphere(rng));
             for (a, b) in [(true, true), (true, false), (false, true), (false, false)] {
-                let (v, forward, reverse) = material.connection(&slope, wi, wo, a, b, rng);
+                let (v, forward, reverse) =
+                    material.connection(&slope, &Interaction::new(wi, wo, side(a), side(b)), rng);
                 let expected = (
-                    material.vertex(&slope, wi, wo, a, b, rng),
-                    material.pdf_phase(&slope, wi, wo, a, b),
-                    material.pdf_phase(&slope, wo, wi, b, a),
+                    material.vertex(&slope, &Interaction::new(wi, wo, side(a), side(b)), rng),
+                    material.pdf_phase(&slope, &Interaction::new(wi, wo, side(a), side(b))),
+                    material.pdf_phase(&slope, &Interaction::new(wo, wi, side(b), side(a))),
                 );
                 assert_eq!(
                     (v, forward, reverse),
@@ -579,4 +586,9 @@ fn connection_equals_vertex_and_both_densities() {
         check("gold GGX", Ggx::new(ax, ay).unwrap(), Conductor::new(gold), &mut rng);
         check("gold Beckmann", Beckmann::new(ax, ay).unwrap(), Conductor::new(gold), &mut rng);
     }
+}
+
+/// The side of the interface for the test tables' `outside` flags.
+fn side(outside: bool) -> Side {
+    if outside { Side::Outside } else { Side::Inside }
 }

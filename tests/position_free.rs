@@ -22,6 +22,7 @@ use microsurface::{
     MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample,
     sample_cosine_hemisphere,
 };
+use microsurface::{Interaction, Side};
 use rand::RngExt;
 use std::f64::consts::{PI, TAU};
 
@@ -75,7 +76,7 @@ impl<S: MicrosurfaceSlope, M: Material> Model for Pf<S, M> {
     }
     fn mix_sample(&self, wi: Vec3, rng: &mut TestRng) -> Vec3 {
         if uniform64(rng) < PHASE_SHARE {
-            self.0.material().sample_phase(self.0.slope(), wi, wi.z > 0.0, rng).wo
+            self.0.material().sample_phase(self.0.slope(), wi, side(wi.z > 0.0), rng).wo
         } else {
             let w = sample_cosine_hemisphere(rng.random::<f32>(), rng.random::<f32>());
             if M::TRANSMITS && uniform64(rng) < 0.5 { -w } else { w }
@@ -83,9 +84,9 @@ impl<S: MicrosurfaceSlope, M: Material> Model for Pf<S, M> {
     }
     fn mix_pdf(&self, wi: Vec3, wo: Vec3) -> f64 {
         let (m, s, out) = (self.0.material(), self.0.slope(), wi.z > 0.0);
-        let mut phase = f64::from(m.pdf_phase(s, wi, wo, out, out));
+        let mut phase = f64::from(m.pdf_phase(s, &Interaction::new(wi, wo, side(out), side(out))));
         let cosine = if M::TRANSMITS {
-            phase += f64::from(m.pdf_phase(s, wi, wo, out, !out));
+            phase += f64::from(m.pdf_phase(s, &Interaction::new(wi, wo, side(out), side(!out))));
             f64::from(wo.z).abs() / (2.0 * PI)
         } else {
             f64::from(wo.z).max(0.0) / PI
@@ -1229,4 +1230,9 @@ fn degenerate_input_stays_finite() {
         }
     }
     println!("degenerate input: {} models, {count} evaluations, all finite", models.len());
+}
+
+/// The side of the interface for the test tables' `outside` flags.
+fn side(outside: bool) -> Side {
+    if outside { Side::Outside } else { Side::Inside }
 }

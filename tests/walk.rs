@@ -26,6 +26,7 @@ use microsurface::{
     Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PhaseSample, ScatteringOrder,
     UniformHeight, WalkSample,
 };
+use microsurface::{Interaction, Side};
 use statrs::distribution::{ContinuousCDF, Normal};
 use std::f64::consts::{PI, TAU};
 
@@ -106,13 +107,13 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Bsdf for Surf<H, 
         self.exact_phase
     }
     fn phase_sample(&self, wi: Vec3, rng: &mut TestRng) -> Vec3 {
-        self.surface.material().sample_phase(self.surface.slope(), wi, wi.z > 0.0, rng).wo
+        self.surface.material().sample_phase(self.surface.slope(), wi, sided(wi.z > 0.0), rng).wo
     }
     fn phase_pdf(&self, wi: Vec3, wo: Vec3, rng: &mut TestRng) -> f64 {
-        let (m, s, side) = (self.surface.material(), self.surface.slope(), wi.z > 0.0);
-        let mut p = m.eval_phase(s, wi, wo, side, true, rng).x;
+        let (m, s, side) = (self.surface.material(), self.surface.slope(), sided(wi.z > 0.0));
+        let mut p = m.eval_phase(s, &Interaction::new(wi, wo, side, Side::Outside), rng).x;
         if M::TRANSMITS {
-            p += m.eval_phase(s, wi, wo, side, false, rng).x;
+            p += m.eval_phase(s, &Interaction::new(wi, wo, side, Side::Inside), rng).x;
         }
         f64::from(p)
     }
@@ -145,11 +146,15 @@ fn reference_eval<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
             HeightSample::Escape => break,
             HeightSample::Hit(local) => h = if outside { local } else { -local },
         }
-        let phase = material.eval_phase(geometry.slope(), -wr, wo, outside, wo_outside, rng);
+        let phase = material.eval_phase(
+            geometry.slope(),
+            &Interaction::new(-wr, wo, sided(outside), sided(wo_outside)),
+            rng,
+        );
         let shadowing = geometry.g1_at(side(wo, wo_outside), if wo_outside { h } else { -h });
         sum += throughput * phase * shadowing;
-        let s = material.sample_phase(geometry.slope(), -wr, outside, rng);
-        (wr, outside, throughput) = (s.wo, s.outside, throughput * s.weight);
+        let s = material.sample_phase(geometry.slope(), -wr, sided(outside), rng);
+        (wr, outside, throughput) = (s.wo, s.side == Side::Outside, throughput * s.weight);
     }
     sum
 }
@@ -720,4 +725,9 @@ fn orders_sum_to_the_full_bsdf() {
     });
     let flat: Vec<(f64, f64)> = out.into_iter().flatten().collect();
     println!("orders: worst |Δ|/SE = {:.2} (z = {z:.2})", worst_z(&flat));
+}
+
+/// The side of the interface for an `outside` flag.
+fn sided(outside: bool) -> Side {
+    if outside { Side::Outside } else { Side::Inside }
 }

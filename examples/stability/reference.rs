@@ -23,6 +23,7 @@ use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Ggx, Material, MicrosurfaceGeometry, MicrosurfaceSlope,
     UniformHeight, fresnel_conductor, fresnel_dielectric,
 };
+use microsurface::{Interaction, Side};
 use rand::SeedableRng;
 use statrs::function::erf::erfc;
 use statrs::function::gamma::ln_gamma;
@@ -577,12 +578,12 @@ fn slope_functions<S: MicrosurfaceSlope>(
                 let wod = d3(wo);
                 d_wi.push(f64::from(s.d_wi(wi, wo)), r.d_wi(wid, wod), || pp(wi, wo));
                 cond.push(
-                    f64::from(perfect.eval_phase(&s, wi, wo, true, true, &mut rng).x),
+                    f64::from(perfect.eval_phase(&s, &Interaction::reflection(wi, wo), &mut rng).x),
                     phase_reflection_ref(&r, RefFresnel::One, wid, wod),
                     || pp(wi, wo),
                 );
                 gold.push(
-                    f64::from(gold_m.eval_phase(&s, wi, wo, true, true, &mut rng).x),
+                    f64::from(gold_m.eval_phase(&s, &Interaction::reflection(wi, wo), &mut rng).x),
                     phase_reflection_ref(&r, gold_ref, wid, wod),
                     || pp(wi, wo),
                 );
@@ -591,13 +592,20 @@ fn slope_functions<S: MicrosurfaceSlope>(
                     let e = f64::from(eta);
                     let pe = || format!("η={eta:.4} {}", pp(wi, wo));
                     refl.push(
-                        f64::from(m.eval_phase(&s, wi, wo, true, true, &mut rng).x),
+                        f64::from(m.eval_phase(&s, &Interaction::reflection(wi, wo), &mut rng).x),
                         phase_reflection_ref(&r, RefFresnel::Dielectric(e), wid, wod),
                         pe,
                     );
                     let t = if grazing_refraction(wid, wod, e) { &mut trans_graze } else { &mut trans };
                     t.push(
-                        f64::from(m.eval_phase(&s, wi, wo, true, false, &mut rng).x),
+                        f64::from(
+                            m.eval_phase(
+                                &s,
+                                &Interaction::new(wi, wo, Side::Outside, Side::Inside),
+                                &mut rng,
+                            )
+                            .x,
+                        ),
                         phase_transmission_ref(&r, e, wid, wod),
                         || format!("η={eta:.4} {}", pp(wi, wo)),
                     );

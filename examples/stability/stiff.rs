@@ -16,6 +16,7 @@ use microsurface::{
     Beckmann, Conductor, Dielectric, Estimator, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
     ScatteringOrder, Shadowing, UniformHeight, WalkSample, sample_cosine_hemisphere,
 };
+use microsurface::{Interaction, Side};
 use rand::RngExt;
 use std::f64::consts::PI;
 
@@ -94,18 +95,20 @@ impl<S: MicrosurfaceSlope, M: Material> Model for Impl<S, M> {
     }
     fn sample_with(&self, wi: Vec3, share: f64, rng: &mut TestRng) -> Vec3 {
         if rng.random::<f64>() < share {
-            self.material.sample_phase(&self.slope, wi, wi.z > 0.0, rng).wo
+            let side = if wi.z > 0.0 { Side::Outside } else { Side::Inside };
+            self.material.sample_phase(&self.slope, wi, side, rng).wo
         } else {
             let w = sample_cosine_hemisphere(rng.random::<f32>(), rng.random::<f32>());
             if M::TRANSMITS && rng.random::<f64>() < 0.5 { -w } else { w }
         }
     }
     fn pdf_with(&self, wi: Vec3, wo: Vec3, share: f64) -> f64 {
-        let (m, s, out) = (&self.material, &self.slope, wi.z > 0.0);
-        let mut phase =
-            f64::from(m.pdf_phase(s, wi, wo, out, true)) + f64::from(m.pdf_phase(s, wi, wo, out, false));
+        let (m, s) = (&self.material, &self.slope);
+        let out = if wi.z > 0.0 { Side::Outside } else { Side::Inside };
+        let mut phase = f64::from(m.pdf_phase(s, &Interaction::new(wi, wo, out, Side::Outside)))
+            + f64::from(m.pdf_phase(s, &Interaction::new(wi, wo, out, Side::Inside)));
         if !M::TRANSMITS {
-            phase = f64::from(m.pdf_phase(s, wi, wo, true, true));
+            phase = f64::from(m.pdf_phase(s, &Interaction::reflection(wi, wo)));
         }
         let cosine =
             if M::TRANSMITS { f64::from(wo.z).abs() / (2.0 * PI) } else { f64::from(wo.z).max(0.0) / PI };

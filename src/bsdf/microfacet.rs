@@ -7,7 +7,7 @@ use super::{
 };
 use crate::error::Error;
 use crate::height::UniformHeight;
-use crate::material::Material;
+use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
 use crate::position_free::{Estimator, PositionFree, Shadowing};
 use crate::slope::MicrosurfaceSlope;
@@ -248,7 +248,10 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self.transport {
             // the research layer's relative_eta_sq(light from, light to): light goes wi → wo
-            Transport::Radiance => self.surface.material().relative_eta_sq(wi.z > 0.0, wo.z > 0.0),
+            Transport::Radiance => self
+                .surface
+                .material()
+                .relative_eta_sq(Side::above_or_inside(wi.z), Side::above_or_inside(wo.z)),
             Transport::Importance => 1.0,
         }
     }
@@ -260,7 +263,10 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             1.0
         } else {
             // relative_eta_sq(a, b) = (η_b/η_a)²
-            self.surface.material().relative_eta_sq(wo.z > 0.0, wi.z > 0.0).sqrt()
+            self.surface
+                .material()
+                .relative_eta_sq(Side::above_or_inside(wo.z), Side::above_or_inside(wi.z))
+                .sqrt()
         }
     }
 

@@ -1,11 +1,10 @@
 //! Conductor microfacets.
 
 use super::{
-    Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_density,
+    Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect, reflection_density,
     reflection_half_vector,
 };
-use crate::contract::is_cosine;
-use crate::contract::is_direction;
+use crate::contract::{is_cosine, is_direction};
 use crate::fresnel::{ComplexIor, conductor_reflectance};
 use crate::rng::uniform;
 use crate::slope::{MicrosurfaceSlope, renormalize};
@@ -22,6 +21,27 @@ const FRESNEL_AT_HALF_VECTOR_BELOW: f32 = 0.05;
 ///
 /// [`Conductor::perfect`] has F = 1 (the supplement's non-absorptive validation baseline);
 /// [`Conductor::new`] uses the exact Fresnel term of a complex IOR per RGB channel.
+///
+/// Its [`Material`] terms, with ωh the normalized ωi + ωo and A the projected area; all 0
+/// unless both directions are outside:
+/// - phase function p(ωi, ωo) = F(ωi·ωh) D_ωi(ωh)/(4 ωi·ωh) = F D(ωh)/(4 A(ωi))
+///   (supplement §3.2); `pdf_phase` is the same without F;
+/// - vertex term F(ωi·ωh) D(ωh)/(4 |cos θi|) (Wang et al. 2022, eq. 2);
+/// - sampling: ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm); for ωi·ωm below
+///   `FRESNEL_AT_HALF_VECTOR_BELOW` F takes the cosine of the half vector recomputed from the
+///   f32 ωi and ωo, as the evaluations do, so that weight = F·(the phase density ratio) holds
+///   to f32 precision;
+/// - single scattering F(ωi·ωh) D(ωh) G2(ωi, ωo)/(4 cos θi) (the Cook–Torrance BRDF times
+///   cos θo).
+///
+/// # Examples
+/// ```
+/// use microsurface::{ComplexIor, Conductor};
+///
+/// let gold = Conductor::new(ComplexIor::GOLD);
+/// assert_eq!(Conductor::perfect().fresnel(0.3), microsurface::glam::Vec3::ONE);
+/// assert!(gold.fresnel(1.0).x > 0.9);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Conductor {
     ior: Option<ComplexIor>,
@@ -48,6 +68,16 @@ impl Conductor {
         self.reflectance(wi.as_dvec3().dot(wh) as f32) * (d / (4.0 * f64::from(wi.z.abs()))) as f32
     }
 
+    /// The reflection half vector of an outside reflection, `None` for every other
+    /// interaction and where the half vector is not a valid facet normal.
+    #[inline(always)]
+    fn half_vector(it: &Interaction) -> Option<DVec3> {
+        if !it.is_outside_reflection() {
+            return None;
+        }
+        reflection_half_vector(it.wi(), it.wo())
+    }
+
     /// The Fresnel term for the cosine between ωi and the facet normal.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `cos_theta` that is NaN or beyond
@@ -71,149 +101,51 @@ impl Conductor {
 
 impl Material for Conductor {
     const TRANSMITS: bool = false;
-
-    /// p(ωi, ωo) = F(ωi·ωh) D_ωi(ωh) / (4 ωi·ωh) = F D(ωh) / (4 A(ωi)), with ωh the normalized
-    /// ωi + ωo and A the projected area (supplement §3.2).
-    #[inline]
-    fn eval_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        _rng: &mut impl Rng,
-    ) -> Vec3 {
-        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        self.eval_phase_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
-    }
+    const EXACT_PHASE_PDF: bool = true;
 
     #[inline]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
-            return Vec3::ZERO;
-        };
-        self.reflectance(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh)
-    }
-
-    const EXACT_PHASE_PDF: bool = true;
-
-    /// D_ωi(ωh)/(4 ωi·ωh): the phase function without F.
-    #[inline]
-    fn pdf_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside)
+        let Some(wh) = Self::half_vector(it) else { return Vec3::ZERO };
+        let wi = it.wi();
+        self.reflectance(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh, it.incident_area())
     }
 
     #[inline]
-    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
-            return 0.0;
-        };
-        phase_reflection(slope, wi, wh)
-    }
-
-    /// F(ωi·ωh) D(ωh) / (4 |cos θi|) (Wang et al. 2022, eq. 2).
-    #[inline]
-    fn vertex<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        _rng: &mut impl Rng,
-    ) -> Vec3 {
-        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
+        let Some(wh) = Self::half_vector(it) else { return 0.0 };
+        phase_reflection(slope, it.wi(), wh, it.incident_area())
     }
 
     #[inline]
     fn vertex_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
-            return Vec3::ZERO;
-        };
-        self.reflection_vertex(wi, wh, slope.d64_unchecked(wh))
+        let Some(wh) = Self::half_vector(it) else { return Vec3::ZERO };
+        self.reflection_vertex(it.wi(), wh, slope.d64_unchecked(wh))
     }
 
     /// One half vector and one D for the vertex term and both densities.
     #[inline]
-    fn connection<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        _rng: &mut impl Rng,
-    ) -> (Vec3, f32, f32) {
-        require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0, 0.0); wi, wo);
-        self.connection_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
-    }
-
-    #[inline]
     fn connection_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         _rng: &mut impl Rng,
     ) -> (Vec3, f32, f32) {
-        let Some(wh) = reflection_half_vector(wi, wo).filter(|_| wi_outside && wo_outside) else {
-            return (Vec3::ZERO, 0.0, 0.0);
-        };
+        let Some(wh) = Self::half_vector(it) else { return (Vec3::ZERO, 0.0, 0.0) };
+        let (wi, wo) = (it.wi(), it.wo());
         let d = slope.d64_unchecked(wh);
         // ωh is also the half vector of ωo → ωi
         let reverse = if wo.as_dvec3().dot(wh) > 0.0 { reflection_density(slope, wo, d) } else { 0.0 };
         (self.reflection_vertex(wi, wh, d), reflection_density(slope, wi, d), reverse)
-    }
-
-    /// ωm from D_ωi, ωo = reflect(ωi, ωm), weight F(ωi·ωm); for ωi·ωm below
-    /// `FRESNEL_AT_HALF_VECTOR_BELOW` F takes the cosine of the half vector recomputed from the
-    /// f32 ωi and ωo, as the evaluations do, so that weight = F·(the phase density ratio) holds
-    /// to f32 precision (before: 3.5e-4 apart for gold, GGX α = 1e-4 at cos θi = 1e-4).
-    #[inline]
-    fn sample_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        _wi_outside: bool,
-        rng: &mut impl Rng,
-    ) -> PhaseSample {
-        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
-        self.sample_phase_unchecked(slope, wi, _wi_outside, rng)
     }
 
     #[inline]
@@ -221,7 +153,7 @@ impl Material for Conductor {
         &self,
         slope: &S,
         wi: Vec3,
-        _wi_outside: bool,
+        _side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
@@ -236,7 +168,7 @@ impl Material for Conductor {
             }
             _ => c,
         };
-        PhaseSample { wo, weight: self.reflectance(cos), outside: true }
+        PhaseSample { wo, weight: self.reflectance(cos), side: Side::Outside }
     }
 
     /// F(ωi·ωh) D(ωh) G2(ωi, ωo) / (4 cos θi) (the Cook–Torrance BRDF times cos θo).

@@ -1,6 +1,9 @@
 //! Dielectric microfacets.
 
-use super::{Material, PhaseSample, g2_reflection, phase_reflection, reflect, reflection_half_vector};
+use super::{
+    Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
+    reflection_half_vector,
+};
 use crate::contract::is_direction;
 use crate::error::Error;
 use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
@@ -32,6 +35,29 @@ struct Refraction {
 /// Non-absorptive by construction: every facet interaction either reflects or refracts, with
 /// the Fresnel term choosing. Configurations seen from inside are evaluated as the vertically
 /// flipped configuration with η ↦ 1/η.
+///
+/// Its [`Material`] terms, for ωi outside (the inside configuration is flipped), with ωh the
+/// reflection or refraction half vector:
+/// - phase function (= `pdf_phase`, the sample weight being 1): reflection
+///   F(ωi·ωh) D_ωi(ωh)/(4 ωi·ωh); transmission η² (1 − F(ωi·ωh)) D_ωi(ωh) |ωo·ωh| /
+///   (ωi·ωh + η ωo·ωh)² (supplement §3.4);
+/// - vertex term: reflection F D/(4|cos θi|); transmission
+///   |ωi·ωh| |ωo·ωh| η² (1 − F) D / (|cos θi| (ωi·ωh + η ωo·ωh)²) (Wang et al. 2022,
+///   eqs. 2–3, every refraction included, see DESIGN.md);
+/// - sampling: ωm from D_ωi, reflect with probability F(ωi·ωm), refract otherwise; weight 1
+///   (supplement §3.4, Algorithm 7), the side of ωo always returned explicitly;
+/// - single scattering: reflection F D G2/(4 cos θi); transmission
+///   |ωi·ωh| |ωo·ωh| η² (1 − F) D B(1 + Λ(ωi), 1 + Λ(−ωo)) / (cos θi (ωi·ωh + η ωo·ωh)²)
+///   (supplement §3.4).
+///
+/// # Examples
+/// ```
+/// use microsurface::Dielectric;
+///
+/// let glass = Dielectric::new(1.5).unwrap();
+/// assert_eq!(glass.flipped().eta(), 1.0 / 1.5);
+/// assert!(Dielectric::new(0.0).is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dielectric {
     eta: f32,
@@ -53,18 +79,15 @@ impl Dielectric {
         self.eta
     }
 
-    /// A configuration with ωi on side `wi_outside`, expressed as the equivalent one with ωi
-    /// outside: unchanged from outside, flipped vertically (ω ↦ −ω, η ↦ 1/η, sides swapped)
-    /// from inside (Heitz et al. 2016, §3.4).
+    /// This interface as seen from ωi's side: itself from outside, [`Dielectric::flipped`]
+    /// from inside (Heitz et al. 2016, §3.4; the directions flip with
+    /// `Interaction::seen_from_outside`).
     #[inline(always)]
-    fn outside_frame(
-        &self,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> (Self, Vec3, Vec3, bool) {
-        if wi_outside { (*self, wi, wo, wo_outside) } else { (self.flipped(), -wi, -wo, !wo_outside) }
+    fn seen_from(&self, side: Side) -> Self {
+        match side {
+            Side::Outside => *self,
+            Side::Inside => self.flipped(),
+        }
     }
 
     /// The same interface seen from inside: η ↦ 1/η.
@@ -100,40 +123,48 @@ impl Dielectric {
         Some(Refraction { wh: h, cos_ih, cos_oh, denom_sq: len * len, transmittance })
     }
 
-    /// The phase function for ωi outside.
+    /// The phase function for ωi outside, `it` in that frame.
     #[inline(always)]
-    fn eval_phase_outside<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wo_outside: bool,
-    ) -> f32 {
-        if wo_outside {
-            let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta) * phase_reflection(slope, wi, wh)
-        } else {
-            let Some(r) = self.refraction(wi, wo) else { return 0.0 };
-            let eta = f64::from(self.eta);
-            (eta * eta * r.transmittance * slope.d_wi64_unchecked(wi, r.wh) * (-r.cos_oh) / r.denom_sq) as f32
+    fn eval_phase_outside<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
+        let (wi, wo) = (it.wi(), it.wo());
+        match it.wo_side() {
+            Side::Outside => {
+                let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
+                dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
+                    * phase_reflection(slope, wi, wh, it.incident_area())
+            }
+            Side::Inside => {
+                let Some(r) = self.refraction(wi, wo) else { return 0.0 };
+                let eta = f64::from(self.eta);
+                // D_ωi(ωh) = (ωi·ωh) D(ωh)/A(ωi), with A known where the walk computed it
+                let d_wi = match it.incident_area() {
+                    Some(area) if wi.z > 0.0 => r.cos_ih * slope.d64_unchecked(r.wh) / f64::from(area),
+                    _ => slope.d_wi64_unchecked(wi, r.wh),
+                };
+                (eta * eta * r.transmittance * d_wi * (-r.cos_oh) / r.denom_sq) as f32
+            }
         }
     }
 
-    /// The vertex term for ωi outside (Wang et al. 2022, eqs. 2–3).
+    /// The vertex term for ωi outside, `it` in that frame (Wang et al. 2022, eqs. 2–3).
     #[inline(always)]
-    fn vertex_outside<S: MicrosurfaceSlope>(&self, slope: &S, wi: Vec3, wo: Vec3, wo_outside: bool) -> f32 {
+    fn vertex_outside<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
+        let (wi, wo) = (it.wi(), it.wo());
         if wi.z == 0.0 {
             return 0.0;
         }
-        if wo_outside {
-            let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
-            dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
-                * (slope.d64_unchecked(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
-        } else {
-            let Some(r) = self.refraction(wi, wo) else { return 0.0 };
-            let eta = f64::from(self.eta);
-            (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64_unchecked(r.wh)
-                / (f64::from(wi.z.abs()) * r.denom_sq)) as f32
+        match it.wo_side() {
+            Side::Outside => {
+                let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
+                dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
+                    * (slope.d64_unchecked(wh) / (4.0 * f64::from(wi.z.abs()))) as f32
+            }
+            Side::Inside => {
+                let Some(r) = self.refraction(wi, wo) else { return 0.0 };
+                let eta = f64::from(self.eta);
+                (r.cos_ih * (-r.cos_oh) * eta * eta * r.transmittance * slope.d64_unchecked(r.wh)
+                    / (f64::from(wi.z.abs()) * r.denom_sq)) as f32
+            }
         }
     }
 
@@ -150,37 +181,6 @@ impl Dielectric {
 
 impl Material for Dielectric {
     const TRANSMITS: bool = true;
-
-    /// Reflection: F(ωi·ωh) D_ωi(ωh)/(4 ωi·ωh); transmission:
-    /// η² (1 − F(ωi·ωh)) D_ωi(ωh) |ωo·ωh| / (ωi·ωh + η ωo·ωh)² (supplement §3.4); the inside
-    /// configuration is flipped.
-    #[inline]
-    fn eval_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        _rng: &mut impl Rng,
-    ) -> Vec3 {
-        // the argument check is `pdf_phase`'s
-        Vec3::splat(self.pdf_phase(slope, wi, wo, wi_outside, wo_outside))
-    }
-
-    #[inline]
-    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        _rng: &mut impl Rng,
-    ) -> Vec3 {
-        Vec3::splat(self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside))
-    }
-
     const EXACT_PHASE_PDF: bool = true;
 
     /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not
@@ -193,86 +193,37 @@ impl Material for Dielectric {
     }
 
     #[inline]
-    fn relative_eta_sq(&self, wi_outside: bool, wo_outside: bool) -> f32 {
-        match (wi_outside, wo_outside) {
-            (true, false) => self.eta * self.eta,
-            (false, true) => 1.0 / (self.eta * self.eta),
+    fn relative_eta_sq(&self, from: Side, to: Side) -> f32 {
+        match (from, to) {
+            (Side::Outside, Side::Inside) => self.eta * self.eta,
+            (Side::Inside, Side::Outside) => 1.0 / (self.eta * self.eta),
             _ => 1.0,
         }
     }
 
-    /// The phase function itself (the sample weight is 1).
     #[inline]
-    fn pdf_phase<S: MicrosurfaceSlope>(
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside)
-    }
-
-    #[inline]
-    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
-        this.eval_phase_outside(slope, wi, wo, wo_outside)
-    }
-
-    /// Reflection F D/(4|cos θi|); transmission
-    /// |ωi·ωh| |ωo·ωh| η² (1 − F) D / (|cos θi| (ωi·ωh + η ωo·ωh)²) (Wang et al. 2022, eqs. 2–3,
-    /// without the released code's extra rejection of refractions back into the incident
-    /// hemisphere); the inside configuration is flipped.
-    #[inline]
-    fn vertex<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, _rng)
+        Vec3::splat(self.pdf_phase_unchecked(slope, it))
+    }
+
+    #[inline]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
+        self.seen_from(it.wi_side()).eval_phase_outside(slope, &it.seen_from_outside())
     }
 
     #[inline]
     fn vertex_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         _rng: &mut impl Rng,
     ) -> Vec3 {
-        let (this, wi, wo, wo_outside) = self.outside_frame(wi, wo, wi_outside, wo_outside);
-        Vec3::splat(this.vertex_outside(slope, wi, wo, wo_outside))
-    }
-
-    /// ωm from D_ωi (of the flipped configuration inside), reflect with probability
-    /// F(ωi·ωm), refract otherwise; weight 1 (supplement §3.4, Algorithm 7). Unlike the
-    /// supplement's listing, the side of ωo is always returned explicitly.
-    #[inline]
-    fn sample_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wi_outside: bool,
-        rng: &mut impl Rng,
-    ) -> PhaseSample {
-        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: wi_outside }; wi);
-        self.sample_phase_unchecked(slope, wi, wi_outside, rng)
+        Vec3::splat(self.seen_from(it.wi_side()).vertex_outside(slope, &it.seen_from_outside()))
     }
 
     #[inline]
@@ -280,23 +231,23 @@ impl Material for Dielectric {
         &self,
         slope: &S,
         wi: Vec3,
-        wi_outside: bool,
+        side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let (this, wi_local, sign) = if wi_outside { (*self, wi, 1.0) } else { (self.flipped(), -wi, -1.0) };
+        let this = self.seen_from(side);
+        let wi_local = side.frame(wi);
         let wm = slope.sample_d_wi_unchecked(wi_local, uniform(rng), uniform(rng));
         let f = dielectric_reflectance(wi_local.dot(wm), this.eta);
-        let (wo_local, crossed) = if uniform(rng) < f {
-            (renormalize(reflect(wi_local, wm), wm), false)
+        let (wo_local, wo_side) = if uniform(rng) < f {
+            (renormalize(reflect(wi_local, wm), wm), side)
         } else {
-            (this.refract(wi_local, wm), true)
+            (this.refract(wi_local, wm), side.flipped())
         };
-        PhaseSample { wo: sign * wo_local, weight: Vec3::ONE, outside: wi_outside != crossed }
+        PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
     }
 
-    /// Reflection (ωo.z > 0): F D G2/(4 cos θi); transmission (ωo.z < 0):
-    /// |ωi·ωh| |ωo·ωh| η² (1 − F) D B(1 + Λ(ωi), 1 + Λ(−ωo)) / (cos θi (ωi·ωh + η ωo·ωh)²)
-    /// (supplement §3.4). For ωi below the surface, the flipped configuration.
+    /// The single-scattering terms of the type's documentation; for ωi below the surface, the
+    /// flipped configuration.
     #[inline]
     fn eval_single_scattering<S: MicrosurfaceSlope>(
         &self,

@@ -1,6 +1,6 @@
 //! Diffuse (Lambertian) microfacets.
 
-use super::{Material, PhaseSample, g2_reflection};
+use super::{Interaction, Material, PhaseSample, Side, g2_reflection};
 use crate::basis::basis;
 use crate::contract::is_direction;
 use crate::error::Error;
@@ -14,6 +14,27 @@ use rand::Rng;
 /// Lambertian microfacets with an RGB albedo (Heitz et al. 2016, supplement §3.3).
 ///
 /// [`Diffuse::white`] has albedo 1 (the supplement's non-absorptive validation baseline).
+///
+/// Its [`Material`] terms, all 0 unless both directions are outside, with ωm drawn from
+/// D_ωi where an integral over the visible normals is estimated:
+/// - phase function p(ωi, ωo) = (a/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm, estimated with one ωm
+///   (supplement §3.3, Algorithm 5): unbiased, stochastic;
+/// - `pdf_phase`: an approximation, 1/(8π) + max(0, cos θo)/(2π): the exact density
+///   (1/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm has no closed form. Positive on the whole sphere, so that
+///   MIS weights built on it never exclude a path;
+/// - vertex term: (a/π) ⟨ωo, ωm⟩ A(ωi)/|cos θi|, an unbiased estimate of
+///   (1/|cos θi|) ∫ (a/π) ⟨ωi, ωm⟩⟨ωo, ωm⟩ D(ωm) dωm;
+/// - sampling: ωm from D_ωi, then ωo cosine-distributed about ωm; weight a;
+/// - single scattering: see [`Material::eval_single_scattering`] below.
+///
+/// # Examples
+/// ```
+/// use microsurface::Diffuse;
+/// use microsurface::glam::Vec3;
+///
+/// assert_eq!(Diffuse::white().albedo(), Vec3::ONE);
+/// assert!(Diffuse::new(Vec3::new(0.5, 1.5, 0.2)).is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Diffuse {
     albedo: Vec3,
@@ -45,117 +66,43 @@ impl Diffuse {
 
 impl Material for Diffuse {
     const TRANSMITS: bool = false;
-
-    /// p(ωi, ωo) = (a/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm, estimated with one ωm drawn from D_ωi
-    /// (supplement §3.3, Algorithm 5): unbiased, stochastic.
-    #[inline]
-    fn eval_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> Vec3 {
-        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        self.eval_phase_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
-    }
+    const EXACT_PHASE_PDF: bool = false;
 
     #[inline]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         rng: &mut impl Rng,
     ) -> Vec3 {
-        if !(wi_outside && wo_outside) {
+        if !it.is_outside_reflection() {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0))
-    }
-
-    const EXACT_PHASE_PDF: bool = false;
-
-    /// An approximation, 1/(8π) + max(0, cos θo)/(2π) for two outside directions: the exact
-    /// density (1/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm has no closed form. Positive on the whole
-    /// sphere, so that MIS weights built on it never exclude a path.
-    #[inline]
-    fn pdf_phase<S: MicrosurfaceSlope>(
-        &self,
-        _slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        self.pdf_phase_unchecked(_slope, wi, wo, wi_outside, wo_outside)
+        let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
+        self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
     }
 
     #[inline]
-    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        _slope: &S,
-        _wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        if !(wi_outside && wo_outside) {
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, _slope: &S, it: &Interaction) -> f32 {
+        if !it.is_outside_reflection() {
             return 0.0;
         }
-        0.125 / PI + 0.5 * FRAC_1_PI * wo.z.max(0.0)
-    }
-
-    /// (a/π) ⟨ωo, ωm⟩ A(ωi)/|cos θi| with ωm drawn from D_ωi: an unbiased estimate of the
-    /// vertex term (1/|cos θi|) ∫ (a/π) ⟨ωi, ωm⟩⟨ωo, ωm⟩ D(ωm) dωm.
-    #[inline]
-    fn vertex<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> Vec3 {
-        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
+        0.125 / PI + 0.5 * FRAC_1_PI * it.wo().z.max(0.0)
     }
 
     #[inline]
     fn vertex_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
+        it: &Interaction,
         rng: &mut impl Rng,
     ) -> Vec3 {
-        if !(wi_outside && wo_outside) || wi.z == 0.0 {
+        let wi = it.wi();
+        if !it.is_outside_reflection() || wi.z == 0.0 {
             return Vec3::ZERO;
         }
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
-    }
-
-    /// ωm from D_ωi, then ωo cosine-distributed about ωm; weight a.
-    #[inline]
-    fn sample_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        _wi_outside: bool,
-        rng: &mut impl Rng,
-    ) -> PhaseSample {
-        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
-        self.sample_phase_unchecked(slope, wi, _wi_outside, rng)
+        self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
     #[inline]
@@ -163,14 +110,14 @@ impl Material for Diffuse {
         &self,
         slope: &S,
         wi: Vec3,
-        _wi_outside: bool,
+        _side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         let local = cosine_hemisphere(uniform(rng), uniform(rng));
         let (t, b) = basis(wm);
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
-        PhaseSample { wo, weight: self.albedo, outside: true }
+        PhaseSample { wo, weight: self.albedo, side: Side::Outside }
     }
 
     /// (a/π) ⟨ωo, ωm⟩ (1 + Λ(ωi))/(1 + Λ(ωi) + Λ(ωo)) with ωm drawn from D_ωi: the

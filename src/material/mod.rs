@@ -4,10 +4,14 @@
 mod conductor;
 mod dielectric;
 mod diffuse;
+mod interaction;
+mod side;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use interaction::{Event, Interaction};
+pub use side::Side;
 
 use crate::contract::is_direction;
 use crate::slope::MicrosurfaceSlope;
@@ -22,54 +26,114 @@ pub struct PhaseSample {
     /// The sample weight p/pdf per RGB channel: the Fresnel term of a conductor, the albedo of
     /// a diffuse facet, 1 for a dielectric (whose Fresnel term chooses the event instead).
     pub weight: Vec3,
-    /// Whether ωo leaves on the outside of the interface (always true for opaque materials;
-    /// false after a refraction).
-    pub outside: bool,
+    /// The side ωo leaves on (always [`Side::Outside`] for opaque materials; the other side
+    /// after a refraction).
+    pub side: Side,
 }
 
-/// The material of the microfacets: a phase function and the single-scattering BSDF.
+mod sealed {
+    /// The private supertrait that seals [`Material`](super::Material).
+    pub trait Sealed {}
+    impl Sealed for super::Conductor {}
+    impl Sealed for super::Dielectric {}
+    impl Sealed for super::Diffuse {}
+}
+
+/// The material of the microfacets: a phase function, the position-free vertex term and the
+/// single-scattering BSDF.
 ///
-/// Directions follow the supplement's convention: `wi` points away from the scattering point
-/// towards where light comes from, `wo` towards where it goes. `wi_outside` and `wo_outside`
-/// tell on which side of the interface each direction lies; a material that does not
-/// transmit is only evaluated with both true. Phase functions are flipped vertically inside a
-/// dielectric (supplement §3.4), so every method is written for `wi_outside = true` and
-/// inside configurations are mapped to it.
+/// Sealed: implemented by [`Conductor`], [`Dielectric`] and [`Diffuse`] only. The walks rely
+/// on properties no trait bound can state (the phase function integrates to the albedo, the
+/// sampler's density is `pdf_phase` where [`Material::EXACT_PHASE_PDF`] says so, the vertex
+/// term is the phase function divided by G1(ωi)), which `tests/` verifies for these three.
+///
+/// Directions follow the supplement's convention: ωi points away from the scattering point
+/// towards where light comes from, ωo towards where it goes; an [`Interaction`] bundles them
+/// with their [`Side`]s. A material that does not transmit gives 0 for every interaction
+/// that is not an outside reflection. Phase functions are flipped vertically inside a
+/// dielectric (supplement §3.4), so every method is written for ωi outside and inside
+/// configurations are mapped to it.
+///
+/// The vertex terms of the position-free model ([`Material::vertex`], [`Material::connection`])
+/// are here rather than in [`PositionFree`](crate::PositionFree): they are the material's
+/// local BSDF without shadowing (Wang et al. 2022, eqs. 2–3), built from the same half
+/// vector, refraction geometry and Fresnel term as the phase function, which equals the
+/// vertex term times 1/G1(ωi); keeping both in one place keeps them consistent.
 ///
 /// Invalid input ([policy](crate#invalid-input)), the same for every method and every
-/// material of the crate: a `wi` or `wo` that is zero, has a NaN or ±∞ component, or is not
+/// material of the crate: a ωi or ωo that is zero, has a NaN or ±∞ component, or is not
 /// unit within [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE) trips a debug assertion in
 /// debug builds; release builds return 0 from the evaluations and densities (`eval_phase`,
 /// `pdf_phase`, `vertex`, `connection`, `eval_single_scattering`) and, from `sample_phase`, a
 /// [`PhaseSample`] with a NaN `wo` and a zero weight. Grazing and below-horizon unit
-/// directions are valid.
-pub trait Material: Copy + core::fmt::Debug + Send + Sync {
+/// directions are valid. Each checked method validates once and calls its unchecked body,
+/// which the crate's walks call directly with the directions they produced themselves.
+pub trait Material: sealed::Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// Whether light can cross the interface (dielectrics).
     const TRANSMITS: bool;
 
-    /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
-    /// given sides. Stochastic (unbiased) for the diffuse material, exact otherwise.
-    fn eval_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> Vec3;
+    /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
+    const EXACT_PHASE_PDF: bool;
 
-    /// Samples ωo from the phase function p(ωi, ·) for a ray arriving on side `wi_outside`.
+    /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
+    /// interaction's sides. Stochastic (unbiased) for the diffuse material, exact otherwise
+    /// (the formulas are on each material's type).
+    #[inline]
+    fn eval_phase<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng) -> Vec3 {
+        require!(it.has_unit_directions(), Vec3::ZERO; it);
+        self.eval_phase_unchecked(slope, it, rng)
+    }
+
+    /// Samples ωo from the phase function p(ωi, ·) for a ray arriving on `side`.
+    #[inline]
     fn sample_phase<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
         wi: Vec3,
-        wi_outside: bool,
+        side: Side,
         rng: &mut impl Rng,
-    ) -> PhaseSample;
+    ) -> PhaseSample {
+        let nothing_side = if Self::TRANSMITS { side } else { Side::Outside };
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: nothing_side }; wi);
+        self.sample_phase_unchecked(slope, wi, side, rng)
+    }
 
-    /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
-    const EXACT_PHASE_PDF: bool;
+    /// The solid-angle density with which [`Material::sample_phase`] draws ωo from ωi: the
+    /// phase function without the per-channel weight. Exact for conductors and dielectrics;
+    /// for diffuse facets, whose density has no closed form, a documented deterministic
+    /// approximation (used only for MIS weights, never to divide a contribution).
+    #[inline]
+    fn pdf_phase<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
+        require!(it.has_unit_directions(), 0.0; it);
+        self.pdf_phase_unchecked(slope, it)
+    }
+
+    /// The vertex term of the position-free path integral (Wang et al. 2022, eqs. 2–3): the
+    /// local BSDF of one bounce without any shadowing, F D(ωh)/(4|cos θi|) for a reflection
+    /// and Walter's BTDF without G for a transmission. It equals the phase function divided
+    /// by the full-spherical masking G1(ωi) = |cos θi|/A(ωi) of the incident direction (A is
+    /// the projected area). Per channel; stochastic (unbiased) for diffuse facets.
+    #[inline]
+    fn vertex<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng) -> Vec3 {
+        require!(it.has_unit_directions(), Vec3::ZERO; it);
+        self.vertex_unchecked(slope, it, rng)
+    }
+
+    /// The vertex term and the phase-function densities of ωo given ωi and of ωi given ωo
+    /// ([`Material::vertex`] and [`Material::pdf_phase`] both ways) of one connection, which an
+    /// implementation may compute together: a conductor evaluates one half vector and one D
+    /// for the three. The bidirectional position-free estimator needs all three for every
+    /// connection. Returns (vertex, pdf ωi → ωo, pdf ωo → ωi).
+    #[inline]
+    fn connection<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        it: &Interaction,
+        rng: &mut impl Rng,
+    ) -> (Vec3, f32, f32) {
+        require!(it.has_unit_directions(), (Vec3::ZERO, 0.0, 0.0); it);
+        self.connection_unchecked(slope, it, rng)
+    }
 
     /// Whether the interface does not interact with light at all: every facet event keeps the
     /// direction and the weight (a dielectric with η = 1 exactly: F = 0, refraction is the
@@ -81,143 +145,13 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         false
     }
 
-    /// The solid-angle density with which [`Material::sample_phase`] draws ωo on side
-    /// `wo_outside` from ωi on side `wi_outside`: the phase function without the per-channel
-    /// weight. Exact for conductors and dielectrics; for diffuse facets, whose density has no
-    /// closed form, a documented deterministic approximation (used only for MIS weights,
-    /// never to divide a contribution).
-    fn pdf_phase<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32;
-
-    /// The vertex term of the position-free path integral (Wang et al. 2022, eqs. 2–3): the
-    /// local BSDF of one bounce without any shadowing, F D(ωh)/(4|cos θi|) for a reflection
-    /// and Walter's BTDF without G for a transmission. It equals the phase function divided
-    /// by the full-spherical masking G1(ωi) = |cos θi|/A(ωi) of the incident direction (A is
-    /// the projected area). Per channel; stochastic (unbiased) for diffuse facets.
-    fn vertex<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> Vec3;
-
-    /// The vertex term and the phase-function densities of ωo given ωi and of ωi given ωo
-    /// ([`Material::vertex`] and [`Material::pdf_phase`] both ways) of one connection, which an
-    /// implementation may compute together: a conductor evaluates one half vector and one D
-    /// for the three. The bidirectional position-free estimator needs all three for every
-    /// connection. Returns (vertex, pdf ωi → ωo, pdf ωo → ωi).
-    #[inline]
-    fn connection<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> (Vec3, f32, f32) {
-        require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0, 0.0); wi, wo);
-        self.connection_unchecked(slope, wi, wo, wi_outside, wo_outside, rng)
-    }
-
-    // The methods without the argument check, for the crate's walks, which call them once or
-    // more per bounce with directions they produced themselves (unit up to rounding). The
-    // required ones default to the checked methods, so that a material outside the crate
-    // keeps its own behaviour; the crate's materials override them with the unchecked bodies.
-
-    /// [`Material::eval_phase`] without the argument check (crate-internal hot path).
-    #[doc(hidden)]
-    #[inline(always)]
-    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> Vec3 {
-        self.eval_phase(slope, wi, wo, wi_outside, wo_outside, rng)
-    }
-
-    /// [`Material::sample_phase`] without the argument check (crate-internal hot path).
-    #[doc(hidden)]
-    #[inline(always)]
-    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wi_outside: bool,
-        rng: &mut impl Rng,
-    ) -> PhaseSample {
-        self.sample_phase(slope, wi, wi_outside, rng)
-    }
-
-    /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
-    #[doc(hidden)]
-    #[inline(always)]
-    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-    ) -> f32 {
-        self.pdf_phase(slope, wi, wo, wi_outside, wo_outside)
-    }
-
-    /// [`Material::vertex`] without the argument check (crate-internal hot path).
-    #[doc(hidden)]
-    #[inline(always)]
-    fn vertex_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> Vec3 {
-        self.vertex(slope, wi, wo, wi_outside, wo_outside, rng)
-    }
-
-    /// [`Material::connection`] without the argument check (crate-internal hot path): by
-    /// default the three separate unchecked calls.
-    #[doc(hidden)]
-    #[inline]
-    fn connection_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        wo: Vec3,
-        wi_outside: bool,
-        wo_outside: bool,
-        rng: &mut impl Rng,
-    ) -> (Vec3, f32, f32) {
-        (
-            self.vertex_unchecked(slope, wi, wo, wi_outside, wo_outside, rng),
-            self.pdf_phase_unchecked(slope, wi, wo, wi_outside, wo_outside),
-            self.pdf_phase_unchecked(slope, wo, wi, wo_outside, wi_outside),
-        )
-    }
-
     /// (ηo/ηi)², the squared ratio of the indices on the two sides of an event from side
-    /// `wi_outside` to side `wo_outside`: η² for a transmission into a dielectric, 1/η² out of
-    /// it, 1 otherwise. It is the factor by which radiance transport differs from importance
+    /// `from` to side `to`: η² for a transmission into a dielectric, 1/η² out of it, 1
+    /// otherwise. It is the factor by which radiance transport differs from importance
     /// transport across the interface.
     #[inline]
-    fn relative_eta_sq(&self, wi_outside: bool, wo_outside: bool) -> f32 {
-        let _ = (wi_outside, wo_outside);
+    fn relative_eta_sq(&self, from: Side, to: Side) -> f32 {
+        let _ = (from, to);
         1.0
     }
 
@@ -230,6 +164,55 @@ pub trait Material: Copy + core::fmt::Debug + Send + Sync {
         wo: Vec3,
         rng: &mut impl Rng,
     ) -> Vec3;
+
+    // The bodies without the argument check: the required methods of the sealed trait, which
+    // the crate's walks call once or more per bounce with directions they produced
+    // themselves (unit up to rounding).
+
+    /// [`Material::eval_phase`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    fn eval_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        it: &Interaction,
+        rng: &mut impl Rng,
+    ) -> Vec3;
+
+    /// [`Material::sample_phase`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    fn sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample;
+
+    /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32;
+
+    /// [`Material::vertex`] without the argument check (crate-internal hot path).
+    #[doc(hidden)]
+    fn vertex_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng)
+    -> Vec3;
+
+    /// [`Material::connection`] without the argument check (crate-internal hot path): by
+    /// default the three separate unchecked calls.
+    #[doc(hidden)]
+    #[inline]
+    fn connection_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        it: &Interaction,
+        rng: &mut impl Rng,
+    ) -> (Vec3, f32, f32) {
+        (
+            self.vertex_unchecked(slope, it, rng),
+            self.pdf_phase_unchecked(slope, it),
+            self.pdf_phase_unchecked(slope, &it.reversed()),
+        )
+    }
 }
 
 /// The normalized half vector of a reflection ωi → ωo, if it is a valid microfacet normal
@@ -266,11 +249,22 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
 /// underflow f64 from a ≈ 26.6 on, where D_ωi is still evaluated (in log space). Relative
 /// error: that of D_ωi (a few f64 ulps times the condition numbers of D, see
 /// [`MicrosurfaceSlope::d64`]) plus the final rounding to f32.
+///
+/// `area` is A(ωi) where the caller knows it (ωi above the horizon: [`Interaction`]'s cache).
 #[inline(always)]
-pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DVec3) -> f32 {
+pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(
+    slope: &S,
+    wi: Vec3,
+    wh: DVec3,
+    area: Option<f32>,
+) -> f32 {
     if wi.z > 0.0 {
         // front-facing: A ≥ cos θi, nothing underflows (the walks' hot path)
-        return reflection_density(slope, wi, slope.d64_unchecked(wh));
+        let d = slope.d64_unchecked(wh);
+        return match area {
+            Some(area) => front_density(d, area),
+            None => reflection_density(slope, wi, d),
+        };
     }
     let cos_ih = wi.as_dvec3().dot(wh);
     if cos_ih <= 0.0 {
@@ -284,7 +278,17 @@ pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wh: DV
 /// and the f32 area serves).
 #[inline(always)]
 pub(crate) fn reflection_density<S: MicrosurfaceSlope>(slope: &S, w: Vec3, d: f64) -> f32 {
-    let area =
-        if w.z > 0.0 { f64::from(slope.projected_area_unchecked(w)) } else { slope.projected_area64(w) };
+    if w.z > 0.0 {
+        return front_density(d, slope.projected_area_unchecked(w));
+    }
+    let area = slope.projected_area64(w);
+    if area <= 0.0 { 0.0 } else { (0.25 * d / area) as f32 }
+}
+
+/// D(ωh)/(4 A(ω)) for D(ωh) = `d` and a front-facing ω with the f32 projected area `area`
+/// (≥ cos θ > 0).
+#[inline(always)]
+fn front_density(d: f64, area: f32) -> f32 {
+    let area = f64::from(area);
     if area <= 0.0 { 0.0 } else { (0.25 * d / area) as f32 }
 }

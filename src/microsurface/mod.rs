@@ -9,7 +9,7 @@ pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
-use crate::material::{Material, PhaseSample};
+use crate::material::{Interaction, Material, PhaseSample, Side};
 use crate::position_free::{PositionFree, Shadowing};
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
@@ -70,9 +70,10 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     pub fn eval_phase(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         let slope = self.geometry.slope();
-        let reflected = self.material.eval_phase(slope, wi, wo, true, true, rng);
+        let reflected = self.material.eval_phase(slope, &Interaction::reflection(wi, wo), rng);
         if M::TRANSMITS {
-            reflected + self.material.eval_phase(slope, wi, wo, true, false, rng)
+            let transmitted = Interaction::new(wi, wo, Side::Outside, Side::Inside);
+            reflected + self.material.eval_phase(slope, &transmitted, rng)
         } else {
             reflected
         }
@@ -84,8 +85,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// a sample with a NaN `wo` and a zero weight (a debug assertion in debug builds).
     #[inline]
     pub fn sample_phase(&self, wi: Vec3, rng: &mut impl Rng) -> PhaseSample {
-        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, outside: true }; wi);
-        self.material.sample_phase(self.geometry.slope(), wi, true, rng)
+        require!(is_direction(wi), PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: Side::Outside }; wi);
+        self.material.sample_phase(self.geometry.slope(), wi, Side::Outside, rng)
     }
 
     /// The single-scattering BSDF times |cos θo| (what `eval` with

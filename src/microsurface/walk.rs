@@ -2,10 +2,10 @@
 //! multiple-scattering BSDF (Heitz et al. 2016, supplement §3.1 Algorithms 2–3 and §3.4).
 
 use super::Microsurface;
-use super::geometry::{first_ln_c1_from_below, flip_ln_c1, next_ln_c1};
+use super::geometry::{ScaledDepth, flip_ln_c1, next_ln_c1};
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
-use crate::material::Material;
+use crate::material::{Interaction, Material, Side};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use core::num::NonZeroU32;
@@ -15,23 +15,14 @@ use rand::Rng;
 /// The hard cap on the number of bounces of one walk: 2¹⁶.
 ///
 /// Walks end with probability one; the cap only guards against non-termination. A walk that
-/// reaches it is dropped (its energy is lost). The longest walks the model produces are those
-/// of a grazing ray through a dielectric with η within a few f32 ulps of 1: the ray crosses
-/// the nearly index-matched interface about Λ(ωi) ≈ αᵢ tan θi/2 times before refraction turns
-/// it, up to a saturation set by |η − 1| (measured with GGX α = 2: η = 1 − 2⁻²⁴ from inside at
-/// cos θi = 1e-6 … 1e-20, the worst case over the f32 values of η ≠ 1, a mean of 9 500
-/// bounces and at most 9 963 in 2 000 walks; η = 1 ± 2e-6 at most 2 800; η = 1 ± 1e-4 at most
-/// 630). The former cap of 1024 dropped up to 100 % of those walks (GGX α = 1, η = 1 − 1e-7,
-/// cos θi = 1e-3: 85 %). η = 1 exactly, where the count grows without bound as cos θi → 0, is
-/// the transparent interface it is ([`crate::Material::is_transparent`]). Such walks cost
-/// about 0.5 ms.
-///
-/// Measured loss (`tests/walk_cap.rs`, Clopper–Pearson upper bounds at 99 % family-wise
-/// confidence): below 1e-4 of the albedo for every material at α = 2 (1e5 walks per
-/// configuration); for η ∈ {1 ± 1e-7, 1 ± 2e-6, 1 ± 1e-4} at cos θi ∈ {1e-3, 1e-2} none of
-/// 1e4 walks per configuration is capped (bound 7e-4, the resolution of that sample; 2e4
-/// walks each gave none either), for the worst case above none of 1e3, and the longest stays
-/// below a quarter of the cap.
+/// reaches it is dropped (its energy is lost). The longest walks are those of a grazing ray
+/// through a dielectric with η within a few f32 ulps of 1, which crosses the nearly
+/// index-matched interface about Λ(ωi) ≈ αᵢ tan θi/2 times before refraction turns it (at
+/// most about 10⁴ bounces); η = 1 exactly is transparent
+/// ([`crate::Material::is_transparent`]). Loss bound (`tests/walk_cap.rs`, 99 % family-wise
+/// confidence): below 1e-4 of the albedo for every material at α = 2, and no capped walk for
+/// |η − 1| ≥ 1e-7 at cos θi ≥ 1e-3. The measurements behind the value are in DESIGN.md
+/// (“The bounce cap”).
 pub const MAX_BOUNCES: u32 = 1 << 16;
 
 /// Which scattering orders an evaluation counts.
@@ -94,14 +85,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// if the ordinary walk cannot start there (an opaque material lit from below starts in
     /// [`Microsurface::eval_from_below`] / [`Microsurface::sample_from_below`] instead).
     #[inline(always)]
-    fn starting_side(wi: Vec3) -> Option<bool> {
-        if wi.z > 0.0 {
-            Some(true)
-        } else if M::TRANSMITS && wi.z < 0.0 {
-            Some(false)
-        } else {
-            None
-        }
+    fn starting_side(wi: Vec3) -> Option<Side> {
+        Side::of(wi.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
     }
 
     /// Evaluates the multiple-scattering BSDF times |cos θo| by a random walk with next-event
@@ -119,7 +104,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let Some(mut outside) = Self::starting_side(wi) else {
+        let Some(mut side) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 {
                 self.eval_from_below(wi, wo, order, rng)
             } else {
@@ -131,9 +116,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             return Vec3::ZERO;
         }
         let slope = self.geometry.slope();
-        let wo_outside = wo.z > 0.0;
+        let wo_side = Side::above_or_inside(wo.z);
         // Λ of ωo seen from its own side, constant along the walk
-        let lambda_o = slope.lambda_unchecked(if wo_outside { wo } else { -wo });
+        let lambda_o = slope.lambda_unchecked(wo_side.frame(wo));
         let last = order.last();
 
         let mut wr = -wi;
@@ -142,24 +127,25 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut throughput = Vec3::ONE;
         let mut sum = Vec3::ZERO;
         for bounce in 1..=last {
-            let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else { break };
-            ln_c1 = next;
+            let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else { break };
+            ln_c1 = hit.ln_c1;
             if order.includes(bounce) {
-                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, outside, wo_outside, rng);
+                let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
+                let phase = self.material.eval_phase_unchecked(slope, &it, rng);
                 if phase != Vec3::ZERO {
-                    let ln_c1_o = if outside == wo_outside { ln_c1 } else { flip_ln_c1(ln_c1) };
+                    let ln_c1_o = if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) };
                     sum += throughput * phase * (lambda_o * ln_c1_o).exp();
                 }
             }
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
-            if s.outside != outside {
+            let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
+            if s.side != side {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
             wr = s.wo;
-            outside = s.outside;
+            side = s.side;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {
                 break;
@@ -185,7 +171,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         require!(is_direction(wi), None; wi);
-        let Some(mut outside) = Self::starting_side(wi) else {
+        let Some(mut side) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 { self.sample_from_below(wi, rng) } else { None };
         };
         if self.material.is_transparent() {
@@ -196,16 +182,16 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut ln_c1 = 0.0;
         let mut weight = Vec3::ONE;
         for bounces in 0..MAX_BOUNCES {
-            let Some(next) = self.next_ln_c1(wr, ln_c1, outside, rng) else {
+            let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else {
                 return Some(WalkSample { wo: wr, weight, bounces });
             };
-            ln_c1 = next;
-            let s = self.material.sample_phase_unchecked(slope, -wr, outside, rng);
-            if s.outside != outside {
+            ln_c1 = hit.ln_c1;
+            let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
+            if s.side != side {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
             wr = s.wo;
-            outside = s.outside;
+            side = s.side;
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
@@ -223,51 +209,48 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// al. 2022, eq. 10). The first intersection's ln C¹ is ln(1 − u)/Λ(−ωi)
     /// (`first_ln_c1_from_below`: the visible-height distribution C^{1/G1(ωi)} of Algorithm 1
     /// of the supplement, extended to the lower hemisphere); from there the walk is the
-    /// ordinary one (supplement §3.1, Algorithm 2), every exit being upwards. Its order-1 term
+    /// ordinary one (supplement §3.1, Algorithm 2), every exit being upwards. It carries the
+    /// depth in the scale of the first hit, −ln C¹·Λ(−ωi), with the masking ratios formed
+    /// from ln Λ (`ScaledDepth`), so that it works for every roughness: Λ(−ωi) ≈ e^{−a²}
+    /// (Beckmann, a = |cot θi|/αᵢ) underflows f32 from a ≈ 9.6 and f64 from a ≈ 26.6. Its order-1 term
     /// is exactly p(ωi, ωo) Λ(−ωi)/(Λ(−ωi) + Λ(ωo)) = F D G2/(4|cos θi|) with the full-spherical
     /// G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17) of the single-scattering model.
     ///
     /// 0 when ωo is at or below the horizon, or when Λ(−ωi) = 0 (ωi at the nadir sees no
     /// microsurface). Stochastic and unbiased, consistent with
     /// [`Microsurface::sample_from_below`] (the same walk).
-    ///
-    /// Known limit: the walk carries Λ in f32. For Beckmann, Λ(−ωi) ≈ e^{−a²} (a = |cot θi|/αᵢ)
-    /// underflows f32 from a ≈ 9.6 on (α = 0.01 at θi = 96°, 0.05 at 120°, 0.1 at 150°), and
-    /// the walk then returns nothing although the model's albedo is that of single scattering
-    /// and more (≈ 0.92 there for F = 1); single scattering, which forms this masking in f64 and
-    /// in log space, does not share the limit. GGX's Λ stays above 1e-106 and is unaffected.
     pub fn eval_from_below(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         if M::TRANSMITS || !(wi.z < 0.0 && wo.z > 0.0) {
             return Vec3::ZERO;
         }
         let slope = self.geometry.slope();
         let mut wr = -wi;
-        let Some(mut ln_c1) = first_ln_c1_from_below(slope.lambda(wr), uniform(rng)) else {
+        let Some(mut depth) = ScaledDepth::first(slope.ln_lambda(wr), uniform(rng)) else {
             return Vec3::ZERO;
         };
-        let lambda_o = slope.lambda(wo);
+        let ln_lambda_o = slope.ln_lambda(wo);
         let last = order.last();
         let mut throughput = Vec3::ONE;
         let mut sum = Vec3::ZERO;
         let mut bounce = 1;
         loop {
             if order.includes(bounce) {
-                let phase = self.material.eval_phase_unchecked(slope, -wr, wo, true, true, rng);
+                let phase = self.material.eval_phase_unchecked(slope, &Interaction::reflection(-wr, wo), rng);
                 if phase != Vec3::ZERO {
-                    sum += throughput * phase * (lambda_o * ln_c1).exp();
+                    sum += throughput * phase * depth.escape_probability(ln_lambda_o) as f32;
                 }
             }
             if bounce == last {
                 break;
             }
-            let s = self.material.sample_phase_unchecked(slope, -wr, true, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng);
             wr = s.wo;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {
                 break;
             }
-            let Some(next) = self.next_ln_c1(wr, ln_c1, true, rng) else { break };
-            ln_c1 = next;
+            let Some(next) = depth.next(slope, wr, uniform(rng)) else { break };
+            depth = next;
             bounce += 1;
         }
         sum
@@ -281,42 +264,181 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// phase-sample weights, f·|cos θo|/pdf.
     ///
     /// `None` if ωi is not below the horizon, the material transmits, Λ(−ωi) = 0, the path was
-    /// absorbed, or it reached [`MAX_BOUNCES`].
-    ///
-    /// Known limit: the walk carries Λ in f32. For Beckmann, Λ(−ωi) ≈ e^{−a²} (a = |cot θi|/αᵢ)
-    /// underflows f32 from a ≈ 9.6 on (α = 0.01 at θi = 96°, 0.05 at 120°, 0.1 at 150°), and
-    /// the walk then returns `None` although the model's albedo is that of single scattering
-    /// and more (≈ 0.92 there for F = 1); single scattering, which forms this masking in f64 and
-    /// in log space, does not share the limit. GGX's Λ stays above 1e-106 and is unaffected.
+    /// absorbed, or it reached [`MAX_BOUNCES`]. Every roughness is resolved, as in
+    /// [`Microsurface::eval_from_below`].
     pub fn sample_from_below(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         if M::TRANSMITS || wi.z.is_nan() || wi.z >= 0.0 {
             return None;
         }
         let slope = self.geometry.slope();
         let mut wr = -wi;
-        let mut ln_c1 = first_ln_c1_from_below(slope.lambda(wr), uniform(rng))?;
+        let mut depth = ScaledDepth::first(slope.ln_lambda(wr), uniform(rng))?;
         let mut weight = Vec3::ONE;
         for bounces in 1..=MAX_BOUNCES {
-            let s = self.material.sample_phase_unchecked(slope, -wr, true, rng);
+            let s = self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng);
             wr = s.wo;
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
             }
-            match self.next_ln_c1(wr, ln_c1, true, rng) {
-                Some(next) => ln_c1 = next,
+            match depth.next(slope, wr, uniform(rng)) {
+                Some(next) => depth = next,
                 None => return Some(WalkSample { wo: wr, weight, bounces }),
             }
         }
         None
     }
 
-    /// ln C¹ of the next intersection of the ray ωr leaving a point with ln C¹ = `ln_c1` on
-    /// side `outside`, or `None` if it escapes. Both are in the frame of that side: inside a
-    /// dielectric the configuration is flipped vertically (supplement §3.4).
+    /// The next intersection of the ray ωr leaving a point with ln C¹ = `ln_c1` on `side`,
+    /// or `None` if it escapes. Both are in the frame of that side: inside a dielectric the
+    /// configuration is flipped vertically (supplement §3.4). One Λ per bounce: the Λ(ωr) of
+    /// the height step also gives the projected area of the next vertex's incident direction
+    /// ([`incident_area`]).
     #[inline(always)]
-    fn next_ln_c1(&self, wr: Vec3, ln_c1: f32, outside: bool, rng: &mut impl Rng) -> Option<f32> {
-        let w = if outside { wr } else { -wr };
-        next_ln_c1(w.z, self.geometry.slope().lambda_unchecked(w), ln_c1, uniform(rng))
+    fn next_hit(&self, wr: Vec3, ln_c1: f32, side: Side, rng: &mut impl Rng) -> Option<Hit> {
+        let w = side.frame(wr);
+        let lambda = self.geometry.slope().lambda_unchecked(w);
+        let ln_c1 = next_ln_c1(w.z, lambda, ln_c1, uniform(rng))?;
+        Some(Hit { ln_c1, incident_area: incident_area(w.z, lambda) })
+    }
+}
+
+/// An intersection of the walk's ray with the microsurface.
+#[derive(Debug, Clone, Copy)]
+struct Hit {
+    /// ln C¹ of its height, in the frame of the ray's side.
+    ln_c1: f32,
+    /// A(ωi) of the incident direction ωi = −ωr there, in the same frame, where known.
+    incident_area: Option<f32>,
+}
+
+/// The projected area A(ωi) = (1 + Λ(ωi)) cos θi (supplement §2.2) of the incident direction
+/// ωi = −ω of a vertex that the ray ω with z-component `z` and Λ(ω) = `lambda` reached going
+/// down: with Λ(ω) = −1 − Λ(ωi), A(ωi) = Λ(ω)·ω.z, one f32 product (relative error below
+/// 2⁻²³ beyond that of Λ). `None` for a ray going up or horizontally (ωi backfacing or
+/// grazing, whose density the materials form in f64 instead) and where Λ saturated at
+/// −`f32::MAX` (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
+#[inline(always)]
+fn incident_area(z: f32, lambda: f32) -> Option<f32> {
+    (z < 0.0 && lambda > -f32::MAX).then_some(lambda * z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::incident_area;
+    use crate::height::UniformHeight;
+    use crate::material::Conductor;
+    use crate::microsurface::{Microsurface, ScatteringOrder};
+    use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+    use glam::Vec3;
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    /// The f32 ulps between `a` and the exact `b`, relative to b.
+    fn ulps(a: f32, b: f64) -> f64 {
+        (f64::from(a) - b).abs() / (b * f64::from(f32::EPSILON))
+    }
+
+    /// The largest relative error of Λ(ωr)·cos θr against the f64 projected area of ωi = −ωr
+    /// over θi and α (the anisotropic case through the azimuth).
+    fn worst<S: MicrosurfaceSlope>(slope: S) -> f64 {
+        let mut worst = 0.0f64;
+        for cos in [1.0f32, 0.9, 0.5, 0.1, 1e-2, 1e-3, 1e-6] {
+            for phi in [0.0f32, 0.7, 1.6] {
+                let sin = (1.0 - cos * cos).sqrt();
+                let wi = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+                let wr = -wi;
+                let area = incident_area(wr.z, slope.lambda_unchecked(wr)).expect("a ray going down");
+                worst = worst.max(ulps(area, slope.projected_area64(wi)));
+            }
+        }
+        worst
+    }
+
+    /// A(ωi) = Λ(ωr)·cos θr for a ray ωr = −ωi going down (Λ(ωr) = −1 − Λ(ωi)): within 4 f32
+    /// ulps of the projected area in f64 (Λ to 2 ulps in the crate's f32 forms, the product
+    /// one rounding more), for GGX and Beckmann from the zenith to 1e-6 from the horizon.
+    #[test]
+    fn incident_area_is_the_projected_area_of_the_incident_direction() {
+        for alpha in [0.01f32, 0.3, 1.0, 2.5] {
+            let g = worst(Ggx::new(alpha, 0.6 * alpha).expect("valid roughness"));
+            let b = worst(Beckmann::new(alpha, 0.6 * alpha).expect("valid roughness"));
+            assert!(g <= 4.0 && b <= 4.0, "α = {alpha}: GGX {g} ulps, Beckmann {b} ulps");
+        }
+    }
+
+    /// No area for a ray going up or horizontally (the incident direction is backfacing or
+    /// grazing) or with Λ saturated.
+    #[test]
+    fn incident_area_is_none_where_it_is_not_the_area() {
+        assert_eq!(incident_area(0.3, 0.2), None);
+        assert_eq!(incident_area(0.0, -f32::MAX), None);
+        assert_eq!(incident_area(-1e-30, -f32::MAX), None);
+        assert_eq!(incident_area(-1e-30, f32::NEG_INFINITY), None);
+        assert_eq!(incident_area(-0.5, f32::NAN), None);
+        assert_eq!(incident_area(-0.5, -1.5), Some(0.75));
+    }
+    /// The direction at polar angle θ (radians) in the xz-plane.
+    fn polar(theta: f32) -> Vec3 {
+        Vec3::new(theta.sin(), 0.0, theta.cos())
+    }
+
+    /// Smooth Beckmann seen from below at θi = 120°, where Λ(−ωi) ≈ e^{−a²} underflows f32
+    /// (α = 0.05: a = |cot θi|/αᵢ = 11.5) and f64 (α = 0.02: a = 28.9): every path of a perfect
+    /// mirror leaves upwards with weight 1 (energy is conserved; GGX as the control). Before,
+    /// the f32 walk found Λ(−ωi) = 0 and lost every path of both Beckmann surfaces.
+    #[test]
+    fn sample_from_below_conserves_energy_at_every_roughness() {
+        fn check<S: MicrosurfaceSlope>(label: &str, slope: S) {
+            let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
+            let wi = polar(120f32.to_radians());
+            let mut rng = Pcg64Mcg::seed_from_u64(17);
+            for k in 0..2000 {
+                let s = surface.sample_from_below(wi, &mut rng);
+                let s = s.unwrap_or_else(|| panic!("{label}: path {k} lost"));
+                assert!(s.weight == Vec3::ONE && s.wo.z > 0.0, "{label}: {s:?}");
+            }
+        }
+        for alpha in [0.05f32, 0.02] {
+            check(&format!("Beckmann α = {alpha}"), Beckmann::isotropic(alpha).expect("valid roughness"));
+            check(&format!("GGX α = {alpha}"), Ggx::isotropic(alpha).expect("valid roughness"));
+        }
+    }
+
+    /// The order-1 term of the walk from below is the full-spherical single scattering
+    /// F D G2/(4|cos θi|), G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17), which
+    /// [`Microsurface::eval_single_scattering`] evaluates in closed form: the walk's mean over
+    /// N = 20 000 evaluations agrees within z σ̂/√N, z = 3.76 (Šidák, family-wise 1e-3 over the
+    /// 6 comparisons), each resolving 5 % of the value. Smooth Beckmann at θi = 120° as in
+    /// `sample_from_below_conserves_energy_at_every_roughness`; ωo drawn from the phase
+    /// function. Before, the walk returned 0 there.
+    #[test]
+    fn eval_from_below_first_order_is_single_scattering_at_every_roughness() {
+        const N: usize = 20_000;
+        const Z: f64 = 3.76;
+        let wi = polar(120f32.to_radians());
+        let first = ScatteringOrder::only(1).expect("order 1");
+        for alpha in [0.05f32, 0.02] {
+            let slope = Beckmann::isotropic(alpha).expect("valid roughness");
+            let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
+            let mut rng = Pcg64Mcg::seed_from_u64(29);
+            for _ in 0..3 {
+                let wo = surface.sample_phase(wi, &mut rng).wo;
+                let expected = f64::from(surface.eval_single_scattering(wi, wo, &mut rng).x);
+                let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+                for _ in 0..N {
+                    let x = f64::from(surface.eval_from_below(wi, wo, first, &mut rng).x);
+                    (sum, sum_sq) = (sum + x, sum_sq + x * x);
+                }
+                let mean = sum / N as f64;
+                let sd = (sum_sq / N as f64 - mean * mean).max(0.0).sqrt();
+                let se = sd / (N as f64).sqrt();
+                let report = format!(
+                    "α = {alpha}, ωo = {wo}: N = {N}, mean {mean}, σ̂ {sd}, z = {Z}, expected {expected}"
+                );
+                assert!(expected > 0.0 && se <= 0.05 * expected, "not resolved: {report}");
+                assert!((mean - expected).abs() <= Z * se, "{report}");
+            }
+        }
     }
 }

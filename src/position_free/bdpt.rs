@@ -1,10 +1,12 @@
 //! The bidirectional estimator (Wang et al. 2022, §4.2, eqs. 27–29), with the exact
 //! per-strategy path densities and the balance heuristic.
 
-use super::segment::{in_side_frame, inv_g1};
-use super::{Exit, Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
+use super::segment::{VertexRole, inv_g1};
+use super::{
+    Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability,
+};
 use crate::contract::is_direction;
-use crate::material::Material;
+use crate::material::{Material, Side};
 use crate::microsurface::ScatteringOrder;
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
@@ -48,7 +50,7 @@ struct LightVertex {
 }
 
 const EMPTY_CAMERA: CameraVertex = CameraVertex {
-    next: Incident { w: Vec3::Z, outside: true },
+    next: Incident { w: Vec3::Z, side: Side::Outside },
     k_next: 0.0,
     connection: DVec3::ZERO,
     throughput: DVec3::ZERO,
@@ -56,7 +58,7 @@ const EMPTY_CAMERA: CameraVertex = CameraVertex {
     pdf_reverse_prev: 0.0,
 };
 const EMPTY_LIGHT: LightVertex = LightVertex {
-    incident: Incident { w: Vec3::Z, outside: true },
+    incident: Incident { w: Vec3::Z, side: Side::Outside },
     throughput: DVec3::ZERO,
     pdf_reverse: 0.0,
     pdf_forward_out: 0.0,
@@ -80,113 +82,105 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_bdpt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
         let last = order.last() as usize;
         let max_sub = (last - 1).min(BDPT_MAX_SUBPATH);
         let mut camera = [EMPTY_CAMERA; BDPT_MAX_SUBPATH];
         let mut light = [EMPTY_LIGHT; BDPT_MAX_SUBPATH];
-        let to_wo = self.exit(wo, wo_outside);
+        let to_wo = self.exit(wo, wo_side);
         let n_camera = self.camera_subpath(start, to_wo, max_sub, &mut camera, rng);
-        let n_light = self.light_subpath(wo, wo_outside, max_sub, &mut light, rng);
+        let n_light = self.light_subpath(wo, wo_side, max_sub, &mut light, rng);
+        let paths = self.subpaths(start, to_wo, &camera[..n_camera], &light[..n_light]);
 
-        // 1 + L̃ of every camera incident direction and the exit data of every light outgoing
-        // direction, shared by all the connections they take part in
-        let mut k_camera = [0.0f64; BDPT_MAX_SUBPATH + 1];
-        k_camera[0] = inv_g1(&self.slope, in_side_frame(start.w, start.outside));
-        for s in 1..=n_camera {
-            k_camera[s] = camera[s - 1].k_next;
-        }
-        let mut exits = [to_wo; BDPT_MAX_SUBPATH + 1];
-        for (t, exit) in exits.iter_mut().enumerate().take(n_light + 1).skip(1) {
-            let l = &light[t - 1];
-            *exit = self.exit(-l.incident.w, l.incident.outside);
-        }
-
-        let mut pdf_forward = [0.0f64; 2 * BDPT_MAX_SUBPATH + 1];
-        let mut pdf_reverse = [0.0f64; 2 * BDPT_MAX_SUBPATH + 1];
+        let mut densities = PathDensities::EMPTY;
         let mut sum = DVec3::ZERO;
         for s in 0..=n_camera {
-            let (at, cam_throughput) =
-                if s == 0 { (start, DVec3::ONE) } else { (camera[s - 1].next, camera[s - 1].throughput) };
             for t in 0..=n_light {
                 let n = s + t + 1;
                 if n > last || !order.includes(n as u32) {
                     continue;
                 }
-                let (out, out_outside, light_throughput) = if t == 0 {
-                    (wo, wo_outside, DVec3::ONE)
-                } else {
-                    let l = &light[t - 1];
-                    (-l.incident.w, l.incident.outside, l.throughput)
-                };
-                let throughput = cam_throughput * light_throughput;
+                let throughput = paths.throughput(s, t);
                 if throughput == DVec3::ZERO {
                     continue;
                 }
-                // the contribution of the connection with the densities of its direction pair
-                let (contribution, forward, reverse) = if t == 0 {
-                    let reverse = if s >= 1 {
-                        f64::from(self.material.pdf_phase_unchecked(
-                            &self.slope,
-                            out,
-                            at.w,
-                            out_outside,
-                            at.outside,
-                        ))
-                    } else {
-                        0.0
-                    };
-                    let c = if s >= 1 {
-                        camera[s - 1].connection
-                    } else {
-                        self.connect_known(at, k_camera[0], exits[0], true, rng)
-                    };
-                    (c, 0.0, reverse)
-                } else {
-                    let factor = self.shadowing_factor(at, k_camera[s], exits[t], false);
-                    if factor == 0.0 {
-                        continue;
-                    }
-                    let (v, forward, reverse) = self.material.connection_unchecked(
-                        &self.slope,
-                        at.w,
-                        out,
-                        at.outside,
-                        out_outside,
-                        rng,
-                    );
-                    (v.as_dvec3() * factor, f64::from(forward), f64::from(reverse))
-                };
-                if contribution == DVec3::ZERO {
-                    continue;
-                }
-                // densities of the directions x_1 … x_{n−1} of this path (index j − 1)
-                for j in 1..=s {
-                    pdf_forward[j - 1] = camera[j - 1].pdf_forward;
-                    if j < s {
-                        pdf_reverse[j - 1] = camera[j].pdf_reverse_prev;
-                    }
-                }
-                if s >= 1 {
-                    pdf_reverse[s - 1] = reverse;
-                }
-                if t >= 1 {
-                    pdf_forward[s] = forward;
-                    for j in (s + 1)..n {
-                        let i = n - j; // light vertex whose sampled incident direction is −x_j
-                        pdf_reverse[j - 1] = light[i - 1].pdf_reverse;
-                        if j > s + 1 {
-                            pdf_forward[j - 1] = light[i].pdf_forward_out;
-                        }
-                    }
-                }
-                let weight = balance_weight(&pdf_forward[..n - 1], &pdf_reverse[..n - 1], s);
-                sum += throughput * contribution * weight;
+                let Some(c) = self.connect_subpaths(&paths, s, t, rng) else { continue };
+                densities.fill(&paths, s, t, &c);
+                sum += throughput * c.contribution * densities.balance_weight(s, n);
             }
         }
         sum.as_vec3()
+    }
+
+    /// The two sub-paths with the per-vertex data every connection shares: 1 + L̃ of every
+    /// camera incident direction and the exit data of every light outgoing direction.
+    fn subpaths<'a>(
+        &self,
+        start: Incident,
+        to_wo: Exit,
+        camera: &'a [CameraVertex],
+        light: &'a [LightVertex],
+    ) -> Subpaths<'a> {
+        let mut exits = [to_wo; BDPT_MAX_SUBPATH + 1];
+        for (exit, l) in exits[1..].iter_mut().zip(light) {
+            *exit = self.exit(-l.incident.w, l.incident.side);
+        }
+        Subpaths { start, k_start: inv_g1(&self.slope, start.in_frame()), camera, light, exits }
+    }
+
+    /// The connection of the first `s` camera directions to the first `t` light directions
+    /// through one vertex (the camera end's incident direction to the light end's outgoing
+    /// one): its contribution without the sub-paths' throughputs and the two densities of its
+    /// direction pair; `None` where it contributes nothing. For t = 0 the connection to ωo,
+    /// which the camera sub-path computed as it went (s ≥ 1).
+    fn connect_subpaths(
+        &self,
+        paths: &Subpaths<'_>,
+        s: usize,
+        t: usize,
+        rng: &mut impl Rng,
+    ) -> Option<Connection> {
+        let (at, k_at) = paths.camera_end(s);
+        let out = paths.exits[t];
+        let connection = if t == 0 {
+            let (contribution, reverse) = match s {
+                0 => (self.connect_known(at, k_at, out, VertexRole::Last, rng), 0.0),
+                _ => (
+                    paths.camera[s - 1].connection,
+                    f64::from(self.material.pdf_phase_unchecked(&self.slope, &at.towards(out).reversed())),
+                ),
+            };
+            Connection { contribution, forward: 0.0, reverse }
+        } else if k_at < LAMBDA_RATIO_LOG_BELOW {
+            // a backfacing camera end whose Λ(−ωin) is below f64's range: v·S = p·(k_in S)
+            // with the relative factor (see `connect_known`); the densities separately
+            let factor = self.relative_shadowing(at, k_at, out).middle;
+            if factor == 0.0 {
+                return None;
+            }
+            let it = at.towards(out);
+            let phase = self.material.eval_phase_unchecked(&self.slope, &it, rng);
+            Connection {
+                contribution: phase.as_dvec3() * factor,
+                forward: f64::from(self.material.pdf_phase_unchecked(&self.slope, &it)),
+                reverse: f64::from(self.material.pdf_phase_unchecked(&self.slope, &it.reversed())),
+            }
+        } else {
+            let factor = self.shadowing_factor(at, k_at, out, VertexRole::Middle);
+            if factor == 0.0 {
+                return None;
+            }
+            let (v, forward, reverse) =
+                self.material.connection_unchecked(&self.slope, &at.towards(out), rng);
+            Connection {
+                contribution: v.as_dvec3() * factor,
+                forward: f64::from(forward),
+                reverse: f64::from(reverse),
+            }
+        };
+        (connection.contribution != DVec3::ZERO).then_some(connection)
     }
 
     /// Samples up to `max` directions from ωi; returns how many were stored.
@@ -199,7 +193,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         rng: &mut impl Rng,
     ) -> usize {
         let mut at = start;
-        let mut k_at = inv_g1(&self.slope, in_side_frame(start.w, start.outside));
+        let mut k_at = inv_g1(&self.slope, start.in_frame());
         let mut throughput = DVec3::ONE;
         for (j, slot) in out.iter_mut().enumerate().take(max) {
             let Some((next, k_next, ratio)) = self.extend_known(at, k_at, rng) else { return j };
@@ -208,12 +202,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 return j;
             }
             let x = -next.w;
-            let pdf_forward =
-                f64::from(self.material.pdf_phase_unchecked(&self.slope, at.w, x, at.outside, next.outside));
+            let step = at.to(x, next.side);
+            let pdf_forward = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step));
             let pdf_reverse_prev =
-                f64::from(self.material.pdf_phase_unchecked(&self.slope, x, at.w, next.outside, at.outside));
+                f64::from(self.material.pdf_phase_unchecked(&self.slope, &step.reversed()));
             // the connection of the new vertex to ωo, the (s, 0) strategy's
-            let connection = self.connect_known(next, k_next, to_wo, true, rng);
+            let connection = self.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
             if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
                 let q = survival_probability(throughput, k_next);
                 if f64::from(uniform(rng)) >= q {
@@ -234,35 +228,34 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     fn light_subpath(
         &self,
         wo: Vec3,
-        wo_outside: bool,
+        wo_side: Side,
         max: usize,
         out: &mut [LightVertex; BDPT_MAX_SUBPATH],
         rng: &mut impl Rng,
     ) -> usize {
-        let (mut b, mut b_outside) = (wo, wo_outside);
+        let (mut b, mut b_side) = (wo, wo_side);
         let mut throughput = DVec3::ONE;
         for (i, slot) in out.iter_mut().enumerate().take(max) {
-            let s = self.material.sample_phase_unchecked(&self.slope, b, b_outside, rng);
-            let a = Incident { w: s.wo, outside: s.outside };
-            let k_in = inv_g1(&self.slope, in_side_frame(a.w, a.outside));
+            let s = self.material.sample_phase_unchecked(&self.slope, b, b_side, rng);
+            let a = Incident { w: s.wo, side: s.side };
+            let k_in = inv_g1(&self.slope, a.in_frame());
             if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
                 return i;
             }
-            let factor = self.shadowing_factor(a, k_in, self.exit(b, b_outside), i == 0)
-                * f64::from(self.material.relative_eta_sq(a.outside, b_outside))
-                * f64::from(self.slope.projected_area_unchecked(in_side_frame(b, b_outside)))
+            // the vertex at ωo is the path's last, every later one a middle vertex
+            let role = if i == 0 { VertexRole::Last } else { VertexRole::Middle };
+            let factor = self.shadowing_factor(a, k_in, self.exit(b, b_side), role)
+                * f64::from(self.material.relative_eta_sq(a.side, b_side))
+                * f64::from(self.slope.projected_area_unchecked(b_side.frame(b)))
                 / f64::from(a.w.z.abs());
             throughput *= s.weight.as_dvec3() * factor;
             if throughput == DVec3::ZERO || !throughput.is_finite() {
                 return i;
             }
-            let pdf_reverse =
-                f64::from(self.material.pdf_phase_unchecked(&self.slope, b, a.w, b_outside, a.outside));
-            let pdf_forward_out = if i == 0 {
-                0.0
-            } else {
-                f64::from(self.material.pdf_phase_unchecked(&self.slope, a.w, b, a.outside, b_outside))
-            };
+            let step = a.to(b, b_side);
+            let pdf_reverse = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step.reversed()));
+            let pdf_forward_out =
+                if i == 0 { 0.0 } else { f64::from(self.material.pdf_phase_unchecked(&self.slope, &step)) };
             if i as u32 + 1 >= ROULETTE_FROM_BOUNCE {
                 let q = throughput.max_element().min(1.0);
                 if f64::from(uniform(rng)) >= q {
@@ -272,9 +265,98 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             }
             *slot = LightVertex { incident: a, throughput, pdf_reverse, pdf_forward_out };
             b = -a.w;
-            b_outside = a.outside;
+            b_side = a.side;
         }
         max
+    }
+}
+
+/// The camera and light sub-paths of one bidirectional evaluation with the data their
+/// connections share.
+struct Subpaths<'a> {
+    /// The incident state at the first vertex (ωi).
+    start: Incident,
+    /// 1 + L̃ of ωi in its side frame.
+    k_start: f64,
+    /// The sampled camera vertices.
+    camera: &'a [CameraVertex],
+    /// The sampled light vertices.
+    light: &'a [LightVertex],
+    /// The exit data of ωo (index 0) and of the outgoing direction of light vertex t (index t).
+    exits: [Exit; BDPT_MAX_SUBPATH + 1],
+}
+
+impl Subpaths<'_> {
+    /// The incident state and its 1 + L̃ at the end of the first `s` camera directions.
+    #[inline]
+    fn camera_end(&self, s: usize) -> (Incident, f64) {
+        match s {
+            0 => (self.start, self.k_start),
+            _ => (self.camera[s - 1].next, self.camera[s - 1].k_next),
+        }
+    }
+
+    /// The product of the two sub-paths' throughputs for the prefixes of lengths `s`, `t`.
+    #[inline]
+    fn throughput(&self, s: usize, t: usize) -> DVec3 {
+        let camera = if s == 0 { DVec3::ONE } else { self.camera[s - 1].throughput };
+        let light = if t == 0 { DVec3::ONE } else { self.light[t - 1].throughput };
+        camera * light
+    }
+}
+
+/// One connection between the sub-paths: its contribution and the densities of its direction
+/// pair, p→ of the connecting direction from the camera side and p← of the camera end's
+/// incident direction given it.
+#[derive(Debug, Clone, Copy)]
+struct Connection {
+    contribution: DVec3,
+    forward: f64,
+    reverse: f64,
+}
+
+/// The densities of the directions x_1 … x_{n−1} of one path (index j − 1): p→ as sampled
+/// from the camera side, p← as sampled from the light side.
+struct PathDensities {
+    forward: [f64; 2 * BDPT_MAX_SUBPATH + 1],
+    reverse: [f64; 2 * BDPT_MAX_SUBPATH + 1],
+}
+
+impl PathDensities {
+    const EMPTY: Self =
+        Self { forward: [0.0; 2 * BDPT_MAX_SUBPATH + 1], reverse: [0.0; 2 * BDPT_MAX_SUBPATH + 1] };
+
+    /// The densities of the path of `s` camera directions, the connection `c` and `t` light
+    /// directions (n = s + t + 1 vertices).
+    #[inline]
+    fn fill(&mut self, paths: &Subpaths<'_>, s: usize, t: usize, c: &Connection) {
+        let n = s + t + 1;
+        for j in 1..=s {
+            self.forward[j - 1] = paths.camera[j - 1].pdf_forward;
+            if j < s {
+                self.reverse[j - 1] = paths.camera[j].pdf_reverse_prev;
+            }
+        }
+        if s >= 1 {
+            self.reverse[s - 1] = c.reverse;
+        }
+        if t >= 1 {
+            self.forward[s] = c.forward;
+            for j in (s + 1)..n {
+                let i = n - j; // light vertex whose sampled incident direction is −x_j
+                self.reverse[j - 1] = paths.light[i - 1].pdf_reverse;
+                if j > s + 1 {
+                    self.forward[j - 1] = paths.light[i].pdf_forward_out;
+                }
+            }
+        }
+    }
+
+    /// The balance-heuristic weight of the strategy with `s` camera directions for the
+    /// filled path of `n` vertices.
+    #[inline]
+    fn balance_weight(&self, s: usize, n: usize) -> f64 {
+        balance_weight(&self.forward[..n - 1], &self.reverse[..n - 1], s)
     }
 }
 

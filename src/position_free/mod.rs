@@ -15,14 +15,14 @@ mod segment;
 pub use segment::Shadowing;
 
 use crate::contract::is_direction;
-use crate::material::Material;
+use crate::material::{Event, Interaction, Material, Side};
 use crate::microsurface::WalkSample;
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec3};
 use rand::Rng;
-use segment::{LAMBDA_SATURATION, VertexShadowing, in_side_frame, inv_g1};
+use segment::{LAMBDA_SATURATION, VertexRole, VertexShadowing, inv_g1};
 
 /// Russian roulette starts after this many sampled bounces (it is unbiased at any depth).
 const ROULETTE_FROM_BOUNCE: u32 = 3;
@@ -32,15 +32,11 @@ const ROULETTE_FROM_BOUNCE: u32 = 3;
 ///
 /// The shadowing factors of a vertex are at most G1 of its incident direction (exactly so for
 /// the correlated transmission and the uncorrelated model, where B(k, ·) and G1·G1out grow as
-/// 1/k). A bounce that sends the path almost straight up carries a factor Λ(ω) → 0 in its
-/// throughput, which the next vertex's G1 = 1/Λ(ω) cancels. A survival probability from the
-/// throughput alone divides the small factor away and keeps the large one: contributions of
-/// size 1/Λ with probability Λ, an infinite variance (measured for conductor GGX α = 1,
-/// θi = 1, ωo = +z: outliers of 4e4 against a mean of 0.32, σ̂ = 54; with G1 in the
-/// probability σ̂ = 0.16). A surviving path's next contributions are then bounded by its
-/// vertex terms. The price: where Λ stays tiny over several bounces (Beckmann, steep
-/// directions) paths live longer (conductor Beckmann α = 0.5, θi = 1, ωo = +z: 10 bounces
-/// instead of 3).
+/// 1/k), so a surviving path's next contributions are bounded by its vertex terms: the
+/// estimator's variance stays finite where a bounce sends the path almost straight up (a
+/// throughput factor Λ(ω) → 0 that the next G1 = 1/Λ(ω) cancels). Why the throughput alone
+/// does not do, with the measured variances: DESIGN.md, “Russian roulette with the next
+/// vertex's masking”.
 #[inline(always)]
 pub(crate) fn survival_probability(throughput: DVec3, k_next: f64) -> f64 {
     (throughput.max_element() * (1.0 / k_next).max(1.0)).min(1.0)
@@ -83,18 +79,45 @@ pub(crate) struct Exit {
     /// The direction.
     pub(crate) w: Vec3,
     /// Its side of the interface.
-    pub(crate) outside: bool,
-    /// Whether it points up in its side frame.
-    pub(crate) can_exit: bool,
-    /// Λ in its side frame where it can exit, else 0.
-    pub(crate) lambda: f64,
+    pub(crate) side: Side,
+    /// Λ in its side frame where it can leave the surface (points up there); `None` where it
+    /// cannot.
+    pub(crate) lambda: Option<f64>,
 }
 
 /// The incident state at a vertex: the direction towards the previous vertex and its side.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Incident {
     pub(crate) w: Vec3,
-    pub(crate) outside: bool,
+    pub(crate) side: Side,
+}
+
+impl Incident {
+    /// The incident direction in the frame of its side.
+    #[inline(always)]
+    pub(crate) fn in_frame(self) -> Vec3 {
+        self.side.frame(self.w)
+    }
+
+    /// The event from this incident direction to `w` on `side`.
+    #[inline(always)]
+    pub(crate) fn to(self, w: Vec3, side: Side) -> Interaction {
+        Interaction::new(self.w, w, self.side, side)
+    }
+
+    /// The event from this incident direction to the outgoing one.
+    #[inline(always)]
+    pub(crate) fn towards(self, out: Exit) -> Interaction {
+        self.to(out.w, out.side)
+    }
+}
+
+impl Exit {
+    /// Whether the direction can leave the surface.
+    #[inline(always)]
+    pub(crate) fn can_exit(self) -> bool {
+        self.lambda.is_some()
+    }
 }
 
 impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
@@ -149,20 +172,20 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
-        self.connect(start, wo, wo_outside, true, rng).as_vec3()
+        self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
     }
 
     /// [`PositionFree::eval_single_scattering`], which accepts ωi below the horizon for an
     /// opaque material (a backfacing view under normal mapping), like every estimator of this
     /// model (kept for the renderer adapter).
     pub(crate) fn eval_single_backfacing(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
-        self.connect(start, wo, wo_outside, true, rng).as_vec3()
+        self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
     }
 
     /// Samples an outgoing direction with the position-free random walk (Wang et al. 2022,
@@ -178,13 +201,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// Nearly index-matched dielectrics at grazing incidence: a refraction through an
     /// interface with η ≈ 1 barely turns the ray, and this model's exit probability per vertex
     /// then falls to about 2^−Λ (it forgets the height a vertex was reached at, which the
-    /// height-tracing walk keeps), so its paths grow as |η − 1| → 0. Measured for GGX α = 1
-    /// with correlated shadowing: mean path lengths of 150 (|η − 1| = 1e-3), 1 100 (1e-4),
-    /// 8 500 (1e-5) and 36 000 bounces (2e-6, 3.5 ms per sample) at cos θi = 1e-3, none
-    /// capped; within one or two f32 ulps of 1 (η = 1 ± 1.2e-7) 98–100 % of such paths reach
-    /// [`crate::MAX_BOUNCES`] and are lost, at 6 ms each (at cos θi = 0.1 none is). η = 1
-    /// itself is transparent ([`crate::Material::is_transparent`]). `tests/walk_cap.rs` checks
-    /// the no-loss range down to |η − 1| = 1e-5.
+    /// height-tracing walk keeps), so its paths grow as |η − 1| → 0: no path is lost to
+    /// [`crate::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk_cap.rs`), while within one or
+    /// two f32 ulps of 1 nearly all grazing paths are (path lengths measured in DESIGN.md,
+    /// “The bounce cap”). η = 1 itself is transparent ([`crate::Material::is_transparent`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
@@ -195,26 +215,26 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             // the Dirac ωo = −ωi of an interface that does not interact (see `Material`)
             return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 1 });
         }
-        if wi.z < 0.0 && inv_g1(&self.slope, in_side_frame(at.w, at.outside)) == 0.0 {
+        if wi.z < 0.0 && self.sees_nothing(at, inv_g1(&self.slope, at.in_frame())) {
             // ωi at the nadir of an opaque material: no facet faces it (projected area 0)
             return None;
         }
         let mut weight = Vec3::ONE;
         for bounces in 1..=crate::MAX_BOUNCES {
-            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
+            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
             }
-            let out = self.exit(s.wo, s.outside);
-            if out.can_exit {
-                let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+            let out = self.exit(s.wo, s.side);
+            if out.can_exit() {
+                let k_in = inv_g1(&self.slope, at.in_frame());
                 // P(exit) = S_last/(S_last + S_middle) = S_last/G1(ωin)
                 if f64::from(uniform(rng)) < self.relative_shadowing(at, k_in, out).last {
                     return Some(WalkSample { wo: s.wo, weight, bounces });
                 }
             }
-            at = Incident { w: -s.wo, outside: s.outside };
+            at = Incident { w: -s.wo, side: s.side };
         }
         None
     }
@@ -240,9 +260,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
         require!(is_direction(wi), None; wi);
         let at = Self::incident(wi)?;
-        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
-        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        let last = self.relative_shadowing(at, k_in, self.exit(s.wo, s.outside)).last;
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
+        let k_in = inv_g1(&self.slope, at.in_frame());
+        let last = self.relative_shadowing(at, k_in, self.exit(s.wo, s.side)).last;
         let weight = s.weight * last as f32;
         (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
     }
@@ -254,10 +274,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside)
+        self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side))
     }
 
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
@@ -270,10 +290,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        let (Some(start), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
-        let single = self.material.pdf_phase_unchecked(&self.slope, start.w, wo, start.outside, wo_outside);
+        let single = self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side));
         let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
         (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
     }
@@ -290,40 +310,29 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// the macrosurface”.
     #[inline(always)]
     pub(crate) fn incident(wi: Vec3) -> Option<Incident> {
-        if wi.z > 0.0 || (!M::TRANSMITS && wi.z < 0.0) {
-            Some(Incident { w: wi, outside: true })
-        } else if M::TRANSMITS && wi.z < 0.0 {
-            Some(Incident { w: wi, outside: false })
-        } else {
-            None
-        }
+        let side = Side::of(wi.z)?;
+        Some(Incident { w: wi, side: if M::TRANSMITS { side } else { Side::Outside } })
     }
 
     /// The side of the macro direction ωo, or `None` if light cannot leave there.
     #[inline(always)]
-    pub(crate) fn exit_side(wo: Vec3) -> Option<bool> {
-        if wo.z > 0.0 {
-            Some(true)
-        } else if M::TRANSMITS && wo.z < 0.0 {
-            Some(false)
-        } else {
-            None
-        }
+    pub(crate) fn exit_side(wo: Vec3) -> Option<Side> {
+        Side::of(wo.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
     }
 
-    /// The forward contribution of one vertex, v(ωin, ωout)·S, where S is the last-vertex
-    /// factor if `last` and the continuing factor otherwise.
+    /// The forward contribution of one vertex in the given role, v(ωin, ωout)·S (S the
+    /// last-vertex or the continuing factor).
     #[inline]
     pub(crate) fn connect(
         &self,
         at: Incident,
         wo: Vec3,
-        wo_outside: bool,
-        last: bool,
+        wo_side: Side,
+        role: VertexRole,
         rng: &mut impl Rng,
     ) -> DVec3 {
-        let k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
-        self.connect_known(at, k_in, self.exit(wo, wo_outside), last, rng)
+        let k_in = inv_g1(&self.slope, at.in_frame());
+        self.connect_known(at, k_in, self.exit(wo, wo_side), role, rng)
     }
 
     /// [`Self::connect`] with the incident 1 + L̃ = `k_in` and the outgoing direction's exit
@@ -334,28 +343,25 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         at: Incident,
         k_in: f64,
         out: Exit,
-        last: bool,
+        role: VertexRole,
         rng: &mut impl Rng,
     ) -> DVec3 {
         if k_in < 1.0 {
             // a backfacing incident direction (below the horizon in its side frame): v·S =
             // p·(k_in S), with the phase function p and the relative factor both free of the
             // tiny k_in = Λ(−ωin), which v = p·k_in and S ∝ 1/k_in would underflow and overflow
-            let v = self.relative_shadowing(at, k_in, out);
-            let factor = if last { v.last } else { v.middle };
+            let factor = self.relative_shadowing(at, k_in, out).factor(role);
             if factor == 0.0 {
                 return DVec3::ZERO;
             }
-            let phase =
-                self.material.eval_phase_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng);
+            let phase = self.material.eval_phase_unchecked(&self.slope, &at.towards(out), rng);
             return phase.as_dvec3() * factor;
         }
-        let factor = self.shadowing_factor(at, k_in, out, last);
+        let factor = self.shadowing_factor(at, k_in, out, role);
         if factor == 0.0 {
             return DVec3::ZERO;
         }
-        self.material.vertex_unchecked(&self.slope, at.w, out.w, at.outside, out.outside, rng).as_dvec3()
-            * factor
+        self.material.vertex_unchecked(&self.slope, &at.towards(out), rng).as_dvec3() * factor
     }
 
     /// The shadowing factors of a vertex relative to its incident masking, k_in·S
@@ -365,44 +371,133 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// Beckmann surfaces): exact to a few f64 ulps down to the smallest α.
     #[inline]
     pub(crate) fn relative_shadowing(&self, at: Incident, k_in: f64, out: Exit) -> VertexShadowing {
-        let reflect = at.outside == out.outside;
-        let ratio = if !(out.can_exit && reflect && self.shadowing == Shadowing::Correlated) {
-            0.0
-        } else if k_in >= LAMBDA_RATIO_LOG_BELOW {
-            out.lambda / k_in
-        } else {
-            // k_in = Λ(−ωin) of a backfacing incident direction, in its side frame
-            let ln_k = self.slope.ln_lambda(-in_side_frame(at.w, at.outside));
-            if ln_k == f64::NEG_INFINITY {
-                f64::INFINITY
-            } else {
-                (self.slope.ln_lambda(in_side_frame(out.w, out.outside)) - ln_k).exp()
+        let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
+        let ratio = match out.lambda {
+            Some(lambda) if event == Event::Reflection && self.shadowing == Shadowing::Correlated => {
+                if k_in >= LAMBDA_RATIO_LOG_BELOW {
+                    lambda / k_in
+                } else {
+                    // k_in = Λ(−ωin) of a backfacing incident direction, in its side frame
+                    let ln_k = self.slope.ln_lambda(-at.in_frame());
+                    if ln_k == f64::NEG_INFINITY {
+                        f64::INFINITY
+                    } else {
+                        (self.slope.ln_lambda(out.side.frame(out.w)) - ln_k).exp()
+                    }
+                }
             }
+            _ => 0.0,
         };
-        self.shadowing.relative(k_in, out.can_exit, out.lambda, ratio, reflect)
+        self.shadowing.relative(k_in, out.lambda, ratio, event)
+    }
+
+    /// Whether the incident state `at` with 1 + L̃ = `k_in` sees no microsurface: Λ(−ωin) = 0
+    /// exactly (straight from below), told apart from a Λ(−ωin) that only underflows f64
+    /// (Beckmann, |cot θ|/αᵢ > 26.6) by ln Λ (−∞ only in the first case).
+    #[inline]
+    pub(crate) fn sees_nothing(&self, at: Incident, k_in: f64) -> bool {
+        k_in == 0.0 && self.slope.ln_lambda(-at.in_frame()) == f64::NEG_INFINITY
     }
 
     /// The exit data of an outgoing direction: whether it points up in its side frame (can
     /// leave the surface) and then its Λ there (0 otherwise).
     #[inline]
-    pub(crate) fn exit(&self, w: Vec3, outside: bool) -> Exit {
-        let frame = in_side_frame(w, outside);
-        let can_exit = frame.z > 0.0;
-        let lambda = if can_exit { self.slope.lambda64(frame).min(LAMBDA_SATURATION) } else { 0.0 };
-        Exit { w, outside, can_exit, lambda }
+    pub(crate) fn exit(&self, w: Vec3, side: Side) -> Exit {
+        let frame = side.frame(w);
+        let lambda = (frame.z > 0.0).then(|| self.slope.lambda64(frame).min(LAMBDA_SATURATION));
+        Exit { w, side, lambda }
     }
 
-    /// The last (`last`) or continuing shadowing factor of a vertex with incident state `at`
+    /// The shadowing factor of a vertex in the given role with incident state `at`
     /// (1 + L̃ = `k_in`) and outgoing direction `out`; 0 where `at` sees no microsurface and
     /// where k_in < `LAMBDA_RATIO_LOG_BELOW` (S would overflow: use [`Self::relative_shadowing`]).
     #[inline(always)]
-    pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, last: bool) -> f64 {
+    pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, role: VertexRole) -> f64 {
         // S ∝ G1in = 1/k_in overflows for a subnormal f64 k_in; its product with a vertex term
         // (∝ k_in) is formed by `relative_shadowing` instead, where callers need it
         if k_in < LAMBDA_RATIO_LOG_BELOW {
             return 0.0;
         }
-        let v = self.shadowing.vertex(k_in, out.can_exit, out.lambda, at.outside == out.outside);
-        if last { v.last } else { v.middle }
+        let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
+        self.shadowing.vertex(k_in, out.lambda, event).factor(role)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::cosine_hemisphere;
+    use crate::material::Conductor;
+    use crate::microsurface::ScatteringOrder;
+    use crate::slope::Beckmann;
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    /// θi = 120°: with Beckmann α = 0.02, a = |cot θi|/αᵢ = 28.9 and Λ(−ωi) ≈ e^{−a²}
+    /// underflows f64.
+    fn from_below() -> Vec3 {
+        let t = 120f32.to_radians();
+        Vec3::new(t.sin(), 0.0, t.cos())
+    }
+
+    fn smooth_mirror(shadowing: Shadowing) -> PositionFree<Beckmann, Conductor> {
+        PositionFree::new(
+            Beckmann::isotropic(0.02).expect("valid roughness"),
+            Conductor::perfect(),
+            shadowing,
+        )
+    }
+
+    /// Smooth Beckmann seen from below where Λ(−ωi) underflows f64: the position-free walk of
+    /// a perfect mirror returns every path, upwards, with weight 1 (energy is conserved), for
+    /// both shadowing models. Before, the nadir test took the underflowed Λ(−ωi) = 0 for “no
+    /// facet faces ωi” and returned `None` for all of them.
+    #[test]
+    fn sample_from_below_sees_smooth_beckmann() {
+        for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
+            let pf = smooth_mirror(shadowing);
+            let mut rng = Pcg64Mcg::seed_from_u64(41);
+            for k in 0..2000 {
+                let s = pf
+                    .sample(from_below(), &mut rng)
+                    .unwrap_or_else(|| panic!("{shadowing:?}: path {k} lost"));
+                assert!(s.weight == Vec3::ONE && s.wo.z > 0.0, "{shadowing:?}: {s:?}");
+            }
+        }
+    }
+
+    /// The same surface: path tracing's albedo ∫ f·cos dωo is 1 for a perfect mirror.
+    /// Estimated as the mean of eval_pt/pdf over N = 20 000 directions drawn from the mixture
+    /// whose density is [`PositionFree::pdf`] (0.8 phase sampling, 0.2 cosine), within z σ̂/√N,
+    /// z = 3.29 (Šidák, family-wise 1e-3 over the two shadowing models), resolving 1 %. Before,
+    /// the path stopped after the first vertex (its incident 1 + L̃ underflowed to 0) and the
+    /// multiple scattering was lost (mean 0.915, 25 σ̂/√N below 1).
+    #[test]
+    fn pt_from_below_conserves_energy_for_smooth_beckmann() {
+        const N: usize = 20_000;
+        const Z: f64 = 3.29;
+        let wi = from_below();
+        for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
+            let pf = smooth_mirror(shadowing);
+            let mut rng = Pcg64Mcg::seed_from_u64(43);
+            let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+            for _ in 0..N {
+                let wo = if uniform(&mut rng) < 1.0 - PDF_COSINE_SHARE {
+                    pf.material.sample_phase(&pf.slope, wi, Side::Outside, &mut rng).wo
+                } else {
+                    cosine_hemisphere(uniform(&mut rng), uniform(&mut rng))
+                };
+                let pdf = f64::from(pf.pdf(wi, wo));
+                let f = f64::from(pf.eval_pt(wi, wo, ScatteringOrder::All, &mut rng).x);
+                let x = if pdf > 0.0 { f / pdf } else { 0.0 };
+                (sum, sum_sq) = (sum + x, sum_sq + x * x);
+            }
+            let mean = sum / N as f64;
+            let sd = (sum_sq / N as f64 - mean * mean).max(0.0).sqrt();
+            let se = sd / (N as f64).sqrt();
+            let report = format!("{shadowing:?}: N = {N}, mean {mean}, σ̂ {sd}, z = {Z}");
+            assert!(se <= 0.01, "not resolved: {report}");
+            assert!((mean - 1.0).abs() <= Z * se, "{report}");
+        }
     }
 }

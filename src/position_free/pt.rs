@@ -1,6 +1,6 @@
 //! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
 
-use super::segment::{in_side_frame, inv_g1};
+use super::segment::{VertexRole, inv_g1};
 use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
 use crate::contract::is_direction;
 use crate::material::Material;
@@ -26,19 +26,19 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_pt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let (Some(mut at), Some(wo_outside)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(mut at), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return Vec3::ZERO;
         };
         let last = order.last();
         // the exit data of ωo (constant) and 1 + L̃ of the current incident direction: one Λ
         // per bounce
-        let to_wo = self.exit(wo, wo_outside);
-        let mut k_in = inv_g1(&self.slope, in_side_frame(at.w, at.outside));
+        let to_wo = self.exit(wo, wo_side);
+        let mut k_in = inv_g1(&self.slope, at.in_frame());
         let mut throughput = DVec3::ONE;
         let mut sum = DVec3::ZERO;
         for bounce in 1..=last {
             if order.includes(bounce) {
-                sum += throughput * self.connect_known(at, k_in, to_wo, true, rng);
+                sum += throughput * self.connect_known(at, k_in, to_wo, VertexRole::Last, rng);
             }
             if bounce == last {
                 break;
@@ -66,8 +66,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
 
     /// Samples the next direction from the incident state `at` (with 1 + L̃ = `k_in`) and
     /// returns the next incident state, its 1 + L̃ and the throughput ratio
-    /// w·S_middle/G1(ωin) = w·k_in·S_middle. Λ of the sampled direction serves both this vertex's continuing factor and the next
-    /// incident masking (Λ(−ω) = −1 − Λ(ω)), so a bounce evaluates Λ once.
+    /// w·S_middle/G1(ωin) = w·k_in·S_middle. Λ of the sampled direction serves both this
+    /// vertex's continuing factor and the next incident masking (Λ(−ω) = −1 − Λ(ω)), so a
+    /// bounce evaluates Λ once.
     #[inline]
     pub(crate) fn extend_known(
         &self,
@@ -75,18 +76,20 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         k_in: f64,
         rng: &mut impl Rng,
     ) -> Option<(Incident, f64, DVec3)> {
-        if k_in == 0.0 || !k_in.is_finite() {
+        if !k_in.is_finite() || self.sees_nothing(at, k_in) {
             return None;
         }
-        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.outside, rng);
-        let out = self.exit(s.wo, s.outside);
+        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
+        let out = self.exit(s.wo, s.side);
         // k_in·S_middle, exact also where k_in underflows (a backfacing low-roughness vertex)
         let middle = self.relative_shadowing(at, k_in, out).middle;
         // the next incident direction −ω: below the horizon in its frame where ω can exit, and
         // then 1 + L̃ = Λ(ω)
-        let k_next =
-            if out.can_exit { out.lambda } else { inv_g1(&self.slope, -in_side_frame(s.wo, s.outside)) };
-        let next = Incident { w: -s.wo, outside: s.outside };
+        let k_next = match out.lambda {
+            Some(lambda) => lambda,
+            None => inv_g1(&self.slope, -s.side.frame(s.wo)),
+        };
+        let next = Incident { w: -s.wo, side: s.side };
         Some((next, k_next, s.weight.as_dvec3() * middle))
     }
 }

@@ -1,6 +1,7 @@
 //! Full-spherical masking and the per-vertex shadowing factors of the position-free path
 //! integral (Wang et al. 2022, §3.3–3.4), for both height models.
 
+use crate::material::Event;
 use crate::slope::MicrosurfaceSlope;
 use crate::special::ln_gamma;
 use glam::Vec3;
@@ -15,13 +16,6 @@ pub enum Shadowing {
     /// random walk of Heitz et al. 2016, not reciprocal.
     #[default]
     Correlated,
-}
-
-/// A direction expressed in the frame of the medium it lies in (mirrored, ω ↦ −ω, inside a
-/// dielectric, as in Heitz et al. 2016 §3.4).
-#[inline(always)]
-pub(crate) fn in_side_frame(w: Vec3, outside: bool) -> Vec3 {
-    if outside { w } else { -w }
 }
 
 /// 1 + L̃(ω) = |1 + Λ(ω)| for an incident direction ω in its side frame: the inverse of the
@@ -45,19 +39,40 @@ pub(crate) fn inv_g1<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> f64 {
 /// far below it on.
 pub(crate) const LAMBDA_SATURATION: f64 = f32::MAX as f64;
 
+/// The role of a vertex in a path: the one the path leaves the microsurface from, or one it
+/// continues from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum VertexRole {
+    /// The path leaves through the outgoing direction.
+    Last,
+    /// The path continues along the outgoing direction.
+    Middle,
+}
+
 /// The shadowing factors of one vertex: `last` when the path leaves through the outgoing
 /// direction, `middle` when it continues (Wang et al. 2022, eqs. 7–8, 12–13 and 17–23,
 /// regrouped per vertex as incident masking × exit or continue factor).
 ///
-/// `k_in` = 1 + L̃ of the incident direction, `lambda_out` = Λ of the outgoing direction in
-/// its own side frame (meaningful when it can exit, i.e. points up there), `reflect` whether
-/// the event keeps the side.
+/// `k_in` = 1 + L̃ of the incident direction, `exit` = Λ of the outgoing direction in its own
+/// side frame where it can exit (points up there), `None` where it cannot; the [`Event`] tells
+/// whether the vertex keeps the side.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct VertexShadowing {
     /// Factor if this is the last vertex (0 when the outgoing direction cannot exit).
     pub last: f64,
     /// Factor if the path continues.
     pub middle: f64,
+}
+
+impl VertexShadowing {
+    /// The factor of a vertex in the given role.
+    #[inline(always)]
+    pub(crate) fn factor(self, role: VertexRole) -> f64 {
+        match role {
+            VertexRole::Last => self.last,
+            VertexRole::Middle => self.middle,
+        }
+    }
 }
 
 impl Shadowing {
@@ -77,26 +92,19 @@ impl Shadowing {
     /// of order e^{−a²}, and only their ratio matters. ratio = ∞ (k_in = 0 straight from
     /// below) gives last = 0, middle = 1. Relative error a few f64 ulps.
     #[inline]
-    pub(crate) fn relative(
-        self,
-        k_in: f64,
-        can_exit: bool,
-        lambda_out: f64,
-        ratio: f64,
-        reflect: bool,
-    ) -> VertexShadowing {
-        if !can_exit {
+    pub(crate) fn relative(self, k_in: f64, exit: Option<f64>, ratio: f64, event: Event) -> VertexShadowing {
+        let Some(lambda_out) = exit else {
             return VertexShadowing { last: 0.0, middle: 1.0 };
-        }
-        match (self, reflect) {
+        };
+        match (self, event) {
             (Shadowing::Uncorrelated, _) => {
                 let g1_out = 1.0 / (1.0 + lambda_out);
                 VertexShadowing { last: g1_out, middle: lambda_out * g1_out }
             }
-            (Shadowing::Correlated, true) => {
+            (Shadowing::Correlated, Event::Reflection) => {
                 VertexShadowing { last: 1.0 / (1.0 + ratio), middle: 1.0 / (1.0 + 1.0 / ratio) }
             }
-            (Shadowing::Correlated, false) => {
+            (Shadowing::Correlated, Event::Transmission) => {
                 let ln_kb =
                     ln_gamma(1.0 + k_in) + ln_gamma(1.0 + lambda_out) - ln_gamma(1.0 + k_in + lambda_out);
                 VertexShadowing { last: ln_kb.exp(), middle: -ln_kb.exp_m1() }
@@ -114,24 +122,23 @@ impl Shadowing {
     ///
     /// The correlated middle factors are the differences written without cancellation:
     /// Λo/(k_in (k_in + Λo)) and −expm1(ln Γ(1 + k_in) + ln Γ(1 + Λo) − ln Γ(1 + k_in + Λo))/k_in.
-    /// Both are ≥ 0 without clamping (the released code clamps the latter to [0, 1], which
-    /// is wrong for G1in > 1).
+    /// Both are ≥ 0 without clamping (for G1in > 1 too, see DESIGN.md).
     #[inline]
-    pub(crate) fn vertex(self, k_in: f64, can_exit: bool, lambda_out: f64, reflect: bool) -> VertexShadowing {
+    pub(crate) fn vertex(self, k_in: f64, exit: Option<f64>, event: Event) -> VertexShadowing {
         let g1_in = 1.0 / k_in;
-        if !can_exit {
+        let Some(lambda_out) = exit else {
             return VertexShadowing { last: 0.0, middle: g1_in };
-        }
-        match (self, reflect) {
+        };
+        match (self, event) {
             (Shadowing::Uncorrelated, _) => {
                 let g1_out = 1.0 / (1.0 + lambda_out);
                 VertexShadowing { last: g1_in * g1_out, middle: g1_in * lambda_out * g1_out }
             }
-            (Shadowing::Correlated, true) => {
+            (Shadowing::Correlated, Event::Reflection) => {
                 let last = 1.0 / (k_in + lambda_out);
                 VertexShadowing { last, middle: lambda_out * last * g1_in }
             }
-            (Shadowing::Correlated, false) => {
+            (Shadowing::Correlated, Event::Transmission) => {
                 // k_in B(k_in, 1 + Λo) = exp(ln_kb)
                 let ln_kb =
                     ln_gamma(1.0 + k_in) + ln_gamma(1.0 + lambda_out) - ln_gamma(1.0 + k_in + lambda_out);
@@ -149,7 +156,7 @@ mod tests {
     #[test]
     fn correlated_transmission_matches_the_beta_function() {
         for (k, l) in [(1.0, 0.5), (1.3, 2.0), (0.2, 7.0), (40.0, 1e-9)] {
-            let v = Shadowing::Correlated.vertex(k, true, l, false);
+            let v = Shadowing::Correlated.vertex(k, Some(l), Event::Transmission);
             let b = beta(k, 1.0 + l);
             assert!((v.last - b).abs() <= 1e-12 * b, "{k} {l}: {} vs {b}", v.last);
             assert!((v.middle - (1.0 / k - b)).abs() <= 1e-9 / k, "{k} {l}");

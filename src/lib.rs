@@ -118,6 +118,7 @@ mod merl;
 mod microsurface;
 mod position_free;
 mod rng;
+mod single_scattering;
 mod slope;
 mod special;
 mod vndf;
@@ -144,6 +145,7 @@ pub use microsurface::{
 pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
+pub use single_scattering::{SingleSample, SingleScattering};
 pub use slope::{
     BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
     StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,

@@ -109,6 +109,7 @@
 mod contract;
 mod albedo;
 mod bsdf;
+mod constants;
 mod error;
 mod frame;
 mod fresnel;
@@ -121,6 +122,7 @@ mod rng;
 mod single_scattering;
 mod slope;
 mod special;
+mod vector;
 mod vndf;
 
 pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};

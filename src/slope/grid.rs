@@ -2,10 +2,11 @@
 //! sampling on the whole sphere (Dupuy 2015, thesis §4.2: the anisotropic data-driven
 //! microsurface).
 
+use super::MicrosurfaceSlope;
 use super::tabulated::{check_ring_count, grid_angle};
-use super::{MicrosurfaceSlope, ensure_visible, normal_from_slopes};
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
+use crate::vector::{ensure_visible, normal_from_slopes};
 use glam::{DVec3, Vec2, Vec3};
 
 /// Intervals of the back-face area table over v = √(1 − |cos θ|) ∈ [0, 1] (≈ θ/√2 near the

@@ -1,9 +1,10 @@
 //! A tabulated isotropic slope distribution (Dupuy 2015, thesis §4.2: data-driven
 //! microsurfaces), with exact visible-normal sampling on the whole sphere.
 
-use super::{MicrosurfaceSlope, ensure_visible, normal_from_slopes};
+use super::MicrosurfaceSlope;
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
+use crate::vector::{ensure_visible, normal_from_slopes};
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -788,6 +789,6 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
         let m = (&self.table).sample_d_wi(s, u1, u2);
         // the table's normal m ∝ (−u, −v, 1): the slopes scale by (sx, sy)
         let stretched = Vec3::new(m.x * self.sx, m.y * self.sy, m.z);
-        ensure_visible(wi, super::normalize_scaled(stretched, Vec3::Z))
+        ensure_visible(wi, crate::vector::normalize_scaled(stretched, Vec3::Z))
     }
 }

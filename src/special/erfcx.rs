@@ -1,7 +1,8 @@
-//! The scaled complementary error function erfcx(u) = exp(u²) erfc(u).
+//! The scaled complementary error function erfcx(u) = exp(u²) erfc(u), and the ratio
+//! r(u) = 1 − √π u erfcx(u) of the Gaussian tail's two terms.
 
-/// 1/√π.
-const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
+use crate::constants::{INV_SQRT_PI, SQRT_PI};
+
 /// From this argument on, erfcx is its asymptotic series.
 pub(crate) const ERFCX_ASYMPTOTIC_FROM: f64 = 25.0;
 /// y = 4/(4 + u) at u = `ERFCX_ASYMPTOTIC_FROM`: the pieces cover y ∈ [`Y_FROM`, 1].
@@ -368,6 +369,24 @@ pub(crate) fn erfcx64(u: f64) -> f64 {
     // 1 − r + 3r² − 15r³ + 105r⁴ − 945r⁵ + 10395r⁶
     let series = 1.0 - r * (1.0 - r * (3.0 - r * (15.0 - r * (105.0 - r * (945.0 - r * 10395.0)))));
     INV_SQRT_PI / u * series
+}
+
+/// From this u = −x̃ on, 1 − m√π erfcx(u) is evaluated by its asymptotic series (which is free
+/// of the cancellation the direct form suffers for large u).
+pub(crate) const PSI_SERIES_FROM: f64 = 8.0;
+
+/// r(u) = 1 − √π u erfcx(u) for u ≥ 0 (the ratio of the Gaussian tail's two terms; r(0) = 1,
+/// r(u) ≈ 1/(2u²) for large u). From `PSI_SERIES_FROM` on, by its asymptotic series
+/// r = r2 − 3r2² + 15r2³ − 105r2⁴ + 945r2⁵ − 10395r2⁶ with r2 = 1/(2u²) (the next term is
+/// below 1e-16 relative for u ≥ 8), free of the cancellation of the direct form, which below
+/// 8 loses at most a factor 2u² ≤ 128 of erfcx's relative accuracy.
+#[inline(always)]
+pub(crate) fn one_minus_scaled_erfcx(u: f64) -> f64 {
+    if u < PSI_SERIES_FROM {
+        return 1.0 - SQRT_PI * u * erfcx64(u);
+    }
+    let r2 = 1.0 / (2.0 * u * u);
+    r2 * (1.0 - r2 * (3.0 - r2 * (15.0 - r2 * (105.0 - r2 * (945.0 - r2 * 10395.0)))))
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ mod trig;
 
 pub use erf::{erf, erfc};
 pub(crate) use erf::{erf64, erfc64};
-pub(crate) use erfcx::erfcx64;
+pub(crate) use erfcx::{PSI_SERIES_FROM, erfcx64, one_minus_scaled_erfcx};
 pub use erfinv::erfinv;
 pub(crate) use erfinv::{erfc_inv_f32, erfinv_from_both_ends, erfinv64};
 pub use gamma::{beta, ln_beta, ln_gamma};

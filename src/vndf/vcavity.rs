@@ -1,18 +1,15 @@
 //! The V-cavity microsurface as an alternative masking model (Tokuyoshi, supplement §2).
 
 use super::VisibleNormalSampler;
-use super::disk::{half_space_band, sample_band};
+use super::beckmann_inversion::{gaussian_slope, visible_slope_x_above};
+use super::disk_band::{half_space_band, sample_band};
+use super::stretch::{Azimuth, disk_frame, stretch, stretch64};
+use crate::constants::INV_SQRT_PI;
 use crate::contract::{are_uniform, is_direction, is_plane_normal};
 use crate::rng::cut_tails64;
-use crate::slope::{
-    Beckmann, Ggx, MicrosurfaceSlope, gaussian_slope, normal_from_slopes, one_minus_scaled_erfcx,
-    visible_slope_x_above,
-};
-use crate::special::{erfc64, erfcx64, erfinv_from_both_ends};
-use glam::{Vec2, Vec3};
-
-/// 1/√π.
-const INV_SQRT_PI: f64 = 0.564_189_583_547_756_3;
+use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+use crate::special::{erfc64, erfcx64, erfinv_from_both_ends, one_minus_scaled_erfcx};
+use glam::Vec3;
 /// From this w = |i_z|/√q on, the Beckmann hit probability is evaluated in log space (its
 /// direct form cancels and then underflows).
 const LOG_SPACE_FROM: f64 = 8.0;
@@ -76,32 +73,6 @@ pub trait VCavitySlope: MicrosurfaceSlope {
     fn sample_unmasked(&self, wi: Vec3, k: Vec3, u1: f32, u2: f32) -> Vec3;
 }
 
-/// Stretches a direction by the roughness: (αx x, αy y, z).
-#[inline(always)]
-fn stretch<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> Vec3 {
-    Vec3::new(slope.alpha_x() * w.x, slope.alpha_y() * w.y, w.z)
-}
-
-/// Stretches a direction by the roughness in double precision: Beckmann terms depend on
-/// exp(−z²/q), which amplifies an f32 rounding of q by 2w² (w = |z|/√q reaches hundreds near
-/// the nadir).
-#[inline(always)]
-fn stretch64<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> glam::DVec3 {
-    glam::DVec3::new(
-        f64::from(slope.alpha_x()) * f64::from(w.x),
-        f64::from(slope.alpha_y()) * f64::from(w.y),
-        f64::from(w.z),
-    )
-}
-
-/// The horizontal unit vector of the azimuth of `w` (x if vertical) and its perpendicular.
-#[inline(always)]
-fn azimuth_frame(w: Vec3) -> (Vec2, Vec2) {
-    let len = (w.x * w.x + w.y * w.y).sqrt();
-    let e = if len > 0.0 { Vec2::new(w.x / len, w.y / len) } else { Vec2::X };
-    (e, e.perp())
-}
-
 impl VCavitySlope for Ggx {
     /// 1 + (√(q + 9 i_z²) − √(q + i_z²))/(2 i_z) below the horizon (q = αx² i_x² + αy² i_y²),
     /// evaluated without cancellation as q (1/(A + 3|i_z|) + 1/(B + |i_z|))/(A + B) with
@@ -130,12 +101,13 @@ impl VCavitySlope for Ggx {
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3 {
         require!(is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; k, u1, u2);
         let ks = stretch(self, k).normalize_or(Vec3::Z);
-        let (e, f) = azimuth_frame(ks);
+        let azimuth = Azimuth::of(ks.x, ks.y);
         let (lo, hi) = (-ks.z, 1.0);
         let p = sample_band(u1, u2, lo, hi);
         let (w, u, z) = (p.t1, p.t2, p.t3);
-        let (x, y) = (u * e.x + w * f.x, u * e.y + w * f.y);
-        Vec3::new(self.alpha_x() * x, self.alpha_y() * y, z).normalize_or(Vec3::Z)
+        // the disk point (u along the azimuth of k, w across it) rotated and unstretched
+        let h = azimuth.unstretch(self.alpha_x(), self.alpha_y(), u, w);
+        Vec3::new(h.x, h.y, z).normalize_or(Vec3::Z)
     }
 
     /// The disk method of Heitz 2018 with the band limited by both the horizon and the plane
@@ -144,13 +116,7 @@ impl VCavitySlope for Ggx {
         require!(is_direction(wi) && is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; wi, k, u1, u2);
         let v = stretch(self, wi).normalize_or(Vec3::Z);
         let ks = stretch(self, k).normalize_or(Vec3::Z);
-        let len_xy = (v.x * v.x + v.y * v.y).sqrt();
-        let (t1_axis, t2_axis) = if len_xy > 0.0 {
-            let t1 = Vec3::new(-v.y / len_xy, v.x / len_xy, 0.0);
-            (t1, v.cross(t1))
-        } else {
-            (Vec3::Y, Vec3::X)
-        };
+        let (t1_axis, t2_axis) = disk_frame(v);
         let (lo_h, hi_h) = half_space_band(t2_axis.z, v.z, true);
         let (lo_k, hi_k) = half_space_band(t2_axis.dot(ks), v.dot(ks), false);
         let (lo, hi) = (lo_h.max(lo_k), hi_h.min(hi_k).max(lo_h.max(lo_k)));
@@ -242,7 +208,7 @@ impl VCavitySlope for Beckmann {
     fn sample_projected(&self, k: Vec3, u1: f32, u2: f32) -> Vec3 {
         require!(is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; k, u1, u2);
         let ks = stretch(self, k);
-        let (e, f) = azimuth_frame(ks);
+        let azimuth = Azimuth::of(ks.x, ks.y);
         let len = f64::from(ks.truncate().length());
         // share of N(0, ½) below the boundary, as a complement 2P = erfc(−boundary)
         let two_p = if len == 0.0 { 2.0 } else { erfc64(-f64::from(ks.z) / len) };
@@ -254,8 +220,7 @@ impl VCavitySlope for Beckmann {
             erfinv_from_both_ends(q - 1.0, 2.0 - q)
         } as f32;
         let y = gaussian_slope(f64::from(u2)) as f32;
-        let s = x * e + y * f;
-        normal_from_slopes(self.alpha_x() * s.x, self.alpha_y() * s.y)
+        azimuth.unstretched_normal(self.alpha_x(), self.alpha_y(), x, y)
     }
 
     /// The exact visible-slope inversion limited to x̃ ∈ [3 cot θ, cot θ) (Tokuyoshi, listings
@@ -264,7 +229,7 @@ impl VCavitySlope for Beckmann {
         require!(is_direction(wi) && is_plane_normal(k) && are_uniform(&[u1, u2]), Vec3::NAN; wi, k, u1, u2);
         let v = stretch64(self, wi);
         let ks = stretch64(self, k);
-        let (e, f) = azimuth_frame(v.as_vec3());
+        let azimuth = Azimuth::of(v.x as f32, v.y as f32);
         let len_xy = v.truncate().length();
         if len_xy == 0.0 {
             return Vec3::Z;
@@ -274,8 +239,7 @@ impl VCavitySlope for Beckmann {
         let lower = ks.z / ks.truncate().length();
         let x = visible_slope_x_above(kappa, lower, f64::from(u1)) as f32;
         let y = gaussian_slope(f64::from(u2)) as f32;
-        let s = x * e + y * f;
-        normal_from_slopes(self.alpha_x() * s.x, self.alpha_y() * s.y)
+        azimuth.unstretched_normal(self.alpha_x(), self.alpha_y(), x, y)
     }
 }
 

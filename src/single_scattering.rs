@@ -198,7 +198,14 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         let (slope, m) = (self.model.slope(), self.model.material());
         let s = m.sample_phase_unchecked(slope, at.w, at.outside, rng);
         let k_in = self.model.incident_k(at);
-        let last = self.model.relative_shadowing(at, k_in, self.model.exit(s.wo, s.outside)).last;
+        let out = self.model.exit(s.wo, s.outside);
+        let last = if k_in >= 1.0 && out.can_exit && at.outside == out.outside {
+            // a reflection from a front-facing ωi: G2/G1 = (1 + Λi)/(1 + Λi + Λo), one division
+            // (the relative factor 1/(1 + Λo/k_in) of the general form below, to an f64 ulp)
+            k_in / (k_in + out.lambda)
+        } else {
+            self.model.relative_shadowing(at, k_in, out).last
+        };
         let weight = s.weight * last as f32;
         if !(last > 0.0 && weight.is_finite()) {
             return None;

@@ -143,7 +143,7 @@ fn eval_with_pdf_is_eval_and_pdf() {
 }
 
 /// The sampler draws what the position-free one-vertex sampler draws from the same uniforms,
-/// with its weight, and adds the density.
+/// with its weight (to an f32 ulp), and adds the density.
 #[test]
 fn sample_is_the_position_free_single_sample() {
     let slope = Beckmann::isotropic(0.4).unwrap();
@@ -155,7 +155,11 @@ fn sample_is_the_position_free_single_sample() {
         let wi = random_direction(&mut dirs);
         let a = model.sample(wi, &mut common::rng(1000 + k));
         let b = pf.sample_single(wi, &mut common::rng(1000 + k));
-        assert_eq!(a.map(|s| (s.wo, s.weight)), b, "at {wi}");
+        // the same direction; the weight to an f32 ulp (the one-division G2/G1 of a reflection)
+        assert_eq!(a.map(|s| s.wo), b.map(|s| s.0), "at {wi}");
+        if let (Some(s), Some((_, w))) = (a, b) {
+            assert!(rel_close(s.weight, w, 2.0 * f32::EPSILON), "weight {} ≠ {w} at {wi}", s.weight);
+        }
         if let Some(s) = a {
             assert_eq!(s.pdf.to_bits(), model.pdf(wi, s.wo).to_bits());
         }

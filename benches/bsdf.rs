@@ -11,7 +11,9 @@
 //! across iterations; the trait calls seed their own generators from the hash of their
 //! arguments (that cost is part of what is measured) and take the counter as key.
 //!
-//! Benchmark ids: `{material}/{technique}/{eval|pdf|sample}/{research|static|dyn}`, and
+//! Benchmark ids: `{material}/{technique}/{eval|pdf|sample}/{research|static|dyn}`,
+//! `{material}/single/eval_with_pdf/{research|static|dyn}` (the research call is
+//! `SingleScattering::eval_with_pdf`; its `sample` returns the density too), and
 //! `gold/single/sample-vs-vndf/{sample_d_wi|static}`.
 
 use core::f32::consts::TAU;
@@ -19,8 +21,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use microsurface::{
     Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material,
-    MicrofacetBsdf, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SpecularLimit,
-    Technique, UniformHeight,
+    MicrofacetBsdf, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing,
+    SingleScattering, SpecularLimit, Technique, UniformHeight,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -80,12 +82,14 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
         PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
     }
 
+    fn single(&self) -> SingleScattering<S, M> {
+        SingleScattering::new(*self.surface.slope(), *self.surface.material())
+    }
+
     #[inline(always)]
     fn eval(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
         match self.technique {
-            Technique::SingleScattering => {
-                self.pf(Shadowing::Correlated).eval_single_scattering(walk_in, walk_out, rng)
-            }
+            Technique::SingleScattering => self.single().eval(walk_in, walk_out, rng),
             Technique::RandomWalk => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
             Technique::PositionFree { estimator, shadowing } => {
                 self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
@@ -96,7 +100,7 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
     #[inline(always)]
     fn pdf(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
         match self.technique {
-            Technique::SingleScattering => self.pf(Shadowing::Correlated).pdf_single(walk_in, walk_out),
+            Technique::SingleScattering => self.single().pdf(walk_in, walk_out),
             _ => self.pf(Shadowing::Correlated).pdf(walk_in, walk_out),
         }
     }
@@ -104,9 +108,8 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
     #[inline(always)]
     fn sample(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<Vec3> {
         match self.technique {
-            Technique::SingleScattering => {
-                self.pf(Shadowing::Correlated).sample_single(walk_in, rng).map(|s| s.0)
-            }
+            // the sample with its density (what the trait's sample returns)
+            Technique::SingleScattering => self.single().sample(walk_in, rng).map(|s| s.wo),
             Technique::RandomWalk => self.surface.sample(walk_in, rng).map(|s| s.wo),
             Technique::PositionFree { shadowing, .. } => {
                 self.pf(shadowing).sample(walk_in, rng).map(|s| s.wo)
@@ -179,6 +182,34 @@ fn bench_material<M: Material + SpecularLimit>(c: &mut Criterion<Clock>, name: &
             })
         });
         g.finish();
+
+        if technique == Technique::SingleScattering {
+            // eval and pdf in one call: the research layer's shares the half vector and D
+            let single = research.single();
+            let mut g = c.benchmark_group(format!("{name}/{tname}/eval_with_pdf"));
+            g.bench_function("research", |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    black_box(&single).eval_with_pdf(black_box(x.wo[k]), black_box(x.wi[k]), &mut rng)
+                })
+            });
+            g.bench_function("static", |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    black_box(&bsdf).eval_with_pdf_keyed(black_box(x.wo[k]), black_box(x.wi[k]), i as u64)
+                })
+            });
+            g.bench_function("dyn", |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    black_box(dynamic).eval_with_pdf_keyed(black_box(x.wo[k]), black_box(x.wi[k]), i as u64)
+                })
+            });
+            g.finish();
+        }
 
         let mut g = c.benchmark_group(format!("{name}/{tname}/sample"));
         g.bench_function("research", |b| {

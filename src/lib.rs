@@ -128,6 +128,7 @@ mod position_free;
 mod rng;
 mod sampling;
 mod sealed;
+mod single_scattering;
 mod slope;
 mod special;
 mod vector;
@@ -156,6 +157,7 @@ pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
 pub use sampling::{concentric_disk, sample_cosine_hemisphere};
+pub use single_scattering::{SingleSample, SingleScattering};
 pub use slope::{
     BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
     StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,

@@ -10,6 +10,7 @@ use crate::height::UniformHeight;
 use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
 use crate::position_free::{Estimator, PositionFree, Shadowing};
+use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use glam::{Vec2, Vec3};
 use rand::Rng;
@@ -243,6 +244,12 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
     }
 
+    /// The single-scattering BSDF over the same slope and material.
+    #[inline(always)]
+    fn single(&self) -> SingleScattering<S, M> {
+        SingleScattering::new(*self.surface.slope(), *self.surface.material())
+    }
+
     /// (η_wo/η_wi)² for radiance transport across a dielectric, 1 otherwise.
     #[inline(always)]
     fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -315,9 +322,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     #[inline(always)]
     fn research_f_cos_out(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut impl Rng) -> Vec3 {
         match self.technique {
-            Technique::SingleScattering => {
-                self.position_free(Shadowing::Correlated).eval_single_backfacing(walk_in, walk_out, rng)
-            }
+            Technique::SingleScattering => self.single().eval_unchecked(walk_in, walk_out, rng),
             Technique::RandomWalk => self.surface.eval(walk_in, walk_out, self.order, rng),
             Technique::PositionFree { estimator, shadowing } => {
                 self.position_free(shadowing).eval(walk_in, walk_out, estimator, self.order, rng)
@@ -329,10 +334,9 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     /// along `walk_in` (exact for single scattering, approximate otherwise).
     #[inline(always)]
     fn research_pdf_out(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
-        let pf = self.position_free(Shadowing::Correlated);
         match self.technique {
-            Technique::SingleScattering => pf.pdf_single(walk_in, walk_out),
-            _ => pf.pdf(walk_in, walk_out),
+            Technique::SingleScattering => self.single().pdf_unchecked(walk_in, walk_out),
+            _ => self.position_free(Shadowing::Correlated).pdf_unchecked(walk_in, walk_out),
         }
     }
 
@@ -401,19 +405,20 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
         let uniforms = [u.x, u.y, uc];
         let walk_in = wo;
-        let (walk_out, weight, exact_pdf) = match self.technique {
+        let (walk_out, weight, pdf, exact_pdf) = match self.technique {
             Technique::SingleScattering => {
+                // at most the phase function's uniforms: the private generator (and its hash)
+                // is built only if a material draws more than the caller gave
                 let mut rng = PrimedRng::new(&uniforms, hash);
-                let (out, weight) =
-                    self.position_free(Shadowing::Correlated).sample_single(walk_in, &mut rng)?;
-                (out, weight, M::EXACT_PHASE_PDF)
+                let s = self.single().sample_unchecked(walk_in, &mut rng)?;
+                (s.wo, s.weight, Some(s.pdf), M::EXACT_PHASE_PDF)
             }
             Technique::RandomWalk => {
                 // the walk draws the height of its first intersection first: from the private
                 // generator, so that the caller's uniforms drive the first visible normal
                 let mut rng = PrimedRng::after_one_private(&uniforms, hash);
                 let s = self.surface.sample(walk_in, &mut rng).filter(|s| self.order.includes(s.bounces))?;
-                (s.wo, s.weight, false)
+                (s.wo, s.weight, None, false)
             }
             Technique::PositionFree { shadowing, .. } => {
                 let mut rng = PrimedRng::new(&uniforms, hash);
@@ -421,11 +426,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
                     .position_free(shadowing)
                     .sample(walk_in, &mut rng)
                     .filter(|s| self.order.includes(s.bounces))?;
-                (s.wo, s.weight, false)
+                (s.wo, s.weight, None, false)
             }
         };
         let wi = walk_out;
-        let pdf = self.research_pdf_out(walk_in, walk_out);
+        let pdf = pdf.unwrap_or_else(|| self.research_pdf_out(walk_in, walk_out));
         let weight = weight * self.transport_scale(wo, wi);
         // the density and the BSDF value f = weight·pdf/|cos θi| the sample implies must be
         // normal f32 numbers: a subnormal one has lost its precision, and eval could not
@@ -448,13 +453,22 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         Some(BsdfSample { wi, weight, pdf, eta: self.relative_eta(wo, wi), flags })
     }
 
-    /// One validation of the directions for both (the research layer has no combined
-    /// evaluation to share more).
+    /// One validation of the directions for both; single scattering also shares the half
+    /// vector, D and Λ of the view ([`SingleScattering::eval_with_pdf`]).
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
         let exact = self.exact_eval(wo);
         if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
             return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
+        }
+        if self.technique == Technique::SingleScattering && wi.z != 0.0 {
+            // one half vector, D and Λ(wo) for both (the walk enters along wo)
+            let seed = self.seed;
+            let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
+            let (f_cos_wi, pdf) = self.single().eval_with_pdf_unchecked(wo, wi, &mut rng);
+            let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
+            let f = if f.is_finite() { f } else { Vec3::ZERO };
+            return (BsdfValue { f, exact }, if pdf.is_finite() { pdf } else { 0.0 });
         }
         let pdf = self.research_pdf_out(wo, wi);
         let pdf = if pdf.is_finite() { pdf } else { 0.0 };

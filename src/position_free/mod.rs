@@ -22,7 +22,8 @@ use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec3};
 use rand::Rng;
-use segment::{LAMBDA_SATURATION, VertexRole, VertexShadowing, inv_g1};
+pub(crate) use segment::VertexRole;
+use segment::{LAMBDA_SATURATION, VertexShadowing, inv_g1};
 
 /// Russian roulette starts after this many sampled bounces (it is unbiased at any depth).
 const ROULETTE_FROM_BOUNCE: u32 = 3;
@@ -178,16 +179,6 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
     }
 
-    /// [`PositionFree::eval_single_scattering`], which accepts ωi below the horizon for an
-    /// opaque material (a backfacing view under normal mapping), like every estimator of this
-    /// model (kept for the renderer adapter).
-    pub(crate) fn eval_single_backfacing(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
-        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return Vec3::ZERO;
-        };
-        self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
-    }
-
     /// Samples an outgoing direction with the position-free random walk (Wang et al. 2022,
     /// §4.3): each bounce draws a visible normal (exact full-spherical VNDF sampling) and an
     /// event; a direction that can leave the surface does so with the probability the
@@ -290,6 +281,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
+        self.pdf_unchecked(wi, wo)
+    }
+
+    /// [`PositionFree::pdf`] for directions the caller has validated (the renderer adapter).
+    #[inline]
+    pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
         let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
             return 0.0;
         };
@@ -318,6 +315,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     #[inline(always)]
     pub(crate) fn exit_side(wo: Vec3) -> Option<Side> {
         Side::of(wo.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
+    }
+
+    /// 1 + L̃ of the incident state `at` (the inverse full-spherical masking, `inv_g1`, in its
+    /// side frame).
+    #[inline(always)]
+    pub(crate) fn incident_k(&self, at: Incident) -> f64 {
+        inv_g1(&self.slope, at.in_frame())
     }
 
     /// The forward contribution of one vertex in the given role, v(ωin, ωout)·S (S the

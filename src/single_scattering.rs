@@ -1,0 +1,222 @@
+//! The single-scattering microfacet BSDF with height-correlated Smith masking-shadowing, on
+//! the whole sphere of incident directions: its evaluation, its sampling density and a sampler
+//! that returns the sample with its density.
+
+use crate::contract::is_direction;
+use crate::material::{Material, Side};
+use crate::position_free::{Incident, PositionFree, Shadowing, VertexRole};
+use crate::slope::MicrosurfaceSlope;
+use glam::Vec3;
+use rand::Rng;
+
+/// An outgoing direction sampled from the single-scattering BSDF, with its weight and density.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SingleSample {
+    /// The outgoing direction ωo (unit).
+    pub wo: Vec3,
+    /// f·|cos θo|/pdf per RGB channel.
+    pub weight: Vec3,
+    /// The solid-angle density of ωo, the value [`SingleScattering::pdf`] gives at (ωi, ωo).
+    pub pdf: f32,
+}
+
+/// The single-scattering microfacet BSDF of slope distribution `S` and material `M`: the
+/// Cook–Torrance / Walter BSDF with height-correlated Smith masking-shadowing (Heitz 2014,
+/// “Understanding the Masking-Shadowing Function”, eq. 99; Heitz et al. 2016, supplement
+/// §3.2–3.4), extended to incident directions below the macrosurface for opaque materials
+/// (a backfacing view under a normal map: Tokuyoshi's full-spherical masking
+/// G1(ωi) = 1/|1 + Λ(ωi)|, Wang et al. 2022, eqs. 10 and 17).
+///
+/// Research-layer convention: `eval(wi, wo)` returns f·|cos θo| for light arriving from ωi and
+/// leaving along ωo, both pointing away from the surface in the local frame:
+///
+/// * reflection: f·|cos θo| = F(ωi·ωh) D(ωh) G2(ωi, ωo) / (4 |cos θi|), with
+///   G2 = 1/(1 + Λ(ωi) + Λ(ωo)) (from below: 1/(Λ(−ωi) + Λ(ωo)));
+/// * transmission through a dielectric: Walter's BTDF with G2 = B(1 + Λ(ωi), 1 + Λ(−ωo)) (B the
+///   beta function, supplement §3.4);
+/// * diffuse facets: an unbiased one-sample estimate (the only stochastic case).
+///
+/// The sampler draws the visible normal from D_ωi exactly (on the whole sphere) and the event
+/// from the material's phase function; its density is the phase function's, which is exact for
+/// conductors and dielectrics ([`Material::EXACT_PHASE_PDF`]) and a documented approximation
+/// for diffuse facets. It is the position-free model of Wang et al. 2022 truncated to one
+/// vertex (`PositionFree::eval_single_scattering` with correlated shadowing), computed without
+/// any of the multiple-scattering machinery.
+///
+/// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit direction
+/// gives 0 from [`SingleScattering::eval`] and [`SingleScattering::pdf`] and `None` from
+/// [`SingleScattering::sample`] (a debug assertion in debug builds).
+///
+/// # Examples
+///
+/// ```
+/// use microsurface::glam::Vec3;
+/// use microsurface::{ComplexIor, Conductor, Ggx, SingleScattering};
+/// use rand::SeedableRng;
+///
+/// let gold = SingleScattering::new(Ggx::isotropic(0.5)?, Conductor::new(ComplexIor::GOLD));
+/// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+/// let wi = Vec3::new(0.6, 0.0, 0.8);
+/// let s = gold.sample(wi, &mut rng).expect("gold reflects");
+/// // the sample carries its density, the one `pdf` gives at its direction
+/// assert_eq!(s.pdf, gold.pdf(wi, s.wo));
+/// // and its weight is f·|cos θo|/pdf there
+/// let f_cos = gold.eval(wi, s.wo, &mut rng);
+/// assert!((s.weight - f_cos / s.pdf).abs().max_element() <= 1e-5 * s.weight.max_element());
+/// # Ok::<(), microsurface::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SingleScattering<S, M> {
+    /// The one-vertex position-free model with height-correlated shadowing: its incident
+    /// states, exit data and relative shadowing factors are those of the single-scattering BSDF.
+    model: PositionFree<S, M>,
+}
+
+impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
+    /// The single-scattering BSDF of the given slope distribution and material.
+    #[inline]
+    pub fn new(slope: S, material: M) -> Self {
+        Self { model: PositionFree::new(slope, material, Shadowing::Correlated) }
+    }
+
+    /// The slope distribution.
+    #[inline]
+    pub fn slope(&self) -> &S {
+        self.model.slope()
+    }
+
+    /// The material.
+    #[inline]
+    pub fn material(&self) -> &M {
+        self.model.material()
+    }
+
+    /// f·|cos θo| (see the type's documentation); 0 for ωi on the horizon, for an opaque
+    /// material's ωo at or below it and where ωi sees no microsurface. Exact (a few f32 ulps,
+    /// the masking in f64) except for diffuse facets (unbiased estimate).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
+    #[inline]
+    pub fn eval(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_unchecked(wi, wo, rng)
+    }
+
+    /// The density with which [`SingleScattering::sample`] draws ωo: the material's phase-function
+    /// density (exact for conductors and dielectrics).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives 0 (a debug assertion in debug builds).
+    #[inline]
+    pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
+        self.pdf_unchecked(wi, wo)
+    }
+
+    /// [`SingleScattering::eval`] and [`SingleScattering::pdf`] in one call, which share the
+    /// half vector, D and Λ(ωi) where the material computes them together
+    /// ([`Material::connection`]).
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
+    /// direction gives (0, 0) (a debug assertion in debug builds).
+    #[inline]
+    pub fn eval_with_pdf(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> (Vec3, f32) {
+        require!(is_direction(wi) && is_direction(wo), (Vec3::ZERO, 0.0); wi, wo);
+        self.eval_with_pdf_unchecked(wi, wo, rng)
+    }
+
+    /// Samples ωo: a visible normal from D_ωi (exact, whole sphere), the material's event, and
+    /// the weight w·G2/G1(ωi) = f·|cos θo|/pdf (w the phase sample's weight: F for a conductor,
+    /// the albedo of a diffuse facet, 1 for a dielectric), with the density of ωo
+    /// ([`SingleScattering::pdf`] at the returned direction, bit for bit). The masking ratio
+    /// is formed in f64 (from logarithms where Λ underflows, backfacing Beckmann views), so
+    /// that the weight equals f·|cos θo|/pdf at the returned f32 direction to a few f32 ulps.
+    /// `None` if ωi cannot light the material (on the horizon, or at the nadir of an opaque
+    /// material) or the sampled direction cannot leave the surface. Resolution limit of
+    /// backfacing Beckmann views below α ≈ 1e-3: see [`PositionFree::sample_single`].
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
+    /// `None` (a debug assertion in debug builds).
+    #[inline]
+    pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<SingleSample> {
+        require!(is_direction(wi), None; wi);
+        self.sample_unchecked(wi, rng)
+    }
+
+    /// [`SingleScattering::eval`] for directions the caller has validated.
+    #[inline(always)]
+    pub(crate) fn eval_unchecked(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
+        let (Some(start), Some(wo_side)) =
+            (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
+        else {
+            return Vec3::ZERO;
+        };
+        self.model.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
+    }
+
+    /// [`SingleScattering::pdf`] for directions the caller has validated.
+    #[inline(always)]
+    pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
+        let (Some(start), Some(wo_side)) =
+            (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
+        else {
+            return 0.0;
+        };
+        self.density(start, wo, wo_side)
+    }
+
+    /// [`SingleScattering::eval_with_pdf`] for directions the caller has validated.
+    #[inline(always)]
+    pub(crate) fn eval_with_pdf_unchecked(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> (Vec3, f32) {
+        let (Some(at), Some(wo_side)) =
+            (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
+        else {
+            return (Vec3::ZERO, 0.0);
+        };
+        let k_in = self.model.incident_k(at);
+        let front = at.in_frame().z > 0.0;
+        if !front {
+            // a backfacing ωi (under a normal map): `connect` forms the value (for k_in < 1 as
+            // phase × relative shadowing, where the vertex term would underflow), and the
+            // density is the phase function's, as `pdf` computes it
+            let out = self.model.exit(wo, wo_side);
+            let f_cos = self.model.connect_known(at, k_in, out, VertexRole::Last, rng).as_vec3();
+            return (f_cos, self.density(at, wo, wo_side));
+        }
+        let m = self.model.material();
+        let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+        let factor = self.model.shadowing_factor(at, k_in, self.model.exit(wo, wo_side), VertexRole::Last);
+        ((vertex.as_dvec3() * factor).as_vec3(), pdf)
+    }
+
+    /// [`SingleScattering::sample`] for a direction the caller has validated.
+    #[inline(always)]
+    pub(crate) fn sample_unchecked(&self, wi: Vec3, rng: &mut impl Rng) -> Option<SingleSample> {
+        let at = PositionFree::<S, M>::incident(wi)?;
+        let (slope, m) = (self.model.slope(), self.model.material());
+        let s = m.sample_phase_unchecked(slope, at.w, at.side, rng);
+        let k_in = self.model.incident_k(at);
+        let out = self.model.exit(s.wo, s.side);
+        let last = if let (true, Some(lambda_o), true) = (k_in >= 1.0, out.lambda, at.side == out.side) {
+            // a reflection from a front-facing ωi: G2/G1 = (1 + Λi)/(1 + Λi + Λo), one division
+            // (the relative factor 1/(1 + Λo/k_in) of the general form below, to an f64 ulp)
+            k_in / (k_in + lambda_o)
+        } else {
+            self.model.relative_shadowing(at, k_in, out).last
+        };
+        let weight = s.weight * last as f32;
+        if !(last > 0.0 && weight.is_finite()) {
+            return None;
+        }
+        // the density at the returned f32 direction, as `pdf` computes it
+        let pdf = m.pdf_phase_unchecked(slope, &at.to(s.wo, s.side));
+        Some(SingleSample { wo: s.wo, weight, pdf })
+    }
+
+    /// The phase-function density of ωo from the incident state `at`.
+    #[inline(always)]
+    fn density(&self, at: Incident, wo: Vec3, wo_side: Side) -> f32 {
+        self.model.material().pdf_phase_unchecked(self.model.slope(), &at.to(wo, wo_side))
+    }
+}

@@ -324,3 +324,46 @@ fn sampler_chi2() {
         );
     });
 }
+
+/// A correlated slope with equal marginals is an ellipse at φα = 45°: is anisotropic: the isotropic table
+/// must reject it (it accepted every slope with αx = αy before).
+#[test]
+fn isotropic_table_rejects_a_correlated_slope() {
+    let rotated = Elliptical::<Beckmann>::from_bivariate(0.3, 0.3, 0.6).unwrap();
+    let (a1, a2, phi) = rotated.ellipse();
+    assert!(a1 > 1.5 * a2 && (phi - std::f32::consts::FRAC_PI_4).abs() < 1e-6, "({a1}, {a2}, {phi})");
+    assert!(microsurface::TabulatedSlope::from_slope(&rotated, 4.0, 64).is_err());
+    let round = Elliptical::<Beckmann>::from_ellipse(0.3, 0.3, 1.0).unwrap();
+    assert!(microsurface::TabulatedSlope::from_slope(&round, 4.0, 64).is_ok());
+    assert!(microsurface::TabulatedSlope::from_slope(&Beckmann::isotropic(0.3).unwrap(), 4.0, 64).is_ok());
+}
+
+/// The compensated conductor of a rotated ellipse is the axis-aligned one seen from rotated
+/// directions (its tables are read at √(α₁ α₂), not at the marginals' √(αx αy)).
+#[test]
+fn compensated_conductor_is_rotation_invariant() {
+    use microsurface::{Bsdf, CompensatedConductor, Compensation};
+    let (a1, a2, phi) = (0.5f32, 0.15f32, 0.9f32);
+    let conductor = Conductor::new(ComplexIor::GOLD);
+    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
+        let e = CompensatedConductor::new(
+            Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap(),
+            conductor,
+            scheme,
+        )
+        .unwrap();
+        let a = CompensatedConductor::new(Ggx::new(a1, a2).unwrap(), conductor, scheme).unwrap();
+        for k in 0..50 {
+            let (t_o, p_o, t_i, p_i) =
+                (1.5 * k as f64 / 50.0, 0.9 * k as f64, 1.4 * (k as f64 * 0.37).fract(), 2.1 * k as f64);
+            let (wo, wi) = (common::dir(t_o, p_o), common::dir(t_i, p_i));
+            let (wo_a, wi_a) =
+                (common::dir(t_o, p_o - f64::from(phi)), common::dir(t_i, p_i - f64::from(phi)));
+            let (fe, fa) = (e.eval(wo, wi).f, a.eval(wo_a, wi_a).f);
+            assert!(
+                (fe - fa).abs().max_element() <= 1e-4 * fa.max_element() + 1e-6,
+                "{scheme:?} {wo} {wi}: {fe} vs {fa}"
+            );
+        }
+    }
+}

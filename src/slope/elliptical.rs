@@ -2,6 +2,8 @@
 //! tangent plane (Dupuy 2015, thesis §2.3).
 
 use super::{Beckmann, Ggx, MicrosurfaceSlope, ensure_visible, is_direction, is_direction64, is_uniform};
+use crate::albedo::AlbedoTable;
+use crate::bsdf::AlbedoTabulated;
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -63,7 +65,9 @@ impl AxisAlignedSlope for Beckmann {
 /// αy; [`MicrosurfaceSlope::alpha_i`] includes the correlation,
 /// αᵢ² = αx² cos²φ + 2ρ αx αy cos φ sin φ + αy² sin²φ. The walks, the position-free estimators,
 /// single scattering and [`MicrofacetBsdf`](crate::MicrofacetBsdf) accept it as any other slope
-/// (they reflect in real microfacet space); `MicrofacetBsdf`'s smooth and walk-length limits
+/// (they reflect in real microfacet space), and [`CompensatedConductor`](crate::CompensatedConductor)
+/// reads its albedo tables at √(α₁ α₂) (the rotation-invariant geometric mean, what √(αx αy) is
+/// for an axis-aligned slope); `MicrofacetBsdf`'s smooth and walk-length limits
 /// compare max(αx, αy) ∈ [α_max/√2, α_max], α_max = max(α₁, α₂), against their thresholds.
 /// It does not implement [`VCavitySlope`](crate::VCavitySlope), whose closed forms are written
 /// in the stretched frame of an axis-aligned distribution.
@@ -215,6 +219,16 @@ impl<S> Elliptical<S> {
             (self.sin_phi * x + self.cos_phi * y) as f32,
             m.z,
         )
+    }
+}
+
+impl<S: AxisAlignedSlope + AlbedoTabulated> AlbedoTabulated for Elliptical<S> {
+    const ALBEDO: AlbedoTable = S::ALBEDO;
+
+    /// √(α₁ α₂): the compensated lobe of the rotated ellipse is that of the axis-aligned one.
+    #[inline]
+    fn albedo_alpha(&self) -> f32 {
+        self.axis_aligned.albedo_alpha()
     }
 }
 

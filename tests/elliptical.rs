@@ -124,9 +124,9 @@ const MARGINALS: [(f32, f32); 2] = [(0.3, 0.3), (0.6, 0.25)];
 /// Views (θ, φ) of the projected-area identities: above, grazing, below the horizon.
 const VIEWS: [(f64, f64); 3] = [(1.1, 0.4), (1.5, 2.2), (2.3, -1.3)];
 
-/// The quadrature of ∫ f over the upper hemisphere: 32 × 64 cells, adaptive to depth 6.
+/// The quadrature of ∫ f over the upper hemisphere: 24 × 48 cells, adaptive to depth 6.
 fn hemisphere(f: &mut impl FnMut(Vec3) -> f64) -> f64 {
-    integrate_sphere(f, 32, 64, true, 1e-6, 6)
+    integrate_sphere(f, 24, 48, true, 1e-6, 6)
 }
 
 fn identities<S: MicrosurfaceSlope>(label: &str, slope: &S) {

@@ -37,7 +37,7 @@ fn identities<S: MicrosurfaceSlope>(label: &str, s: &Noncentral<S>) {
     for (theta, phi) in VIEWS {
         let w = common::dir(theta, phi).normalize();
         let quad = hemisphere(&mut |m| d(m) * f64::from(w.dot(m)).max(0.0));
-        let a = s.projected_area(w);
+        let a = f64::from(s.projected_area(w));
         assert!((quad - a).abs() < 1e-5 * (1.0 + a), "{label} {w}: ∫⟨ω,m⟩⁺D = {quad}, A = {a}");
         if a > 1e-3 {
             let visible = hemisphere(&mut |m| f64::from(s.d_wi(w, m)));

@@ -157,15 +157,15 @@ impl<S: MicrosurfaceSlope> Noncentral<S> {
         DVec3::new(w.x, w.y, w.z - w.x * self.mean_x - w.y * self.mean_y)
     }
 
-    /// The projected area A(ω) = ∫ ⟨ω, ωm⟩⁺ D(ωm) dωm = ‖k‖ A_S(k/‖k‖) for any ω, in f64
-    /// (k as in the type's documentation; the f32 rounding of k/‖k‖ is the only error beyond
-    /// `S`'s `projected_area64`).
+    /// The projected area A(ω) = ∫ ⟨ω, ωm⟩⁺ D(ωm) dωm = ‖k‖ A_S(k/‖k‖) for any ω, evaluated in
+    /// f64 (k as in the type's documentation; the f32 rounding of k/‖k‖ is the only error beyond
+    /// `S`'s `projected_area64`) and rounded to f32.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a non-unit `w` gives NaN.
     #[inline]
-    pub fn projected_area(&self, w: Vec3) -> f64 {
-        require!(is_direction(w), f64::NAN; w);
-        self.projected_area_unchecked(w)
+    pub fn projected_area(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w) as f32
     }
 
     #[inline(always)]

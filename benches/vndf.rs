@@ -4,13 +4,16 @@
 //! the V-cavity model. One call per iteration on 1024 pre-generated (direction, uniforms)
 //! pairs from a fixed seed, rotated behind `black_box`.
 //!
-//! Benchmark ids: `vndf/{sampler}/a{α}/t{θi}`.
+//! Benchmark ids: `vndf/{sampler}/a{α}/t{θi}`; the cost of elliptical anisotropy (a rotated
+//! ellipse against the axis-aligned one of the same radii, 0.5 × 0.1, θi = 0.9):
+//! `elliptical/{d,lambda,sample_d_wi}/{ggx,beckmann}/{aligned,rotated}`.
 
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::{
-    Beckmann, BeckmannNewton, Ggx, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
+    AxisAlignedSlope, Beckmann, BeckmannNewton, Elliptical, Ggx, GgxDisk, GgxSphericalCap, MicrosurfaceSlope,
+    SmithVndf, VCavity, VisibleNormalSampler,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -65,12 +68,57 @@ fn samplers(c: &mut Criterion) {
     bench_sampler(c, "beckmann_vcavity", |a| VCavity(beckmann(a)));
 }
 
+/// D, Λ and `sample_d_wi` of one slope on the pre-generated inputs.
+fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion, name: &str, slope: S) {
+    let mut group = c.benchmark_group("elliptical");
+    let data = inputs(0.9, 7_100);
+    let mut i = 0usize;
+    group.bench_function(format!("d/{name}"), |b| {
+        b.iter(|| {
+            // a direction of the upper hemisphere as the normal
+            let wm = data[i & (N - 1)].0;
+            i = i.wrapping_add(1);
+            black_box(slope.d(black_box(wm)))
+        })
+    });
+    group.bench_function(format!("lambda/{name}"), |b| {
+        b.iter(|| {
+            let w = data[i & (N - 1)].0;
+            i = i.wrapping_add(1);
+            black_box(slope.lambda(black_box(w)))
+        })
+    });
+    group.bench_function(format!("sample_d_wi/{name}"), |b| {
+        b.iter(|| {
+            let (wi, u) = data[i & (N - 1)];
+            i = i.wrapping_add(1);
+            black_box(slope.sample_d_wi(black_box(wi), black_box(u[0]), black_box(u[1])))
+        })
+    });
+    group.finish();
+}
+
+fn elliptical_pair<S: AxisAlignedSlope>(c: &mut Criterion, family: &str) {
+    let (a1, a2, phi) = (0.5, 0.1, 0.6);
+    bench_slope(c, &format!("{family}/aligned"), S::axis_aligned(a1, a2).expect("valid radii"));
+    bench_slope(
+        c,
+        &format!("{family}/rotated"),
+        Elliptical::<S>::from_ellipse(a1, a2, phi).expect("valid ellipse"),
+    );
+}
+
+fn elliptical(c: &mut Criterion) {
+    elliptical_pair::<Ggx>(c, "ggx");
+    elliptical_pair::<Beckmann>(c, "beckmann");
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default()
         .warm_up_time(Duration::from_millis(300))
         .measurement_time(Duration::from_secs(1))
         .sample_size(20);
-    targets = samplers
+    targets = samplers, elliptical
 }
 criterion_main!(benches);

@@ -159,9 +159,9 @@ pub use rand;
 pub use sampling::{concentric_disk, sample_cosine_hemisphere};
 pub use single_scattering::{SingleSample, SingleScattering};
 pub use slope::{
-    BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
-    StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,
-    extract_isotropic, extract_isotropic_fn,
+    AxisAlignedSlope, BackscatterShadowing, Beckmann, Elliptical, Extraction, Ggx, GridExtraction, GridSlope,
+    MAX_RINGS, MicrosurfaceSlope, Noncentral, StretchedTabulated, TabulatedSlope, extract_anisotropic,
+    extract_anisotropic_fn, extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{

@@ -40,6 +40,14 @@ const FRESNEL_PANELS: usize = 4;
 pub trait AlbedoTabulated: MicrosurfaceSlope {
     /// The family's tables.
     const ALBEDO: AlbedoTable;
+
+    /// The isotropic roughness the tables are read at: √(αx αy), the geometric mean of the
+    /// principal radii (for an [`Elliptical`](crate::Elliptical) slope √(α₁ α₂), which is
+    /// invariant under its rotation).
+    #[inline]
+    fn albedo_alpha(&self) -> f32 {
+        (self.alpha_x() * self.alpha_y()).sqrt()
+    }
 }
 
 impl AlbedoTabulated for Ggx {
@@ -160,7 +168,7 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
     /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`] (= 1), the
     /// tables' range: there is no albedo to compensate with beyond it.
     pub fn new(slope: S, conductor: Conductor, scheme: Compensation) -> Result<Self, Error> {
-        let alpha = (slope.alpha_x() * slope.alpha_y()).sqrt();
+        let alpha = slope.albedo_alpha();
         // the slope's roughnesses are finite and > 0; their product may overflow to ∞ (rejected)
         if alpha > MAX_TABULATED_ALPHA {
             return Err(Error::InvalidParameter {

@@ -246,10 +246,16 @@ impl TabulatedSlope {
     /// …) by [`Self::from_radial_fn`] of its `p22(r, 0)`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if `slope` is anisotropic (`name = "alpha_y"`), else as
+    /// [`Error::InvalidParameter`] if `slope` is anisotropic (`name = "alpha_y"`: αx ≠ αy, or a
+    /// projected roughness on the diagonal that differs from αx, as for a correlated slope), else as
     /// [`Self::from_radial_fn`].
     pub fn from_slope<S: MicrosurfaceSlope>(slope: &S, scale: f32, rings: usize) -> Result<Self, Error> {
-        if slope.alpha_x() != slope.alpha_y() {
+        // αx = αy is not enough: a correlated (rotated elliptical) slope has equal marginals
+        // and a different αᵢ on the diagonals
+        let diagonal = Vec3::new(core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0);
+        if slope.alpha_x() != slope.alpha_y()
+            || (slope.alpha_i(diagonal) - slope.alpha_x()).abs() > 1e-6 * slope.alpha_x()
+        {
             return Err(Error::InvalidParameter {
                 name: "alpha_y",
                 value: slope.alpha_y(),

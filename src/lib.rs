@@ -113,6 +113,7 @@ mod error;
 mod frame;
 mod fresnel;
 mod height;
+mod leadr;
 mod material;
 mod merl;
 mod microsurface;
@@ -136,6 +137,10 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 /// can name the crate's types.
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+pub use leadr::{
+    CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, MomentLevel,
+    SlopeMoments,
+};
 pub use material::{Conductor, Dielectric, Diffuse, Material, PhaseSample};
 pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
 pub use microsurface::{

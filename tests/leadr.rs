@@ -19,7 +19,7 @@ use microsurface::{
     MIN_LEADR_ALPHA, SlopeMoments,
 };
 use surface::{NormalMip, direction, procedural_height_map};
-use validate::{Lobe, filter_error};
+use validate::{Lobe, filter_error, filter_errors};
 
 /// The validation map: 64 × 64 texels, RMS slope 0.2 per axis, fixed seed.
 fn validation_map() -> HeightMap {
@@ -46,10 +46,8 @@ fn errors(
     let wi = direction(theta, 30.0).as_dvec3();
     let filtered = Lobe::leadr(&leadr.lobe(level, x as isize, y as isize));
     let naive = Lobe::texel(normals.slope(level, x as isize, y as isize), f64::from(alpha));
-    (
-        filter_error(wi, &reference, &filtered, 1.0).relative_l1,
-        filter_error(wi, &reference, &naive, 1.0).relative_l1,
-    )
+    let e = filter_errors(wi, &reference, &[filtered, naive], 1.0);
+    (e[0].relative_l1, e[1].relative_l1)
 }
 
 /// Where the thesis says LEADR holds (coarse texels over many fine ones, views up to 60°), the

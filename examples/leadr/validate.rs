@@ -119,14 +119,21 @@ pub struct FilterError {
 }
 
 /// The relative L1 error over outgoing directions of `filtered` against the average of the
-/// `reference` lobes' BRDFs, for light from `wi`, by the midpoint rule in the half-vector slope
-/// plane (ωo = mirror of ωi about ωh(h̃); the map is one to one onto the ωo with
-/// (ωi + ωo).z > 0, which holds for every ωo above the horizon). `refine` multiplies the node
-/// density (1 for the stated default, 2 to check convergence).
+/// `reference` lobes' BRDFs, for light from `wi` ([`filter_errors`] for one candidate).
 pub fn filter_error(wi: DVec3, reference: &[Lobe], filtered: &Lobe, refine: f64) -> FilterError {
-    let (mut lo, mut hi) = filtered.slope_box();
-    let mut sigma = filtered.min_sigma();
-    for l in reference {
+    filter_errors(wi, reference, &[*filtered], refine)[0]
+}
+
+/// The relative L1 errors over outgoing directions of each candidate lobe against the average
+/// of the `reference` lobes' BRDFs, for light from `wi`, by the midpoint rule in the half-vector
+/// slope plane (ωo = mirror of ωi about ωh(h̃); the map is one to one onto the ωo with
+/// (ωi + ωo).z > 0, which holds for every ωo above the horizon), over a box holding
+/// `BOX_SIGMAS` standard deviations of every lobe. `refine` multiplies the node density (1 for
+/// the stated default, 2 to check convergence).
+pub fn filter_errors(wi: DVec3, reference: &[Lobe], candidates: &[Lobe], refine: f64) -> Vec<FilterError> {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    let mut sigma = f64::INFINITY;
+    for l in reference.iter().chain(candidates) {
         let (a, b) = l.slope_box();
         lo = lo.min(a);
         hi = hi.max(b);
@@ -137,8 +144,9 @@ pub fn filter_error(wi: DVec3, reference: &[Lobe], filtered: &Lobe, refine: f64)
     let nodes = ((extent.max_element() / step_wanted).ceil() as usize).clamp(16, MAX_NODES);
     let step = extent / nodes as f64;
     let g1_ref: Vec<f64> = reference.iter().map(|l| l.g1(wi)).collect();
-    let g1_filtered = filtered.g1(wi);
-    let (mut diff, mut total) = (0.0, 0.0);
+    let g1_candidates: Vec<f64> = candidates.iter().map(|l| l.g1(wi)).collect();
+    let mut diff = vec![0.0; candidates.len()];
+    let mut total = 0.0;
     for j in 0..nodes {
         for i in 0..nodes {
             let slope = lo + (DVec2::new(i as f64, j as f64) + 0.5) * step;
@@ -157,11 +165,12 @@ pub fn filter_error(wi: DVec3, reference: &[Lobe], filtered: &Lobe, refine: f64)
                 .map(|(l, &g)| l.albedo_density(g, wi, slope, h, wo, cos_ih))
                 .sum::<f64>()
                 / reference.len() as f64;
-            let filtered_value = filtered.albedo_density(g1_filtered, wi, slope, h, wo, cos_ih);
-            diff += (filtered_value - reference_value).abs();
+            for ((d, c), &g) in diff.iter_mut().zip(candidates).zip(&g1_candidates) {
+                *d += (c.albedo_density(g, wi, slope, h, wo, cos_ih) - reference_value).abs();
+            }
             total += reference_value;
         }
     }
     let cell = step.x * step.y;
-    FilterError { relative_l1: diff / total, albedo: total * cell, nodes }
+    diff.iter().map(|d| FilterError { relative_l1: d / total, albedo: total * cell, nodes }).collect()
 }

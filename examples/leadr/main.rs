@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release --example leadr [-- --quick] [--out DIR]` (default `target/leadr`).
 //! Writes `leadr.png`: top row supersampled | LEADR | naive; bottom row the MIP level used per
-//! pixel (black 0, white the coarsest) | 4 × |LEADR − reference| | 4 × |naive − reference|
+//! pixel (black 0, white the coarsest) | 2 × |LEADR − reference| | 2 × |naive − reference|
 //! (tone-mapped values).
 
 mod render;
@@ -56,8 +56,11 @@ fn main() {
         max_samples: if quick { 8 } else { 24 },
     };
     let panels = scene.render();
-    let tone = |v: f64| 1.0 - (-0.6 * v).exp();
     let [reference, leadr_img, naive_img] = &panels.images;
+    // exposure: the reference's mean radiance maps to 1 − 1/e
+    let lit: Vec<f64> = reference.iter().zip(&panels.lod).filter(|(_, l)| !l.is_nan()).map(|(v, _)| *v).collect();
+    let exposure = lit.len() as f64 / lit.iter().sum::<f64>();
+    let tone = |v: f64| 1.0 - (-exposure * v).exp();
     println!(
         "\npicture ({width} × {height} per panel, α = {alpha}): error of the tone-mapped pixels against the supersampled reference"
     );
@@ -95,8 +98,8 @@ fn main() {
         put(k, 0, &|i| tone(img[i]));
     }
     put(0, 1, &|i| if panels.lod[i].is_nan() { 0.0 } else { panels.lod[i] / top });
-    put(1, 1, &|i| 4.0 * (tone(leadr_img[i]) - tone(reference[i])).abs());
-    put(2, 1, &|i| 4.0 * (tone(naive_img[i]) - tone(reference[i])).abs());
+    put(1, 1, &|i| 2.0 * (tone(leadr_img[i]) - tone(reference[i])).abs());
+    put(2, 1, &|i| 2.0 * (tone(naive_img[i]) - tone(reference[i])).abs());
     let path = out.join("leadr.png");
     let file = std::io::BufWriter::new(std::fs::File::create(&path).expect("create the PNG"));
     let mut encoder = png::Encoder::new(file, (3 * width) as u32, (2 * height) as u32);

@@ -279,3 +279,46 @@ fn bad_input_is_rejected() {
         "normal"
     );
 }
+
+/// Invalid lookup arguments ([policy](microsurface#invalid-input)): a non-finite `uv` or a NaN
+/// `lod` trips the debug assertion; release builds return texel (0, 0) of the level (level 0
+/// for `trilinear`).
+#[test]
+fn invalid_lookups_follow_the_policy() {
+    let map = LeadrMap::from_height_map(&procedural_height_map(8, 0.3, 5), Beckmann::isotropic(0.2).unwrap())
+        .unwrap();
+    let calls: [(&str, Box<dyn Fn() -> SlopeMoments>, SlopeMoments); 4] = [
+        (
+            "bilinear NaN",
+            Box::new(|| map.level(1).bilinear(Vec2::new(f32::NAN, 0.2))),
+            map.level(1).texel(0, 0),
+        ),
+        (
+            "bilinear ∞",
+            Box::new(|| map.level(2).bilinear(Vec2::new(0.1, f32::INFINITY))),
+            map.level(2).texel(0, 0),
+        ),
+        ("trilinear uv", Box::new(|| map.trilinear(Vec2::new(f32::NAN, 0.2), 1.0)), map.level(0).texel(0, 0)),
+        (
+            "trilinear lod",
+            Box::new(|| map.trilinear(Vec2::new(0.3, 0.2), f32::NAN)),
+            map.level(0).texel(0, 0),
+        ),
+    ];
+    for (name, call, nothing) in calls {
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(&call));
+        if cfg!(debug_assertions) {
+            let message = result.expect_err(name);
+            let text = message.downcast_ref::<String>().map(String::as_str).unwrap_or("");
+            assert!(text.starts_with("invalid input"), "{name}: {text}");
+        } else {
+            assert_eq!(result.expect(name), nothing, "{name}");
+        }
+    }
+    // valid extremes are lookups, not violations: wrapping coordinates and clamped levels
+    assert_eq!(map.trilinear(Vec2::new(1.25, -0.75), 99.0), map.level(3).texel(0, 0));
+    assert_eq!(
+        map.trilinear(Vec2::new(0.3, 0.2), f32::NEG_INFINITY),
+        map.level(0).bilinear(Vec2::new(0.3, 0.2))
+    );
+}

@@ -58,7 +58,8 @@ fn main() {
     let panels = scene.render();
     let [reference, leadr_img, naive_img] = &panels.images;
     // exposure: the reference's mean radiance maps to 1 − 1/e
-    let lit: Vec<f64> = reference.iter().zip(&panels.lod).filter(|(_, l)| !l.is_nan()).map(|(v, _)| *v).collect();
+    let lit: Vec<f64> =
+        reference.iter().zip(&panels.lod).filter(|(_, l)| !l.is_nan()).map(|(v, _)| *v).collect();
     let exposure = lit.len() as f64 / lit.iter().sum::<f64>();
     let tone = |v: f64| 1.0 - (-exposure * v).exp();
     println!(

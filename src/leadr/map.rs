@@ -40,13 +40,12 @@ impl MomentLevel {
     /// The moments at texture coordinates `uv` ∈ [0, 1)² (wrapping), interpolated bilinearly
     /// between texel centres (texel (x, y) is centred at ((x + ½)/width, (y + ½)/height)).
     /// Moments filter linearly, so this is exact LEADR filtering of the four texels with the
-    /// bilinear weights. A non-finite `uv` gives texel (0, 0).
+    /// bilinear weights.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a non-finite `uv` trips a debug
+    /// assertion; release builds return texel (0, 0) (moments have no "nothing").
     pub fn bilinear(&self, uv: Vec2) -> SlopeMoments {
-        let uv = if uv.is_finite() {
-            uv
-        } else {
-            Vec2::splat(0.5) / Vec2::new(self.width as f32, self.height as f32)
-        };
+        require!(uv.is_finite(), self.texels[0]; uv);
         let p = uv.as_dvec2() * glam::DVec2::new(self.width as f64, self.height as f64) - 0.5;
         let (x0, y0) = (p.x.floor(), p.y.floor());
         let (fx, fy) = (p.x - x0, p.y - y0);
@@ -188,10 +187,14 @@ impl LeadrMap {
 
     /// The moments at texture coordinates `uv` (wrapping) and fractional MIP level `lod`
     /// (clamped to [0, coarsest]): trilinear filtering, bilinear within the two nearest
-    /// levels and linear between them, exact for moments. A NaN `lod` is level 0.
+    /// levels and linear between them, exact for moments.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): a non-finite `uv` or a NaN `lod` trips a
+    /// debug assertion; release builds return texel (0, 0) of level 0.
     pub fn trilinear(&self, uv: Vec2, lod: f32) -> SlopeMoments {
+        require!(uv.is_finite() && !lod.is_nan(), self.levels[0].texels[0]; uv, lod);
         let top = (self.levels.len() - 1) as f32;
-        let lod = if lod.is_nan() { 0.0 } else { lod.clamp(0.0, top) };
+        let lod = lod.clamp(0.0, top);
         let l0 = lod.floor();
         let t = f64::from(lod - l0);
         let a = self.level(l0 as usize).bilinear(uv).to_array();

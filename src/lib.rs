@@ -150,9 +150,9 @@ pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
 pub use slope::{
-    BackscatterShadowing, Beckmann, Extraction, Ggx, GridExtraction, GridSlope, MAX_RINGS, MicrosurfaceSlope,
-    StretchedTabulated, TabulatedSlope, extract_anisotropic, extract_anisotropic_fn, extract_fresnel,
-    extract_isotropic, extract_isotropic_fn,
+    AxisAlignedSlope, BackscatterShadowing, Beckmann, Elliptical, Extraction, Ggx, GridExtraction, GridSlope,
+    MAX_RINGS, MicrosurfaceSlope, Noncentral, StretchedTabulated, TabulatedSlope, extract_anisotropic,
+    extract_anisotropic_fn, extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{

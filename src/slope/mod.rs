@@ -5,19 +5,23 @@
 //! frame (z up). Λ is the signed Smith function, with Λ(−ω) = −1 − Λ(ω).
 
 mod beckmann;
+mod elliptical;
 mod extract;
 mod ggx;
 mod grid;
+mod noncentral;
 mod tabulated;
 
 pub use beckmann::Beckmann;
 pub(crate) use beckmann::{gaussian_slope, one_minus_scaled_erfcx, visible_slope_x_above};
+pub use elliptical::{AxisAlignedSlope, Elliptical};
 pub use extract::{
     BackscatterShadowing, Extraction, GridExtraction, extract_anisotropic, extract_anisotropic_fn,
     extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use ggx::Ggx;
 pub use grid::GridSlope;
+pub use noncentral::Noncentral;
 pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};

@@ -1,6 +1,8 @@
 //! The noncentral anisotropic Beckmann lobe of a LEAN/LEADR texel.
 
 use super::SlopeMoments;
+use crate::error::Error;
+use crate::slope::{Beckmann, Elliptical, Noncentral};
 use glam::Vec2;
 
 /// The smallest roughness a LEADR lobe is given along any direction: the covariance's
@@ -126,6 +128,21 @@ impl LeadrLobe {
     /// Whether the covariance of the moments was used as is.
     pub fn treatment(&self) -> CovarianceTreatment {
         self.treatment
+    }
+
+    /// The lobe as the crate's slope distribution: the correlated Beckmann distribution
+    /// [`Elliptical::<Beckmann>::from_bivariate`] of (αx, αy, ρ), sheared to the mean slope by
+    /// [`Noncentral::new`], whose D (eq. 3.2), projected area and G1 (eq. 3.3) and visible
+    /// normals (eq. 3.4) are those of the lobe.
+    ///
+    /// # Errors
+    /// Those of the two constructors; a lobe from [`Self::from_moments`] satisfies both
+    /// (roughness ≥ [`MIN_LEADR_ALPHA`] and finite, |ρ| < 1, a finite mean).
+    pub fn slope(&self) -> Result<Noncentral<Elliptical<Beckmann>>, Error> {
+        Noncentral::new(
+            Elliptical::<Beckmann>::from_bivariate(self.alpha_x, self.alpha_y, self.rho)?,
+            self.mean_slope,
+        )
     }
 
     /// The slope covariance Σ = ½ [[αx², ρ αx αy], [ρ αx αy, αy²]] as [Σxx, Σyy, Σxy].

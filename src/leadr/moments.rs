@@ -7,7 +7,7 @@ use glam::{DVec2, Vec2, Vec3};
 /// The first and second slope moments of a texel of a LEAN/LEADR map (Dupuy 2015, §3.3,
 /// eqs. 3.5–3.9; Olano and Baker 2010):
 ///
-/// E₁ = E[x̃], E₂ = E[ỹ], E₃ = E[x̃²], E₄ = E[ỹ²], E₅ = E[x̃ỹ],
+/// E₁ = E(x̃), E₂ = E(ỹ), E₃ = E(x̃²), E₄ = E(ỹ²), E₅ = E(x̃ỹ),
 ///
 /// with slopes x̃ = ∂ξ/∂x, ỹ = ∂ξ/∂y of the displaced surface (the crate's convention
 /// x̃ = −m.x/m.z). The moments are raw (not central), so that they filter linearly: the

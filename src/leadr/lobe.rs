@@ -51,6 +51,10 @@ pub enum CovarianceTreatment {
 /// assert_eq!(lobe.treatment(), CovarianceTreatment::AsGiven);
 /// assert!((lobe.alpha_x() - 0.3).abs() < 1e-6 && (lobe.alpha_y() - 0.1).abs() < 1e-6);
 /// assert!(lobe.rho().abs() < 1e-5 && lobe.mean_slope() == Vec2::new(0.1, -0.2));
+/// // the crate's noncentral slope distribution, for D, G1 and visible-normal sampling
+/// let slope = lobe.slope()?;
+/// let wi = microsurface::glam::Vec3::new(0.5, 0.0, 0.866);
+/// assert!(slope.g1(wi) > 0.0 && slope.d(slope.mean_normal()) > 0.0);
 /// # Ok::<(), microsurface::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -245,7 +245,7 @@ fn invalid_covariance_is_floored_to_the_nearest_valid_one() {
         let ok = [l.alpha_x(), l.alpha_y(), l.rho()].iter().all(|v| v.is_finite())
             && l.alpha_x() >= MIN_LEADR_ALPHA * 0.999
             && l.alpha_y() >= MIN_LEADR_ALPHA * 0.999
-            && f64::from(l.rho().abs()) <= 1.0 - 0.25 * MIN_EIGENVALUE_RATIO;
+            && l.rho().abs() <= 1.0 - 0.25 * MIN_EIGENVALUE_RATIO;
         assert!(ok, "{e:?} → {l:?}");
     }
 }
@@ -366,4 +366,33 @@ fn closed_form_matches_the_crate_noncentral_slope() {
         worst.0,
         worst.1
     );
+}
+
+/// Rounding breaks the covariance of steep, smooth texels: at mean slope ±60 with α = 1e-3 the
+/// variance α²/2 = 5e-7 is far below the f32 spacing of E₃ ≈ 3600 (2.4e-4), so the stored moments
+/// lose it and the difference E₃ − E₁² is rounding noise of either sign. Every lobe of the
+/// pyramid is still finite, with roughness ≥ `MIN_LEADR_ALPHA`, and the floor is what caught it.
+#[test]
+fn rounding_of_steep_texels_is_floored() {
+    let base = Beckmann::isotropic(1e-3).unwrap();
+    let normals: Vec<Vec3> = (0..16)
+        .map(|i| {
+            let s = if i % 2 == 0 { 60.0 } else { -60.0 + 1e-3 * i as f32 };
+            Vec3::new(-s, 0.3 * s, 1.0)
+        })
+        .collect();
+    let map = LeadrMap::from_normal_map(4, 4, &normals, base).unwrap();
+    let mut floored = 0;
+    for level in 0..map.level_count() {
+        for (i, t) in map.level(level).texels().iter().enumerate() {
+            let l = LeadrLobe::from_moments(t);
+            let ok = [l.alpha_x(), l.alpha_y(), l.rho()].iter().all(|v| v.is_finite())
+                && l.alpha_x() >= 0.999 * MIN_LEADR_ALPHA
+                && l.alpha_y() >= 0.999 * MIN_LEADR_ALPHA
+                && l.rho().abs() < 1.0;
+            assert!(ok, "level {level} texel {i}: {t:?} → {l:?}");
+            floored += usize::from(l.treatment() == CovarianceTreatment::EigenvalueFloored);
+        }
+    }
+    assert!(floored > 0, "the test case must exercise the floor");
 }

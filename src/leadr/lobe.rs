@@ -15,7 +15,7 @@ pub const MIN_LEADR_ALPHA: f32 = 1e-4;
 /// eigenvalue is floored at this fraction of the larger. It keeps the correlation
 /// |ρ| ≤ 1 − 5e-7, which f32 distinguishes from 1 (its spacing below 1 is 6e-8), for
 /// every covariance.
-pub const MIN_EIGENVALUE_RATIO: f64 = 1e-6;
+pub const MIN_EIGENVALUE_RATIO: f32 = 1e-6;
 
 /// Whether [`LeadrLobe::from_moments`] had to change the covariance of its moments.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -85,7 +85,7 @@ impl LeadrLobe {
         let radius = half_diff.hypot(xy);
         let (l1, l2) = (half_sum + radius, half_sum - radius);
         let min_variance = 0.5 * f64::from(MIN_LEADR_ALPHA) * f64::from(MIN_LEADR_ALPHA);
-        let floor = min_variance.max(MIN_EIGENVALUE_RATIO * l1);
+        let floor = min_variance.max(f64::from(MIN_EIGENVALUE_RATIO) * l1);
         let (cov, treatment) = if l2 >= floor {
             ([xx, yy, xy], CovarianceTreatment::AsGiven)
         } else {

@@ -111,3 +111,216 @@ fn constructors_reject_invalid_parameters() {
     bad(Elliptical::from_ellipse(0.3, 0.2, f32::INFINITY), "phi");
     assert!(Elliptical::<Ggx>::from_bivariate(0.3, 0.2, 0.999_999).is_ok());
 }
+
+use common::chi2::{Chi2Grid, chi2_test};
+use common::quadrature::integrate_sphere;
+use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
+use std::f64::consts::PI;
+
+/// Correlations of the identity tests, up to |ρ| = 0.99.
+const RHOS: [f32; 5] = [-0.99, -0.6, 0.0, 0.8, 0.99];
+/// Marginals (αx, αy) of the identity tests.
+const MARGINALS: [(f32, f32); 2] = [(0.3, 0.3), (0.6, 0.25)];
+/// Views (θ, φ) of the projected-area identities: above, grazing, below the horizon.
+const VIEWS: [(f64, f64); 3] = [(1.1, 0.4), (1.5, 2.2), (2.3, -1.3)];
+
+/// The quadrature of ∫ f over the upper hemisphere: 32 × 64 cells, adaptive to depth 6.
+fn hemisphere(f: &mut impl FnMut(Vec3) -> f64) -> f64 {
+    integrate_sphere(f, 32, 64, true, 1e-6, 6)
+}
+
+fn identities<S: MicrosurfaceSlope>(label: &str, slope: &S) {
+    // eq. 2.8: ∫ D cos θm = 1
+    let norm = hemisphere(&mut |m| slope.d64(m.as_dvec3()) * f64::from(m.z));
+    assert!((norm - 1.0).abs() < 2e-5, "{label}: ∫ D cos θm = {norm:.8}");
+    for (theta, phi) in VIEWS {
+        let w = common::dir(theta, phi).normalize();
+        // signed: ∫⟨ω, m⟩ D = cos θ; clamped: ∫⟨ω, m⟩⁺ D = A(ω) = (1 + Λ(ω)) cos θ
+        let signed = hemisphere(&mut |m| slope.d64(m.as_dvec3()) * f64::from(w.dot(m)));
+        let clamped = hemisphere(&mut |m| slope.d64(m.as_dvec3()) * f64::from(w.dot(m)).max(0.0));
+        let area = slope.projected_area64(w);
+        let from_lambda = (1.0 + slope.lambda64(w)) * f64::from(w.z);
+        assert!(
+            (signed - f64::from(w.z)).abs() < 2e-5,
+            "{label} {w}: ∫⟨ω,m⟩D = {signed:.8}, cos θ = {}",
+            w.z
+        );
+        assert!((clamped - area).abs() < 2e-5, "{label} {w}: ∫⟨ω,m⟩⁺D = {clamped:.8}, A = {area:.8}");
+        assert!(
+            (from_lambda - area).abs() < 1e-6 * (1.0 + area),
+            "{label} {w}: (1 + Λ) cos θ = {from_lambda:.8}, A = {area:.8}"
+        );
+        if area > 1e-3 {
+            let visible = hemisphere(&mut |m| slope.d_wi64(w, m.as_dvec3()));
+            assert!(
+                (visible - 1.0).abs() < 2e-5 / area,
+                "{label} {w}: ∫ D_ωi = {visible:.8} (A = {area:.3e})"
+            );
+        }
+    }
+}
+
+#[test]
+fn normalization_and_projected_area_up_to_rho_0_99() {
+    let mut cases = Vec::new();
+    for &(ax, ay) in &MARGINALS {
+        for &rho in &RHOS {
+            cases.push((ax, ay, rho));
+        }
+    }
+    common::par_map(&cases, |_, &(ax, ay, rho)| {
+        identities(
+            &format!("beckmann ({ax}, {ay}, ρ {rho})"),
+            &Elliptical::<Beckmann>::from_bivariate(ax, ay, rho).unwrap(),
+        );
+        identities(
+            &format!("ggx ({ax}, {ay}, ρ {rho})"),
+            &Elliptical::<Ggx>::from_bivariate(ax, ay, rho).unwrap(),
+        );
+    });
+}
+
+/// The correlated projected roughness: Λ of the ellipse equals Λ of the isotropic distribution
+/// of roughness αᵢ(ω) (the Smith Λ depends on ω through cot θ/αᵢ only).
+#[test]
+fn alpha_i_carries_the_correlation() {
+    for &rho in &RHOS {
+        let e = Elliptical::<Beckmann>::from_bivariate(0.4, 0.2, rho).unwrap();
+        for k in 0..64 {
+            let w = common::dir(0.3 + 2.5 * k as f64 / 64.0, 0.37 * k as f64).normalize();
+            let iso = Beckmann::isotropic(e.alpha_i(w)).unwrap();
+            let (a, b) = (e.lambda64(w), iso.lambda64(w));
+            assert!((a - b).abs() <= 1e-5 * (1.0 + a.abs()), "ρ {rho} {w}: Λ {a} vs Λ(αᵢ) {b}");
+        }
+    }
+}
+
+/// The rotated ellipse (α₁, α₂, φα) seen from (θ, ψ) is the axis-aligned (α₁, α₂) seen from
+/// (θ, ψ − φα): D, Λ and the walk's albedo per scattering order with the same seed.
+#[test]
+fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
+    const ROTATIONS: [(f32, f32, f32); 3] = [(0.6, 0.15, 0.7), (0.3, 0.9, -1.2), (1.0, 0.25, 2.0)];
+    const ORDERS: usize = 4;
+    const WALKS: usize = 20_000;
+    const VIEWS_PER_CASE: usize = 3;
+    let z = common::family_z(0.01, ROTATIONS.len() * VIEWS_PER_CASE * 2 * ORDERS);
+    for &(a1, a2, phi) in &ROTATIONS {
+        let e = Elliptical::<Beckmann>::from_ellipse(a1, a2, phi).unwrap();
+        let aligned = Beckmann::new(a1, a2).unwrap();
+        let ge = Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap();
+        let ga = Ggx::new(a1, a2).unwrap();
+        for k in 0..100 {
+            let (theta, psi) = (3.0 * k as f64 / 100.0, 0.61 * k as f64);
+            let (w, w_aligned) = (common::dir(theta, psi), common::dir(theta, psi - f64::from(phi)));
+            let rel = |a: f64, b: f64| (a - b).abs() / (a.abs().max(b.abs()).max(1e-300));
+            let (d, d_aligned) = (e.d64(w.as_dvec3()), aligned.d64(w_aligned.as_dvec3()));
+            // the two f32 directions differ by their roundings (~1e-7): D's condition 2t
+            let t = (-(d * PI * f64::from(a1 * a2) * f64::from(w.z).powi(4)).ln()).max(0.0);
+            assert!(
+                rel(d, d_aligned) < 1e-6 * (1.0 + t) || d < 1e-290,
+                "{a1} {a2} {phi} {w}: D {d} vs {d_aligned}"
+            );
+            let (l, l_aligned) = (e.lambda64(w), aligned.lambda64(w_aligned));
+            assert!(rel(l, l_aligned) < 1e-4 || (l - l_aligned).abs() < 1e-12, "{w}: Λ {l} vs {l_aligned}");
+            let (g, g_aligned) = (ge.lambda64(w), ga.lambda64(w_aligned));
+            assert!(
+                rel(g, g_aligned) < 1e-4 || (g - g_aligned).abs() < 1e-12,
+                "{w}: GGX Λ {g} vs {g_aligned}"
+            );
+        }
+        for (v, (theta, psi)) in [(0.4, 0.3), (1.2, 2.0), (1.45, -2.5)].into_iter().enumerate() {
+            let (wi, wi_aligned) = (common::dir(theta, psi), common::dir(theta, psi - f64::from(phi)));
+            for (material, name) in [(0, "gold"), (1, "glass")] {
+                let seed = 1000 + 10 * v as u64 + material;
+                let per_order = |slope_is_elliptical: bool| {
+                    let mut rng = common::rng(seed);
+                    let mut orders = vec![Vec::with_capacity(WALKS); ORDERS];
+                    for _ in 0..WALKS {
+                        let s = match (material, slope_is_elliptical) {
+                            (0, true) => {
+                                Microsurface::new(UniformHeight, e, Conductor::new(ComplexIor::GOLD))
+                                    .sample(wi, &mut rng)
+                            }
+                            (0, false) => {
+                                Microsurface::new(UniformHeight, aligned, Conductor::new(ComplexIor::GOLD))
+                                    .sample(wi_aligned, &mut rng)
+                            }
+                            (_, true) => Microsurface::new(UniformHeight, e, Dielectric::new(1.5).unwrap())
+                                .sample(wi, &mut rng),
+                            (_, false) => {
+                                Microsurface::new(UniformHeight, aligned, Dielectric::new(1.5).unwrap())
+                                    .sample(wi_aligned, &mut rng)
+                            }
+                        };
+                        let (weight, bounces) =
+                            s.map_or((0.0, 0), |s| (f64::from(s.weight.x), s.bounces as usize));
+                        for (order, values) in orders.iter_mut().enumerate() {
+                            let this = bounces == order + 1 || (order + 1 == ORDERS && bounces >= ORDERS);
+                            values.push(if this { weight } else { 0.0 });
+                        }
+                    }
+                    orders
+                };
+                let (a, b) = (per_order(true), per_order(false));
+                for order in 0..ORDERS {
+                    // paired differences of the same seed's walks
+                    let mut diff = common::Stats::default();
+                    let mut level = common::Stats::default();
+                    for (x, y) in a[order].iter().zip(&b[order]) {
+                        diff.push(x - y);
+                        level.push(*x);
+                    }
+                    let label = format!(
+                        "{name} ({a1}, {a2}, φ {phi}) θ {theta} order {}{}",
+                        order + 1,
+                        if order + 1 == ORDERS { "+" } else { "" }
+                    );
+                    // the paired SE is at most that of one estimate: bound it by 1e-2
+                    common::assert_mean(&label, &diff, 0.0, z, 1e-2, 0.0);
+                    assert!(level.mean() > 0.0 || order > 1, "{label}: no energy in this order");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn sampler_chi2() {
+    // (ellipse, view θ, view φ): above and below the horizon, strong correlation
+    const CASES: [((f32, f32, f32), f64, f64); 6] = [
+        ((0.5, 0.1, 0.3), 0.7, 1.0),
+        ((0.2, 0.8, -1.0), 1.3, -2.0),
+        ((0.9, 0.3, 0.785), 1.57, 0.5),
+        ((0.4, 0.04, 2.4), 0.2, 0.0),
+        ((0.6, 0.3, 1.3), 2.0, 2.5),
+        ((1.2, 0.5, -0.4), 2.7, -0.9),
+    ];
+    const N: usize = 200_000;
+    let alpha = common::sidak(0.01, 2 * CASES.len());
+    common::par_map(&CASES, |i, &((a1, a2, phi), theta, psi)| {
+        let wi = common::dir(theta, psi).normalize();
+        let grid = Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) };
+        let b = Elliptical::<Beckmann>::from_ellipse(a1, a2, phi).unwrap();
+        let mut rng = common::rng(77 + i as u64);
+        chi2_test(
+            &format!("beckmann ({a1}, {a2}, φ {phi}) from {wi}"),
+            grid,
+            |m| b.d_wi64(wi, m.as_dvec3()),
+            || Some(b.sample_d_wi(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+            N,
+            alpha,
+            1.0,
+        );
+        let g = Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap();
+        let mut rng = common::rng(177 + i as u64);
+        chi2_test(
+            &format!("ggx ({a1}, {a2}, φ {phi}) from {wi}"),
+            grid,
+            |m| g.d_wi64(wi, m.as_dvec3()),
+            || Some(g.sample_d_wi(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+            N,
+            alpha,
+            1.0,
+        );
+    });
+}

@@ -234,7 +234,7 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
                 let seed = 1000 + 10 * v as u64 + material;
                 let per_order = |slope_is_elliptical: bool| {
                     let mut rng = common::rng(seed);
-                    let mut orders = vec![Vec::with_capacity(WALKS); ORDERS];
+                    let mut orders: Vec<Vec<f64>> = (0..ORDERS).map(|_| Vec::with_capacity(WALKS)).collect();
                     for _ in 0..WALKS {
                         let s = match (material, slope_is_elliptical) {
                             (0, true) => {

@@ -1,64 +1,218 @@
-//! Noncentral (sheared) microsurfaces (Dupuy 2015, thesis §3.2): D's normalization (eq. 3.1)
-//! and mean normal, the projected area and G1 (eq. 3.3) against quadrature, the sampler's
-//! chi-square fit (eq. 3.4) and the constructor's rejections.
+//! Noncentral (sheared) microsurfaces (Dupuy 2015, thesis §3.2): D against eq. 3.2, its
+//! normalization (eq. 3.1) and mean normal, the projected area against quadrature, G1 against
+//! eq. 3.3, the sampler's chi-square fit (eq. 3.4) and the constructor's rejections.
 
 mod common;
 
+use common::chi2::{Chi2Grid, chi2_test};
 use common::quadrature::integrate_sphere;
 use glam::{Vec2, Vec3};
-use microsurface::{Beckmann, Elliptical, Ggx, MicrosurfaceSlope, Noncentral};
+use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope, Noncentral};
+use std::f64::consts::PI;
 
-fn cases() -> Vec<(&'static str, Box<dyn Fn(Vec3) -> f64>, Box<dyn Fn(Vec3) -> f64>, Vec3)> {
-    fn boxed<S: MicrosurfaceSlope + 'static>(
-        label: &'static str,
-        s: Noncentral<S>,
-    ) -> (&'static str, Box<dyn Fn(Vec3) -> f64>, Box<dyn Fn(Vec3) -> f64>, Vec3) {
-        let n = s.mean_normal();
-        (label, Box::new(move |m| s.d64(m.as_dvec3())), Box::new(move |w| s.projected_area(w)), n)
+/// Views (θ, φ): above the horizon facing and away from the tilt, grazing, below.
+const VIEWS: [(f64, f64); 5] = [(0.0, 0.0), (1.0, 0.3), (1.3, 3.5), (1.55, 2.0), (2.2, -1.0)];
+
+fn hemisphere(f: &mut impl FnMut(Vec3) -> f64) -> f64 {
+    integrate_sphere(f, 24, 48, true, 1e-6, 6)
+}
+
+fn identities<S: MicrosurfaceSlope>(label: &str, s: &Noncentral<S>) {
+    let d = |m: Vec3| s.d64(m.as_dvec3());
+    let cos = hemisphere(&mut |m| d(m) * f64::from(m.z));
+    assert!((cos - 1.0).abs() < 1e-5, "{label}: ∫ D cos θ = {cos}");
+    // ∫ m D dω = n sec θn (the mean normal, unnormalized)
+    let mx = hemisphere(&mut |m| d(m) * f64::from(m.x));
+    let my = hemisphere(&mut |m| d(m) * f64::from(m.y));
+    let (ex, ey) = (-f64::from(s.mean_slope().x), -f64::from(s.mean_slope().y));
+    assert!(
+        (mx - ex).abs() < 1e-4 && (my - ey).abs() < 1e-4,
+        "{label}: ∫ m D = ({mx}, {my}), expected ({ex}, {ey})"
+    );
+    let n = s.mean_normal();
+    assert!(
+        (f64::from(n.x / n.z) - ex).abs() < 1e-6 && (f64::from(n.y / n.z) - ey).abs() < 1e-6,
+        "{label}: n = {n}"
+    );
+    for (theta, phi) in VIEWS {
+        let w = common::dir(theta, phi).normalize();
+        let quad = hemisphere(&mut |m| d(m) * f64::from(w.dot(m)).max(0.0));
+        let a = s.projected_area(w);
+        assert!((quad - a).abs() < 1e-5 * (1.0 + a), "{label} {w}: ∫⟨ω,m⟩⁺D = {quad}, A = {a}");
+        if a > 1e-3 {
+            let visible = hemisphere(&mut |m| f64::from(s.d_wi(w, m)));
+            assert!((visible - 1.0).abs() < 2e-5 / a, "{label} {w}: ∫ D_ωi = {visible} (A = {a:.3e})");
+        }
     }
-    vec![
-        boxed(
-            "beckmann 0.3, (0.4, -0.2)",
-            Noncentral::new(Beckmann::isotropic(0.3).unwrap(), Vec2::new(0.4, -0.2)).unwrap(),
-        ),
-        boxed(
-            "ggx 0.5, (-0.8, 0.3)",
-            Noncentral::new(Ggx::isotropic(0.5).unwrap(), Vec2::new(-0.8, 0.3)).unwrap(),
-        ),
-        boxed(
-            "elliptical beckmann (0.3, 0.1, ρ 0.6), (0.5, 0.5)",
-            Noncentral::new(
-                Elliptical::<Beckmann>::from_bivariate(0.3, 0.1, 0.6).unwrap(),
-                Vec2::new(0.5, 0.5),
-            )
-            .unwrap(),
-        ),
-        boxed(
-            "elliptical ggx (0.2, 0.4, ρ −0.9), (1.2, 0.0)",
-            Noncentral::new(Elliptical::<Ggx>::from_bivariate(0.2, 0.4, -0.9).unwrap(), Vec2::new(1.2, 0.0))
-                .unwrap(),
-        ),
-    ]
 }
 
 #[test]
 fn d_is_normalized_with_the_mean_normal_and_projected_area() {
-    for (label, d, area, n) in cases() {
-        let cos = integrate_sphere(&mut |m| d(m) * f64::from(m.z), 24, 48, true, 1e-6, 6);
-        assert!((cos - 1.0).abs() < 1e-5, "{label}: ∫ D cos θ = {cos}");
-        // ∫ m D dω = n sec θn (the mean normal, unnormalized)
-        let mx = integrate_sphere(&mut |m| d(m) * f64::from(m.x), 24, 48, true, 1e-6, 6);
-        let my = integrate_sphere(&mut |m| d(m) * f64::from(m.y), 24, 48, true, 1e-6, 6);
-        let (ex, ey) = (f64::from(n.x / n.z), f64::from(n.y / n.z));
+    identities(
+        "beckmann 0.3, (0.4, -0.2)",
+        &Noncentral::new(Beckmann::isotropic(0.3).unwrap(), Vec2::new(0.4, -0.2)).unwrap(),
+    );
+    identities(
+        "ggx 0.5, (-0.8, 0.3)",
+        &Noncentral::new(Ggx::isotropic(0.5).unwrap(), Vec2::new(-0.8, 0.3)).unwrap(),
+    );
+    identities(
+        "elliptical beckmann (0.3, 0.1, ρ 0.6), (0.5, 0.5)",
+        &Noncentral::new(Elliptical::<Beckmann>::from_bivariate(0.3, 0.1, 0.6).unwrap(), Vec2::new(0.5, 0.5))
+            .unwrap(),
+    );
+    identities(
+        "elliptical ggx (0.2, 0.4, ρ −0.9), (1.2, 0.0)",
+        &Noncentral::new(Elliptical::<Ggx>::from_bivariate(0.2, 0.4, -0.9).unwrap(), Vec2::new(1.2, 0.0))
+            .unwrap(),
+    );
+}
+
+/// Eq. 3.2 written out for the correlated Beckmann distribution.
+#[test]
+fn d_matches_eq_3_2() {
+    let (ax, ay, rho, xn, yn) = (0.35f32, 0.2f32, -0.4f32, 0.3f32, -0.6f32);
+    let s = Noncentral::new(Elliptical::<Beckmann>::from_bivariate(ax, ay, rho).unwrap(), Vec2::new(xn, yn))
+        .unwrap();
+    let (ax, ay, rho, xn, yn) = (f64::from(ax), f64::from(ay), f64::from(rho), f64::from(xn), f64::from(yn));
+    let root = (1.0 - rho * rho).sqrt();
+    for k in 0..300 {
+        let m = common::dir(1.5 * k as f64 / 300.0, 0.83 * k as f64).normalize().as_dvec3();
+        let (x, y) = (-m.x / m.z - xn, -m.y / m.z - yn);
+        let (u, v) = (x / ax, (ax * y - rho * ay * x) / (ax * ay * root));
+        let expected = (-(u * u) - v * v).exp() / (PI * ax * ay * root * m.z.powi(4));
+        let d = s.d64(m);
+        // f32 radii of the internal ellipse: relative 2r²·6e-8 of the exponent r²
+        let tol = 1e-6 + 2e-7 * (u * u + v * v);
         assert!(
-            (mx - ex).abs() < 1e-4 && (my - ey).abs() < 1e-4,
-            "{label}: ∫ m D = ({mx}, {my}), expected ({ex}, {ey})"
+            (d - expected).abs() <= tol * expected || (d < 1e-290 && expected < 1e-290),
+            "{m}: {d} vs {expected}"
         );
-        for w in [Vec3::Z, common::dir(1.0, 0.3), common::dir(1.4, 2.5), common::dir(2.2, -1.0)] {
-            let w = w.normalize();
-            let quad = integrate_sphere(&mut |m| d(m) * f64::from(w.dot(m)).max(0.0), 24, 48, true, 1e-6, 6);
-            let a = area(w);
-            assert!((quad - a).abs() < 1e-5 * (1.0 + a), "{label} {w}: ∫⟨ω,m⟩⁺D = {quad}, A = {a}");
+    }
+}
+
+/// G1 by eq. 3.3: (cos θ/c) G1_S(k′) with c = ⟨ω, n⟩ sec θn and k′ = (ω.x, ω.y, c)/‖·‖, for the
+/// views with c > 0, where the central G1_S(k′) = 1/(1 + Λ_S(k′)) is the thesis' G1_std.
+#[test]
+fn g1_matches_eq_3_3() {
+    let central = Elliptical::<Ggx>::from_bivariate(0.3, 0.5, 0.7).unwrap();
+    let mean = Vec2::new(0.7, -0.4);
+    let s = Noncentral::new(central, mean).unwrap();
+    let (mut above, mut exceeds_one) = (0, 0);
+    for k in 0..400 {
+        let w = common::dir(1.56 * k as f64 / 400.0, 0.71 * k as f64).normalize();
+        let c = f64::from(w.z) - f64::from(w.x) * f64::from(mean.x) - f64::from(w.y) * f64::from(mean.y);
+        let g1 = f64::from(s.g1(w));
+        assert!(g1.is_finite() && g1 > 0.0, "{w}: G1 = {g1}");
+        if c <= 0.0 {
+            continue;
+        }
+        above += 1;
+        let k_prime = glam::DVec3::new(f64::from(w.x), f64::from(w.y), c).normalize().as_vec3();
+        let expected = f64::from(w.z) / c / (1.0 + central.lambda64(k_prime));
+        assert!((g1 - expected).abs() <= 1e-5 * expected, "{w}: G1 = {g1}, eq. 3.3 = {expected}");
+        exceeds_one += usize::from(g1 > 1.0);
+    }
+    assert!(above > 300 && exceeds_one > 10, "{above} views with c > 0, {exceeds_one} with G1 > 1");
+    // the central case is the central G1 itself
+    let flat = Noncentral::new(central, Vec2::ZERO).unwrap();
+    for k in 0..100 {
+        let w = common::dir(1.56 * k as f64 / 100.0, 1.3 * k as f64).normalize();
+        let expected = 1.0 / (1.0 + central.lambda64(w));
+        assert!((f64::from(flat.g1(w)) - expected).abs() <= 1e-6 * expected, "{w}");
+    }
+    assert_eq!(s.g1(Vec3::new(0.6, 0.0, -0.8)), 0.0);
+}
+
+#[test]
+fn sampler_chi2() {
+    const N: usize = 200_000;
+    const CASES: usize = 8;
+    let alpha = common::sidak(0.01, CASES);
+    let grid = Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) };
+    let run = |i: usize,
+               label: &str,
+               d_wi: &dyn Fn(Vec3, Vec3) -> f64,
+               sample: &dyn Fn(Vec3, f32, f32) -> Vec3,
+               wi: Vec3| {
+        let mut rng = common::rng(300 + i as u64);
+        chi2_test(
+            &format!("{label} from {wi}"),
+            grid,
+            |m| d_wi(wi, m),
+            || Some(sample(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+            N,
+            alpha,
+            1.0,
+        );
+    };
+    let b = Noncentral::new(Beckmann::isotropic(0.3).unwrap(), Vec2::new(0.5, -0.3)).unwrap();
+    let g = Noncentral::new(Ggx::new(0.4, 0.2).unwrap(), Vec2::new(-0.9, 0.2)).unwrap();
+    let eb =
+        Noncentral::new(Elliptical::<Beckmann>::from_bivariate(0.4, 0.15, 0.8).unwrap(), Vec2::new(0.6, 0.6))
+            .unwrap();
+    let eg = Noncentral::new(Elliptical::<Ggx>::from_bivariate(0.2, 0.5, -0.7).unwrap(), Vec2::new(0.0, 1.5))
+        .unwrap();
+    let views = [common::dir(0.6, 0.4), common::dir(1.4, 3.6), common::dir(2.1, 1.0), common::dir(1.2, 0.3)];
+    let views: Vec<Vec3> = views.iter().map(|w| w.normalize()).collect();
+    common::par_map(&[0usize, 1, 2, 3], |_, &j| match j {
+        0 => {
+            run(
+                0,
+                "beckmann 0.3, (0.5, −0.3)",
+                &|wi, m| f64::from(b.d_wi(wi, m)),
+                &|wi, u1, u2| b.sample_d_wi(wi, u1, u2),
+                views[0],
+            );
+            run(
+                1,
+                "beckmann 0.3, (0.5, −0.3)",
+                &|wi, m| f64::from(b.d_wi(wi, m)),
+                &|wi, u1, u2| b.sample_d_wi(wi, u1, u2),
+                views[2],
+            );
+        }
+        1 => {
+            run(
+                2,
+                "ggx (0.4, 0.2), (−0.9, 0.2)",
+                &|wi, m| f64::from(g.d_wi(wi, m)),
+                &|wi, u1, u2| g.sample_d_wi(wi, u1, u2),
+                views[1],
+            );
+            run(
+                3,
+                "ggx (0.4, 0.2), (−0.9, 0.2)",
+                &|wi, m| f64::from(g.d_wi(wi, m)),
+                &|wi, u1, u2| g.sample_d_wi(wi, u1, u2),
+                views[3],
+            );
+        }
+        2 => {
+            let l = "elliptical beckmann (0.4, 0.15, ρ 0.8), (0.6, 0.6)";
+            run(4, l, &|wi, m| f64::from(eb.d_wi(wi, m)), &|wi, u1, u2| eb.sample_d_wi(wi, u1, u2), views[1]);
+            run(5, l, &|wi, m| f64::from(eb.d_wi(wi, m)), &|wi, u1, u2| eb.sample_d_wi(wi, u1, u2), views[3]);
+        }
+        _ => {
+            let l = "elliptical ggx (0.2, 0.5, ρ −0.7), (0, 1.5)";
+            run(6, l, &|wi, m| f64::from(eg.d_wi(wi, m)), &|wi, u1, u2| eg.sample_d_wi(wi, u1, u2), views[0]);
+            run(7, l, &|wi, m| f64::from(eg.d_wi(wi, m)), &|wi, u1, u2| eg.sample_d_wi(wi, u1, u2), views[2]);
+        }
+    });
+}
+
+#[test]
+fn constructor_rejects_non_finite_mean_slopes() {
+    let slope = Beckmann::isotropic(0.2).unwrap();
+    for (mean, name) in [
+        (Vec2::new(f32::NAN, 0.0), "mean_slope.x"),
+        (Vec2::new(0.0, f32::INFINITY), "mean_slope.y"),
+        (Vec2::new(f32::NEG_INFINITY, 1.0), "mean_slope.x"),
+    ] {
+        match Noncentral::new(slope, mean) {
+            Err(Error::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+            other => panic!("{mean}: expected a rejection, got {other:?}"),
         }
     }
+    assert!(Noncentral::new(slope, Vec2::new(1e6, -1e6)).is_ok());
 }

@@ -396,3 +396,54 @@ fn rounding_of_steep_texels_is_floored() {
     }
     assert!(floored > 0, "the test case must exercise the floor");
 }
+
+/// The linear slope map of §3.4 (stretching, shearing, height scaling): transformed moments are
+/// the moments of the transformed slopes with the transformed base covariance, the map commutes
+/// with the MIP filtering, and non-finite or overflowing maps are rejected.
+#[test]
+fn slope_map_transforms_moments() {
+    use glam::Mat2;
+    let a = Mat2::from_cols(Vec2::new(1.5, 0.3), Vec2::new(-0.4, 0.8));
+    let base = Beckmann::isotropic(0.2).unwrap();
+    let s = Vec2::new(0.3, -0.7);
+    let t = SlopeMoments::from_slope(s, base).unwrap().transformed(a).unwrap();
+    let ws = (a * s).as_dvec2();
+    let ad = a.as_dmat2();
+    let base_cov = ad * ad.transpose() * 0.02; // A (α²/2 I) Aᵀ
+    let expected = [
+        ws.x,
+        ws.y,
+        ws.x * ws.x + base_cov.x_axis.x,
+        ws.y * ws.y + base_cov.y_axis.y,
+        ws.x * ws.y + base_cov.y_axis.x,
+    ];
+    for (g, w) in t.to_array().iter().zip(expected) {
+        assert!((f64::from(*g) - w).abs() < 1e-6, "{t:?} vs {expected:?}");
+    }
+    // commutes with filtering: level 2 transformed = average of the transformed input texels
+    let map = LeadrMap::from_height_map(&procedural_height_map(8, 0.3, 9), base).unwrap();
+    let coarse = map.level(2).texel(1, 0).transformed(a).unwrap().to_array();
+    let fine: Vec<SlopeMoments> =
+        (0..16).map(|i| map.level(0).texel(4 + i % 4, i / 4).transformed(a).unwrap()).collect();
+    let direct = SlopeMoments::average(&fine).unwrap().to_array();
+    for (c, d) in coarse.iter().zip(direct) {
+        assert!((c - d).abs() <= 1e-6 * (1.0 + d.abs()), "{coarse:?} vs {direct:?}");
+    }
+    // a height scale β scales the mean by β and the lobe's roughness by β
+    let lobe = LeadrLobe::from_moments(&map.level(1).texel(0, 0));
+    let scaled = LeadrLobe::from_moments(
+        &map.level(1).texel(0, 0).transformed(Mat2::from_diagonal(Vec2::splat(2.0))).unwrap(),
+    );
+    assert!(
+        (scaled.alpha_x() - 2.0 * lobe.alpha_x()).abs() < 1e-5 && (scaled.rho() - lobe.rho()).abs() < 1e-5
+    );
+    assert!((scaled.mean_slope() - 2.0 * lobe.mean_slope()).length() < 1e-6);
+    // bad maps
+    let m = SlopeMoments::from_slope(s, base).unwrap();
+    let name = |r: Result<SlopeMoments, Error>| match r {
+        Err(Error::InvalidParameter { name, .. }) => name,
+        _ => "accepted",
+    };
+    assert_eq!(name(m.transformed(Mat2::from_cols(Vec2::new(f32::NAN, 0.0), Vec2::Y))), "slope_map");
+    assert_eq!(name(m.transformed(Mat2::from_diagonal(Vec2::splat(1e30)))), "slope_map");
+}

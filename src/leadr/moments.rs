@@ -2,7 +2,7 @@
 
 use crate::error::Error;
 use crate::slope::{Beckmann, MicrosurfaceSlope};
-use glam::{DVec2, Vec2, Vec3};
+use glam::{DMat2, DVec2, Mat2, Vec2, Vec3};
 
 /// The first and second slope moments of a texel of a LEAN/LEADR map (Dupuy 2015, §3.3,
 /// eqs. 3.5–3.9; Olano and Baker 2010):
@@ -128,6 +128,37 @@ impl SlopeMoments {
         }
         let n = texels.len() as f64;
         Some(Self::from_array64(sum.map(|s| s / n)))
+    }
+
+    /// The moments of the slopes mapped linearly, s′ = A s: E′₁,₂ = A (E₁, E₂) and
+    /// [[E′₃, E′₅], [E′₅, E′₄]] = A [[E₃, E₅], [E₅, E₄]] Aᵀ, computed in f64 (Dupuy 2015, §3.4,
+    /// "Surface Stretching and Shearing" and "Height Scaling").
+    ///
+    /// For moments stored in texture space and a surface parameterized by u(x, y), v(x, y), the
+    /// world-space moments take A with rows (∂u/∂x, ∂v/∂x) and (∂u/∂y, ∂v/∂y) (as a `Mat2`,
+    /// column-major: `Mat2::from_cols((∂u/∂x, ∂u/∂y), (∂v/∂x, ∂v/∂y))`), assumed constant over the
+    /// texel; a height scale β is A = β I. The map is linear, so it commutes with the MIP
+    /// filtering and can be applied at lookup time. It maps the base roughness's share of the
+    /// moments too (a stretched or height-scaled surface stretches its microgeometry as well).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`"slope_map"`) if an entry of A is not finite or a
+    /// resulting moment overflows f32.
+    pub fn transformed(&self, slope_map: Mat2) -> Result<Self, Error> {
+        let bad = |value| Error::InvalidParameter {
+            name: "slope_map",
+            value,
+            expected: "finite, moments within f32",
+        };
+        if let Some(&v) = slope_map.to_cols_array().iter().find(|v| !v.is_finite()) {
+            return Err(bad(v));
+        }
+        let a = slope_map.as_dmat2();
+        let [e1, e2, e3, e4, e5] = self.to_array().map(f64::from);
+        let mean = a * DVec2::new(e1, e2);
+        let second = a * DMat2::from_cols(DVec2::new(e3, e5), DVec2::new(e5, e4)) * a.transpose();
+        Self::from_f64(mean, [second.x_axis.x, second.y_axis.y, second.y_axis.x])
+            .map_err(|_| bad(f32::INFINITY))
     }
 
     /// The mean slope (E₁, E₂), the mesosurface's slope (x̃n, ỹn) (eqs. 3.5–3.6).

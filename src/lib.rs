@@ -121,6 +121,7 @@ mod constants;
 mod error;
 mod fresnel;
 mod height;
+mod leadr;
 mod material;
 mod merl;
 mod microsurface;
@@ -148,6 +149,10 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 /// can name the crate's types.
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+pub use leadr::{
+    CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, MomentLevel,
+    SlopeMoments,
+};
 pub use material::{Conductor, Dielectric, Diffuse, Event, Interaction, Material, PhaseSample, Side};
 pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
 pub use microsurface::{

@@ -3,7 +3,7 @@
 
 use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction, is_direction64, is_uniform};
 use crate::vector::ensure_visible;
-use crate::albedo::AlbedoTable;
+use crate::albedo::{AlbedoTable, DielectricAlbedoTable};
 use crate::bsdf::AlbedoTabulated;
 use crate::error::Error;
 use glam::{DVec3, Vec2, Vec3};
@@ -225,6 +225,7 @@ impl<S> Elliptical<S> {
 
 impl<S: AxisAlignedSlope + AlbedoTabulated> AlbedoTabulated for Elliptical<S> {
     const ALBEDO: AlbedoTable = S::ALBEDO;
+    const DIELECTRIC_ALBEDO: DielectricAlbedoTable = S::DIELECTRIC_ALBEDO;
 
     /// √(α₁ α₂): the compensated lobe of the rotated ellipse is that of the axis-aligned one.
     #[inline]

@@ -3,14 +3,12 @@
 //! order: nodes, interpolation between nodes within the stated bound, the average albedo, and
 //! the range policy.
 
-mod common;
-
-use common::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
 use glam::Vec3;
 use microsurface::{
     ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Conductor, Ggx, Microsurface, MicrosurfaceSlope, UniformHeight,
 };
 use rand::RngExt;
+use validation::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
 
 /// Family-wise significance of each test.
 const FAMILY_ALPHA: f64 = 1e-3;

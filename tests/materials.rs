@@ -14,19 +14,19 @@
 //! the statistic Σ (O − N m̂)² / (N m̂ + N² Var m̂) includes the variance of the estimated
 //! expectation, and its degrees of freedom are moment-matched, k − Σ m/(1 + N Var m̂/m)
 //! (k − 1 when the expectation is exact, k when its noise dominates). See `stochastic_chi2`.
-mod common;
-use common::par_map;
+use validation::par_map;
+use validation::stochastic::{StochasticGrid, stochastic_chi2_with};
+use validation::uniform_sphere;
 
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate_sphere;
-use common::{Stats, TestRng};
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope,
     PhaseSample, UniformHeight,
 };
-use statrs::distribution::{ChiSquared, ContinuousCDF};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
+use validation::{Stats, TestRng};
 
 const ALPHAS: [(f32, f32); 3] = [(0.3, 0.3), (1.0, 1.0), (1.0, 0.1)];
 const ETA: f32 = 1.5;
@@ -131,15 +131,7 @@ fn surfaces(kinds: &[Kind]) -> Vec<Box<dyn Phase>> {
 }
 
 fn wi_at(theta: f64) -> Vec3 {
-    common::dir(theta, PHI_I)
-}
-
-/// A uniform direction on the sphere.
-fn uniform_sphere(rng: &mut TestRng) -> Vec3 {
-    let z = 2.0 * common::uniform64(rng) - 1.0;
-    let phi = TAU * common::uniform64(rng);
-    let s = (1.0 - z * z).max(0.0).sqrt();
-    DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()
+    validation::dir(theta, PHI_I)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -158,7 +150,7 @@ const NORM_THETAS: [f64; 5] = [0.0, 0.9, 1.5, 1.9, 2.2];
 const QUAD_TOL: f64 = 1e-3;
 
 #[test]
-fn energy_conservation_exact_quadrature() {
+fn energy_conservation_exact_quadrature_4_3_1() {
     // (surface, θi, side of ωi): the dielectric also from inside the interface
     let surfaces = surfaces(&[Kind::Conductor, Kind::Dielectric]);
     let mut cases = Vec::new();
@@ -175,7 +167,7 @@ fn energy_conservation_exact_quadrature() {
     let worst = par_map(&cases, |_, &(s, theta, wi_out)| {
         let surface = &surfaces[s];
         let wi = wi_at(theta);
-        let mut rng = common::rng(0); // unused: the densities are exact
+        let mut rng = validation::rng(0); // unused: the densities are exact
         let mut f = |wo: Vec3| {
             if wi_out { surface.eval(wi, wo, &mut rng) } else { surface.total(wi, wo, false, &mut rng) }
         };
@@ -199,25 +191,25 @@ fn energy_conservation_exact_quadrature() {
 }
 
 #[test]
-fn energy_conservation_diffuse_monte_carlo() {
+fn energy_conservation_diffuse_monte_carlo_4_3_1() {
     // ∫p dωo = E[4π p(ωi, ωo)] for ωo uniform on the sphere; p is itself stochastic, and one
     // eval per ωo keeps the estimator unbiased.
     const N: usize = 200_000;
     let surfaces = surfaces(&[Kind::Diffuse]);
     let cases: Vec<(usize, f64)> =
         (0..surfaces.len()).flat_map(|s| NORM_THETAS.iter().map(move |&t| (s, t))).collect();
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(s, theta)| {
         let surface = &surfaces[s];
         let wi = wi_at(theta);
-        let mut rng = common::rng(1000 + i as u64);
+        let mut rng = validation::rng(1000 + i as u64);
         let mut stats = Stats::default();
         for _ in 0..N {
             let wo = uniform_sphere(&mut rng);
             stats.push(4.0 * PI * surface.eval(wi, wo, &mut rng));
         }
         let label = format!("{}: diffuse ∫p dωo, θi = {theta}", surface.name());
-        common::assert_mean(&label, &stats, 1.0, z, 5e-3, 0.0);
+        validation::assert_mean(&label, &stats, 1.0, z, 5e-3, 0.0);
         (stats.mean(), stats.se())
     });
     let worst = out.iter().map(|(m, se)| ((m - 1.0) / se).abs()).fold(0.0, f64::max);
@@ -251,13 +243,13 @@ fn assert_rel(label: &str, a: f64, b: f64) -> f64 {
 }
 
 #[test]
-fn reciprocity_exact() {
-    let mut rng = common::rng(0); // unused: exact densities
+fn reciprocity_exact_4_3_2() {
+    let mut rng = validation::rng(0); // unused: exact densities
     let mut worst: f64 = 0.0;
     let mut checked = 0;
     for surface in surfaces(&[Kind::Conductor, Kind::Dielectric]) {
         for &(ti, pi, to, po) in &RECIPROCITY_PAIRS {
-            let (wi, wo) = (common::dir(ti, pi), common::dir(to, po));
+            let (wi, wo) = (validation::dir(ti, pi), validation::dir(to, po));
             // reflection: (1 + Λ(ωi)) cos θi p(ωi, ωo) = (1 + Λ(ωo)) cos θo p(ωo, ωi)
             let a = surface.smith_area(wi) * surface.sided(wi, wo, true, true, &mut rng);
             let b = surface.smith_area(wo) * surface.sided(wo, wi, true, true, &mut rng);
@@ -287,17 +279,17 @@ fn reciprocity_exact() {
 }
 
 #[test]
-fn reciprocity_diffuse_two_sample() {
+fn reciprocity_diffuse_two_sample_4_3_2() {
     const N: usize = 100_000;
     let surfaces = surfaces(&[Kind::Diffuse]);
     let cases: Vec<(usize, usize)> =
         (0..surfaces.len()).flat_map(|s| (0..RECIPROCITY_PAIRS.len()).map(move |p| (s, p))).collect();
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(s, p)| {
         let surface = &surfaces[s];
         let (ti, pi, to, po) = RECIPROCITY_PAIRS[p];
-        let (wi, wo) = (common::dir(ti, pi), common::dir(to, po));
-        let mut rng = common::rng(2000 + i as u64);
+        let (wi, wo) = (validation::dir(ti, pi), validation::dir(to, po));
+        let mut rng = validation::rng(2000 + i as u64);
         let (ai, ao) = (surface.smith_area(wi), surface.smith_area(wo));
         let (mut a, mut b) = (Stats::default(), Stats::default());
         for _ in 0..N {
@@ -307,7 +299,7 @@ fn reciprocity_diffuse_two_sample() {
         let label = format!("{}: diffuse reciprocity θi = {ti}, θo = {to}", surface.name());
         let scale = a.mean().max(b.mean());
         assert!(scale > 1e-4, "{label}: vanishing phase function {scale:e}: vacuous");
-        common::assert_two_sample(&label, &a, &b, z, 0.03 * scale);
+        validation::assert_two_sample(&label, &a, &b, z, 0.03 * scale);
         (a.mean() - b.mean()).abs() / (a.se().hypot(b.se()))
     });
     let worst = out.iter().cloned().fold(0.0, f64::max);
@@ -328,7 +320,7 @@ const INSIDE_THETA: f64 = 2.5;
 const CHI2_N: usize = 100_000;
 
 #[test]
-fn sampling_chi2_exact() {
+fn sampling_chi2_exact_4_3_3() {
     // (surface, θi, ωi outside)
     let surfaces = surfaces(&[Kind::Conductor, Kind::Dielectric]);
     let mut cases = Vec::new();
@@ -340,20 +332,20 @@ fn sampling_chi2_exact() {
             cases.push((s, INSIDE_THETA, false));
         }
     }
-    let alpha = common::sidak(0.01, cases.len());
+    let alpha = validation::sidak(0.01, cases.len());
     // the dielectric's branch probabilities: z-tests, one per dielectric case
     let dielectric_cases = cases.iter().filter(|c| surfaces[c.0].kind() == Kind::Dielectric).count();
-    let z = common::family_z(0.01, dielectric_cases);
+    let z = validation::family_z(0.01, dielectric_cases);
     let p_values = par_map(&cases, |i, &(s, theta, wi_out)| {
         let surface = &surfaces[s];
         let wi = wi_at(theta);
         let label = format!("{}: sample_phase, θi = {theta}, ωi outside = {wi_out}", surface.name());
-        let mut rng = common::rng(3000 + i as u64);
-        let mut dummy = common::rng(0);
+        let mut rng = validation::rng(3000 + i as u64);
+        let mut dummy = validation::rng(0);
         let mut same_side = 0usize;
         let pdf = |wo: Vec3| {
             if wi_out {
-                surface.eval(wi, wo, &mut common::rng(0))
+                surface.eval(wi, wo, &mut validation::rng(0))
             } else {
                 surface.total(wi, wo, false, &mut dummy)
             }
@@ -389,7 +381,14 @@ fn sampling_chi2_exact() {
             for k in 0..CHI2_N {
                 stats.push(if k < same_side { 1.0 } else { 0.0 });
             }
-            common::assert_mean(&format!("{label}: reflection probability"), &stats, p_same, z, 2e-3, 1e-4);
+            validation::assert_mean(
+                &format!("{label}: reflection probability"),
+                &stats,
+                p_same,
+                z,
+                2e-3,
+                1e-4,
+            );
         }
         outcome.p_value
     });
@@ -406,134 +405,51 @@ const DIFFUSE_NPHI: usize = 20;
 /// Uniform directions (one stochastic eval each) per cell for the expected probabilities.
 const PER_CELL: usize = 10_000;
 const DIFFUSE_CHI2_N: usize = 50_000;
+/// The largest noise ratio N·Var(m̂)/m of a cell at which the test keeps its power.
+const MAX_NOISE_RATIO: f64 = 0.25;
 
 #[test]
-fn sampling_chi2_diffuse_stochastic_density() {
+fn sampling_chi2_diffuse_stochastic_density_4_3_3() {
     let surfaces = surfaces(&[Kind::Diffuse]);
     let cases: Vec<(usize, f64)> =
         (0..surfaces.len()).flat_map(|s| SAMPLE_THETAS.iter().map(move |&t| (s, t))).collect();
-    let alpha = common::sidak(0.01, cases.len());
+    let alpha = validation::sidak(0.01, cases.len());
     let out = par_map(&cases, |i, &(s, theta)| {
         let surface = &surfaces[s];
         let wi = wi_at(theta);
         let label = format!("{}: sample_phase, θi = {theta}", surface.name());
-        let mut rng = common::rng(4000 + i as u64);
-        let mut expectation_rng = common::rng(5000 + i as u64);
-        stochastic_chi2(
+        let mut rng = validation::rng(4000 + i as u64);
+        let mut expectation_rng = validation::rng(5000 + i as u64);
+        let grid = StochasticGrid {
+            z_lo: -1.0,
+            nz: DIFFUSE_NZ,
+            nphi: DIFFUSE_NPHI,
+            cell_start: PER_CELL,
+            cell_max: PER_CELL,
+            noise_ratio: 0.0,
+            max_noise_ratio: MAX_NOISE_RATIO,
+        };
+        stochastic_chi2_with(
             &label,
-            DIFFUSE_NZ,
-            DIFFUSE_NPHI,
-            PER_CELL,
+            grid,
             &mut |wo| surface.eval(wi, wo, &mut expectation_rng),
             &mut || {
                 let s = surface.sample(wi, &mut rng);
                 assert_eq!(s.weight, Vec3::ONE, "{label}: white diffuse weight");
                 assert!(s.outside);
-                s.wo
+                Some(s.wo)
             },
             DIFFUSE_CHI2_N,
             alpha,
         )
     });
-    let worst = out.iter().map(|o| o.0).fold(1.0, f64::min);
-    let worst_ratio = out.iter().map(|o| o.1).fold(0.0, f64::max);
+    let worst = out.iter().map(|o| o.p_value).fold(1.0, f64::min);
+    let worst_ratio = out.iter().map(|o| o.max_ratio).fold(0.0, f64::max);
     println!(
         "diffuse phase sampling χ²: {} tests, N = {DIFFUSE_CHI2_N}, {PER_CELL} evals per cell, worst p = {worst:.3e} \
          (α = {alpha:.2e}), largest N·Var(m̂)/m = {worst_ratio:.3}",
         cases.len()
     );
-}
-
-/// Chi-square test of `sample` against a density known only through an unbiased stochastic
-/// estimator `density`, over an equal-area `nz` × `nphi` grid of (cos θ, φ) on the sphere.
-///
-/// The expected probability m̂ of each cell is the cell's area times the mean of `per_cell`
-/// evaluations at independent uniform points of the cell, with variance Var m̂ = area²·SE².
-/// Cells with N m̂ < 5 are pooled. The statistic Σ (O − N m̂)²/(N m̂ + N² Var m̂) has mean
-/// k − Σ m/(1 + N Var m̂/m) over the k cells used; it is compared with the chi-square
-/// distribution of that (fractional) number of degrees of freedom. Returns the p-value and
-/// the largest noise ratio N Var m̂/m; panics with a report if p < `alpha`, or if the noise of
-/// the expectation is not small against the multinomial noise (ratio > 0.25: the test would
-/// lose its power).
-#[allow(clippy::too_many_arguments)]
-fn stochastic_chi2(
-    label: &str,
-    nz: usize,
-    nphi: usize,
-    per_cell: usize,
-    density: &mut dyn FnMut(Vec3) -> f64,
-    sample: &mut dyn FnMut() -> Vec3,
-    n: usize,
-    alpha: f64,
-) -> (f64, f64) {
-    let mut point_rng = common::rng(0x5eed);
-    let cell_of = |w: Vec3| -> usize {
-        let w = w.as_dvec3().normalize();
-        let iz = (((w.z.clamp(-1.0, 1.0) + 1.0) / 2.0 * nz as f64) as usize).min(nz - 1);
-        let ip = ((w.y.atan2(w.x).rem_euclid(TAU) / TAU * nphi as f64) as usize).min(nphi - 1);
-        iz * nphi + ip
-    };
-    let cells = nz * nphi;
-    let (mut mass, mut var) = (vec![0.0; cells], vec![0.0; cells]);
-    for iz in 0..nz {
-        for ip in 0..nphi {
-            let (z0, dz) = (-1.0 + 2.0 * iz as f64 / nz as f64, 2.0 / nz as f64);
-            let (p0, dp) = (TAU * ip as f64 / nphi as f64, TAU / nphi as f64);
-            let mut stats = Stats::default();
-            for _ in 0..per_cell {
-                let z = z0 + dz * common::uniform64(&mut point_rng);
-                let phi = p0 + dp * common::uniform64(&mut point_rng);
-                let s = (1.0 - z * z).max(0.0).sqrt();
-                let w = DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3();
-                stats.push(density(w));
-            }
-            let area = dz * dp;
-            mass[iz * nphi + ip] = area * stats.mean();
-            var[iz * nphi + ip] = (area * stats.se()).powi(2);
-        }
-    }
-    let mut observed = vec![0u64; cells];
-    for _ in 0..n {
-        let w = sample();
-        assert!(w.is_finite(), "{label}: non-finite sample {w}");
-        observed[cell_of(w)] += 1;
-    }
-    let nf = n as f64;
-    let (mut stat, mut dof, mut max_ratio) = (0.0, 0.0, 0.0f64);
-    let (mut pool_m, mut pool_v, mut pool_o) = (0.0, 0.0, 0.0);
-    let mut add = |m: f64, v: f64, o: f64, stat: &mut f64, dof: &mut f64| {
-        let denom = nf * m + nf * nf * v;
-        *stat += (o - nf * m).powi(2) / denom;
-        let ratio = nf * v / m;
-        max_ratio = max_ratio.max(ratio);
-        *dof += 1.0 - m / (1.0 + ratio);
-    };
-    for c in 0..cells {
-        if nf * mass[c] < 5.0 {
-            pool_m += mass[c];
-            pool_v += var[c];
-            pool_o += observed[c] as f64;
-        } else {
-            add(mass[c], var[c], observed[c] as f64, &mut stat, &mut dof);
-        }
-    }
-    if pool_m > 0.0 {
-        add(pool_m, pool_v, pool_o, &mut stat, &mut dof);
-    } else {
-        assert!(pool_o == 0.0, "{label}: {pool_o} samples fell where the density is zero");
-    }
-    let total: f64 = mass.iter().sum();
-    let p_value = 1.0 - ChiSquared::new(dof).unwrap().cdf(stat);
-    assert!(
-        max_ratio <= 0.25,
-        "{label}: the expectation is too noisy (N·Var(m̂)/m = {max_ratio:.3}): raise the evaluations per cell"
-    );
-    assert!(
-        p_value >= alpha,
-        "{label}: chi-square rejects the sampler: χ² = {stat:.2}, dof = {dof:.2}, p = {p_value:.3e} < α = {alpha:.3e} \
-         (N = {n}, Σm̂ = {total:.5}, largest N·Var(m̂)/m = {max_ratio:.3})"
-    );
-    (p_value, max_ratio)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -572,7 +488,7 @@ fn connection_equals_vertex_and_both_densities() {
         assert!(checked > 1000, "{label}: only {checked} non-zero densities checked");
         checked
     }
-    let mut rng = common::rng(0xc0ec);
+    let mut rng = validation::rng(0xc0ec);
     let gold = ComplexIor::new(Vec3::new(0.18, 0.42, 1.37), Vec3::new(3.42, 2.35, 1.77)).unwrap();
     for (ax, ay) in [(0.05, 0.05), (0.5, 0.5), (1.0, 0.2)] {
         check("conductor GGX", Ggx::new(ax, ay).unwrap(), Conductor::perfect(), &mut rng);

@@ -19,11 +19,7 @@
 //! SE so that the test can fail; chi-square tests run at the Šidák-corrected level
 //! `sidak(0.01, CHI2_FAMILY)` over all chi-square tests of this file. Every generator is a
 //! fixed-seed PCG.
-mod common;
 
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate_sphere;
-use common::{Stats, TestRng, assert_two_sample, dir, family_z, par_map, sidak, uniform32, uniform64};
 use glam::{Vec2, Vec3};
 use microsurface::{
     Beckmann, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor,
@@ -31,6 +27,11 @@ use microsurface::{
     ScatteringOrder, ShadingFrame, Shadowing, SpecularLimit, Technique, Transport, sample_cosine_hemisphere,
 };
 use std::f64::consts::PI;
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
+use validation::{
+    Stats, TestRng, assert_two_sample, dir, family_z, par_map, sidak, uniform_sphere, uniform32, uniform64,
+};
 
 const ETA: f32 = 1.5;
 /// Roughness of the multiple-scattering tests (enough for a visible second order).
@@ -113,14 +114,6 @@ const ALL_TECHNIQUES: [(&str, Technique); 6] = [
 fn eta_ratio_sq(wo: Vec3, wi: Vec3) -> f32 {
     let eta = |w: Vec3| if w.z > 0.0 { 1.0 } else { ETA };
     (eta(wo) / eta(wi)).powi(2)
-}
-
-/// A uniform direction on the sphere.
-fn uniform_sphere(rng: &mut TestRng) -> Vec3 {
-    let z = 2.0 * uniform64(rng) - 1.0;
-    let phi = 2.0 * PI * uniform64(rng);
-    let s = (1.0 - z * z).max(0.0).sqrt();
-    glam::DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()
 }
 
 fn rel_close(a: Vec3, b: Vec3, rel: f32) -> bool {
@@ -290,8 +283,8 @@ fn check_weight_vs_albedo<S: MicrosurfaceSlope, M: Material + SpecularLimit>(
 ) {
     let label = format!("{label} wo = {wo}");
     let exact = is_exact(b);
-    let w = weight_stats(&label, b, wo, exact, n_sample, &mut common::rng(seed));
-    let mut rng = common::rng(seed + 1_000_000);
+    let w = weight_stats(&label, b, wo, exact, n_sample, &mut validation::rng(seed));
+    let mut rng = validation::rng(seed + 1_000_000);
     let a = albedo_stats(&label, b, wo, exact, n_eval, &mut rng);
     compare_channels(&label, &w, &a, chromatic, z);
 }
@@ -473,8 +466,8 @@ fn pdf_mass<B: Bsdf>(b: &B, wo: Vec3) -> f64 {
 fn chi2_exact<B: Bsdf>(label: &str, b: &B, wo: Vec3, seed: u64, z: f64, pdf_scale: f64) -> (f64, f64) {
     let mass = pdf_mass(b, wo);
     assert!(mass <= 1.0 + 1e-3, "{label}: ∫pdf = {mass} > 1");
-    let mut rng = common::rng(seed);
-    let mut eval_rng = common::rng(seed + 7);
+    let mut rng = validation::rng(seed);
+    let mut eval_rng = validation::rng(seed + 7);
     let out = chi2_test(
         label,
         chi2_grid(),
@@ -665,11 +658,11 @@ fn normal_mapping_weight_is_unbiased() {
         let albedo = match backfacing_bsdf(sname, gold()) {
             (Some(b), _) => {
                 check_weight_vs_albedo(&label, &b, wo, true, 60_000, 60_000, seed, z);
-                albedo_stats(&label, &b, wo, true, 2_000, &mut common::rng(seed + 5))
+                albedo_stats(&label, &b, wo, true, 2_000, &mut validation::rng(seed + 5))
             }
             (_, Some(b)) => {
                 check_weight_vs_albedo(&label, &b, wo, true, 60_000, 60_000, seed, z);
-                albedo_stats(&label, &b, wo, true, 2_000, &mut common::rng(seed + 5))
+                albedo_stats(&label, &b, wo, true, 2_000, &mut validation::rng(seed + 5))
             }
             _ => unreachable!(),
         };
@@ -744,8 +737,8 @@ impl Visit for TransportCheck {
             let ratio = eta_ratio_sq(wo, wi);
             let mut nonzero = 0;
             for seed in 0..40 {
-                let fr = r.eval_rng(wo, wi, &mut common::rng(seed));
-                let fi = i.eval_rng(wo, wi, &mut common::rng(seed));
+                let fr = r.eval_rng(wo, wi, &mut validation::rng(seed));
+                let fi = i.eval_rng(wo, wi, &mut validation::rng(seed));
                 assert_eq!(fr.exact, fi.exact, "{label}");
                 assert!(
                     rel_close(fr.f, fi.f * ratio, 1e-5),
@@ -760,8 +753,8 @@ impl Visit for TransportCheck {
         for wo in [view_out(), view_in()] {
             let mut crossed = 0;
             for seed in 0..400 {
-                let sr = r.sample_rng(wo, &mut common::rng(seed));
-                let si = i.sample_rng(wo, &mut common::rng(seed));
+                let sr = r.sample_rng(wo, &mut validation::rng(seed));
+                let si = i.sample_rng(wo, &mut validation::rng(seed));
                 match (sr, si) {
                     (None, None) => {}
                     (Some(sr), Some(si)) => {
@@ -798,7 +791,7 @@ fn transport_modes_differ_by_the_eta_ratio() {
 /// missing or misplaced η² changes f by a factor 2.25).
 #[test]
 fn single_scattering_is_reciprocal() {
-    let mut rng = common::rng(4000);
+    let mut rng = validation::rng(4000);
     let ss = Technique::SingleScattering;
     let d = mf(ggx(0.4, 0.7), dielectric()).with_technique(ss);
     let c = mf(beckmann(0.6, 0.3), gold()).with_technique(ss);
@@ -845,7 +838,7 @@ fn stochastic_models_are_reciprocal() {
     let mut seed = 4100;
     let mut stats = |label: &str, f: &mut dyn FnMut(&mut TestRng) -> f64, n: usize| {
         seed += 1;
-        let mut rng = common::rng(seed);
+        let mut rng = validation::rng(seed);
         let mut s = Stats::default();
         for _ in 0..n {
             s.push(f(&mut rng));
@@ -883,7 +876,7 @@ fn stochastic_models_are_reciprocal() {
 
 #[test]
 fn shading_frame_is_orthonormal_and_round_trips() {
-    let mut rng = common::rng(5000);
+    let mut rng = validation::rng(5000);
     let mut normals = vec![
         Vec3::Z,
         -Vec3::Z,
@@ -951,7 +944,7 @@ fn energy_batches<S: MicrosurfaceSlope, M: Material + SpecularLimit>(
     walks: usize,
     seed: u64,
 ) -> (Stats, Stats) {
-    let mut rng = common::rng(seed);
+    let mut rng = validation::rng(seed);
     let (mut total, mut first) = (Stats::default(), Stats::default());
     for _ in 0..batches {
         let t = b.energy_by_order(wo, walks, &mut rng);
@@ -979,7 +972,7 @@ fn albedo_mean_stats<S: MicrosurfaceSlope, M: Material + SpecularLimit>(
     n: usize,
     seed: u64,
 ) -> Stats {
-    let mut rng = common::rng(seed);
+    let mut rng = validation::rng(seed);
     let mut st = Stats::default();
     for _ in 0..n {
         let w = proposal_sample(b, wo, &mut rng);
@@ -1075,7 +1068,7 @@ fn check_bad_input<B: Bsdf>(
     backfacing_view_valid: bool,
     seed: u64,
 ) {
-    let mut rng = common::rng(seed);
+    let mut rng = validation::rng(seed);
     let (good_o, good_i) = (dir(0.6, 0.3), dir(0.8, 2.0));
     let zero_f = |v: &BsdfValue| v.f == Vec3::ZERO;
     let zero_pdf = |p: &f32| *p == 0.0;
@@ -1159,7 +1152,7 @@ impl Visit for BadInput {
         _: &[Vec3],
     ) {
         self.0 += 1;
-        // every technique accepts backfacing views of opaque materials (tests/backfacing_views.rs)
+        // every technique accepts backfacing views of opaque materials (tests/walk/backfacing_views.rs)
         check_bad_input(label, b, !M::TRANSMITS, true, self.0);
     }
 }
@@ -1223,7 +1216,7 @@ fn classic_rejects_invalid_parameters() {
 
 #[test]
 fn classic_is_reciprocal() {
-    let mut rng = common::rng(7000);
+    let mut rng = validation::rng(7000);
     for ndf in [ClassicNdf::Phong(30.0), ClassicNdf::Beckmann(0.3), ClassicNdf::Ggx(0.3)] {
         let b = ClassicBrdf::new(
             Vec3::new(0.3, 0.4, 0.5),
@@ -1264,7 +1257,7 @@ fn dyn_scene() -> Vec<(String, Box<dyn Bsdf>)> {
 #[test]
 fn identical_inputs_give_identical_bits() {
     let scene = dyn_scene();
-    let mut rng = common::rng(8000);
+    let mut rng = validation::rng(8000);
     let calls: Vec<(Vec3, Vec3, f32, Vec2, u64)> = (0..64)
         .map(|_| {
             let wo = uniform_sphere(&mut rng);
@@ -1367,7 +1360,7 @@ fn hashed_eval_is_unbiased_over_many_pairs() {
     par_map(&cases, |i, &(v, t, glass)| {
         let wo = views[v];
         let (tname, technique) = techniques[t];
-        let mut rng = common::rng(8100 + i as u64);
+        let mut rng = validation::rng(8100 + i as u64);
         let (albedo, reference) = if glass {
             let b = mf(ggx(ALPHA_MS, ALPHA_MS), dielectric())
                 .with_technique(technique)
@@ -1431,7 +1424,7 @@ fn research_albedo<S: MicrosurfaceSlope, M: Material + SpecularLimit>(
 /// E[eval]·|cos θi| (non-absorptive materials in importance transport: weights 1).
 #[test]
 fn stochastic_sample_with_stratified_uniforms_passes_chi_square() {
-    use common::stochastic::stochastic_chi2;
+    use validation::stochastic::stochastic_chi2;
     const SIDE: usize = 224; // 50 176 samples
     let cases = [
         ("walk conductor", false, Technique::RandomWalk),
@@ -1441,7 +1434,7 @@ fn stochastic_sample_with_stratified_uniforms_passes_chi_square() {
     let alpha_test = sidak(0.01, cases.len());
     let p = par_map(&cases, |i, &(label, glass, t)| {
         let wo = dir(0.6, 0.8);
-        let mut rng = common::rng(8200 + i as u64);
+        let mut rng = validation::rng(8200 + i as u64);
         let uniforms = stratified_uniforms(SIDE, &mut rng);
         let run = |b: &dyn Bsdf, z_lo: f64, nz: usize| {
             let mut key = 0u64;
@@ -1523,7 +1516,7 @@ fn pixel_keys_decorrelate_repeated_directions() {
     );
     // and the keyed image is an unbiased estimate: its mean against the research walk's
     let mut reference = Stats::default();
-    let mut rng = common::rng(8300);
+    let mut rng = validation::rng(8300);
     for _ in 0..200_000 {
         let f = b.surface().eval(wo, wi, ScatteringOrder::All, &mut rng);
         reference.push(f64::from(f.element_sum()) / 3.0 / f64::from(wi.z));
@@ -1576,7 +1569,7 @@ fn flags_describe_the_lobes() {
 /// reflection, and consistent with the side of wi.
 #[test]
 fn samples_carry_the_relative_index() {
-    let mut rng = common::rng(8400);
+    let mut rng = validation::rng(8400);
     let (mut entering, mut leaving, mut reflected) = (0, 0, 0);
     for (_, t) in ALL_TECHNIQUES {
         let b = mf(ggx(ALPHA_MS, ALPHA_MS), dielectric()).with_technique(t);
@@ -1625,7 +1618,7 @@ fn backfacing_views_keep_their_lobe_across_smooth_alpha() {
     for (k, (tname, t)) in cases.into_iter().enumerate() {
         let stats = [0.99, 1.01].map(|f| {
             let b = mf(ggx(f * SMOOTH_ALPHA, f * SMOOTH_ALPHA), gold()).with_technique(t);
-            let mut rng = common::rng(8600 + k as u64);
+            let mut rng = validation::rng(8600 + k as u64);
             let mut st = Stats::default();
             for _ in 0..N {
                 st.push(b.sample_rng(wo, &mut rng).map_or(0.0, |s| f64::from(s.weight.x)));
@@ -1649,7 +1642,7 @@ fn the_specular_limit_below_smooth_alpha() {
     let wo = dir(0.6, 0.4);
     let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
     let f_glass = fresnel_dielectric(wo.z, ETA);
-    let mut rng = common::rng(8500);
+    let mut rng = validation::rng(8500);
     for (tname, t) in ALL_TECHNIQUES {
         // conductor
         let b = mf(ggx(below, 0.5 * below), gold()).with_technique(t);
@@ -1716,7 +1709,7 @@ fn the_specular_limit_below_smooth_alpha() {
 /// passes straight through with weight 1, and eval and pdf are 0.
 #[test]
 fn index_matched_dielectric_is_a_specular_transmission() {
-    let mut rng = common::rng(8600);
+    let mut rng = validation::rng(8600);
     for (tname, t) in ALL_TECHNIQUES {
         let b = mf(ggx(0.5, 0.5), Dielectric::new(1.0).unwrap()).with_technique(t);
         let f = b.flags();
@@ -1765,7 +1758,7 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
     let slope = ggx(0.4, 0.25);
     let gold_b = mf(slope, gold()).with_technique(Technique::SingleScattering);
     let glass_b = mf(slope, dielectric()).with_technique(Technique::SingleScattering);
-    let mut rng = common::rng(8700);
+    let mut rng = validation::rng(8700);
     let (mut reflections, mut refractions) = (0, 0);
     for _ in 0..2000 {
         let wo = dir(1.4 * uniform64(&mut rng), 2.0 * PI * uniform64(&mut rng));

@@ -6,15 +6,14 @@
 //! A = Λ(−ωv)|cos θv|; for low roughness both are of order e^{−a²} (Beckmann, a = |cot θ|/αᵢ):
 //! an f32 subnormal from a ≈ 9.6, 0 in f64 from a ≈ 26.6. The weight of a perfect conductor
 //! is Λ(−ωv)/(Λ(−ωv) + Λ(ωl)), a ratio of two such numbers (issue 12, defect 2).
-mod common;
 
-use common::{TestRng, dir, uniform32};
 use glam::{Vec2, Vec3};
 use microsurface::{
     Beckmann, Bsdf, ComplexIor, Conductor, Ggx, Material, MicrofacetBsdf, MicrosurfaceSlope, SpecularLimit,
     Technique,
 };
 use statrs::function::erf::erfc;
+use validation::{TestRng, dir, uniform32};
 
 /// The largest relative difference allowed between a sample's weight and f·|cos θ|/pdf at its
 /// direction. Both are formed from the same f32 phase density and the same f64 masking
@@ -95,7 +94,7 @@ fn subnormal_backfacing_lambda_matches_an_independent_reference() {
     let d = (-((h.x / ax64).powi(2) + (h.y / ay64).powi(2)) / (h.z * h.z)).exp()
         / (core::f64::consts::PI * ax64 * ay64 * h.z.powi(4));
     let pdf_ref = d / (4.0 * lv * f64::from(v.z.abs()));
-    let mut rng = common::rng(12);
+    let mut rng = validation::rng(12);
     let f = b.eval(v, l).f.x;
     let pdf = b.pdf(v, l);
     let ratio = f64::from(f * l.z / pdf);
@@ -118,7 +117,7 @@ const RESOLVED_MEDIAN_COS: f32 = 1e-4;
 /// The median ωv·ωm of `n` visible normals of `slope` seen from `wv`.
 fn median_visible_cos<S: MicrosurfaceSlope>(slope: &S, wv: Vec3, n: usize, rng: &mut TestRng) -> f32 {
     let mut c: Vec<f32> = (0..n)
-        .map(|_| wv.dot(slope.sample_d_wi(wv, common::uniform32(rng), common::uniform32(rng))))
+        .map(|_| wv.dot(slope.sample_d_wi(wv, validation::uniform32(rng), validation::uniform32(rng))))
         .collect();
     c.sort_by(f32::total_cmp);
     c[n / 2]
@@ -136,7 +135,7 @@ fn backfacing_single_scattering_weights_match_down_to_the_smallest_roughness() {
     let mut pairs: Vec<(f32, f32)> = [1e-4, 1e-3, 0.02, 0.05, 0.2, 1.0].iter().map(|&a| (a, a)).collect();
     pairs.extend([(1e-4, 0.5), (0.3, 1e-3), (0.12920733, 5.243904e-4), (1e-3, 1e-4)]);
     let views = [(1.6, 0.3), (1.8, 1.2), (2.3, 0.7), (2.9, 2.0)];
-    let mut rng = common::rng(1212);
+    let mut rng = validation::rng(1212);
     let mut report = Vec::new();
     for &(ax, ay) in &pairs {
         for &(theta, phi) in &views {

@@ -2,15 +2,14 @@
 //! weight equals f·|cos θi|/pdf at its direction to f32 precision, also for low roughness at
 //! grazing views and for the samples drawn from the most extreme uniforms, and no sample
 //! comes back with a subnormal pdf or BSDF value (whose precision is lost).
-mod common;
 
-use common::dir;
 use core::convert::Infallible;
 use glam::{Vec2, Vec3};
 use microsurface::{
     Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Ggx, Material, MicrofacetBsdf, MicrosurfaceSlope,
     SpecularLimit, Technique,
 };
+use validation::dir;
 
 /// Weight against f·|cos|/pdf without a Fresnel weight (perfect conductor, dielectric): both
 /// come from the same f32 density and f64 masking, a few ulps apart; 16 ulps allowed.
@@ -63,7 +62,7 @@ fn check_one<S: MicrosurfaceSlope, M: Material + SpecularLimit, R: rand::Rng>(
 /// GGX α = 1e-4 at grazing: gold weights were 3.5e-4 apart from f·cos/pdf at cos θ = 1e-4).
 #[test]
 fn low_roughness_grazing_weights_match() {
-    let mut rng = common::rng(5);
+    let mut rng = validation::rng(5);
     let n = 2000;
     for alpha in [1e-4f32, 1e-3] {
         for cos in [1e-2f64, 1e-3, 1e-4, 1e-5] {

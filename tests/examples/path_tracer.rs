@@ -3,14 +3,12 @@
 //! gold sphere that match an independent numerical integral; renders are the same bits for
 //! any number of threads.
 
-mod common;
-#[path = "../examples/path_tracer/tracer.rs"]
-mod tracer;
-
-use common::{Stats, family_z};
 use glam::Vec3;
 use microsurface::{Bsdf, ComplexIor, Conductor, Ggx, MicrofacetBsdf, ShadingFrame, Technique};
-use tracer::{Camera, Environment, Hit, RenderStats, Scene, Sphere, render, showcase_scene};
+use validation::tracer::{
+    self, Camera, Environment, Hit, RenderStats, Scene, Sphere, render, showcase_scene,
+};
+use validation::{Stats, family_z};
 
 /// Every BSDF call is a pure function of its arguments and the tracer's generators are
 /// seeded per row: one thread and three threads render the same bits (a stochastic BSDF that
@@ -91,7 +89,7 @@ fn single_scattering_pixels_match_a_numerical_integral() {
     let (width, height) = (64u32, 64u32);
     let pixels = [(32u32, 32u32), (20, 30), (44, 40), (32, 16), (25, 47)];
     let z = family_z(0.01, pixels.len() * 3);
-    let mut rng = common::rng(2024);
+    let mut rng = validation::rng(2024);
     let stats = RenderStats::default();
     for (px, py) in pixels {
         let d = camera.ray(px as f32 + 0.5, py as f32 + 0.5, width, height);
@@ -107,7 +105,7 @@ fn single_scattering_pixels_match_a_numerical_integral() {
                 let f = bsdf.eval(wo, wi).f;
                 f64::from(f[c]) * f64::from(wi.z) * f64::from(sky.radiance(frame.to_world(wi))[c])
             };
-            *r = common::quadrature::integrate_sphere(&mut integrand, 16, 32, true, 1e-6, 8);
+            *r = validation::quadrature::integrate_sphere(&mut integrand, 16, 32, true, 1e-6, 8);
         }
         // the path tracer at the pixel centre
         let mut channels = [Stats::default(); 3];
@@ -118,7 +116,7 @@ fn single_scattering_pixels_match_a_numerical_integral() {
             }
         }
         for c in 0..3 {
-            common::assert_mean(
+            validation::assert_mean(
                 &format!("pixel ({px}, {py}) channel {c}"),
                 &channels[c],
                 reference[c],

@@ -3,21 +3,9 @@
 //! the albedos add up), and every SVG and the HTML page parse and reference only files that
 //! exist.
 
-#[path = "../examples/report/configure.rs"]
-mod configure;
-#[path = "../examples/report/measure.rs"]
-mod measure;
-#[path = "../examples/report/pipeline.rs"]
-mod pipeline;
-#[path = "../examples/report/plot.rs"]
-mod plot;
-#[path = "../examples/report/reduce.rs"]
-mod reduce;
-#[path = "../examples/report/write.rs"]
-mod write;
-
-use configure::{Config, Est, LOBE_MATERIALS, Options};
 use std::path::Path;
+use validation::report::configure::{Config, Est, LOBE_MATERIALS, Options};
+use validation::report::{configure, pipeline};
 
 fn quick_report() -> (pipeline::Report, std::path::PathBuf) {
     let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));
@@ -219,7 +207,7 @@ fn quick_report_is_complete_finite_and_consistent() {
     }
 
     // (PT and BDPT estimating the same model is tested with adequate sample sizes in
-    // tests/position_free.rs: at the quick report's 1024 samples the PT estimates of
+    // tests/position_free/estimators.rs: at the quick report's 1024 samples the PT estimates of
     // near-specular configurations are too heavy-tailed for their sample SE to be trusted)
 
     // the white furnace of the non-absorptive walks: ∫eval = 1 within 5 SE, and the albedo

@@ -1,8 +1,8 @@
 //! The height distributions: the round trip c1(inv_c1(u)) = u, the documented end values,
 //! the density against the CDF by quadrature, the Gaussian CDF against statrs, and no NaN.
-mod common;
 
 use microsurface::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+use validation::check::ulp32;
 
 /// Half the f32 spacing at 1: the rounding of a value in [½, 1].
 const HALF_ULP_1: f64 = f32::EPSILON as f64 * 0.5;
@@ -175,7 +175,7 @@ fn gaussian_height() {
         let back = height.c1(h);
         let (u64_, h64) = (f64::from(u), f64::from(h));
         let tail = u64_.min(1.0 - u64_);
-        let bound = 2.0 * (1.0 + h64 * h64) * HALF_ULP_1 * tail + 0.5 * ulp32(u);
+        let bound = 2.0 * (1.0 + h64 * h64) * HALF_ULP_1 * tail + 0.5 * ulp32(f64::from(u));
         let ratio = (f64::from(back) - u64_).abs() / bound;
         if ratio > worst {
             worst = ratio;
@@ -190,10 +190,4 @@ fn gaussian_height() {
     println!("gaussian: ∫p1 = {mass:.12}, max |c1 − ∫p1| = {diff:.3e}");
     assert!((mass - 1.0).abs() < 2e-7, "gaussian: ∫p1 = {mass}");
     assert!(diff < 2e-7, "gaussian: c1 differs from ∫p1 by {diff:e}");
-}
-
-/// The f32 spacing at |u| (2⁻¹⁴⁹ for subnormals).
-fn ulp32(u: f32) -> f64 {
-    let u = u.abs();
-    if u == 0.0 { f64::from(f32::from_bits(1)) } else { f64::from(u.next_up() - u) }
 }

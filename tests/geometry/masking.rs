@@ -5,15 +5,14 @@
 //! Notation: Λi = Λ(ωi), Λo = Λ(ωo); c = C¹(h). A ray leaving c0 = C¹(h0) upwards in ω escapes
 //! with probability c0^Λ(ω); otherwise it hits at c ∈ [c0, 1) with P(hit, c ≤ x) = 1 − (c0/x)^Λ.
 //! A downward ray always hits, with P(c ≤ x) = (x/c0)^|Λ(ω)|, |Λ(ω)| = 1 + Λ(−ω).
-mod common;
 
-use common::{Stats, TestRng, assert_mean, dir, family_z, sidak, uniform32, uniform64};
 use glam::Vec3;
 use microsurface::{
     Beckmann, GaussianHeight, Ggx, HeightSample, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope,
     UniformHeight,
 };
 use statrs::function::{beta as sbeta, erf as serf};
+use validation::{Stats, TestRng, assert_mean, dir, family_z, sidak, uniform32, uniform64};
 
 /// Samples per expectation: SE ≤ √(¼/N) = 1.6e-3 for a probability.
 const N: usize = 100_000;
@@ -137,7 +136,7 @@ impl Visitor for Masking {
 #[test]
 fn masking_4_1_1() {
     let z = family_z(FAMILY_ALPHA, SURFACES * THETAS.len() * 2);
-    for_each_surface(&mut Masking { rng: common::rng(411), z });
+    for_each_surface(&mut Masking { rng: validation::rng(411), z });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -197,13 +196,13 @@ impl Visitor for MaskingShadowing {
 #[test]
 fn masking_shadowing_4_1_2() {
     let z = family_z(FAMILY_ALPHA, SURFACES * PAIRS.len() * 2);
-    for_each_surface(&mut MaskingShadowing { rng: common::rng(412), z, transmission: false });
+    for_each_surface(&mut MaskingShadowing { rng: validation::rng(412), z, transmission: false });
 }
 
 #[test]
 fn masking_shadowing_transmission_4_1_3() {
     let z = family_z(FAMILY_ALPHA, SURFACES * PAIRS.len() * 2);
-    for_each_surface(&mut MaskingShadowing { rng: common::rng(413), z, transmission: true });
+    for_each_surface(&mut MaskingShadowing { rng: validation::rng(413), z, transmission: true });
 }
 
 /// C¹(h0) values of the starting heights of 4.1.4/4.1.5: the supplement's invC1(0.99), inside
@@ -270,13 +269,13 @@ impl Visitor for ShadowingGivenMasking {
 #[test]
 fn shadowing_given_masking_4_1_4() {
     let z = family_z(FAMILY_ALPHA, SURFACES * START_C1.len() * PAIRS.len() * 2);
-    for_each_surface(&mut ShadowingGivenMasking { rng: common::rng(414), z, transmission: false });
+    for_each_surface(&mut ShadowingGivenMasking { rng: validation::rng(414), z, transmission: false });
 }
 
 #[test]
 fn shadowing_given_masking_transmission_4_1_5() {
     let z = family_z(FAMILY_ALPHA, SURFACES * START_C1.len() * PAIRS.len() * 2);
-    for_each_surface(&mut ShadowingGivenMasking { rng: common::rng(415), z, transmission: true });
+    for_each_surface(&mut ShadowingGivenMasking { rng: validation::rng(415), z, transmission: true });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -426,7 +425,7 @@ fn hit_heights_follow_their_distribution() {
     // escape-rate tests: up directions × finite starts × surfaces
     let escape_family = SURFACES * KS_UP.len() * 2;
     let mut v = HitHeights {
-        rng: common::rng(4100),
+        rng: validation::rng(4100),
         cases: Vec::new(),
         z: family_z(FAMILY_ALPHA, escape_family),
         escape_tests: 0,
@@ -466,7 +465,7 @@ fn ks_rejects_a_wrong_hit_distribution() {
     let g = MicrosurfaceGeometry::new(UniformHeight, Ggx::isotropic(1.0).unwrap());
     let h0 = g.height().inv_c1(0.9);
     let c0 = UniformHeight.c1_ref(h0);
-    let mut rng = common::rng(4101);
+    let mut rng = validation::rng(4101);
     let (mut right, mut wrong) = (Vec::new(), Vec::new());
     for _ in 0..KS_ATTEMPTS {
         let c = UniformHeight.c1_ref(hit(g.sample_height(-Vec3::Z, h0, uniform32(&mut rng)), "down"));
@@ -576,5 +575,5 @@ impl Visitor for SpecialCases {
 
 #[test]
 fn sample_height_special_cases() {
-    for_each_surface(&mut SpecialCases { rng: common::rng(4102) });
+    for_each_surface(&mut SpecialCases { rng: validation::rng(4102) });
 }

@@ -2,29 +2,14 @@
 //! parameter; degenerate but legal inputs (grazing and near-grazing directions, ωo = −ωi, the
 //! poles, η = 1 and η = 1 + 1e-6) give finite results from every evaluation and sampling
 //! routine.
-mod common;
 
-use common::TestRng;
 use glam::Vec3;
 use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Error, GaussianHeight, Ggx, Material, Microsurface,
+    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, Material, Microsurface,
     MicrosurfaceHeight, MicrosurfaceSlope, ScatteringOrder, UniformHeight,
 };
-
-fn assert_rejects<T: std::fmt::Debug>(result: Result<T, Error>, name: &str, value: f32) {
-    match result {
-        Err(Error::InvalidParameter { name: n, value: v, .. }) => {
-            assert_eq!(n, name, "wrong parameter named for {value}");
-            assert!(
-                v.to_bits() == value.to_bits() || (v.is_nan() && value.is_nan()),
-                "reported {v}, passed {value}"
-            );
-        }
-        Ok(x) => panic!("`{name}` = {value} was accepted: {x:?}"),
-        #[allow(unreachable_patterns)]
-        Err(e) => panic!("`{name}` = {value}: unexpected error {e:?}"),
-    }
-}
+use validation::TestRng;
+use validation::check::assert_rejects;
 
 const BAD_POSITIVE: [f32; 7] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0, -1.0, -1e-30];
 
@@ -132,7 +117,7 @@ fn check_materials<H: MicrosurfaceHeight, S: MicrosurfaceSlope>(h: H, s: S, rng:
 
 #[test]
 fn degenerate_inputs_give_finite_results() {
-    let mut rng = common::rng(99);
+    let mut rng = validation::rng(99);
     let mut n = 0;
     for (ax, ay) in [(0.5, 0.5), (1.0, 0.1), (2.0, 2.0), (1e-3, 1e-3)] {
         n += check_materials(UniformHeight, Ggx::new(ax, ay).unwrap(), &mut rng);

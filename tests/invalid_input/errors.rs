@@ -2,32 +2,10 @@
 //! `Error::InvalidParameter { name, value, expected }` naming the offending parameter; the
 //! error's Display names it too, and `Error` is a `std::error::Error`.
 use glam::Vec3;
-use microsurface::{
-    Beckmann, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Dielectric, Diffuse, Error, Ggx,
-};
+use microsurface::{Beckmann, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Dielectric, Diffuse, Ggx};
+use validation::check::assert_rejects;
 
 const NON_FINITE: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
-
-/// Asserts that `result` is `InvalidParameter` for `name` with the rejected `value` (NaN
-/// compared as NaN), a non-empty `expected`, and a Display that contains the name.
-#[track_caller]
-fn assert_rejects<T: std::fmt::Debug>(result: Result<T, Error>, name: &str, value: f32) {
-    let err = result.expect_err(&format!("{name} = {value} must be rejected"));
-    match err {
-        Error::InvalidParameter { name: n, value: v, expected } => {
-            assert_eq!(n, name, "wrong parameter named for {name} = {value}");
-            assert!(
-                v == value || (v.is_nan() && value.is_nan()),
-                "{name}: reported value {v}, passed {value}"
-            );
-            assert!(!expected.is_empty(), "{name}: empty `expected`");
-        }
-        #[allow(unreachable_patterns)]
-        other => panic!("{name} = {value}: unexpected error {other:?}"),
-    }
-    let shown = err.to_string();
-    assert!(shown.contains(name), "Display `{shown}` does not name `{name}`");
-}
 
 #[test]
 fn roughness_constructors() {

@@ -12,10 +12,8 @@
 //! between both sides for a dielectric). The phase component follows the sharp single-bounce
 //! lobe at low roughness; the cosine component covers the multiply scattered light.
 //! Accumulation is in f64; every generator is a fixed-seed PCG.
-mod common;
-use common::par_map;
+use validation::par_map;
 
-use common::{Stats, TestRng, family_z, uniform64};
 use glam::Vec3;
 use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Estimator, Ggx, Material, Microsurface,
@@ -24,6 +22,7 @@ use microsurface::{
 };
 use rand::RngExt;
 use std::f64::consts::{PI, TAU};
+use validation::{Stats, TestRng, family_z, uniform64};
 
 const ETA: f32 = 1.5;
 /// Azimuth of the incident directions (so that anisotropic roughness matters).
@@ -126,7 +125,7 @@ fn beckmann(ax: f32, ay: f32) -> Beckmann {
 
 /// Incident direction at polar angle θ (azimuth `PHI_I`), from below if `inside`.
 fn incident(theta: f64, inside: bool) -> Vec3 {
-    let w = common::dir(theta, PHI_I);
+    let w = validation::dir(theta, PHI_I);
     if inside { -w } else { w }
 }
 
@@ -277,7 +276,7 @@ fn white_furnace() {
     const N_BDPT_CONDUCTOR: usize = 56_000;
     let thetas = [0.0, 0.8, 1.5];
     let alphas = [(0.1, 0.1), (0.5, 0.5), (1.0, 1.0), (1.0, 0.1)];
-    let mut coin = common::rng(0xf0_4ace);
+    let mut coin = validation::rng(0xf0_4ace);
     let mut runs = Vec::new();
     for &theta in &thetas {
         for &(ax, ay) in &alphas {
@@ -300,7 +299,7 @@ fn white_furnace() {
             (_, _) => dielectric(beckmann(ax, ay), sh),
         };
         let wi = incident(theta, mat == 2);
-        let mut rng = common::rng(0xf0_0000 + i as u64);
+        let mut rng = validation::rng(0xf0_0000 + i as u64);
         let n = match (est, mat) {
             (Estimator::Pt, 0) => N_PT_CONDUCTOR,
             (Estimator::Pt, _) => N_PT,
@@ -338,7 +337,7 @@ fn white_furnace() {
         // the dielectric estimators are heavy-tailed (PT NEE into sharp lobes, chains of
         // from-below incidences): the budget only reaches SE ≲ 2.5e-2 for their worst runs
         let max_se = if runs[i].4 == 0 { 3e-3 } else { 6e-2 };
-        common::assert_mean(label, stats, 1.0, z, max_se, 1e-4);
+        validation::assert_mean(label, stats, 1.0, z, max_se, 1e-4);
     }
 }
 
@@ -375,7 +374,7 @@ fn stats_of(values: impl IntoIterator<Item = f64>) -> Stats {
 /// Asserts a two-sample agreement with a relative bound on the combined SE.
 fn assert_agree(label: &str, a: &Stats, b: &Stats, z: f64, rel_se: f64) {
     let scale = a.mean().abs().max(b.mean().abs()).max(1e-3);
-    common::assert_two_sample(label, a, b, z, rel_se * scale);
+    validation::assert_two_sample(label, a, b, z, rel_se * scale);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -396,19 +395,19 @@ fn pt_and_bdpt_agree() {
         let diff = || {
             boxed(beckmann(0.8, 0.8), Diffuse::new(Vec3::new(0.8, 0.5, 0.2)).unwrap(), sh, "diffuse Beckmann")
         };
-        cases.push((cond(), common::dir(0.3, 0.0), common::dir(0.9, 2.5)));
-        cases.push((cond(), common::dir(1.3, 0.0), common::dir(1.2, 0.2)));
-        cases.push((diel(), common::dir(0.5, 0.0), common::dir(0.8, 2.0)));
-        cases.push((diel(), common::dir(0.5, 0.0), common::dir(2.4, 1.0)));
-        cases.push((diel(), common::dir(1.2, 0.0), common::dir(2.9, 0.5)));
-        cases.push((diel(), -common::dir(0.6, 0.0), common::dir(2.5, 2.0)));
-        cases.push((diel(), -common::dir(0.3, 0.0), common::dir(0.7, 1.0)));
-        cases.push((diff(), common::dir(0.4, 0.0), common::dir(1.0, 2.0)));
-        cases.push((diff(), common::dir(1.4, 0.0), common::dir(0.2, 1.0)));
+        cases.push((cond(), validation::dir(0.3, 0.0), validation::dir(0.9, 2.5)));
+        cases.push((cond(), validation::dir(1.3, 0.0), validation::dir(1.2, 0.2)));
+        cases.push((diel(), validation::dir(0.5, 0.0), validation::dir(0.8, 2.0)));
+        cases.push((diel(), validation::dir(0.5, 0.0), validation::dir(2.4, 1.0)));
+        cases.push((diel(), validation::dir(1.2, 0.0), validation::dir(2.9, 0.5)));
+        cases.push((diel(), -validation::dir(0.6, 0.0), validation::dir(2.5, 2.0)));
+        cases.push((diel(), -validation::dir(0.3, 0.0), validation::dir(0.7, 1.0)));
+        cases.push((diff(), validation::dir(0.4, 0.0), validation::dir(1.0, 2.0)));
+        cases.push((diff(), validation::dir(1.4, 0.0), validation::dir(0.2, 1.0)));
     }
     let z = family_z(0.01, cases.len());
     let results = par_map(&cases, |i, (m, wi, wo)| {
-        let mut rng = common::rng(0xb0_0000 + i as u64);
+        let mut rng = validation::rng(0xb0_0000 + i as u64);
         let pt = point(m.as_ref(), *wi, *wo, Estimator::Pt, ALL, N_PT, &mut rng);
         let bdpt = point(m.as_ref(), *wi, *wo, Estimator::Bdpt, ALL, N_BDPT, &mut rng);
         (format!("PT vs BDPT {} ωi={wi} ωo={wo}", m.label()), pt, bdpt)
@@ -439,7 +438,7 @@ fn pt_and_bdpt_agree() {
 /// factors). The uncorrelated one equals it times G1(ωi)G1(ωo)/G2 for reflection.
 #[test]
 fn single_bounce_paths() {
-    let mut rng = common::rng(0x51);
+    let mut rng = validation::rng(0x51);
     let mut worst = 0.0f64;
     let mut checked = 0;
     for (ax, ay) in [(0.2, 0.2), (0.7, 0.7), (1.0, 0.3)] {
@@ -508,13 +507,21 @@ fn sphere(rng: &mut TestRng) -> Vec3 {
 fn orders_sum_to_the_whole() {
     const N: usize = 12_000;
     let models = [
-        (conductor(ggx(0.7, 0.7), Shadowing::Correlated), common::dir(0.6, 0.0), common::dir(1.0, 2.0)),
+        (
+            conductor(ggx(0.7, 0.7), Shadowing::Correlated),
+            validation::dir(0.6, 0.0),
+            validation::dir(1.0, 2.0),
+        ),
         (
             conductor(beckmann(1.0, 1.0), Shadowing::Uncorrelated),
-            common::dir(1.2, 0.0),
-            common::dir(0.3, 1.0),
+            validation::dir(1.2, 0.0),
+            validation::dir(0.3, 1.0),
         ),
-        (dielectric(ggx(0.7, 0.7), Shadowing::Correlated), common::dir(0.6, 0.0), common::dir(2.5, 2.0)),
+        (
+            dielectric(ggx(0.7, 0.7), Shadowing::Correlated),
+            validation::dir(0.6, 0.0),
+            validation::dir(2.5, 2.0),
+        ),
     ];
     let mut cases = Vec::new();
     for (mi, _) in models.iter().enumerate() {
@@ -527,7 +534,7 @@ fn orders_sum_to_the_whole() {
     let z = family_z(0.01, cases.len());
     let results = par_map(&cases, |i, &(mi, est, k)| {
         let (m, wi, wo) = &models[mi];
-        let mut rng = common::rng(0x0d_0000 + i as u64);
+        let mut rng = validation::rng(0x0d_0000 + i as u64);
         let mut sum = Stats::default();
         let mut whole = Stats::default();
         let target = if k == 64 { ALL } else { up_to(k) };
@@ -571,10 +578,10 @@ fn orders_sum_to_the_whole() {
 fn reciprocity() {
     const N: usize = 60_000;
     let pairs = [
-        (common::dir(0.3, 0.2), common::dir(1.1, 2.5)),
-        (common::dir(1.3, 0.0), common::dir(0.6, 1.0)),
-        (common::dir(0.5, 0.4), common::dir(2.7, 0.4 + std::f64::consts::PI)),
-        (-common::dir(0.4, 0.0), -common::dir(1.0, 1.5)),
+        (validation::dir(0.3, 0.2), validation::dir(1.1, 2.5)),
+        (validation::dir(1.3, 0.0), validation::dir(0.6, 1.0)),
+        (validation::dir(0.5, 0.4), validation::dir(2.7, 0.4 + std::f64::consts::PI)),
+        (-validation::dir(0.4, 0.0), -validation::dir(1.0, 1.5)),
     ];
     let mut cases = Vec::new();
     for sh in [Shadowing::Uncorrelated, Shadowing::Correlated] {
@@ -592,7 +599,7 @@ fn reciprocity() {
     let n_unc = cases.iter().filter(|c| c.0.label().contains("Uncorrelated")).count();
     let z = family_z(0.01, n_unc);
     let results = par_map(&cases, |i, (m, wi, wo)| {
-        let mut rng = common::rng(0x4ec_0000 + i as u64);
+        let mut rng = validation::rng(0x4ec_0000 + i as u64);
         let eta_sq = |w: Vec3| if w.z < 0.0 { f64::from(ETA * ETA) } else { 1.0 };
         let mut fwd = Stats::default();
         let mut bwd = Stats::default();
@@ -654,7 +661,7 @@ fn heitz_comparison() {
     // per case: total (corr vs walk) + 4 orders × 2 models (PT vs own sample)
     let z = family_z(0.01, cases.len() * (1 + 8));
     let results = par_map(&cases, |i, &(mat, theta)| {
-        let mut rng = common::rng(0x4e17_0000 + i as u64);
+        let mut rng = validation::rng(0x4e17_0000 + i as u64);
         let wi = incident(theta, false);
         let slope = ggx(1.0, 1.0);
         // walk: fraction of exits per order
@@ -751,7 +758,7 @@ fn heitz_comparison() {
     }
 }
 
-use common::assert_two_sample;
+use validation::assert_two_sample;
 
 // ---------------------------------------------------------------------------------------------
 // Per order against deterministic quadrature (conductor F = 1, GGX α = 1)
@@ -1021,7 +1028,7 @@ fn per_order_albedos_against_quadrature() {
     // (θ index, estimate): 0 walk, 1/2 PT, 3/4 BDPT, 5/6 own sample() (correlated, uncorrelated)
     let jobs: Vec<(usize, usize)> = (0..thetas.len()).flat_map(|t| (0..7).map(move |e| (t, e))).collect();
     let results = par_map(&jobs, |i, &(t, e)| {
-        let mut rng = common::rng(0x9e7_0000 + i as u64);
+        let mut rng = validation::rng(0x9e7_0000 + i as u64);
         let wi = incident(thetas[t], false);
         let sh = if e % 2 == 1 { Shadowing::Correlated } else { Shadowing::Uncorrelated };
         let pf = PositionFree::new(slope, Conductor::perfect(), sh);
@@ -1085,7 +1092,7 @@ fn per_order_albedos_against_quadrature() {
         }];
         for k in 0..3 {
             let l = format!("conductor F=1 GGX α=1 θi={} {label} order {}", thetas[t], k + 1);
-            common::assert_mean(&l, &st[k], reference[k], z, 2.5e-3, 0.0);
+            validation::assert_mean(&l, &st[k], reference[k], z, 2.5e-3, 0.0);
         }
     }
 }
@@ -1114,7 +1121,7 @@ fn bdpt_subpath_cap_loses_negligible_energy() {
     let results = par_map(&cases, |i, &(sh, inside)| {
         let m = dielectric(ggx(2.0, 2.0), sh);
         let wi = incident(1.5, inside);
-        let mut rng = common::rng(0xca9_0000 + i as u64);
+        let mut rng = validation::rng(0xca9_0000 + i as u64);
         let mut long = 0u64;
         let mut lost = 0u64;
         for _ in 0..N_WALK {
@@ -1125,7 +1132,7 @@ fn bdpt_subpath_cap_loses_negligible_energy() {
             }
         }
         let mut pairs = Vec::new();
-        for wo in [common::dir(1.4, 2.0), common::dir(2.0, 0.5)] {
+        for wo in [validation::dir(1.4, 2.0), validation::dir(2.0, 0.5)] {
             let pt = point(m.as_ref(), wi, wo, Estimator::Pt, ALL, 60_000, &mut rng);
             let bdpt = point(m.as_ref(), wi, wo, Estimator::Bdpt, ALL, 20_000, &mut rng);
             pairs.push((wo, pt, bdpt));
@@ -1162,7 +1169,7 @@ fn bdpt_subpath_cap_loses_negligible_energy() {
 /// returns finite, non-negative values (and `sample` finite directions and weights).
 #[test]
 fn degenerate_input_stays_finite() {
-    let mut rng = common::rng(0xbad);
+    let mut rng = validation::rng(0xbad);
     let mut models: Vec<Box<dyn Model>> = Vec::new();
     for sh in [Shadowing::Uncorrelated, Shadowing::Correlated] {
         for a in [1e-3f32, 0.5, 4.0] {
@@ -1182,8 +1189,8 @@ fn degenerate_input_stays_finite() {
         Vec3::new(g, 0.0, -1e-7),
         Vec3::Z,
         -Vec3::Z,
-        common::dir(0.7, 1.0),
-        -common::dir(0.7, 1.0),
+        validation::dir(0.7, 1.0),
+        -validation::dir(0.7, 1.0),
     ];
     let mut count = 0;
     for m in &models {

@@ -3,12 +3,10 @@
 //! E[eval_bdpt(ωi, ωo)] = f·|cos θo| as a density of ωo, for both shadowing models
 //! (Wang et al. 2022, §4.3).
 
-mod common;
-
-use common::par_map;
-use common::stochastic::stochastic_chi2;
 use glam::Vec3;
 use microsurface::{Conductor, Dielectric, Ggx, Material, PositionFree, ScatteringOrder, Shadowing};
+use validation::par_map;
+use validation::stochastic::stochastic_chi2;
 
 /// Samples per test.
 const N: usize = 50_000;
@@ -22,9 +20,9 @@ fn run<M: Material>(
     alpha_test: f64,
 ) -> f64 {
     let pf = PositionFree::new(Ggx::isotropic(alpha).unwrap(), material, shadowing);
-    let wi = common::dir(0.5, 0.3);
-    let mut eval_rng = common::rng(seed);
-    let mut sample_rng = common::rng(seed + 1);
+    let wi = validation::dir(0.5, 0.3);
+    let mut eval_rng = validation::rng(seed);
+    let mut sample_rng = validation::rng(seed + 1);
     let transmits = M::TRANSMITS;
     let z_lo = if transmits { -1.0 } else { 0.0 };
     let (nz, nphi) = if transmits { (16, 16) } else { (8, 16) };
@@ -57,7 +55,7 @@ fn position_free_sampling_matches_the_averaged_evaluation() {
             })
         })
         .collect();
-    let alpha_test = common::sidak(0.01, cases.len());
+    let alpha_test = validation::sidak(0.01, cases.len());
     let p = par_map(&cases, |i, &(dielectric, alpha, sh)| {
         let seed = 9_000 + 10 * i as u64;
         if dielectric {

@@ -1,5 +1,5 @@
 //! The accuracy map: every f32 function of the crate against a double-precision reference
-//! (`examples/stability/reference.rs`, statrs special functions) on a dense grid — α
+//! (`validation/src/reference.rs`, statrs special functions) on a dense grid — α
 //! log-spaced over [1e-4, 4] (12 isotropic values and 5 anisotropic pairs, ratios up to 1e4),
 //! cos θ over [−1, 1] down to 1e-9 and exactly 0 at the horizon (and sin θ = 1e-20, 1e-30 at
 //! the poles), several azimuths; Fresnel terms on 2005 cosines.
@@ -17,11 +17,8 @@
 //!
 //! Tests marked `#[ignore = "library bug: …"]` exceed their bound because of a defect found
 //! here (root cause and fix in the report); un-ignore them once it is fixed.
-#[path = "../examples/stability/reference.rs"]
-mod reference;
-
-use reference::FunctionReport;
 use std::sync::OnceLock;
+use validation::reference::{self, FunctionReport};
 
 fn map() -> &'static [FunctionReport] {
     static MAP: OnceLock<Vec<FunctionReport>> = OnceLock::new();

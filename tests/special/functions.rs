@@ -3,9 +3,9 @@
 //!
 //! Run with `cargo test --release --test special_functions -- --nocapture` to see the measured
 //! figures.
-mod common;
 
 use statrs::function::{beta as sbeta, erf as serf, gamma as sgamma};
+use validation::check::ulp32;
 
 /// 2/√π = erf'(0).
 const TWO_OVER_SQRT_PI: f64 = std::f64::consts::FRAC_2_SQRT_PI;
@@ -19,13 +19,6 @@ fn key(x: f32) -> i64 {
 /// The distance in f32 ulps between `x` and `reference` rounded to f32.
 fn ulp_distance(x: f32, reference: f64) -> u64 {
     key(x).abs_diff(key(reference as f32))
-}
-
-/// The spacing of the f32 numbers at |v| (subnormal spacing 2⁻¹⁴⁹ below the normal range).
-fn ulp32(v: f64) -> f64 {
-    let v = v.abs();
-    let e = if v == 0.0 { -1023 } else { ((v.to_bits() >> 52) & 0x7ff) as i32 - 1023 };
-    2f64.powi(e.max(-126) - 23)
 }
 
 /// |x − reference| in units of the f32 spacing at the reference (0.5 = correctly rounded).

@@ -4,9 +4,6 @@
 //! (eq. 4.3, monostatic G1), the convergence of the iteration, Fresnel extraction, the α fits,
 //! and the extraction's cost.
 
-mod common;
-
-use common::dir;
 use glam::Vec3;
 use microsurface::{
     BackscatterShadowing, Beckmann, ComplexIor, Conductor, Error, Ggx, Microsurface, MicrosurfaceSlope,
@@ -14,6 +11,7 @@ use microsurface::{
     fresnel_conductor,
 };
 use std::f64::consts::FRAC_PI_2;
+use validation::dir;
 
 /// The backscattering f_r(o, o) of the crate's single-scattering conductor on `slope`.
 fn crate_backscatter<S: MicrosurfaceSlope>(slope: S, ior: Option<ComplexIor>) -> impl Fn(f64) -> f64 {
@@ -21,7 +19,7 @@ fn crate_backscatter<S: MicrosurfaceSlope>(slope: S, ior: Option<ComplexIor>) ->
     let surface = Microsurface::new(UniformHeight, slope, material);
     move |theta: f64| {
         let o = dir(theta, 0.0);
-        let mut g = common::rng(0);
+        let mut g = validation::rng(0);
         f64::from(surface.eval_single_scattering(o, o, &mut g).x) / f64::from(o.z)
     }
 }
@@ -208,7 +206,7 @@ fn fresnel_round_trip() {
     let surface = Microsurface::new(UniformHeight, ggx, Conductor::new(gold));
     let bins = 12;
     let fresnel = extract_fresnel(&e.slope, BackscatterShadowing::HeightCorrelated, bins, 24, 24, |i, o| {
-        let mut g = common::rng(0);
+        let mut g = validation::rng(0);
         f64::from(surface.eval_single_scattering(i, o, &mut g).x) / f64::from(o.z)
     });
     for (b, f) in fresnel.iter().enumerate() {
@@ -264,10 +262,10 @@ fn multiple_scattering_inversion() {
     // orders (all minus the exact single scattering) of the walk on a given slope
     let backscatter = |slope: &TabulatedSlope, seed: u64| -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
-        let rows = common::par_map(&angles, |i, &theta| {
+        let rows = validation::par_map(&angles, |i, &theta| {
             let o = dir(theta, 0.0);
-            let mut g = common::rng(seed + i as u64);
-            let mut st = common::Stats::default();
+            let mut g = validation::rng(seed + i as u64);
+            let mut st = validation::Stats::default();
             for _ in 0..samples {
                 st.push(f64::from(surface.eval(o, o, ScatteringOrder::All, &mut g).x) / f64::from(o.z));
             }
@@ -328,7 +326,7 @@ fn anisotropic_round_trip() {
     let surface = Microsurface::new(UniformHeight, ggx, Conductor::perfect());
     let start = std::time::Instant::now();
     let e = extract_anisotropic_fn(0.3, 0.6, 24, 8, BackscatterShadowing::HeightCorrelated, |o| {
-        let mut g = common::rng(0);
+        let mut g = validation::rng(0);
         f64::from(surface.eval_single_scattering(o, o, &mut g).x) / f64::from(o.z)
     })
     .unwrap();

@@ -4,15 +4,13 @@
 //! anisotropic GGX (no analytic model in the crate), agreement with the analytic anisotropic
 //! GGX, and the white furnace of the walk.
 
-mod common;
-
-use common::chi2::{Chi2Grid, chi2_test};
-use common::{Stats, assert_mean, dir, family_z, rng, sidak, uniform32, uniform64};
 use glam::Vec3;
 use microsurface::{
     Conductor, Ggx, GridSlope, Microsurface, MicrosurfaceSlope, ScatteringOrder, UniformHeight,
 };
 use std::f64::consts::{PI, TAU};
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::{Stats, assert_mean, dir, family_z, rng, sidak, uniform32, uniform64};
 
 /// GGX (αx, αy) rotated by ψ in the slope plane.
 fn rotated_ggx(ax: f64, ay: f64, psi: f64) -> impl Fn(f64, f64) -> f64 {
@@ -121,7 +119,7 @@ fn sampler_chi2() {
     let cases = [(0.0, 0.0), (0.8, 0.7), (1.45, 2.0), (2.1, 4.0)];
     let alpha = sidak(1e-3, cases.len());
     let grid = Chi2Grid { quad_tol: 1e-6, max_depth: 8, ..Chi2Grid::sphere(12, 16) };
-    common::par_map(&cases, |k, &(theta, phi)| {
+    validation::par_map(&cases, |k, &(theta, phi)| {
         let mut g = rng(0x9d + k as u64);
         let wi = dir(theta, phi);
         chi2_test(

@@ -1,15 +1,13 @@
 //! The MERL isotropic BRDF format: round trip of files the crate writes from its own models,
 //! MERL's nearest-bin lookup, bad files, and the extraction (Dupuy 2015 §4.2) run on a file.
 
-mod common;
-
-use common::{dir, rng, uniform64};
 use glam::Vec3;
 use microsurface::{
     BackscatterShadowing, Conductor, Ggx, MerlBrdf, MerlError, Microsurface, TabulatedSlope, UniformHeight,
     extract_isotropic_fn, half_diff_angles,
 };
 use std::f64::consts::{FRAC_PI_2, PI};
+use validation::{dir, rng, uniform64};
 
 fn ggx_brdf(alpha: f32) -> impl Fn(Vec3, Vec3) -> Vec3 {
     let surface = Microsurface::new(UniformHeight, Ggx::isotropic(alpha).unwrap(), Conductor::perfect());

@@ -4,16 +4,14 @@
 //! whole sphere, agreement with the analytic GGX and Beckmann it tabulates, and the random walk
 //! on a non-analytic distribution (a mixture of two GGX lobes): white furnace and reciprocity.
 
-mod common;
-
-use common::chi2::{Chi2Grid, chi2_test};
-use common::{Stats, assert_mean, assert_two_sample, dir, family_z, rng, sidak, uniform32, uniform64};
 use glam::Vec3;
 use microsurface::{
     Beckmann, Conductor, Dielectric, Diffuse, Error, Estimator, Ggx, MicrofacetBsdf, Microsurface,
     MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, TabulatedSlope, UniformHeight,
 };
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::{Stats, assert_mean, assert_two_sample, dir, family_z, rng, sidak, uniform32, uniform64};
 
 /// 16-point Gauss–Legendre nodes and weights on [−1, 1].
 const GL16: [(f64, f64); 8] = [
@@ -246,7 +244,7 @@ fn sampler_chi2() {
         cases.iter().map(|&(l, t, th)| (l, t, th, false)).collect();
     jobs.push(("12 rings, sample_p22_11", &coarse, 0.8, true));
     jobs.push(("12 rings, sample_p22_11", &coarse, 2.4, true));
-    common::par_map(&jobs, |k, &(label, t, theta, stretched)| {
+    validation::par_map(&jobs, |k, &(label, t, theta, stretched)| {
         let mut g = rng(0x7ab + k as u64);
         let wi = dir(theta, if stretched { 2.0 } else { 0.9 });
         let a = t.alpha_x();
@@ -407,7 +405,7 @@ fn walk_matches_analytic_ggx() {
     let n = 60_000;
     for theta in thetas {
         let wi = dir(theta, 0.2);
-        let orders = |surface: &dyn Fn(&mut common::TestRng) -> Option<u32>, seed: u64| {
+        let orders = |surface: &dyn Fn(&mut validation::TestRng) -> Option<u32>, seed: u64| {
             let mut g = rng(seed);
             let mut stats = [Stats::default(); 3];
             for _ in 0..n {
@@ -440,7 +438,7 @@ fn white_furnace_on_mixture() {
     let mut g = rng(9);
     for theta in thetas {
         let wi = dir(theta, 0.0);
-        type Eval<'a> = &'a dyn Fn(Vec3, Vec3, &mut common::TestRng) -> f32;
+        type Eval<'a> = &'a dyn Fn(Vec3, Vec3, &mut validation::TestRng) -> f32;
         let c: Eval = &|wi, wo, g| conductor.eval(wi, wo, ScatteringOrder::All, g).x;
         let d: Eval = &|wi, wo, g| diffuse.eval(wi, wo, ScatteringOrder::All, g).x;
         for (label, eval) in [("conductor", c), ("diffuse", d)] {
@@ -542,7 +540,7 @@ fn stretched_anisotropic() {
     let grid = Chi2Grid { quad_tol: 1e-6, max_depth: 8, ..Chi2Grid::sphere(12, 16) };
     let cases = [(0.7, 0.4), (2.2, 1.0)];
     let alpha = sidak(1e-3, cases.len());
-    common::par_map(&cases, |k, &(theta, phi)| {
+    validation::par_map(&cases, |k, &(theta, phi)| {
         let mut g = rng(0x5ee + k as u64);
         let wi = dir(theta, phi);
         chi2_test(
@@ -615,7 +613,7 @@ fn invalid_input_gives_the_documented_nothing() {
     fn check<S: MicrosurfaceSlope>(name: &str, s: S, bad: &[Vec3]) {
         for &w in bad {
             if cfg!(debug_assertions) {
-                continue; // the debug assertion fires instead (tests/invalid_input.rs checks the mode)
+                continue; // the debug assertion fires instead (tests/invalid_input/policy.rs checks the mode)
             }
             assert!(s.lambda(w).is_nan(), "{name}: lambda({w})");
             assert!(s.projected_area(w).is_nan(), "{name}: projected_area({w})");

@@ -6,19 +6,18 @@
 //! slopes are stretched to α = 1 and rotated to the azimuth of the incident direction ω, where
 //! the normals visible from ω are the half-plane x' < κ = cot θ̃ (θ̃ the stretched angle of
 //! ω). The half-plane is mapped to a rectangle by x' = tan u, y' = √(1 + x'²) tan v and
-//! integrated with the adaptive 5×5 Gauss–Legendre of `common::quadrature::integrate`.
+//! integrated with the adaptive 5×5 Gauss–Legendre of `validation::quadrature::integrate`.
 //! Every assertion states its absolute tolerance (1e-4), which covers the quadrature error
 //! (adaptive tolerances 1e-7 absolute and 1e-6 relative per initial cell) and the f32
 //! evaluations of the densities.
 //!
 //! One broad-lobe cross-check uses the sphere quadrature `integrate_sphere` in (cos θ, φ)
 //! instead, so that the slope-space mapping is not trusted blindly.
-mod common;
 
-use common::quadrature::{integrate_grid, integrate_sphere};
 use glam::Vec3;
 use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
 use std::f64::consts::FRAC_PI_2;
+use validation::quadrature::{self, CrossMap, VisibleTolerance, integrate_sphere};
 
 /// Roughness pairs (αx, αy) of the suite.
 const ALPHAS: [(f32, f32); 5] = [(0.05, 0.05), (0.3, 0.3), (1.0, 1.0), (1.0, 0.1), (0.2, 1.5)];
@@ -39,40 +38,17 @@ const ASSERT_TOL: f64 = 1e-4;
 /// (between the axes, so that αᵢ differs from both αx and αy).
 fn incident(alpha: (f32, f32), theta: f64) -> Vec3 {
     let phi = if alpha.0 == alpha.1 { 0.0 } else { 0.7 };
-    common::dir(theta, phi)
+    validation::dir(theta, phi)
 }
 
 /// ∫ g(ωm) dωm over the upper-hemisphere normals visible from `w` (w·ωm > 0, ωm.z > 0), in
-/// slope space adapted to the slope distribution `s`. `g` gets ωm (f32, unit) and must
+/// slope space adapted to the slope distribution `s` (`validation::quadrature::integrate_visible`
+/// with the tangent cross map, valid for any distribution). `g` gets ωm (f32, unit) and must
 /// return the integrand (e.g. D(ωm) times something). Returns 0 if `w` = −z (nothing is
 /// visible).
-fn integrate_visible<S: MicrosurfaceSlope>(s: &S, w: Vec3, mut g: impl FnMut(Vec3) -> f64) -> f64 {
-    let (ax, ay) = (f64::from(s.alpha_x()), f64::from(s.alpha_y()));
-    let (wx, wy, wz) = (f64::from(w.x) * ax, f64::from(w.y) * ay, f64::from(w.z));
-    let h = (wx * wx + wy * wy).sqrt();
-    let (cos_phi, sin_phi, u_hi) = if h > 0.0 {
-        (wx / h, wy / h, (wz / h).atan())
-    } else if wz > 0.0 {
-        (1.0, 0.0, FRAC_PI_2)
-    } else {
-        return 0.0;
-    };
-    let lo = -FRAC_PI_2;
-    let mut f = |u: f64, v: f64| {
-        let (x, dx) = (u.tan(), 1.0 / (u.cos() * u.cos()));
-        let sigma = (1.0 + x * x).sqrt();
-        let (y, dy) = (sigma * v.tan(), sigma / (v.cos() * v.cos()));
-        // stretched and rotated slopes → slopes
-        let sx = ax * (cos_phi * x - sin_phi * y);
-        let sy = ay * (sin_phi * x + cos_phi * y);
-        let norm = (1.0 + sx * sx + sy * sy).sqrt();
-        let m = Vec3::new((-sx / norm) as f32, (-sy / norm) as f32, (1.0 / norm) as f32);
-        let cos3 = 1.0 / (norm * norm * norm);
-        let value = g(m);
-        if value == 0.0 { 0.0 } else { value * cos3 * ax * ay * dx * dy }
-    };
-    // an initial grid fine enough that the adaptive refinement sees every lobe
-    integrate_grid(&mut f, lo, u_hi, 24, 12, QUAD_TOL, REL_TOL, MAX_DEPTH)
+fn integrate_visible<S: MicrosurfaceSlope>(s: &S, w: Vec3, g: impl FnMut(Vec3) -> f64) -> f64 {
+    let tol = VisibleTolerance { abs_tol: QUAD_TOL, rel_tol: REL_TOL, max_depth: MAX_DEPTH };
+    quadrature::integrate_visible((s.alpha_x(), s.alpha_y()), CrossMap::Tangent, w, tol, g)
 }
 
 /// The ten slope distributions of the suite: GGX and Beckmann at every roughness.
@@ -141,7 +117,7 @@ impl Failures {
 
 /// Supplement §4.2.1: ∫ D_ωi(ωm) dωm = 1 for 2 slopes × 5 roughnesses × 6 incident angles.
 #[test]
-fn vndf_integrates_to_one() {
+fn vndf_integrates_to_one_4_2_1() {
     let mut fails = Failures::default();
     let mut cases = 0;
     let mut worst = 0.0f64;
@@ -169,7 +145,7 @@ fn vndf_integrates_to_one() {
 
 /// ∫ D(ωm) cos θm dωm = 1 (the projected area towards the zenith) for every roughness.
 #[test]
-fn ndf_projects_to_unit_area() {
+fn ndf_projects_to_unit_area_4_2_1() {
     let mut fails = Failures::default();
     let mut cases = 0;
     for (name, s) in all_slopes() {
@@ -194,7 +170,7 @@ fn sphere_directions() -> Vec<Vec3> {
     let mut out = Vec::new();
     for t in thetas {
         for phi in [0.0, 0.7, 2.5] {
-            out.push(common::dir(t, phi));
+            out.push(validation::dir(t, phi));
         }
     }
     out

@@ -15,20 +15,20 @@
 //! half-plane is mapped to rectangles whose width follows the lobe (a tan map around the
 //! Gaussian/GGX peak above the horizon, a tan map of κ − x scaled to the tail below it), with
 //! cell edges at the kinks of the densities (x = κ, 3κ, −κ, 0), and integrated with the
-//! adaptive 5×5 Gauss–Legendre of `common::quadrature::integrate`. Sharp and broad lobes,
+//! adaptive 5×5 Gauss–Legendre of `validation::quadrature::integrate`. Sharp and broad lobes,
 //! isotropic or not, all become unit-width lobes there.
-mod common;
 
-use common::chi2::{Chi2Grid, Chi2Outcome, chi2_test};
-use common::quadrature::integrate;
-use common::{dir, rng, sidak, uniform32};
 use glam::{DVec3, Vec3};
 use microsurface::{
-    Beckmann, BeckmannNewton, Ggx, GgxDisk, GgxSphericalCap, MicrosurfaceSlope, SmithVndf, VCavity,
-    VisibleNormalSampler, smith_normalization,
+    Beckmann, BeckmannNewton, Ggx, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
+    smith_normalization,
 };
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use validation::check::panic_message;
+use validation::chi2::{Chi2Grid, Chi2Outcome, chi2_test};
+use validation::quadrature::{SlopeFamily, SlopeTails, integrate_upper};
+use validation::{dir, rng, sidak, uniform32};
 
 /// Family-wise significance of all the chi-square tests of the file.
 const FAMILY_ALPHA: f64 = 0.01;
@@ -77,8 +77,12 @@ const KINDS: [Kind; 7] = [
 ];
 
 impl Kind {
-    fn is_beckmann(self) -> bool {
-        matches!(self, Kind::SmithBeckmann | Kind::BeckmannNewton | Kind::VCavityBeckmann)
+    fn tails(self) -> SlopeTails {
+        if matches!(self, Kind::SmithBeckmann | Kind::BeckmannNewton | Kind::VCavityBeckmann) {
+            SlopeTails::Gaussian
+        } else {
+            SlopeTails::PowerLaw
+        }
     }
 }
 
@@ -113,18 +117,8 @@ fn make(kind: Kind, (ax, ay): (f32, f32)) -> Box<dyn Sampler> {
 }
 
 /// Three uniforms in [0, 1) from the seeded PCG.
-fn uniforms(rng: &mut common::TestRng) -> [f32; 3] {
+fn uniforms(rng: &mut validation::TestRng) -> [f32; 3] {
     [uniform32(rng), uniform32(rng), uniform32(rng)]
-}
-
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
-    if let Some(s) = payload.downcast_ref::<String>() {
-        s.clone()
-    } else if let Some(s) = payload.downcast_ref::<&str>() {
-        (*s).to_string()
-    } else {
-        "(non-string panic)".to_string()
-    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -132,102 +126,10 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 // ---------------------------------------------------------------------------------------
 
 /// ∫ f(ωm) dωm over the upper hemisphere (ωm.z > 0), in the stretched and rotated slope space
-/// of roughness (αx, αy) seen from `wi` (see the module documentation). `gaussian` selects the
-/// conditional width of ỹ (Beckmann: 1; GGX: √(1 + x̃²)). `f` gets ωm as a unit f32 vector.
-///
-/// Adaptive, with absolute tolerance `QUAD_REL_TOL` × (a first, coarse estimate of the
-/// integral), so that tiny integrals (H near the nadir) are also resolved relatively.
-fn integrate_slopes(alpha: (f32, f32), gaussian: bool, wi: Vec3, mut f: impl FnMut(Vec3) -> f64) -> f64 {
-    let coarse = integrate_slopes_tol(alpha, gaussian, wi, &mut f, None);
-    if coarse == 0.0 {
-        return 0.0;
-    }
-    integrate_slopes_tol(alpha, gaussian, wi, &mut f, Some(QUAD_REL_TOL * coarse.abs()))
-}
-
-/// x(s) and dx/ds of a segment parameterization of the stretched slope x̃.
-type SlopeMap = Box<dyn Fn(f64) -> (f64, f64)>;
-
-fn integrate_slopes_tol(
-    (ax, ay): (f32, f32),
-    gaussian: bool,
-    wi: Vec3,
-    f: &mut impl FnMut(Vec3) -> f64,
-    tol: Option<f64>,
-) -> f64 {
-    let (ax, ay) = (f64::from(ax), f64::from(ay));
-    let (wx, wy, wz) = (f64::from(wi.x) * ax, f64::from(wi.y) * ay, f64::from(wi.z));
-    let h = (wx * wx + wy * wy).sqrt();
-    let (cos_phi, sin_phi) = if h > 0.0 { (wx / h, wy / h) } else { (1.0, 0.0) };
-    // κ = cot θ̃ (+∞ straight above; everything is invisible straight below)
-    let kappa = if h > 0.0 {
-        wz / h
-    } else if wz > 0.0 {
-        f64::INFINITY
-    } else {
-        f64::NEG_INFINITY
-    };
-    // x(s) and dx/ds on segments of s, with breakpoints at the kinks
-    let (x_of, segments): (SlopeMap, Vec<f64>) = if kappa >= 0.0 {
-        // x = tan s on (−π/2, atan κ): the peak at x = 0, the mirror kink at x = −κ
-        let hi = kappa.atan();
-        let mut b = vec![-FRAC_PI_2, hi];
-        for x in [0.0, -kappa, -2.0 * kappa] {
-            let s = f64::atan(x);
-            if s > -FRAC_PI_2 && s < hi {
-                b.push(s);
-            }
-        }
-        b.sort_by(f64::total_cmp);
-        (Box::new(|s: f64| (s.tan(), 1.0 / (s.cos() * s.cos()))), b)
-    } else if kappa > f64::NEG_INFINITY {
-        // x = κ − c tan s, s ∈ (0, π/2): the lobe hugs x = κ (Beckmann) or spreads over |κ|
-        // (GGX); kinks at x = 3κ (V-cavity) and edges at x = 2κ, 0
-        let k = -kappa;
-        let c = if gaussian { 1.0 / (1.0 + 2.0 * k) } else { k.max(1.0) };
-        let mut b = vec![0.0, FRAC_PI_2];
-        for t in [k, 2.0 * k, 0.5 * k, 4.0 * k] {
-            b.push((t / c).atan());
-        }
-        b.sort_by(f64::total_cmp);
-        b.dedup();
-        (Box::new(move |s: f64| (kappa - c * s.tan(), c / (s.cos() * s.cos()))), b)
-    } else {
-        return 0.0;
-    };
-    let mut g = |s: f64, v: f64| {
-        let (x, dx) = x_of(s);
-        let sigma = if gaussian { 1.0 } else { (1.0 + x * x).sqrt() };
-        let (y, dy) = (sigma * v.tan(), sigma / (v.cos() * v.cos()));
-        let sx = ax * (cos_phi * x - sin_phi * y);
-        let sy = ay * (sin_phi * x + cos_phi * y);
-        let norm = (1.0 + sx * sx + sy * sy).sqrt();
-        if !norm.is_finite() {
-            return 0.0;
-        }
-        let m = Vec3::new((-sx / norm) as f32, (-sy / norm) as f32, (1.0 / norm) as f32);
-        let value = f(m);
-        if value == 0.0 { 0.0 } else { value * ax * ay * dx * dy / (norm * norm * norm) }
-    };
-    let (per_segment, nv) = (8usize, 12usize);
-    let cells = (segments.len() - 1) * per_segment * nv;
-    let (cell_tol, depth) = match tol {
-        Some(t) => (t / cells as f64, 3),
-        None => (f64::INFINITY, 1),
-    };
-    let mut total = 0.0;
-    for w in segments.windows(2) {
-        for i in 0..per_segment {
-            let s0 = w[0] + (w[1] - w[0]) * i as f64 / per_segment as f64;
-            let s1 = w[0] + (w[1] - w[0]) * (i + 1) as f64 / per_segment as f64;
-            for j in 0..nv {
-                let v0 = -FRAC_PI_2 + PI * j as f64 / nv as f64;
-                let v1 = -FRAC_PI_2 + PI * (j + 1) as f64 / nv as f64;
-                total += integrate(&mut g, s0, s1, v0, v1, cell_tol, depth);
-            }
-        }
-    }
-    total
+/// of roughness (αx, αy) seen from `wi` (see the module documentation and
+/// `validation::quadrature::integrate_upper`), relative tolerance `QUAD_REL_TOL`.
+fn integrate_slopes(alpha: (f32, f32), tails: SlopeTails, wi: Vec3, f: impl FnMut(Vec3) -> f64) -> f64 {
+    integrate_upper(alpha, tails, wi, QUAD_REL_TOL, f)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -255,8 +157,8 @@ const CHI2_QUAD_DEPTH: u32 = 5;
 ///   pole in the middle of the support {ωm.z > 0, ωi·ωm > 0}, normalize(z + ωi), as far as
 ///   possible from both of its edges (a pole near an edge, e.g. z at grazing incidence, lets
 ///   all the nodes of the cells around it miss their thin visible part).
-fn grid_for(sampler: &dyn Sampler, gaussian: bool, wi: Vec3, seed: u64) -> (Chi2Grid, String) {
-    let (mut grid, label) = if wi.z < 0.0 && gaussian {
+fn grid_for(sampler: &dyn Sampler, tails: SlopeTails, wi: Vec3, seed: u64) -> (Chi2Grid, String) {
+    let (mut grid, label) = if wi.z < 0.0 && tails == SlopeTails::Gaussian {
         (Chi2Grid { pole: wi.normalize(), ..Chi2Grid::sphere(16, 32) }, "sphere 16×32 around ωi".to_string())
     } else if wi.z < 0.0 {
         (Chi2Grid::sphere(16, 32), "sphere 16×32 around z".to_string())
@@ -300,7 +202,7 @@ fn chi2_config(
 ) -> Result<Chi2Outcome, String> {
     let sampler = make(kind, alpha);
     let wi = dir(theta, PHI);
-    let (grid, grid_label) = grid_for(sampler.as_ref(), kind.is_beckmann(), wi, seed ^ 0x9E37_79B9_7F4A_7C15);
+    let (grid, grid_label) = grid_for(sampler.as_ref(), kind.tails(), wi, seed ^ 0x9E37_79B9_7F4A_7C15);
     let label = format!(
         "{kind:?} α = {alpha:?}, θi = {theta}, φi = {PHI}, wi = {wi:.5}, N = {N_CHI2}, seed = {seed}, {grid_label}"
     );
@@ -337,7 +239,7 @@ fn chi2_config(
 /// thick along ωi·ωm = 0, which no (cos θ, φ) cell grid of the shared harness resolves (its
 /// quadrature reports ∫pdf = 0). The exact Smith sampler (which `BeckmannNewton` defers to
 /// below the horizon) is chi-square tested there in slope-space coordinates by
-/// `tests/vndf_sampling.rs` (θi = 2.8); the V-cavity's backfacing branch reuses its solver.
+/// `tests/vndf/sampling.rs` (θi = 2.8); the V-cavity's backfacing branch reuses its solver.
 fn unresolvable_on_the_sphere(kind: Kind, alpha: (f32, f32), theta: f64) -> bool {
     matches!(kind, Kind::SmithBeckmann | Kind::BeckmannNewton | Kind::VCavityBeckmann)
         && alpha == (0.05, 0.05)
@@ -427,7 +329,7 @@ fn chi2_negative_control() {
         let sampler = GgxDisk(Ggx::new(sampled, sampled).unwrap());
         let wrong = SmithVndf(Ggx::new(claimed, claimed).unwrap());
         let wi = dir(theta, PHI);
-        let (grid, grid_label) = grid_for(&sampler, false, wi, seed + 1000);
+        let (grid, grid_label) = grid_for(&sampler, SlopeTails::PowerLaw, wi, seed + 1000);
         let mut r = rng(seed);
         let result = catch_unwind(AssertUnwindSafe(|| {
             chi2_test(
@@ -477,8 +379,7 @@ fn pdf_integrates_to_one() {
             let sampler = make(kind, alpha);
             for &theta in &thetas {
                 let wi = dir(theta, PHI);
-                let integral =
-                    integrate_slopes(alpha, kind.is_beckmann(), wi, |wm| f64::from(sampler.pdf(wi, wm)));
+                let integral = integrate_slopes(alpha, kind.tails(), wi, |wm| f64::from(sampler.pdf(wi, wm)));
                 let label = format!("{kind:?} α = {alpha:?}, θi = {theta:.4}, wi = {wi:.5}");
                 let err = (integral - 1.0).abs();
                 if err.is_nan() || err > worst.0 {
@@ -510,7 +411,7 @@ fn pdf_integrates_to_one() {
 }
 
 /// A uniform direction on the sphere.
-fn sample_sphere(r: &mut common::TestRng) -> Vec3 {
+fn sample_sphere(r: &mut validation::TestRng) -> Vec3 {
     let z = 1.0 - 2.0 * uniform32(r);
     let phi = std::f32::consts::TAU * uniform32(r);
     let s = (1.0 - z * z).max(0.0).sqrt();
@@ -522,16 +423,16 @@ fn sample_sphere(r: &mut common::TestRng) -> Vec3 {
 /// projected_area(i)/projected_area(i′) < 1; with `smith_normalization` it integrates to 1.
 #[test]
 fn previous_normalization_loses_mass_below_the_horizon() {
-    fn check<S: MicrosurfaceSlope>(name: &str, slope: S, gaussian: bool, theta: f64, assert_below: bool) {
+    fn check<S: SlopeFamily>(name: &str, slope: S, theta: f64, assert_below: bool) {
         let alpha = (slope.alpha_x(), slope.alpha_y());
         let i = dir(theta, PHI);
         let mirrored = Vec3::new(i.x, i.y, i.z.abs());
         let g1_prev = 1.0 / (1.0 + f64::from(slope.lambda(mirrored)));
         let iz = f64::from(i.z.abs());
-        let previous = integrate_slopes(alpha, gaussian, i, |m| {
+        let previous = integrate_slopes(alpha, S::TAILS, i, |m| {
             g1_prev * f64::from(i.dot(m).max(0.0)) * f64::from(slope.d(m)) / iz
         });
-        let ours = integrate_slopes(alpha, gaussian, i, |m| {
+        let ours = integrate_slopes(alpha, S::TAILS, i, |m| {
             f64::from(smith_normalization(&slope, i, m))
                 * f64::from(i.dot(m).max(0.0))
                 * f64::from(slope.d(m))
@@ -555,11 +456,11 @@ fn previous_normalization_loses_mass_below_the_horizon() {
         }
     }
     for (theta, assert_below) in [(2.0, true), (1.8, true), (2.4, true), (2.9, true), (1.2, false)] {
-        check("GGX", Ggx::new(0.5, 0.5).unwrap(), false, theta, assert_below);
-        check("Beckmann", Beckmann::new(0.5, 0.5).unwrap(), true, theta, assert_below);
+        check("GGX", Ggx::new(0.5, 0.5).unwrap(), theta, assert_below);
+        check("Beckmann", Beckmann::new(0.5, 0.5).unwrap(), theta, assert_below);
     }
-    check("GGX", Ggx::new(1.0, 0.1).unwrap(), false, 2.0, true);
-    check("Beckmann", Beckmann::new(1.0, 0.1).unwrap(), true, 2.0, true);
+    check("GGX", Ggx::new(1.0, 0.1).unwrap(), 2.0, true);
+    check("Beckmann", Beckmann::new(1.0, 0.1).unwrap(), 2.0, true);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -579,12 +480,7 @@ fn vcavity_g(i: DVec3, m: DVec3) -> f64 {
 /// divides by H.
 #[test]
 fn vcavity_hit_probability_matches_quadrature() {
-    fn check<S: microsurface::VCavitySlope>(
-        name: &str,
-        slope: S,
-        gaussian: bool,
-        failures: &mut Vec<String>,
-    ) {
+    fn check<S: microsurface::VCavitySlope + SlopeFamily>(name: &str, slope: S, failures: &mut Vec<String>) {
         let alpha = (slope.alpha_x(), slope.alpha_y());
         let cavity = VCavity(slope);
         for theta in [0.0, 0.5, 1.2, 1.55, FRAC_PI_2 + 1e-3, 1.8, 2.0, 2.4, 2.9, 3.1] {
@@ -592,7 +488,7 @@ fn vcavity_hit_probability_matches_quadrature() {
                 let i = dir(theta, phi);
                 let id = i.as_dvec3();
                 let iz = id.z.abs();
-                let quad = integrate_slopes(alpha, gaussian, i, |m| {
+                let quad = integrate_slopes(alpha, S::TAILS, i, |m| {
                     let md = m.as_dvec3();
                     vcavity_g(id, md) * id.dot(md).max(0.0) * f64::from(slope.d(m)) / iz
                 });
@@ -613,8 +509,8 @@ fn vcavity_hit_probability_matches_quadrature() {
     }
     let mut failures = Vec::new();
     for (ax, ay) in [(0.05, 0.05), (0.3, 0.3), (1.0, 1.0), (1.0, 0.1), (0.2, 1.5)] {
-        check("GGX", Ggx::new(ax, ay).unwrap(), false, &mut failures);
-        check("Beckmann", Beckmann::new(ax, ay).unwrap(), true, &mut failures);
+        check("GGX", Ggx::new(ax, ay).unwrap(), &mut failures);
+        check("Beckmann", Beckmann::new(ax, ay).unwrap(), &mut failures);
     }
     assert!(failures.is_empty(), "{} hit probabilities disagree:\n{}", failures.len(), failures.join("\n"));
 }
@@ -685,7 +581,7 @@ fn degenerate_inputs() {
         Vec3::new(0.6, -0.8, -0.0),
         Vec3::new(-0.6, 0.8, 0.0),
         // (the zero vector, also (0, 0, −0), is invalid input, not a degenerate direction: see
-        // tests/invalid_input.rs)
+        // tests/invalid_input/policy.rs)
         Vec3::new(f32::MIN_POSITIVE, 0.0, 1.0),
         Vec3::new(f32::MIN_POSITIVE, 0.0, -1.0),
         // ordinary directions, for the uniforms at the ends (φ = 0 exactly: sin φ = 0)

@@ -9,17 +9,16 @@
 //! normal (a few lobe widths wide, from quadrature) for sharp ones; (3) every sample is a
 //! finite unit normal of the upper hemisphere visible from ωi. Negative controls show that
 //! the same harness rejects wrong samplers.
-mod common;
 
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::{integrate, integrate_grid};
-use common::{Stats, assert_mean};
 use glam::Vec3;
 use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
-use statrs::distribution::{ChiSquared, ContinuousCDF};
-use std::f64::consts::FRAC_PI_2;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use validation::check::panic_message;
+use validation::chi2::SlopeGrid;
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::{CrossMap, SlopeFamily, VisibleTolerance, integrate_visible};
+use validation::{Stats, assert_mean};
 
 const ALPHAS: [(f32, f32); 5] = [(0.05, 0.05), (0.3, 0.3), (1.0, 1.0), (1.0, 0.1), (0.2, 1.5)];
 const THETAS: [f64; 6] = [0.0, 0.5, 1.2, 1.55, 2.0, 2.8];
@@ -53,14 +52,14 @@ trait SlopeDyn: Send + Sync {
     fn d_wi(&self, wi: Vec3, m: Vec3) -> f32;
     /// D_ωi at a normal given in double precision (no rounding of the normal to f32).
     fn d_wi64(&self, wi: Vec3, m: glam::DVec3) -> f64;
-    /// Whether the slopes are Gaussian (Beckmann): the cross slope is then N(0, ½) whatever
-    /// the other, and binned through erf.
-    fn gaussian(&self) -> bool;
+    /// The cross map matched to the tails (Beckmann: the cross slope is N(0, ½) whatever the
+    /// other, and binned through erf).
+    fn cross_map(&self) -> CrossMap;
     fn sample(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
     fn visible_integral(&self, w: Vec3, g: &mut dyn FnMut(Vec3) -> f64) -> f64;
 }
 
-impl<S: MicrosurfaceSlope> SlopeDyn for S {
+impl<S: SlopeFamily + Send + Sync> SlopeDyn for S {
     fn alpha(&self) -> (f32, f32) {
         (self.alpha_x(), self.alpha_y())
     }
@@ -70,50 +69,20 @@ impl<S: MicrosurfaceSlope> SlopeDyn for S {
     fn d_wi64(&self, wi: Vec3, m: glam::DVec3) -> f64 {
         MicrosurfaceSlope::d_wi64(self, wi, m)
     }
-    fn gaussian(&self) -> bool {
-        std::any::type_name::<S>().contains("Beckmann")
+    fn cross_map(&self) -> CrossMap {
+        S::TAILS.cross_map()
     }
     fn sample(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         self.sample_d_wi(wi, u1, u2)
     }
     fn visible_integral(&self, w: Vec3, g: &mut dyn FnMut(Vec3) -> f64) -> f64 {
-        integrate_visible(self, w, g)
+        integrate_visible(SlopeDyn::alpha(self), S::TAILS.cross_map(), w, TOLERANCE, g)
     }
 }
 
-/// ∫ g(ωm) dωm over the normals visible from `w`, in stretched slope space rotated to the
-/// azimuth of `w`, where the visible normals are the half-plane x' < cot θ̃; mapped by
-/// x' = tan u, y' = √(1 + x'²) tan v and integrated adaptively (tolerance `tol`). The same
-/// scheme is validated against the analytic normalizations in `vndf_normalization.rs`.
-fn integrate_visible<S: MicrosurfaceSlope>(s: &S, w: Vec3, mut g: impl FnMut(Vec3) -> f64) -> f64 {
-    let (ax, ay) = (f64::from(s.alpha_x()), f64::from(s.alpha_y()));
-    let (wx, wy, wz) = (f64::from(w.x) * ax, f64::from(w.y) * ay, f64::from(w.z));
-    let h = (wx * wx + wy * wy).sqrt();
-    let (cos_phi, sin_phi, u_hi) = if h > 0.0 {
-        (wx / h, wy / h, (wz / h).atan())
-    } else if wz > 0.0 {
-        (1.0, 0.0, FRAC_PI_2)
-    } else {
-        return 0.0;
-    };
-    let lo = -FRAC_PI_2;
-    let gaussian = std::any::type_name::<S>().contains("Beckmann");
-    let mut f = |u: f64, v: f64| {
-        let (x, dx) = (u.tan(), 1.0 / (u.cos() * u.cos()));
-        let (y, dy) = cross_y(x, v, gaussian);
-        if !y.is_finite() {
-            return 0.0;
-        }
-        let sx = ax * (cos_phi * x - sin_phi * y);
-        let sy = ay * (sin_phi * x + cos_phi * y);
-        let norm = (1.0 + sx * sx + sy * sy).sqrt();
-        let m = Vec3::new((-sx / norm) as f32, (-sy / norm) as f32, (1.0 / norm) as f32);
-        let value = g(m);
-        if value == 0.0 { 0.0 } else { value * ax * ay * dx * dy / (norm * norm * norm) }
-    };
-    // an initial grid fine enough that the adaptive refinement sees every lobe
-    integrate_grid(&mut f, lo, u_hi, 24, 12, QUAD_TOL, REL_TOL, MAX_DEPTH)
-}
+/// The tolerances of the visible-normal quadrature.
+const TOLERANCE: VisibleTolerance =
+    VisibleTolerance { abs_tol: QUAD_TOL, rel_tol: REL_TOL, max_depth: MAX_DEPTH };
 
 /// One configuration of the suite.
 struct Case {
@@ -139,7 +108,7 @@ fn cases() -> Vec<Case> {
                 out.push(Case {
                     label: format!("{name} α = ({}, {}), θi = {theta}, φi = {phi}", a.0, a.1),
                     slope,
-                    wi: common::dir(theta, phi),
+                    wi: validation::dir(theta, phi),
                     seed: 0x5eed_0000 + idx as u64,
                 });
             }
@@ -186,196 +155,35 @@ fn sample_defect(wi: Vec3, m: Vec3) -> Option<String> {
     None
 }
 
-/// The frame of the visible half-plane of `w` in stretched slope space: (cos φ̃, sin φ̃, u_hi)
-/// with u_hi = atan(cot θ̃), or `None` if nothing is visible.
-fn visible_frame(a: (f32, f32), w: Vec3) -> Option<(f64, f64, f64)> {
-    let (wx, wy, wz) = (f64::from(w.x) * f64::from(a.0), f64::from(w.y) * f64::from(a.1), f64::from(w.z));
-    let h = (wx * wx + wy * wy).sqrt();
-    if h > 0.0 {
-        Some((wx / h, wy / h, (wz / h).atan()))
-    } else if wz > 0.0 {
-        Some((1.0, 0.0, FRAC_PI_2))
-    } else {
-        None
-    }
-}
-
-/// The (u, v) coordinates of `integrate_visible` of a normal (u may exceed u_hi if ωm is not
-/// visible).
-fn uv_of(a: (f32, f32), frame: (f64, f64, f64), m: Vec3, gaussian: bool) -> (f64, f64) {
-    let (cos_phi, sin_phi, _) = frame;
-    let z = f64::from(m.z).max(1e-300);
-    let sx = -f64::from(m.x) / z / f64::from(a.0);
-    let sy = -f64::from(m.y) / z / f64::from(a.1);
-    let x = cos_phi * sx + sin_phi * sy;
-    let y = -sin_phi * sx + cos_phi * sy;
-    (x.atan(), cross_v(x, y, gaussian))
-}
-
-/// The cross coordinate v ∈ (−π/2, π/2) of the slopes (x, y): atan(y/√(1 + x²)) for GGX, whose
-/// conditional spreads with x, and (π/2) erf(y) for Beckmann, whose cross slope is N(0, ½)
-/// whatever x (so that thin lobes far from the origin stay resolved).
-fn cross_v(x: f64, y: f64, gaussian: bool) -> f64 {
-    if gaussian { FRAC_PI_2 * statrs::function::erf::erf(y) } else { (y / (1.0 + x * x).sqrt()).atan() }
-}
-
-/// The inverse of [`cross_v`] for a given x: (y, dy/dv).
-fn cross_y(x: f64, v: f64, gaussian: bool) -> (f64, f64) {
-    if gaussian {
-        let y = statrs::function::erf::erf_inv(v / FRAC_PI_2);
-        (y, (y * y).exp() * std::f64::consts::PI.sqrt() / std::f64::consts::PI)
-    } else {
-        let sigma = (1.0 + x * x).sqrt();
-        (sigma * v.tan(), sigma / (v.cos() * v.cos()))
-    }
-}
-
-/// A chi-square test with bins in the slope-space coordinates (u, v) of `integrate_visible`
-/// (a feature the shared harness lacks): the lobe of D_ωi is resolved in these coordinates
-/// whatever α and θi (including the thin crescents of Beckmann below the horizon, which
-/// equal-area bins on the sphere do not resolve). NU u-bins of equal probability (edges
-/// from 1024 quadrature strips), each split in NV equal v-bins; expected probabilities by
-/// adaptive quadrature; cells with expectation < 5 pooled, as in `common::chi2`.
+/// The slope-space chi-square test (`validation::chi2::slope_chi2`) of a case: 25 u-bins of
+/// equal probability (edges from 1024 quadrature strips), each split in 32 equal v-bins.
 fn slope_chi2(
     c: &Case,
-    mut sample: impl FnMut() -> Vec3,
+    sample: impl FnMut() -> Vec3,
     n: usize,
     alpha: f64,
 ) -> Result<(f64, usize, f64, f64), String> {
-    const NU: usize = 25;
-    const NV: usize = 32;
-    const STRIPS: usize = 1024;
-    let a = c.slope.alpha();
-    let Some(frame) = visible_frame(a, c.wi) else { return Err(format!("{}: nothing visible", c.label)) };
-    let (cos_phi, sin_phi, u_hi) = frame;
-    let (ax, ay) = (f64::from(a.0), f64::from(a.1));
+    let grid = SlopeGrid { nu: 25, nv: 32, strips: 1024, rel_tol: REL_TOL, max_depth: MAX_DEPTH };
     let (wi, slope) = (c.wi, &c.slope);
-    let gaussian = c.slope.gaussian();
-    let mut f = |u: f64, v: f64| {
-        let (x, dx) = (u.tan(), 1.0 / (u.cos() * u.cos()));
-        let (y, dy) = cross_y(x, v, gaussian);
-        if !y.is_finite() {
-            return 0.0;
-        }
-        let sx = ax * (cos_phi * x - sin_phi * y);
-        let sy = ay * (sin_phi * x + cos_phi * y);
-        let norm = (1.0 + sx * sx + sy * sy).sqrt();
-        // the normal stays in f64: rounding it to f32 flips the visibility of normals near the
-        // boundary of thin lobes (Beckmann far below the horizon)
-        let m = glam::DVec3::new(-sx / norm, -sy / norm, 1.0 / norm);
-        let value = slope.d_wi64(wi, m);
-        if value == 0.0 { 0.0 } else { value * ax * ay * dx * dy / (norm * norm * norm) }
-    };
-    let (vlo, vhi) = (-FRAC_PI_2, FRAC_PI_2);
-    // marginal in u by strips
-    let strips = |lo: f64, f: &mut dyn FnMut(f64, f64) -> f64| {
-        let mut cum = vec![0.0; STRIPS + 1];
-        for k in 0..STRIPS {
-            let u0 = lo + (u_hi - lo) * k as f64 / STRIPS as f64;
-            let u1 = lo + (u_hi - lo) * (k + 1) as f64 / STRIPS as f64;
-            let mut strip = 0.0;
-            for j in 0..8 {
-                let v0 = vlo + (vhi - vlo) * j as f64 / 8.0;
-                let v1 = vlo + (vhi - vlo) * (j + 1) as f64 / 8.0;
-                let mut g = |u: f64, v: f64| f(u, v);
-                let rough = integrate(&mut g, u0, u1, v0, v1, 0.0, 0).abs();
-                strip += integrate(&mut g, u0, u1, v0, v1, (1e-9f64).max(REL_TOL * rough), 5);
-            }
-            cum[k + 1] = cum[k] + strip;
-        }
-        cum
-    };
-    // a second pass zooms onto the support when the lobe spans only a few strips (the thin
-    // crescents of Beckmann far below the horizon): the mass left below `lo` is < 1e-12
-    let mut lo = -FRAC_PI_2;
-    let mut cum = strips(lo, &mut f);
-    let first = cum.iter().position(|&c| c > 1e-12 * cum[STRIPS]).unwrap_or(1).saturating_sub(1);
-    if first > 0 {
-        lo += (u_hi - lo) * first as f64 / STRIPS as f64;
-        cum = strips(lo, &mut f);
-    }
-    let total = cum[STRIPS];
-    if (total - 1.0).abs() > 1e-3 {
-        return Err(format!("{}: D_ωi integrates to {total:.6} by quadrature, expected 1", c.label));
-    }
-    // equal-probability u edges (linear interpolation in the cumulative)
-    let mut edges = vec![lo];
-    let mut k = 0;
-    for b in 1..NU {
-        let target = total * b as f64 / NU as f64;
-        while cum[k + 1] < target {
-            k += 1;
-        }
-        let t = (target - cum[k]) / (cum[k + 1] - cum[k]).max(1e-300);
-        edges.push(lo + (u_hi - lo) * (k as f64 + t) / STRIPS as f64);
-    }
-    edges.push(u_hi);
-    // expected probabilities per cell; the last cell (index NU·NV) is "not visible"
-    let mut expected = vec![0.0; NU * NV + 1];
-    for i in 0..NU {
-        for j in 0..NV {
-            let v0 = vlo + (vhi - vlo) * j as f64 / NV as f64;
-            let v1 = vlo + (vhi - vlo) * (j + 1) as f64 / NV as f64;
-            let rough = integrate(&mut f, edges[i], edges[i + 1], v0, v1, 0.0, 0).abs();
-            expected[i * NV + j] =
-                integrate(&mut f, edges[i], edges[i + 1], v0, v1, (1e-9f64).max(REL_TOL * rough), MAX_DEPTH);
-        }
-    }
-    let mut observed = vec![0u64; NU * NV + 1];
-    for _ in 0..n {
-        let m = sample();
-        let (u, v) = uv_of(a, frame, m, gaussian);
-        let cell = if !(u.is_finite() && v.is_finite()) || u > u_hi {
-            NU * NV
-        } else {
-            let i = edges.partition_point(|&e| e <= u).clamp(1, NU) - 1;
-            let j = (((v - vlo) / (vhi - vlo) * NV as f64) as usize).min(NV - 1);
-            i * NV + j
-        };
-        observed[cell] += 1;
-    }
-    let (mut stat, mut used, mut pool_e, mut pool_o) = (0.0, 0usize, 0.0, 0.0);
-    for (e, o) in expected.iter().zip(&observed) {
-        let (e, o) = (e * n as f64, *o as f64);
-        if e < 5.0 {
-            pool_e += e;
-            pool_o += o;
-        } else {
-            stat += (o - e) * (o - e) / e;
-            used += 1;
-        }
-    }
-    if pool_e > 0.0 {
-        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-        used += 1;
-    } else if pool_o > 0.0 {
-        return Err(format!("{}: {pool_o} samples where D_ωi is 0 (N = {n})", c.label));
-    }
-    let dof = used.saturating_sub(1).max(1);
-    let p = 1.0 - ChiSquared::new(dof as f64).unwrap().cdf(stat);
-    if p < alpha {
-        return Err(format!(
-            "{}: slope-space chi-square rejects the sampler: χ² = {stat:.2}, dof = {dof}, p = {p:.3e} < α = {alpha:.3e} \
-             (N = {n}, ∫D_ωi = {total:.6}, {NU} × {NV} bins)",
-            c.label
-        ));
-    }
-    Ok((stat, dof, p, total))
-}
-
-/// The panic message of a caught panic.
-fn panic_message(e: Box<dyn std::any::Any + Send>) -> String {
-    e.downcast_ref::<String>()
-        .cloned()
-        .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
-        .unwrap_or_else(|| "(non-string panic)".into())
+    let o = validation::chi2::slope_chi2(
+        &c.label,
+        slope.alpha(),
+        slope.cross_map(),
+        wi,
+        grid,
+        |m| slope.d_wi64(wi, m),
+        sample,
+        n,
+        alpha,
+    )?;
+    Ok((o.statistic, o.dof, o.p_value, o.integral))
 }
 
 /// Runs one case: returns (χ², dof, p, ∫D_ωi), or the failure message.
 fn run_case(c: &Case) -> Result<(f64, usize, f64, f64), String> {
     let q = quadrature_moments(c);
-    let alpha = common::sidak(FAMILY_ALPHA, CASES);
-    let mut rng = common::rng(c.seed);
+    let alpha = validation::sidak(FAMILY_ALPHA, CASES);
+    let mut rng = validation::rng(c.seed);
     let mut stats = [Stats::default(); 6];
     let mut defects = (0usize, None::<String>);
     let (wi, slope) = (c.wi, &c.slope);
@@ -406,19 +214,19 @@ fn run_case(c: &Case) -> Result<(f64, usize, f64, f64), String> {
             defects.1.unwrap()
         ));
     }
-    let z = common::family_z(FAMILY_ALPHA, MOMENTS);
+    let z = validation::family_z(FAMILY_ALPHA, MOMENTS);
     let names = ["E[x]", "E[y]", "E[z]", "E[x²]", "E[y²]", "E[z²]"];
     for (k, name) in names.iter().enumerate() {
         let label = format!("{}: {name} (quadrature ∫D_ωi = {:.8})", c.label, q[0]);
         std::panic::catch_unwind(|| assert_mean(&label, &stats[k], q[k + 1], z, MAX_SE, QUAD_EXACT_TOL))
-            .map_err(panic_message)?;
+            .map_err(|e| panic_message(e.as_ref()))?;
     }
     Ok(outcome)
 }
 
 /// Supplement §4.2.2 plus a chi-square test, for all 60 cases (two threads).
 #[test]
-fn vndf_sampling_matches_density() {
+fn vndf_sampling_matches_density_4_2_2() {
     let cases = cases();
     let next = AtomicUsize::new(0);
     let results = Mutex::new(Vec::new());
@@ -448,7 +256,10 @@ fn vndf_sampling_matches_density() {
         .filter_map(|(i, r)| r.as_ref().ok().map(|o| (o.2, &cases[*i].label)))
         .min_by(|a, b| a.0.total_cmp(&b.0));
     if let Some((p, label)) = worst {
-        println!("worst p-value {p:.4} ({label}); α per test = {:.3e}", common::sidak(FAMILY_ALPHA, CASES));
+        println!(
+            "worst p-value {p:.4} ({label}); α per test = {:.3e}",
+            validation::sidak(FAMILY_ALPHA, CASES)
+        );
     }
     assert!(
         failures.is_empty(),
@@ -481,7 +292,7 @@ fn vndf_samples_are_valid_at_extreme_uniforms() {
 /// Runs the harness on a sampler that is known to be wrong and returns whether it rejected
 /// it (the harness panics on rejection).
 fn rejects(label: &str, wi: Vec3, pdf: &dyn SlopeDyn, sampler: impl Fn(f32, f32) -> Vec3, seed: u64) -> bool {
-    let mut rng = common::rng(seed);
+    let mut rng = validation::rng(seed);
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         chi2_test(
             label,
@@ -493,7 +304,7 @@ fn rejects(label: &str, wi: Vec3, pdf: &dyn SlopeDyn, sampler: impl Fn(f32, f32)
                 Some(sampler(u1, u2))
             },
             N_CONTROL,
-            common::sidak(FAMILY_ALPHA, CASES),
+            validation::sidak(FAMILY_ALPHA, CASES),
             1.0,
         )
     }))
@@ -504,7 +315,7 @@ fn rejects(label: &str, wi: Vec3, pdf: &dyn SlopeDyn, sampler: impl Fn(f32, f32)
 /// samplers that are slightly wrong, so the suite can fail.
 #[test]
 fn chi2_rejects_wrong_samplers() {
-    let wi = common::dir(0.5, 0.0);
+    let wi = validation::dir(0.5, 0.0);
     let ggx = Ggx::isotropic(0.3).unwrap();
     // GGX normals sampled with a roughness 10 % too high
     let wrong_alpha = Ggx::isotropic(0.33).unwrap();
@@ -519,7 +330,7 @@ fn chi2_rejects_wrong_samplers() {
         "the chi-square harness accepted GGX normals sampled with α = 0.33 against α = 0.3 (θi = 0.5)"
     );
     // normals from D cos θm (the visible normals seen from the zenith) instead of D_ωi
-    let wi = common::dir(1.2, 0.0);
+    let wi = validation::dir(1.2, 0.0);
     assert!(
         rejects("D cos θm sampled for D_ωi", wi, &ggx, |u1, u2| ggx.sample_d_wi(Vec3::Z, u1, u2), 92),
         "the chi-square harness accepted normals from D cos θm against D_ωi (θi = 1.2)"
@@ -546,7 +357,7 @@ fn beckmann_deep_cases(full: bool) -> Vec<Case> {
         .map(|(i, &(a, theta))| Case {
             label: format!("beckmann α = {a}, θi = {theta}"),
             slope: Box::new(Beckmann::isotropic(a).unwrap()),
-            wi: common::dir(theta, 0.3),
+            wi: validation::dir(theta, 0.3),
             seed: 0x5eed_1700 + i as u64 + if full { 100 } else { 0 },
         })
         .collect()
@@ -555,10 +366,10 @@ fn beckmann_deep_cases(full: bool) -> Vec<Case> {
 /// The chi-square test in slope space (`slope_chi2`) of `n` Beckmann samples per case, at the
 /// Šidák level of the family; panics listing the failures.
 fn beckmann_deep_chi2(cases: &[Case], n: usize) {
-    let alpha = common::sidak(FAMILY_ALPHA, cases.len());
+    let alpha = validation::sidak(FAMILY_ALPHA, cases.len());
     let mut failures = Vec::new();
     for c in cases {
-        let mut rng = common::rng(c.seed);
+        let mut rng = validation::rng(c.seed);
         let (wi, slope) = (c.wi, &c.slope);
         let r = slope_chi2(
             c,

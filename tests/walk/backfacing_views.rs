@@ -25,16 +25,15 @@
 //!
 //! Statistics: |mean − expected| ≤ z·SE (two-sample: z·√(SE1² + SE2²)), z = `family_z(0.01,
 //! m)` over the m assertions of a test function, each with an upper bound on its SE.
-mod common;
 
-use common::stochastic::stochastic_chi2;
-use common::{Stats, assert_mean, assert_two_sample, family_z, par_map, sidak, uniform32};
 use glam::{DVec3, Vec2, Vec3};
 use microsurface::{
     Beckmann, Bsdf, ComplexIor, Conductor, Diffuse, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
     MicrosurfaceSlope, PositionFree, ScatteringOrder, ShadingFrame, Shadowing, Technique, UniformHeight,
 };
 use std::f64::consts::{PI, TAU};
+use validation::stochastic::stochastic_chi2;
+use validation::{Stats, assert_mean, assert_two_sample, family_z, par_map, sidak, uniform32};
 
 /// z of the incident directions below the horizon.
 const WI_Z: [f32; 3] = [-0.072, -0.3, -0.6];
@@ -133,9 +132,9 @@ fn mean3(v: Vec3) -> f64 {
 }
 
 /// A uniform direction on the upper hemisphere (density 1/(2π)).
-fn uniform_upper(rng: &mut common::TestRng) -> Vec3 {
-    let z = 1.0 - common::uniform64(rng);
-    let phi = TAU * common::uniform64(rng);
+fn uniform_upper(rng: &mut validation::TestRng) -> Vec3 {
+    let z = 1.0 - validation::uniform64(rng);
+    let phi = TAU * validation::uniform64(rng);
     let r = (1.0 - z * z).max(0.0).sqrt();
     DVec3::new(r * phi.cos(), r * phi.sin(), z).as_vec3()
 }
@@ -170,19 +169,20 @@ fn sample_energy(n: usize, mut sample: impl FnMut() -> Option<(Vec3, u32)>) -> S
 fn importance<S: MicrosurfaceSlope, M: Material>(
     pf: &PositionFree<S, M>,
     wi: Vec3,
-    rng: &mut common::TestRng,
+    rng: &mut validation::TestRng,
 ) -> (Vec3, f64) {
     let cosine = |w: Vec3| f64::from(w.z.max(0.0)) / PI;
     if !M::EXACT_PHASE_PDF {
-        let w = microsurface::sample_cosine_hemisphere(common::uniform32(rng), common::uniform32(rng));
+        let w =
+            microsurface::sample_cosine_hemisphere(validation::uniform32(rng), validation::uniform32(rng));
         return (w, cosine(w));
     }
-    let w = if common::uniform64(rng) < 0.5 {
+    let w = if validation::uniform64(rng) < 0.5 {
         // the phase function's sampler (exact density `pdf_phase`; a direction below the
         // horizon, where every integrand here is 0, is kept with its density)
         pf.material().sample_phase(pf.slope(), wi, true, rng).wo
     } else {
-        microsurface::sample_cosine_hemisphere(common::uniform32(rng), common::uniform32(rng))
+        microsurface::sample_cosine_hemisphere(validation::uniform32(rng), validation::uniform32(rng))
     };
     let phase = f64::from(pf.material().pdf_phase(pf.slope(), wi, w, true, true));
     (w, 0.5 * phase + 0.5 * cosine(w))
@@ -192,8 +192,8 @@ fn importance<S: MicrosurfaceSlope, M: Material>(
 /// (from `Only(1)`, `Only(2)` and `All` minus `UpTo(2)` on independent calls) and all.
 fn eval_energy(
     n: usize,
-    rng: &mut common::TestRng,
-    mut direction: impl FnMut(&mut common::TestRng) -> (Vec3, f64),
+    rng: &mut validation::TestRng,
+    mut direction: impl FnMut(&mut validation::TestRng) -> (Vec3, f64),
     mut eval: impl FnMut(Vec3, ScatteringOrder) -> Vec3,
 ) -> [Stats; 4] {
     let mut out = [Stats::default(); 4];
@@ -220,7 +220,7 @@ fn eval_energy(
 /// uniform sampling for diffuse facets (stochastic integrand). The quadrature is returned as
 /// one observation (SE 0); its error (below 1e-5) is far below the tests' SE.
 fn single_albedo<S: MicrosurfaceSlope, M: Material>(pf: &PositionFree<S, M>, wi: Vec3, seed: u64) -> Stats {
-    let mut rng = common::rng(seed);
+    let mut rng = validation::rng(seed);
     if M::EXACT_PHASE_PDF {
         // the integrand peaks about the mirror direction: integrate on a fine grid of cells
         let mut f = |z: f64, phi: f64| {
@@ -234,7 +234,7 @@ fn single_albedo<S: MicrosurfaceSlope, M: Material>(pf: &PositionFree<S, M>, wi:
             for ip in 0..np {
                 let (z0, z1) = (iz as f64 / nz as f64, (iz + 1) as f64 / nz as f64);
                 let (p0, p1) = (TAU * ip as f64 / np as f64, TAU * (ip + 1) as f64 / np as f64);
-                sum += common::quadrature::integrate(&mut f, z0, z1, p0, p1, 1e-7, 6);
+                sum += validation::quadrature::integrate(&mut f, z0, z1, p0, p1, 1e-7, 6);
             }
         }
         let mut s = Stats::default();
@@ -272,10 +272,10 @@ fn walk_energy_orders_and_single_scattering() {
         with_surface!(slope, mat, |surface| {
             let wi = wi_below(wz);
             let label = format!("walk {slope:?} {mat:?} ωi.z = {wz}");
-            let mut rng = common::rng(100 + i as u64);
+            let mut rng = validation::rng(100 + i as u64);
             let e = sample_energy(WALKS, || surface.sample(wi, &mut rng).map(|s| (s.weight, s.bounces)));
-            let mut eval_rng = common::rng(200 + i as u64);
-            let mut inner = common::rng(300 + i as u64);
+            let mut eval_rng = validation::rng(200 + i as u64);
+            let mut inner = validation::rng(300 + i as u64);
             let pf = PositionFree::new(*surface.slope(), *surface.material(), Shadowing::Correlated);
             let ev = eval_energy(
                 EVALS,
@@ -356,8 +356,8 @@ fn walk_sampling_chi2() {
         with_surface!(slope, mat, |surface| {
             let wi = wi_below(wz);
             let label = format!("walk χ² {slope:?} {mat:?} ωi.z = {wz}");
-            let mut rng = common::rng(600 + i as u64);
-            let mut eval_rng = common::rng(700 + i as u64);
+            let mut rng = validation::rng(600 + i as u64);
+            let mut eval_rng = validation::rng(700 + i as u64);
             let r = stochastic_chi2(
                 &label,
                 0.0,
@@ -416,17 +416,17 @@ fn position_free_energy_pt_bdpt_and_orders() {
         with_position_free!(slope, mat, shadowing, |pf| {
             let wi = wi_below(wz);
             let label = format!("position-free {shadowing:?} {slope:?} {mat:?} ωi.z = {wz}");
-            let mut rng = common::rng(1000 + i as u64);
+            let mut rng = validation::rng(1000 + i as u64);
             let e = sample_energy(PF_WALKS, || pf.sample(wi, &mut rng).map(|s| (s.weight, s.bounces)));
-            let mut inner = common::rng(1100 + i as u64);
+            let mut inner = validation::rng(1100 + i as u64);
             let pt = eval_energy(
                 PF_EVALS,
-                &mut common::rng(1200 + i as u64),
+                &mut validation::rng(1200 + i as u64),
                 |r| importance(&pf, wi, r),
                 |wo, order| pf.eval_pt(wi, wo, order, &mut inner),
             );
             let mut bdpt = Stats::default();
-            let mut dir_rng = common::rng(1300 + i as u64);
+            let mut dir_rng = validation::rng(1300 + i as u64);
             for _ in 0..PF_EVALS {
                 let (wo, pdf) = importance(&pf, wi, &mut dir_rng);
                 bdpt.push(mean3(pf.eval_bdpt(wi, wo, ScatteringOrder::All, &mut inner)) / pdf);
@@ -493,8 +493,8 @@ fn position_free_sampling_chi2() {
         with_position_free!(slope, mat, shadowing, |pf| {
             let wi = wi_below(wz);
             let label = format!("position-free χ² {shadowing:?} {slope:?} {mat:?} ωi.z = {wz}");
-            let mut rng = common::rng(1500 + i as u64);
-            let mut eval_rng = common::rng(1600 + i as u64);
+            let mut rng = validation::rng(1500 + i as u64);
+            let mut eval_rng = validation::rng(1600 + i as u64);
             let r = stochastic_chi2(
                 &label,
                 0.0,
@@ -577,7 +577,7 @@ fn bsdf_white_furnace_with_tilted_shading_normals() {
                 .expect("valid parameters")
                 .with_technique(technique);
             let single = b.with_technique(Technique::SingleScattering);
-            let mut rng = common::rng(2000 + i as u64);
+            let mut rng = validation::rng(2000 + i as u64);
             let mut single_stats = Stats::default();
             for _ in 0..BSDF_SAMPLES {
                 let s =
@@ -653,7 +653,7 @@ fn walk_order_one_matches_single_scattering_pointwise() {
         with_surface!(slope, mat, |surface| {
             let wi = wi_below(wz);
             // ωo: drawn from the phase function (where single scattering lives), above z = 0.05
-            let mut dir_rng = common::rng(2400 + i as u64);
+            let mut dir_rng = validation::rng(2400 + i as u64);
             let wo = loop {
                 let w = surface.sample_phase(wi, &mut dir_rng).wo;
                 if w.z > 0.05 {
@@ -661,7 +661,7 @@ fn walk_order_one_matches_single_scattering_pointwise() {
                 }
             };
             let label = format!("order 1 {slope:?} {mat:?} ωi.z = {wz}, ωo #{k} = {wo}");
-            let mut rng = common::rng(2500 + i as u64);
+            let mut rng = validation::rng(2500 + i as u64);
             let exact = mean3(surface.eval_single_scattering(wi, wo, &mut rng));
             let mut st = Stats::default();
             for _ in 0..20_000 {
@@ -691,10 +691,10 @@ fn first_height_from_below_follows_the_full_spherical_masking() {
     for (i, &(gaussian, wz, a)) in cases.iter().enumerate() {
         let wi = wi_below(wz);
         let k = f64::from(slope.lambda(-wi));
-        let mut rng = common::rng(2700 + i as u64);
+        let mut rng = validation::rng(2700 + i as u64);
         let mut st = Stats::default();
         for _ in 0..20_000 {
-            let u = common::uniform32(&mut rng);
+            let u = validation::uniform32(&mut rng);
             let c = if gaussian {
                 let g = microsurface::MicrosurfaceGeometry::new(microsurface::GaussianHeight, slope);
                 microsurface::MicrosurfaceHeight::c1(g.height(), g.sample_height_from_below(wi, u).unwrap())
@@ -743,14 +743,14 @@ fn height_space_walk_from_below_matches_the_c1_walk() {
             let label = format!("height-space walk {slope:?} gaussian = {gaussian} ωi.z = {wz}");
             let material = *surface.material();
             let s = *surface.slope();
-            let mut rng = common::rng(2800 + i as u64);
+            let mut rng = validation::rng(2800 + i as u64);
             // one walk in height space: (weight, bounces, exit cosine)
-            let height_walk = |rng: &mut common::TestRng| -> Option<(Vec3, u32, f32)> {
+            let height_walk = |rng: &mut validation::TestRng| -> Option<(Vec3, u32, f32)> {
                 let (g_u, g_g) = (
                     MicrosurfaceGeometry::new(UniformHeight, s),
                     MicrosurfaceGeometry::new(GaussianHeight, s),
                 );
-                let u = common::uniform32(rng);
+                let u = validation::uniform32(rng);
                 let mut h = if gaussian {
                     g_g.sample_height_from_below(wi, u)?
                 } else {
@@ -761,7 +761,7 @@ fn height_space_walk_from_below_matches_the_c1_walk() {
                     let p = material.sample_phase(&s, -wr, true, rng);
                     wr = p.wo;
                     weight *= p.weight;
-                    let u = common::uniform32(rng);
+                    let u = validation::uniform32(rng);
                     let next =
                         if gaussian { g_g.sample_height(wr, h, u) } else { g_u.sample_height(wr, h, u) };
                     match next {
@@ -780,7 +780,7 @@ fn height_space_walk_from_below_matches_the_c1_walk() {
                 r.map(|(w, k, _)| (w, k))
             });
             let mut cos_c = Stats::default();
-            let mut rng_c = common::rng(2900 + i as u64);
+            let mut rng_c = validation::rng(2900 + i as u64);
             let e_c = sample_energy(WALKS, || {
                 let r = surface.sample(wi, &mut rng_c);
                 if let Some(s) = r {
@@ -812,7 +812,7 @@ fn position_free_pt_equals_bdpt_pointwise() {
     let worst = par_map(&cases, |i, &(mat, shadowing, k)| {
         with_position_free!(Slope::Ggx, mat, shadowing, |pf| {
             let wi = wi_below(-0.3);
-            let mut rng = common::rng(3000 + i as u64);
+            let mut rng = validation::rng(3000 + i as u64);
             let wo = loop {
                 let w = pf.material().sample_phase(pf.slope(), wi, true, &mut rng).wo;
                 if w.z > 0.05 {

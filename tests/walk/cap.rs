@@ -7,16 +7,15 @@
 //! probability of `None`. With k capped walks out of N, its one-sided Clopper–Pearson upper
 //! confidence bound at level 1 − α (Šidák-corrected over the configurations) must be below
 //! 1e-4. The test reports the mean number of bounces and the fraction of walks longer than
-//! 64 bounces (the truncation of `tests/walk.rs`'s order sum).
-mod common;
+//! 64 bounces (the truncation of `tests/walk/random_walk.rs`'s order sum).
 
-use common::{Stats, TestRng};
 use glam::Vec3;
 use microsurface::{
     Beckmann, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, MAX_BOUNCES, Material, Microsurface,
     MicrosurfaceHeight, MicrosurfaceSlope, UniformHeight, WalkSample,
 };
 use statrs::distribution::{Beta, ContinuousCDF};
+use validation::{Stats, TestRng};
 
 const ALPHA: f32 = 2.0;
 const N: usize = 100_000;
@@ -68,8 +67,8 @@ fn run_one<H: MicrosurfaceHeight, S: MicrosurfaceSlope>(
     theta: f64,
     seed: u64,
 ) -> (usize, Stats, usize) {
-    let mut rng = common::rng(seed);
-    let wi = common::dir(theta, 0.7);
+    let mut rng = validation::rng(seed);
+    let wi = validation::dir(theta, 0.7);
     match m {
         Mat::Conductor => walks(Microsurface::new(h, s, Conductor::perfect()), wi, &mut rng),
         Mat::Diffuse => walks(Microsurface::new(h, s, Diffuse::white()), wi, &mut rng),
@@ -94,7 +93,7 @@ fn cap_removes_less_than_1e4_of_the_albedo() {
             }
         }
     }
-    let alpha = common::sidak(0.01, cases.len());
+    let alpha = validation::sidak(0.01, cases.len());
     let results: Vec<_> = std::thread::scope(|scope| {
         let handles: Vec<_> = cases
             .chunks(cases.len().div_ceil(2))
@@ -181,9 +180,9 @@ fn near_index_matched_dielectrics_terminate() {
     }
     cases.push((1.0 - 5.960_464_5e-8, 1e-6, true, N_WORST));
     cases.push((1.0 + 1.192_092_9e-7, 1e-6, false, N_WORST));
-    let level = common::sidak(0.01, cases.len() - 2);
-    let results = common::par_map(&cases, |k, &(eta, cos, inside, n)| {
-        let mut rng = common::rng(9100 + k as u64);
+    let level = validation::sidak(0.01, cases.len() - 2);
+    let results = validation::par_map(&cases, |k, &(eta, cos, inside, n)| {
+        let mut rng = validation::rng(9100 + k as u64);
         let wi = Vec3::new((1.0 - cos * cos).sqrt() as f32, 0.0, cos as f32);
         let wi = if inside { -wi } else { wi };
         let surface =
@@ -246,9 +245,9 @@ fn position_free_near_index_matched_dielectrics_terminate() {
             cases.push((shadowing, eta, 0.1));
         }
     }
-    let level = common::sidak(0.01, cases.len());
-    let results = common::par_map(&cases, |k, &(shadowing, eta, cos)| {
-        let mut rng = common::rng(9300 + k as u64);
+    let level = validation::sidak(0.01, cases.len());
+    let results = validation::par_map(&cases, |k, &(shadowing, eta, cos)| {
+        let mut rng = validation::rng(9300 + k as u64);
         let wi = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
         let pf = PositionFree::new(Ggx::isotropic(1.0).unwrap(), Dielectric::new(eta).unwrap(), shadowing);
         (0..N).filter(|_| pf.sample(wi, &mut rng).is_none()).count()
@@ -265,7 +264,7 @@ fn position_free_near_index_matched_dielectrics_terminate() {
 #[test]
 fn index_matched_dielectric_is_transparent() {
     use microsurface::{Estimator, PositionFree, ScatteringOrder, Shadowing};
-    let mut rng = common::rng(9200);
+    let mut rng = validation::rng(9200);
     let m = Dielectric::new(1.0).unwrap();
     for cos in [1.0f32, 1e-3, 1e-8] {
         for wi in
@@ -279,7 +278,7 @@ fn index_matched_dielectric_is_transparent() {
                 let p = pf.sample(wi, &mut rng).expect("a transparent walk always leaves");
                 assert_eq!((p.wo, p.weight, p.bounces), (-wi, Vec3::ONE, 1), "cos {cos}");
             }
-            for wo in [-wi, common::dir(2.5, 0.3), common::dir(0.5, 1.0)] {
+            for wo in [-wi, validation::dir(2.5, 0.3), validation::dir(0.5, 1.0)] {
                 assert_eq!(surface.eval(wi, wo, ScatteringOrder::All, &mut rng), Vec3::ZERO);
                 let v = pf.eval(wi, wo, Estimator::Pt, ScatteringOrder::All, &mut rng);
                 assert_eq!(v, Vec3::ZERO, "position-free eval at η = 1, cos {cos}, wo {wo:?}");

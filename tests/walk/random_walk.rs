@@ -15,11 +15,9 @@
 //! uniform directions in the cell, one independent `eval` each, refined until the variance
 //! of the estimate is at most a tenth of the multinomial variance, and that variance is
 //! still included in the statistic (with moment-matched degrees of freedom).
-mod common;
-use common::par_map;
-use common::stochastic::stochastic_chi2;
+use validation::par_map;
+use validation::stochastic::stochastic_chi2;
 
-use common::{Stats, TestRng};
 use glam::{DVec3, Vec3};
 use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, HeightSample, Material,
@@ -28,6 +26,7 @@ use microsurface::{
 };
 use statrs::distribution::{ContinuousCDF, Normal};
 use std::f64::consts::{PI, TAU};
+use validation::{Stats, TestRng};
 
 const ALPHAS: [(f32, f32); 3] = [(0.5, 0.5), (1.5, 1.5), (1.0, 0.3)];
 const THETAS: [f64; 4] = [0.0, 0.8, 1.2, 1.5];
@@ -140,7 +139,7 @@ fn reference_eval<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
     let mut h = if outside { f32::INFINITY } else { f32::NEG_INFINITY };
     let (mut throughput, mut sum) = (Vec3::ONE, Vec3::ZERO);
     for _ in 0..microsurface::MAX_BOUNCES {
-        let u = common::uniform32(rng);
+        let u = validation::uniform32(rng);
         match geometry.sample_height(side(wr, outside), if outside { h } else { -h }, u) {
             HeightSample::Escape => break,
             HeightSample::Hit(local) => h = if outside { local } else { -local },
@@ -202,8 +201,8 @@ fn build(h: Height, s: Slope, alpha: (f32, f32), m: Mat) -> Box<dyn Bsdf> {
 
 /// A uniform direction with cos θ ∈ [z_lo, 1].
 fn uniform_dir(z_lo: f64, rng: &mut TestRng) -> Vec3 {
-    let z = z_lo + (1.0 - z_lo) * common::uniform64(rng);
-    let phi = TAU * common::uniform64(rng);
+    let z = z_lo + (1.0 - z_lo) * validation::uniform64(rng);
+    let phi = TAU * validation::uniform64(rng);
     let s = (1.0 - z * z).max(0.0).sqrt();
     DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()
 }
@@ -213,7 +212,7 @@ fn uniform_dir(z_lo: f64, rng: &mut TestRng) -> Vec3 {
 ///
 /// ωo is uniform, or — for the F = 1 conductor and the dielectric, whose sharp lobes make the
 /// uniform estimator noisy — drawn from the defensive mixture q = ½ uniform + ½ phase function
-/// of ωi (an exact density validated by tests/phase_functions.rs; independent of `sample`),
+/// of ωi (an exact density validated by tests/materials.rs; independent of `sample`),
 /// with the estimator eval/q.
 fn albedo(bsdf: &dyn Bsdf, wi: Vec3, upper_only: bool, n: usize, rng: &mut TestRng) -> [Stats; 3] {
     let z_lo = if bsdf.transmits() && !upper_only { -1.0 } else { 0.0 };
@@ -221,7 +220,7 @@ fn albedo(bsdf: &dyn Bsdf, wi: Vec3, upper_only: bool, n: usize, rng: &mut TestR
     let mixture = bsdf.exact_phase() && !upper_only;
     let mut stats = [Stats::default(); 3];
     for _ in 0..n {
-        let wo = if mixture && common::uniform64(rng) < 0.5 {
+        let wo = if mixture && validation::uniform64(rng) < 0.5 {
             bsdf.phase_sample(wi, rng)
         } else {
             uniform_dir(z_lo, rng)
@@ -249,7 +248,7 @@ fn worst_z(values: &[(f64, f64)]) -> f64 {
 // ---------------------------------------------------------------------------------------------
 
 #[test]
-fn white_furnace() {
+fn white_furnace_4_4_1() {
     const N: usize = 120_000;
     // (material, height, slope, α index, θi, lit from inside)
     let mut cases = Vec::new();
@@ -266,18 +265,18 @@ fn white_furnace() {
             }
         }
     }
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(m, h, s, a, theta, inside)| {
         let bsdf = build(h, s, ALPHAS[a], m);
-        let wi = common::dir(theta, PHI_I);
-        let mut rng = common::rng(100 + i as u64);
+        let wi = validation::dir(theta, PHI_I);
+        let mut rng = validation::rng(100 + i as u64);
         // the dielectric's eval is the noisiest (σ̂ ≈ 3.3 against ≈ 2.4): twice the walks
         let n = if m == Mat::Dielectric { 2 * N } else { N };
         let [stats, _, _] = albedo(bsdf.as_ref(), wi, false, n, &mut rng);
         let label = format!("{}: white furnace θi = {theta:.3} (lit from inside: {inside})", bsdf.name());
         // at grazing incidence the dielectric's σ̂ reaches 4.8: SE ≤ 1e-2 there, 8e-3 otherwise
         let max_se = if m == Mat::Dielectric { 1e-2 } else { 8e-3 };
-        common::assert_mean(&label, &stats, 1.0, z, max_se, 0.0);
+        validation::assert_mean(&label, &stats, 1.0, z, max_se, 0.0);
         (stats.mean() - 1.0, stats.se())
     });
     for (case, (d, se)) in cases.iter().zip(&out) {
@@ -310,7 +309,7 @@ enum Pair {
 }
 
 #[test]
-fn reciprocity() {
+fn reciprocity_4_4_2() {
     const N: usize = 100_000;
     let pairs = [(0.3, 0.0, 1.1, 2.6), (1.2, 0.5, 0.6, 3.7), (1.5, 1.0, 0.9, 4.4)];
     let mut cases = Vec::new();
@@ -329,10 +328,10 @@ fn reciprocity() {
             }
         }
     }
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(m, h, s, a, (ti, pi, to, po), pair)| {
         let bsdf = build(h, s, ALPHAS[a], m);
-        let (mut wi, mut wo) = (common::dir(ti, pi), common::dir(to, po));
+        let (mut wi, mut wo) = (validation::dir(ti, pi), validation::dir(to, po));
         // generalized reciprocity f(ωi, ωo)/ηo² = f(ωo, ωi)/ηi²: only crossing pairs differ
         let mut scale_a = 1.0;
         match pair {
@@ -340,7 +339,7 @@ fn reciprocity() {
             Pair::Through => {
                 // forward transmission, inside the lobe: ωo's azimuth opposite to ωi's and
                 // half the polar angle (off-lobe values are too noisy to test)
-                wo = -common::dir(0.5 * to, pi);
+                wo = -validation::dir(0.5 * to, pi);
                 scale_a = 1.0 / f64::from(ETA * ETA);
             }
             Pair::Below => {
@@ -348,7 +347,7 @@ fn reciprocity() {
                 wo = -wo;
             }
         }
-        let mut rng = common::rng(200 + i as u64);
+        let mut rng = validation::rng(200 + i as u64);
         let (mut fa, mut fb) = (Stats::default(), Stats::default());
         for _ in 0..N {
             fa.push(
@@ -360,7 +359,7 @@ fn reciprocity() {
         let label = format!("{}: reciprocity {pair:?} θi = {ti}, θo = {to}", bsdf.name());
         let scale = fa.mean().max(fb.mean());
         assert!(scale > 1e-3, "{label}: vanishing BSDF {scale:e}: the test would be vacuous");
-        common::assert_two_sample(&label, &fa, &fb, z, 0.04 * scale);
+        validation::assert_two_sample(&label, &fa, &fb, z, 0.04 * scale);
         (fa.mean() - fb.mean(), fa.se().hypot(fb.se()))
     });
     println!(
@@ -375,7 +374,7 @@ fn reciprocity() {
 // ---------------------------------------------------------------------------------------------
 
 #[test]
-fn first_order_equals_single_scattering() {
+fn first_order_equals_single_scattering_4_4_3() {
     const N: usize = 100_000;
     let only1 = ScatteringOrder::only(1).unwrap();
     // (θi, θo) with signs: the dielectric is also lit from inside
@@ -395,11 +394,11 @@ fn first_order_equals_single_scattering() {
             }
         }
     }
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(m, h, s, a, ti, to)| {
         let bsdf = build(h, s, ALPHAS[a], m);
-        let (wi, wo) = (common::dir(ti, PHI_I), common::dir(to, PHI_I + PI));
-        let mut rng = common::rng(300 + i as u64);
+        let (wi, wo) = (validation::dir(ti, PHI_I), validation::dir(to, PHI_I + PI));
+        let mut rng = validation::rng(300 + i as u64);
         let (mut walk, mut single) = (Stats::default(), Stats::default());
         for _ in 0..N {
             walk.push(f64::from(bsdf.eval(wi, wo, only1, &mut rng).x));
@@ -411,10 +410,10 @@ fn first_order_equals_single_scattering() {
         assert!(scale > 1e-3, "{label}: vanishing value {scale:e}: the test would be vacuous");
         if single.std() == 0.0 {
             // exact single scattering (conductor, dielectric): one-sample test, f32 tolerance
-            common::assert_mean(&label, &walk, single.mean(), z, 0.01 * scale, 1e-5 * scale);
+            validation::assert_mean(&label, &walk, single.mean(), z, 0.01 * scale, 1e-5 * scale);
             (walk.mean() - single.mean(), walk.se())
         } else {
-            common::assert_two_sample(&label, &walk, &single, z, 0.01 * scale);
+            validation::assert_two_sample(&label, &walk, &single, z, 0.01 * scale);
             (walk.mean() - single.mean(), walk.se().hypot(single.se()))
         }
     });
@@ -432,7 +431,7 @@ fn first_order_equals_single_scattering() {
 const CHI2_N: usize = 30_000;
 
 #[test]
-fn sampling_chi2() {
+fn sampling_chi2_4_4_4() {
     // (material, height, slope, α index, θi): every material, height, slope, roughness,
     // grazing incidence and the dielectric lit from inside
     let cases = [
@@ -448,13 +447,13 @@ fn sampling_chi2() {
         (Mat::Dielectric, Height::Gaussian, Slope::Ggx, 0, PI - 0.8),
         (Mat::Dielectric, Height::Uniform, Slope::Beckmann, 1, PI - 1.5),
     ];
-    let alpha = common::sidak(0.01, cases.len());
+    let alpha = validation::sidak(0.01, cases.len());
     let out = par_map(&cases, |i, &(m, h, s, a, theta)| {
         let bsdf = build(h, s, ALPHAS[a], m);
-        let wi = common::dir(theta, PHI_I);
+        let wi = validation::dir(theta, PHI_I);
         let label = format!("{}: sample, θi = {theta:.3}", bsdf.name());
-        let mut rng = common::rng(400 + i as u64);
-        let mut eval_rng = common::rng(500 + i as u64);
+        let mut rng = validation::rng(400 + i as u64);
+        let mut eval_rng = validation::rng(500 + i as u64);
         let mut bounces = Stats::default();
         let z_lo = if bsdf.transmits() { -1.0 } else { 0.0 };
         let (nz, nphi) = if bsdf.transmits() { (16, 16) } else { (8, 16) };
@@ -517,21 +516,21 @@ fn walk_in_c1_space_matches_the_height_space_walk_for_both_heights() {
                 let back = PHI_I + PI;
                 let pairs = if m == Mat::Dielectric {
                     vec![
-                        (common::dir(1.0, PHI_I), common::dir(1.0, back)),
-                        (common::dir(1.0, PHI_I), common::dir(PI - 0.6, back)),
-                        (common::dir(PI - 0.3, PHI_I), common::dir(0.45, back)),
+                        (validation::dir(1.0, PHI_I), validation::dir(1.0, back)),
+                        (validation::dir(1.0, PHI_I), validation::dir(PI - 0.6, back)),
+                        (validation::dir(PI - 0.3, PHI_I), validation::dir(0.45, back)),
                     ]
                 } else {
-                    vec![(common::dir(1.0, PHI_I), common::dir(0.6, 3.5))]
+                    vec![(validation::dir(1.0, PHI_I), validation::dir(0.6, 3.5))]
                 };
                 cases.extend(pairs.into_iter().map(|(wi, wo)| (m, s, a, h, wi, wo)));
             }
         }
     }
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(m, s, a, h, wi, wo)| {
         let bsdf = build(h, s, ALPHAS[a], m);
-        let mut rng = common::rng(600 + i as u64);
+        let mut rng = validation::rng(600 + i as u64);
         let (mut walk, mut reference) = (Stats::default(), Stats::default());
         for _ in 0..N {
             walk.push(f64::from(bsdf.eval(wi, wo, ScatteringOrder::All, &mut rng).x));
@@ -545,7 +544,7 @@ fn walk_in_c1_space_matches_the_height_space_walk_for_both_heights() {
         );
         let scale = walk.mean().max(reference.mean());
         assert!(scale > 1e-3, "{label}: vanishing value {scale:e}");
-        common::assert_two_sample(&label, &walk, &reference, z, 0.01 * scale);
+        validation::assert_two_sample(&label, &walk, &reference, z, 0.01 * scale);
         println!(
             "{label}: {:.5} ± {:.5} vs {:.5} ± {:.5}",
             walk.mean(),
@@ -571,12 +570,13 @@ fn gold_conductor_albedo() {
     const N: usize = 200_000;
     let cases = [(Height::Uniform, Slope::Ggx, 1, 0.8), (Height::Gaussian, Slope::Beckmann, 2, 1.3)];
     // per case and channel: the two-sample equality and the one-sided upper bound
-    let z = common::family_z(0.01, 3 * cases.len());
-    let z_one_sided = Normal::new(0.0, 1.0).unwrap().inverse_cdf(1.0 - common::sidak(0.01, 3 * cases.len()));
+    let z = validation::family_z(0.01, 3 * cases.len());
+    let z_one_sided =
+        Normal::new(0.0, 1.0).unwrap().inverse_cdf(1.0 - validation::sidak(0.01, 3 * cases.len()));
     let out = par_map(&cases, |i, &(h, s, a, theta)| {
         let bsdf = build(h, s, ALPHAS[a], Mat::Gold);
-        let wi = common::dir(theta, PHI_I);
-        let mut rng = common::rng(700 + i as u64);
+        let wi = validation::dir(theta, PHI_I);
+        let mut rng = validation::rng(700 + i as u64);
         let by_eval = albedo(bsdf.as_ref(), wi, false, N, &mut rng);
         let mut by_sample = [Stats::default(); 3];
         let mut first_fresnel = [Stats::default(); 3];
@@ -604,7 +604,7 @@ fn gold_conductor_albedo() {
                 f.mean(),
                 f.se()
             );
-            common::assert_two_sample(
+            validation::assert_two_sample(
                 &format!("{label}: albedo by eval vs E[weight] of sample"),
                 e,
                 &by_sample[c],
@@ -634,18 +634,18 @@ fn gold_conductor_albedo() {
 fn grey_diffuse_sample_weight_matches_albedo() {
     const N: usize = 200_000;
     let cases = [(Height::Gaussian, Slope::Ggx, 1, 0.5), (Height::Uniform, Slope::Beckmann, 2, 1.4)];
-    let z = common::family_z(0.01, cases.len());
+    let z = validation::family_z(0.01, cases.len());
     let out = par_map(&cases, |i, &(h, s, a, theta)| {
         let bsdf = build(h, s, ALPHAS[a], Mat::Diffuse(0.5));
-        let wi = common::dir(theta, PHI_I);
-        let mut rng = common::rng(800 + i as u64);
+        let wi = validation::dir(theta, PHI_I);
+        let mut rng = validation::rng(800 + i as u64);
         let [by_eval, _, _] = albedo(bsdf.as_ref(), wi, false, N, &mut rng);
         let mut by_sample = Stats::default();
         for _ in 0..N {
             by_sample.push(bsdf.sample(wi, &mut rng).map_or(0.0, |s| f64::from(s.weight.x)));
         }
         let label = format!("{}: albedo 0.5, θi = {theta}: ∫eval vs E[weight]", bsdf.name());
-        common::assert_two_sample(&label, &by_eval, &by_sample, z, 3e-3);
+        validation::assert_two_sample(&label, &by_eval, &by_sample, z, 3e-3);
         assert!(by_eval.mean() < 0.5, "{label}: the albedo must be below the facet albedo");
         println!(
             "{label}: {:.4} ± {:.4} vs {:.4} ± {:.4}",
@@ -663,7 +663,7 @@ fn grey_diffuse_sample_weight_matches_albedo() {
 // scattering orders
 // ---------------------------------------------------------------------------------------------
 
-/// Orders summed: the mass beyond is negligible (tests/walk_cap.rs measures the fraction of
+/// Orders summed: the mass beyond is negligible (tests/walk/cap.rs measures the fraction of
 /// walks longer than 64 bounces at α = 2: below 1e-4, and none at these α in its runs).
 const MAX_ORDER: u32 = 64;
 
@@ -675,11 +675,11 @@ fn orders_sum_to_the_full_bsdf() {
         (Mat::Diffuse(1.0), Height::Gaussian, Slope::Beckmann, 1, 1.2, 0.4),
         (Mat::Dielectric, Height::Gaussian, Slope::Ggx, 2, 0.5, PI - 0.7),
     ];
-    let z = common::family_z(0.01, 2 * cases.len());
+    let z = validation::family_z(0.01, 2 * cases.len());
     let out = par_map(&cases, |i, &(m, h, s, a, ti, to)| {
         let bsdf = build(h, s, ALPHAS[a], m);
-        let (wi, wo) = (common::dir(ti, PHI_I), common::dir(to, PHI_I + PI));
-        let mut rng = common::rng(900 + i as u64);
+        let (wi, wo) = (validation::dir(ti, PHI_I), validation::dir(to, PHI_I + PI));
+        let mut rng = validation::rng(900 + i as u64);
         let (mut sum, mut all, mut sum3, mut up3) =
             (Stats::default(), Stats::default(), Stats::default(), Stats::default());
         for _ in 0..N {
@@ -697,8 +697,8 @@ fn orders_sum_to_the_full_bsdf() {
         let label = format!("{}: θi = {ti}, θo = {to:.3}", bsdf.name());
         let scale = all.mean();
         assert!(scale > 1e-3, "{label}: vanishing BSDF {scale:e}");
-        common::assert_two_sample(&format!("{label}: Σ only(n) vs All"), &sum, &all, z, 0.02 * scale);
-        common::assert_two_sample(
+        validation::assert_two_sample(&format!("{label}: Σ only(n) vs All"), &sum, &all, z, 0.02 * scale);
+        validation::assert_two_sample(
             &format!("{label}: Σ_{{n≤3}} only(n) vs up_to(3)"),
             &sum3,
             &up3,

@@ -4,18 +4,15 @@
 //! (η = 1.5) lit from inside at the critical angle and ±0.02 rad around it.
 //!
 //! Every albedo is ∫ eval dωo estimated by importance sampling with an evaluable mixture
-//! density (see `examples/stability/stiff.rs`), asserted |mean − 1| ≤ z·SE (+1e-4 for BDPT:
+//! density (see `validation/src/stability/stiff.rs`), asserted |mean − 1| ≤ z·SE (+1e-4 for BDPT:
 //! the documented bound on the energy of paths beyond its sub-path cap), z = family_z(0.01, m)
 //! over the m assertions of the test, and SE ≤ the configuration's stated `max_se`. Walk
 //! lengths: mean bounces of `sample()` below the configuration's stated bound, no walk
 //! dropped. Seeds are fixed (PCG).
-mod common;
-#[path = "../examples/stability/stiff.rs"]
-mod stiff;
 
-use common::{assert_mean, family_z};
 use microsurface::Estimator;
-use stiff::{Tech, configs};
+use validation::stability::stiff::{self, Tech, configs};
+use validation::{assert_mean, family_z};
 
 /// The deterministic f32 rounding allowed between two f32 estimators of an albedo ≈ 1 (8 ulps).
 const F32_ALBEDO_TOL: f64 = 1e-6;

@@ -1,7 +1,7 @@
 //! A test-only double-precision reference for the f32 crate and the accuracy map built on it.
 //!
-//! Shared by `tests/accuracy_map.rs` (which asserts the bounds) and `examples/stability.rs`
-//! (which prints the map), through `#[path = ...]`.
+//! Used by `tests/special/accuracy_map.rs` (which asserts the bounds) and
+//! `examples/stability.rs` (which prints the map).
 //!
 //! The reference evaluates the definitions of the supplement (Heitz et al. 2016) in f64, on
 //! the *same* f32 inputs the crate receives (widened exactly), with `statrs` special functions.
@@ -16,7 +16,6 @@
 //! units of 1e-30 below. Reflectances (Fresnel terms, in [0, 1]) are compared with the floor
 //! 1e-6 (`REFLECTANCE_FLOOR`): their relative error is asserted where F ≥ 1e-6 and their
 //! absolute error (≤ bound × 1e-6) below.
-#![allow(dead_code)]
 
 use glam::{DVec3, Vec3};
 use microsurface::{
@@ -488,7 +487,7 @@ fn fmt_v(v: Vec3) -> String {
     format!("({:.3e}, {:.3e}, {:.3e})", v.x, v.y, v.z)
 }
 
-/// The measured bounds (see the report in `tests/accuracy_map.rs`).
+/// The measured bounds (see the report in `tests/special/accuracy_map.rs`).
 pub mod bounds {
     /// Λ, G1, D, projected area, αᵢ (elementwise functions of one direction).
     pub const DIRECTION: f64 = 1e-6;

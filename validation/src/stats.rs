@@ -1,10 +1,6 @@
-//! Shared statistics for the integration tests: seeded generators, standard-error tests,
-//! Šidák-corrected significance, quadrature on the sphere and the chi-square harness.
-#![allow(dead_code)]
-
-pub mod chi2;
-pub mod quadrature;
-pub mod stochastic;
+//! The statistical assertions: seeded generators, standard-error tests (mean within z·SE,
+//! SE small enough to mean something), Šidák-corrected significance, and helpers to draw
+//! directions and run cases on both cores.
 
 use rand::SeedableRng;
 use statrs::distribution::{ContinuousCDF, Normal};
@@ -116,6 +112,15 @@ pub fn assert_two_sample(label: &str, a: &Stats, b: &Stats, z: f64, max_se: f64)
         b.mean(),
         b.std()
     );
+}
+
+/// A uniform direction on the sphere (f64 arithmetic, rounded to f32): z = 2u₁ − 1,
+/// φ = 2πu₂.
+pub fn uniform_sphere(rng: &mut TestRng) -> glam::Vec3 {
+    let z = 2.0 * uniform64(rng) - 1.0;
+    let phi = std::f64::consts::TAU * uniform64(rng);
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    glam::DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()
 }
 
 /// A unit direction from spherical angles.

@@ -1,7 +1,8 @@
 //! Chi-square tests of samplers against densities known only through unbiased stochastic
 //! estimators (the random walks, the position-free estimators, diffuse phase functions).
 
-use super::{Stats, rng, uniform64};
+use crate::chi2::{Cell, pool};
+use crate::{Stats, rng, uniform64};
 use glam::{DVec3, Vec3};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::TAU;
@@ -20,16 +21,40 @@ pub const NOISE_RATIO: f64 = 0.1;
 pub const CELL_START: usize = 1_000;
 pub const CELL_MAX: usize = 64_000;
 
+/// The binning and the expectation budget of [`stochastic_chi2_with`]: an equal-area `nz` ×
+/// `nphi` grid of (cos θ, φ) on cos θ ≥ `z_lo`; per cell, `cell_start` evaluations doubled
+/// until N·Var(m̂)/m ≤ `noise_ratio` or `cell_max` (equal: a fixed budget); the test fails
+/// if a cell used keeps N·Var(m̂)/m > `max_noise_ratio` (it would lose its power).
+#[derive(Debug, Clone, Copy)]
+pub struct StochasticGrid {
+    pub z_lo: f64,
+    pub nz: usize,
+    pub nphi: usize,
+    pub cell_start: usize,
+    pub cell_max: usize,
+    pub noise_ratio: f64,
+    pub max_noise_ratio: f64,
+}
+
+impl StochasticGrid {
+    /// The default budget ([`CELL_START`] doubled up to [`CELL_MAX`], [`NOISE_RATIO`], at most
+    /// 4 × [`NOISE_RATIO`]) on cos θ ≥ `z_lo`.
+    pub fn adaptive(z_lo: f64, nz: usize, nphi: usize) -> Self {
+        Self {
+            z_lo,
+            nz,
+            nphi,
+            cell_start: CELL_START,
+            cell_max: CELL_MAX,
+            noise_ratio: NOISE_RATIO,
+            max_noise_ratio: 4.0 * NOISE_RATIO,
+        }
+    }
+}
+
 /// Chi-square test of `sample` against a density known only through an unbiased stochastic
-/// estimator `density`, over an equal-area `nz` × `nphi` grid of (cos θ, φ) on cos θ ≥ z_lo.
-///
-/// The expected probability m̂ of a cell is its area times the mean of `density` at uniform
-/// points of the cell, one independent evaluation each, doubled until N·Var(m̂)/m ≤
-/// `NOISE_RATIO` (or `CELL_MAX` points). Cells with N m̂ < 5 are pooled. The statistic
-/// Σ (O − N m̂)²/(N m̂ + N² Var m̂) has mean k − Σ m/(1 + N Var m̂/m) over the k cells used, and
-/// is compared with the chi-square distribution with that (fractional) number of degrees of
-/// freedom. Samples outside cos θ ≥ z_lo, or where every estimate is 0, fail the test.
-/// Failed samples (`None`) are allowed only for the mass the density leaves out.
+/// estimator `density`, over an equal-area `nz` × `nphi` grid of (cos θ, φ) on cos θ ≥ z_lo,
+/// with the default budget ([`StochasticGrid::adaptive`]; see [`stochastic_chi2_with`]).
 #[allow(clippy::too_many_arguments)]
 pub fn stochastic_chi2(
     label: &str,
@@ -41,6 +66,29 @@ pub fn stochastic_chi2(
     n: usize,
     alpha: f64,
 ) -> Chi2Result {
+    stochastic_chi2_with(label, StochasticGrid::adaptive(z_lo, nz, nphi), density, sample, n, alpha)
+}
+
+/// Chi-square test of `sample` against a density known only through an unbiased stochastic
+/// estimator `density`, over the grid `grid` (Mitsuba's `ChiSquareTest` with a stochastic
+/// expectation).
+///
+/// The expected probability m̂ of a cell is its area times the mean of `density` at uniform
+/// points of the cell, one independent evaluation each, doubled until N·Var(m̂)/m ≤
+/// `noise_ratio` (or `cell_max` points). Cells with N m̂ < 5 are pooled ([`crate::chi2::pool`]).
+/// The statistic Σ (O − N m̂)²/(N m̂ + N² Var m̂) has mean k − Σ m/(1 + N Var m̂/m) over the k
+/// cells used, and is compared with the chi-square distribution with that (fractional) number
+/// of degrees of freedom. Samples outside cos θ ≥ z_lo, or where every estimate is 0, fail the
+/// test. Failed samples (`None`) are allowed only for the mass the density leaves out.
+pub fn stochastic_chi2_with(
+    label: &str,
+    grid: StochasticGrid,
+    density: &mut dyn FnMut(Vec3) -> f64,
+    sample: &mut dyn FnMut() -> Option<Vec3>,
+    n: usize,
+    alpha: f64,
+) -> Chi2Result {
+    let StochasticGrid { z_lo, nz, nphi, cell_start, cell_max, noise_ratio, max_noise_ratio } = grid;
     let mut point_rng = rng(0x5eed);
     let nf = n as f64;
     let cells = nz * nphi;
@@ -50,7 +98,7 @@ pub fn stochastic_chi2(
         for ip in 0..nphi {
             let (z0, p0) = (z_lo + dz * iz as f64, dp * ip as f64);
             let mut stats = Stats::default();
-            let mut target = CELL_START;
+            let mut target = cell_start;
             loop {
                 while (stats.n as usize) < target {
                     let z = z0 + dz * uniform64(&mut point_rng);
@@ -59,7 +107,7 @@ pub fn stochastic_chi2(
                     stats.push(density(DVec3::new(s * phi.cos(), s * phi.sin(), z).as_vec3()));
                 }
                 let (m, v) = (dz * dp * stats.mean(), (dz * dp * stats.se()).powi(2));
-                if m == 0.0 || nf * v / m <= NOISE_RATIO || target >= CELL_MAX {
+                if m == 0.0 || nf * v / m <= noise_ratio || target >= cell_max {
                     break;
                 }
                 target *= 2;
@@ -88,31 +136,17 @@ pub fn stochastic_chi2(
         failures as f64 <= missing + 5.0 * missing.max(1.0).sqrt() + 1.0,
         "{label}: {failures} failed samples out of {n}, expected about {missing:.1}"
     );
-    let (mut stat, mut dof, mut max_ratio) = (0.0, 0.0, 0.0f64);
-    let mut add = |m: f64, v: f64, o: f64| {
-        let ratio = nf * v / m;
-        stat += (o - nf * m).powi(2) / (nf * m * (1.0 + ratio));
-        dof += 1.0 - m / (1.0 + ratio);
-        max_ratio = max_ratio.max(ratio);
-    };
-    let (mut pool_m, mut pool_v, mut pool_o) = (0.0, 0.0, 0.0);
-    for c in 0..cells {
-        if nf * mass[c] < 5.0 {
-            pool_m += mass[c];
-            pool_v += var[c];
-            pool_o += observed[c] as f64;
-        } else {
-            add(mass[c], var[c], observed[c] as f64);
-        }
-    }
-    if pool_m > 0.0 {
-        add(pool_m, pool_v, pool_o);
-    } else {
-        assert!(pool_o == 0.0, "{label}: {pool_o} samples fell where the density is zero");
-    }
+    let pooled =
+        pool(n, (0..cells).map(|c| Cell { mass: mass[c], variance: var[c], observed: observed[c] as f64 }));
+    assert!(
+        pooled.statistic.is_finite(),
+        "{label}: {} samples fell where the density is zero",
+        pooled.zero_mass_observed
+    );
+    let (stat, dof, max_ratio) = (pooled.statistic, pooled.stochastic_dof, pooled.max_ratio);
     let p_value = 1.0 - ChiSquared::new(dof).unwrap().cdf(stat);
     assert!(
-        max_ratio <= 4.0 * NOISE_RATIO,
+        max_ratio <= max_noise_ratio,
         "{label}: the expectation stayed too noisy (N·Var(m̂)/m = {max_ratio:.3}): the test would lose its power"
     );
     assert!(

@@ -1,12 +1,11 @@
 //! A small CPU path tracer over the `microsurface` BSDFs: spheres, one spherical area light,
 //! an environment; next-event estimation, Russian roulette and multiple importance sampling
-//! (the classic unidirectional path tracer with MIS). Shared by `main.rs` and
-//! `tests/path_tracer.rs`.
+//! (the classic unidirectional path tracer with MIS). Used by
+//! `examples/path_tracer/main.rs` and `tests/examples/path_tracer.rs`.
 //!
 //! The materials are a `Vec<Box<dyn Bsdf>>`: no enum, no dispatch macro. The BSDF samples
 //! are driven by the tracer's own uniforms; the stochastic BSDFs get the path's index as
 //! their key, so a render is a pure function of its seed (identical for any thread count).
-#![allow(dead_code)]
 
 use glam::{Vec2, Vec3};
 use microsurface::{

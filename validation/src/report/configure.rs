@@ -24,7 +24,6 @@ pub struct Options {
 }
 
 /// The default output directory.
-#[allow(dead_code)] // used by main.rs, not by tests/report.rs
 pub fn default_out_dir() -> PathBuf {
     PathBuf::from("target").join("report")
 }

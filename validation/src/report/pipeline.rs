@@ -6,7 +6,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// What one run of the report produced.
-#[allow(dead_code)] // `budget` and `results` are read by tests/report.rs
 pub struct Report {
     pub budget: Budget,
     pub results: Results,

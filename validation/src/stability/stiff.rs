@@ -1,16 +1,15 @@
 //! Stiff random walks: the Heitz et al. 2016 walk and the position-free PT and BDPT estimators
 //! (both shadowing models) at α = 1e-3, at α = 4, at θi = 1.57 rad and for a dielectric lit
-//! from inside near the critical angle. Shared by `tests/stiff.rs` (assertions) and
-//! `examples/stability.rs` (the report), through `#[path = ...]`; needs `crate::common`.
+//! from inside near the critical angle. Used by `tests/walk/stiff.rs` (assertions) and
+//! `examples/stability.rs` (the report).
 //!
 //! Albedo: ∫ eval(ωi, ωo) dωo by importance-sampled Monte Carlo, ωo drawn from the mixture
 //! 0.8 × the material's phase-function sampler (whose exact density `pdf_phase` is summed over
 //! both sides) + 0.2 × a cosine lobe (split between both hemispheres for a dielectric); one
 //! independent `eval` per direction, so each sample is unbiased and the standard error is
 //! the sample's. Walk length: the `bounces` of `sample()`.
-#![allow(dead_code)]
 
-use crate::common::{Stats, TestRng};
+use crate::{Stats, TestRng};
 use glam::Vec3;
 use microsurface::{
     Beckmann, Conductor, Dielectric, Estimator, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
@@ -235,7 +234,7 @@ pub struct Run {
 pub fn run(config: Config, tech: Tech, seed: u64) -> Run {
     let model = config.model(tech);
     let wi = config.wi();
-    let mut rng = crate::common::rng(seed);
+    let mut rng = crate::rng(seed);
     let mut albedo = Stats::default();
     for _ in 0..config.n {
         let wo = model.mix_sample(wi, &mut rng);
@@ -261,7 +260,7 @@ pub fn run(config: Config, tech: Tech, seed: u64) -> Run {
 pub fn order_one(config: Config, tech: Tech, seed: u64) -> [Stats; 4] {
     let model = config.model(tech);
     let wi = config.wi();
-    let mut rng = crate::common::rng(seed);
+    let mut rng = crate::rng(seed);
     let [mut o1, mut ss, mut diff, mut multi] = [Stats::default(); 4];
     let only1 = ScatteringOrder::only(1).unwrap();
     for _ in 0..config.n {

@@ -28,9 +28,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
 
-#[path = "common/clock.rs"]
-mod clock;
-use clock::{Clock, config};
+use validation::clock::{Clock, config};
 
 /// The number of pre-generated inputs (a power of two).
 const N: usize = 1024;

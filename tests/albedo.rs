@@ -3,9 +3,6 @@
 //! order: nodes, interpolation between nodes within the stated bound, the average albedo, and
 //! the range policy.
 
-mod common;
-
-use common::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
 use glam::Vec3;
 use microsurface::{
     ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Bsdf, Conductor, DIELECTRIC_TABLE_SIZE, Dielectric,
@@ -13,6 +10,7 @@ use microsurface::{
     Transport, UniformHeight,
 };
 use rand::RngExt;
+use validation::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
 
 /// Family-wise significance of each test.
 const FAMILY_ALPHA: f64 = 1e-3;

@@ -3,16 +3,14 @@
 //! albedo tables' interpolation error, the normalization of the Kulla–Conty lobe, its
 //! reciprocity, and the constructor's range.
 
-mod common;
-
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate_sphere;
-use common::{Stats, assert_mean, dir, family_z, sidak, uniform32};
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
     AlbedoTable, AlbedoTabulated, Beckmann, Bsdf, CompensatedConductor, CompensatedDielectric, Compensation,
     ComplexIor, Conductor, Dielectric, Ggx, Transport,
 };
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
+use validation::{Stats, assert_mean, dir, family_z, sidak, uniform32};
 
 /// The tables' largest interpolation error of E (measured by the generator, `AlbedoTable`).
 const TABLE_ERROR_GGX: f64 = 1.2e-3;
@@ -38,7 +36,11 @@ fn rel_close(a: Vec3, b: Vec3, rel: f32) -> bool {
 }
 
 /// A sample from fresh uniforms.
-fn draw<B: Bsdf + ?Sized>(b: &B, wo: Vec3, rng: &mut common::TestRng) -> Option<microsurface::BsdfSample> {
+fn draw<B: Bsdf + ?Sized>(
+    b: &B,
+    wo: Vec3,
+    rng: &mut validation::TestRng,
+) -> Option<microsurface::BsdfSample> {
     let uc = uniform32(rng);
     let u = Vec2::new(uniform32(rng), uniform32(rng));
     b.sample(wo, uc, u)
@@ -88,7 +90,7 @@ fn sample_matches_pdf_and_weights_match_eval() {
         // the single-scattering lobe's reflections below the horizon are refused: ∫pdf < 1
         let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 8, 16, false, 1e-4, 6);
         assert!(mass <= 1.0 + 1e-3, "{label}: ∫pdf = {mass} > 1");
-        let mut rng = common::rng(1600 + k as u64);
+        let mut rng = validation::rng(1600 + k as u64);
         let out = chi2_test(
             label,
             Chi2Grid { quad_tol: 1e-4, max_depth: 6, ..Chi2Grid::sphere(20, 40) },
@@ -159,7 +161,7 @@ fn white_furnace_within_table_error() {
         for scheme in [Compensation::KullaConty, Compensation::Turquin] {
             let b = CompensatedConductor::new(slope, Conductor::perfect(), scheme).unwrap();
             let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-            let mut rng = common::rng(seed + scheme as u64);
+            let mut rng = validation::rng(seed + scheme as u64);
             let mut stats = Stats::default();
             for _ in 0..n {
                 stats.push(draw(&b, wo, &mut rng).map_or(0.0, |s| f64::from(s.weight.x)));
@@ -251,7 +253,7 @@ fn fresnel_average_is_accurate() {
 /// lobe's f32 rounding), on 2000 random pairs of upper-hemisphere directions per case.
 #[test]
 fn kulla_conty_is_reciprocal() {
-    let mut rng = common::rng(1800);
+    let mut rng = validation::rng(1800);
     for a in [0.05f32, 0.3, 1.0] {
         let b = CompensatedConductor::new(beckmann(a), gold(), Compensation::KullaConty).unwrap();
         for _ in 0..2000 {
@@ -305,7 +307,7 @@ fn backfacing_views_are_single_scattering() {
     let b = CompensatedConductor::new(ggx(0.4), gold(), Compensation::KullaConty).unwrap();
     let ss = *b.single_scattering();
     let wo = dir(1.8, 0.3);
-    let mut rng = common::rng(1900);
+    let mut rng = validation::rng(1900);
     for _ in 0..200 {
         let uc = uniform32(&mut rng);
         let u = Vec2::new(uniform32(&mut rng), uniform32(&mut rng));
@@ -394,7 +396,7 @@ fn dielectric_sample_matches_pdf_and_weights_match_eval() {
         let wo = dir(*theta, 0.4);
         let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 8, 16, false, 1e-4, 6);
         assert!(mass <= 1.0 + 1e-3, "{label}: ∫pdf = {mass} > 1");
-        let mut rng = common::rng(2600 + k as u64);
+        let mut rng = validation::rng(2600 + k as u64);
         let out = chi2_test(
             label,
             Chi2Grid { quad_tol: 1e-4, max_depth: 6, ..Chi2Grid::sphere(20, 40) },
@@ -459,7 +461,7 @@ fn dielectric_white_furnace_within_table_error() {
         for above in [true, false] {
             let s = (1.0 - mu * mu).max(0.0).sqrt();
             let wo = Vec3::new(s, 0.0, if above { mu } else { -mu });
-            let mut rng = common::rng(seed + u64::from(above));
+            let mut rng = validation::rng(seed + u64::from(above));
             let mut stats = Stats::default();
             for _ in 0..n {
                 let uc = uniform32(&mut rng);

@@ -2,7 +2,7 @@
 //! D against eq. 2.26, the normalization and projected-area identities, the rotation identity,
 //! the sampler's chi-square fit and the constructors' rejections.
 
-mod common;
+
 
 use glam::Vec3;
 use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope};
@@ -62,7 +62,7 @@ fn conversions_round_trip_and_d_matches_eq_2_26() {
         let exact = bivariate_of(a1, a2, phi);
         let given = (f64::from(b.0), f64::from(b.1), f64::from(b.2));
         for k in 0..200 {
-            let wm = common::dir(1.5 * (k as f64 / 200.0), 0.7 * k as f64).normalize();
+            let wm = validation::dir(1.5 * (k as f64 / 200.0), 0.7 * k as f64).normalize();
             for (p_std, d, params, label) in [
                 (beckmann_std as fn(f64, f64) -> f64, e.d64(wm.as_dvec3()), exact, "beckmann, ellipse"),
                 (
@@ -112,8 +112,8 @@ fn constructors_reject_invalid_parameters() {
     assert!(Elliptical::<Ggx>::from_bivariate(0.3, 0.2, 0.999_999).is_ok());
 }
 
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate_sphere;
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
 use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
 use std::f64::consts::PI;
 
@@ -134,7 +134,7 @@ fn identities<S: MicrosurfaceSlope>(label: &str, slope: &S) {
     let norm = hemisphere(&mut |m| slope.d64(m.as_dvec3()) * f64::from(m.z));
     assert!((norm - 1.0).abs() < 2e-5, "{label}: ∫ D cos θm = {norm:.8}");
     for (theta, phi) in VIEWS {
-        let w = common::dir(theta, phi).normalize();
+        let w = validation::dir(theta, phi).normalize();
         // signed: ∫⟨ω, m⟩ D = cos θ; clamped: ∫⟨ω, m⟩⁺ D = A(ω) = (1 + Λ(ω)) cos θ
         let signed = hemisphere(&mut |m| slope.d64(m.as_dvec3()) * f64::from(w.dot(m)));
         let clamped = hemisphere(&mut |m| slope.d64(m.as_dvec3()) * f64::from(w.dot(m)).max(0.0));
@@ -168,7 +168,7 @@ fn normalization_and_projected_area_up_to_rho_0_99() {
             cases.push((ax, ay, rho));
         }
     }
-    common::par_map(&cases, |_, &(ax, ay, rho)| {
+    validation::par_map(&cases, |_, &(ax, ay, rho)| {
         identities(
             &format!("beckmann ({ax}, {ay}, ρ {rho})"),
             &Elliptical::<Beckmann>::from_bivariate(ax, ay, rho).unwrap(),
@@ -187,7 +187,7 @@ fn alpha_i_carries_the_correlation() {
     for &rho in &RHOS {
         let e = Elliptical::<Beckmann>::from_bivariate(0.4, 0.2, rho).unwrap();
         for k in 0..64 {
-            let w = common::dir(0.3 + 2.5 * k as f64 / 64.0, 0.37 * k as f64).normalize();
+            let w = validation::dir(0.3 + 2.5 * k as f64 / 64.0, 0.37 * k as f64).normalize();
             let iso = Beckmann::isotropic(e.alpha_i(w)).unwrap();
             let (a, b) = (e.lambda64(w), iso.lambda64(w));
             assert!((a - b).abs() <= 1e-5 * (1.0 + a.abs()), "ρ {rho} {w}: Λ {a} vs Λ(αᵢ) {b}");
@@ -203,7 +203,7 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
     const ORDERS: usize = 4;
     const WALKS: usize = 20_000;
     const VIEWS_PER_CASE: usize = 3;
-    let z = common::family_z(0.01, ROTATIONS.len() * VIEWS_PER_CASE * 2 * ORDERS);
+    let z = validation::family_z(0.01, ROTATIONS.len() * VIEWS_PER_CASE * 2 * ORDERS);
     for &(a1, a2, phi) in &ROTATIONS {
         let e = Elliptical::<Beckmann>::from_ellipse(a1, a2, phi).unwrap();
         let aligned = Beckmann::new(a1, a2).unwrap();
@@ -211,7 +211,7 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
         let ga = Ggx::new(a1, a2).unwrap();
         for k in 0..100 {
             let (theta, psi) = (3.0 * k as f64 / 100.0, 0.61 * k as f64);
-            let (w, w_aligned) = (common::dir(theta, psi), common::dir(theta, psi - f64::from(phi)));
+            let (w, w_aligned) = (validation::dir(theta, psi), validation::dir(theta, psi - f64::from(phi)));
             let rel = |a: f64, b: f64| (a - b).abs() / (a.abs().max(b.abs()).max(1e-300));
             let (d, d_aligned) = (e.d64(w.as_dvec3()), aligned.d64(w_aligned.as_dvec3()));
             // the two f32 directions differ by their roundings (~1e-7): D's condition 2t
@@ -229,11 +229,11 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
             );
         }
         for (v, (theta, psi)) in [(0.4, 0.3), (1.2, 2.0), (1.45, -2.5)].into_iter().enumerate() {
-            let (wi, wi_aligned) = (common::dir(theta, psi), common::dir(theta, psi - f64::from(phi)));
+            let (wi, wi_aligned) = (validation::dir(theta, psi), validation::dir(theta, psi - f64::from(phi)));
             for (material, name) in [(0, "gold"), (1, "glass")] {
                 let seed = 1000 + 10 * v as u64 + material;
                 let per_order = |slope_is_elliptical: bool| {
-                    let mut rng = common::rng(seed);
+                    let mut rng = validation::rng(seed);
                     let mut orders: Vec<Vec<f64>> = (0..ORDERS).map(|_| Vec::with_capacity(WALKS)).collect();
                     for _ in 0..WALKS {
                         let s = match (material, slope_is_elliptical) {
@@ -264,8 +264,8 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
                 let (a, b) = (per_order(true), per_order(false));
                 for order in 0..ORDERS {
                     // paired differences of the same seed's walks
-                    let mut diff = common::Stats::default();
-                    let mut level = common::Stats::default();
+                    let mut diff = validation::Stats::default();
+                    let mut level = validation::Stats::default();
                     for (x, y) in a[order].iter().zip(&b[order]) {
                         diff.push(x - y);
                         level.push(*x);
@@ -276,7 +276,7 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
                         if order + 1 == ORDERS { "+" } else { "" }
                     );
                     // the paired SE is at most that of one estimate: bound it by 1e-2
-                    common::assert_mean(&label, &diff, 0.0, z, 1e-2, 0.0);
+                    validation::assert_mean(&label, &diff, 0.0, z, 1e-2, 0.0);
                     assert!(level.mean() > 0.0 || order > 1, "{label}: no energy in this order");
                 }
             }
@@ -296,28 +296,28 @@ fn sampler_chi2() {
         ((1.2, 0.5, -0.4), 2.7, -0.9),
     ];
     const N: usize = 200_000;
-    let alpha = common::sidak(0.01, 2 * CASES.len());
-    common::par_map(&CASES, |i, &((a1, a2, phi), theta, psi)| {
-        let wi = common::dir(theta, psi).normalize();
+    let alpha = validation::sidak(0.01, 2 * CASES.len());
+    validation::par_map(&CASES, |i, &((a1, a2, phi), theta, psi)| {
+        let wi = validation::dir(theta, psi).normalize();
         let grid = Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) };
         let b = Elliptical::<Beckmann>::from_ellipse(a1, a2, phi).unwrap();
-        let mut rng = common::rng(77 + i as u64);
+        let mut rng = validation::rng(77 + i as u64);
         chi2_test(
             &format!("beckmann ({a1}, {a2}, φ {phi}) from {wi}"),
             grid,
             |m| b.d_wi64(wi, m.as_dvec3()),
-            || Some(b.sample_d_wi(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+            || Some(b.sample_d_wi(wi, validation::uniform32(&mut rng), validation::uniform32(&mut rng))),
             N,
             alpha,
             1.0,
         );
         let g = Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap();
-        let mut rng = common::rng(177 + i as u64);
+        let mut rng = validation::rng(177 + i as u64);
         chi2_test(
             &format!("ggx ({a1}, {a2}, φ {phi}) from {wi}"),
             grid,
             |m| g.d_wi64(wi, m.as_dvec3()),
-            || Some(g.sample_d_wi(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+            || Some(g.sample_d_wi(wi, validation::uniform32(&mut rng), validation::uniform32(&mut rng))),
             N,
             alpha,
             1.0,
@@ -356,9 +356,9 @@ fn compensated_conductor_is_rotation_invariant() {
         for k in 0..50 {
             let (t_o, p_o, t_i, p_i) =
                 (1.5 * k as f64 / 50.0, 0.9 * k as f64, 1.4 * (k as f64 * 0.37).fract(), 2.1 * k as f64);
-            let (wo, wi) = (common::dir(t_o, p_o), common::dir(t_i, p_i));
+            let (wo, wi) = (validation::dir(t_o, p_o), validation::dir(t_i, p_i));
             let (wo_a, wi_a) =
-                (common::dir(t_o, p_o - f64::from(phi)), common::dir(t_i, p_i - f64::from(phi)));
+                (validation::dir(t_o, p_o - f64::from(phi)), validation::dir(t_i, p_i - f64::from(phi)));
             let (fe, fa) = (e.eval(wo, wi).f, a.eval(wo_a, wi_a).f);
             assert!(
                 (fe - fa).abs().max_element() <= 1e-4 * fa.max_element() + 1e-6,

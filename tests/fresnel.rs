@@ -3,7 +3,6 @@
 //! the Fresnel equations, Schlick's approximation, and the metal presets.
 //!
 //! Everything here is deterministic: the tolerances are f32 rounding bounds, stated per test.
-mod common;
 
 use glam::Vec3;
 use microsurface::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
@@ -210,10 +209,10 @@ fn presets() -> [(&'static str, ComplexIor); 4] {
 fn conductor_matches_complex_fresnel_equations() {
     let mut iors: Vec<(String, Vec3, Vec3)> =
         presets().iter().map(|(n, ior)| (n.to_string(), ior.eta(), ior.k())).collect();
-    let mut rng = common::rng(77);
+    let mut rng = validation::rng(77);
     for i in 0..40 {
-        let eta = Vec3::new(0.1, 0.1, 0.1) + 3.0 * Vec3::new(common::uniform32(&mut rng), 0.5, 1.0);
-        let k = 8.0 * Vec3::new(common::uniform32(&mut rng), common::uniform32(&mut rng), 0.05);
+        let eta = Vec3::new(0.1, 0.1, 0.1) + 3.0 * Vec3::new(validation::uniform32(&mut rng), 0.5, 1.0);
+        let k = 8.0 * Vec3::new(validation::uniform32(&mut rng), validation::uniform32(&mut rng), 0.05);
         iors.push((format!("random {i}"), eta, k));
     }
     let mut worst = 0.0f64;

@@ -2,10 +2,10 @@
 //! normalization (eq. 3.1) and mean normal, the projected area against quadrature, G1 against
 //! eq. 3.3, the sampler's chi-square fit (eq. 3.4) and the constructor's rejections.
 
-mod common;
 
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate_sphere;
+
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
 use glam::{Vec2, Vec3};
 use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope, Noncentral};
 use std::f64::consts::PI;
@@ -35,7 +35,7 @@ fn identities<S: MicrosurfaceSlope>(label: &str, s: &Noncentral<S>) {
         "{label}: n = {n}"
     );
     for (theta, phi) in VIEWS {
-        let w = common::dir(theta, phi).normalize();
+        let w = validation::dir(theta, phi).normalize();
         let quad = hemisphere(&mut |m| d(m) * f64::from(w.dot(m)).max(0.0));
         let a = f64::from(s.projected_area(w));
         assert!((quad - a).abs() < 1e-5 * (1.0 + a), "{label} {w}: ∫⟨ω,m⟩⁺D = {quad}, A = {a}");
@@ -77,7 +77,7 @@ fn d_matches_eq_3_2() {
     let (ax, ay, rho, xn, yn) = (f64::from(ax), f64::from(ay), f64::from(rho), f64::from(xn), f64::from(yn));
     let root = (1.0 - rho * rho).sqrt();
     for k in 0..300 {
-        let m = common::dir(1.5 * k as f64 / 300.0, 0.83 * k as f64).normalize().as_dvec3();
+        let m = validation::dir(1.5 * k as f64 / 300.0, 0.83 * k as f64).normalize().as_dvec3();
         let (x, y) = (-m.x / m.z - xn, -m.y / m.z - yn);
         let (u, v) = (x / ax, (ax * y - rho * ay * x) / (ax * ay * root));
         let expected = (-(u * u) - v * v).exp() / (PI * ax * ay * root * m.z.powi(4));
@@ -100,7 +100,7 @@ fn g1_matches_eq_3_3() {
     let s = Noncentral::new(central, mean).unwrap();
     let (mut above, mut exceeds_one) = (0, 0);
     for k in 0..400 {
-        let w = common::dir(1.56 * k as f64 / 400.0, 0.71 * k as f64).normalize();
+        let w = validation::dir(1.56 * k as f64 / 400.0, 0.71 * k as f64).normalize();
         let c = f64::from(w.z) - f64::from(w.x) * f64::from(mean.x) - f64::from(w.y) * f64::from(mean.y);
         let g1 = f64::from(s.g1(w));
         assert!(g1.is_finite() && g1 > 0.0, "{w}: G1 = {g1}");
@@ -117,7 +117,7 @@ fn g1_matches_eq_3_3() {
     // the central case is the central G1 itself
     let flat = Noncentral::new(central, Vec2::ZERO).unwrap();
     for k in 0..100 {
-        let w = common::dir(1.56 * k as f64 / 100.0, 1.3 * k as f64).normalize();
+        let w = validation::dir(1.56 * k as f64 / 100.0, 1.3 * k as f64).normalize();
         let expected = 1.0 / (1.0 + central.lambda64(w));
         assert!((f64::from(flat.g1(w)) - expected).abs() <= 1e-6 * expected, "{w}");
     }
@@ -128,19 +128,19 @@ fn g1_matches_eq_3_3() {
 fn sampler_chi2() {
     const N: usize = 200_000;
     const CASES: usize = 8;
-    let alpha = common::sidak(0.01, CASES);
+    let alpha = validation::sidak(0.01, CASES);
     let grid = Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) };
     let run = |i: usize,
                label: &str,
                d_wi: &dyn Fn(Vec3, Vec3) -> f64,
                sample: &dyn Fn(Vec3, f32, f32) -> Vec3,
                wi: Vec3| {
-        let mut rng = common::rng(300 + i as u64);
+        let mut rng = validation::rng(300 + i as u64);
         chi2_test(
             &format!("{label} from {wi}"),
             grid,
             |m| d_wi(wi, m),
-            || Some(sample(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+            || Some(sample(wi, validation::uniform32(&mut rng), validation::uniform32(&mut rng))),
             N,
             alpha,
             1.0,
@@ -153,9 +153,9 @@ fn sampler_chi2() {
             .unwrap();
     let eg = Noncentral::new(Elliptical::<Ggx>::from_bivariate(0.2, 0.5, -0.7).unwrap(), Vec2::new(0.0, 1.5))
         .unwrap();
-    let views = [common::dir(0.6, 0.4), common::dir(1.4, 3.6), common::dir(2.1, 1.0), common::dir(1.2, 0.3)];
+    let views = [validation::dir(0.6, 0.4), validation::dir(1.4, 3.6), validation::dir(2.1, 1.0), validation::dir(1.2, 0.3)];
     let views: Vec<Vec3> = views.iter().map(|w| w.normalize()).collect();
-    common::par_map(&[0usize, 1, 2, 3], |_, &j| match j {
+    validation::par_map(&[0usize, 1, 2, 3], |_, &j| match j {
         0 => {
             run(
                 0,
@@ -231,16 +231,16 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
     )
     .unwrap();
     let views = [
-        common::dir(0.5, 0.2).normalize(),
-        common::dir(1.2, 2.8).normalize(),
-        common::dir(1.0, -0.3).normalize(),
+        validation::dir(0.5, 0.2).normalize(),
+        validation::dir(1.2, 2.8).normalize(),
+        validation::dir(1.0, -0.3).normalize(),
     ];
-    let alpha = common::sidak(0.01, views.len());
-    let z = common::family_z(0.01, views.len());
-    common::par_map(&views, |i, &wi| {
+    let alpha = validation::sidak(0.01, views.len());
+    let z = validation::family_z(0.01, views.len());
+    validation::par_map(&views, |i, &wi| {
         let mass =
             integrate_sphere(&mut |wo| f64::from(s.pdf_single_scattering(wi, wo)), 24, 48, true, 1e-6, 7);
-        let mut rng = common::rng(500 + i as u64);
+        let mut rng = validation::rng(500 + i as u64);
         chi2_test(
             &format!("single scattering from {wi}"),
             Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) },
@@ -249,8 +249,8 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
                 s.sample_single_scattering(
                     &conductor,
                     wi,
-                    common::uniform32(&mut rng),
-                    common::uniform32(&mut rng),
+                    validation::uniform32(&mut rng),
+                    validation::uniform32(&mut rng),
                 )
                 .map(|x| x.wo)
             },
@@ -266,18 +266,18 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
             1e-6,
             7,
         );
-        let mut rng = common::rng(600 + i as u64);
-        let mut weights = common::Stats::default();
+        let mut rng = validation::rng(600 + i as u64);
+        let mut weights = validation::Stats::default();
         for _ in 0..N {
             let w = s.sample_single_scattering(
                 &conductor,
                 wi,
-                common::uniform32(&mut rng),
-                common::uniform32(&mut rng),
+                validation::uniform32(&mut rng),
+                validation::uniform32(&mut rng),
             );
             weights.push(w.map_or(0.0, |w| f64::from(w.weight.x)));
         }
         // G1(ωo) > 1 away from the tilt makes the weights spread (σ̂ ≈ 1.2 at θ = 1.2): SE ≤ 5e-3
-        common::assert_mean(&format!("albedo from {wi}"), &weights, albedo, z, 5e-3, 1e-5);
+        validation::assert_mean(&format!("albedo from {wi}"), &weights, albedo, z, 5e-3, 1e-5);
     });
 }

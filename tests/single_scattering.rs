@@ -8,11 +8,11 @@
 //!   position-free model with correlated shadowing (`PositionFree::eval_single_scattering`);
 //! * invalid directions give 0 / `None` (a debug assertion in debug builds).
 
-mod common;
 
-use common::chi2::{Chi2Grid, chi2_test};
-use common::quadrature::integrate_sphere;
-use common::{dir, sidak, uniform32, z_two_sided};
+
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
+use validation::{dir, sidak, uniform32, z_two_sided};
 use glam::Vec3;
 use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, MicrosurfaceSlope, PositionFree,
@@ -30,7 +30,7 @@ fn rel_close(a: Vec3, b: Vec3, tol: f32) -> bool {
 }
 
 /// A random unit direction on the whole sphere.
-fn random_direction(rng: &mut common::TestRng) -> Vec3 {
+fn random_direction(rng: &mut validation::TestRng) -> Vec3 {
     let z = 2.0 * uniform32(rng) - 1.0;
     let phi = core::f32::consts::TAU * uniform32(rng);
     let r = (1.0 - z * z).max(0.0).sqrt();
@@ -47,8 +47,8 @@ fn check_sampler<S: MicrosurfaceSlope, M: Material>(
 ) {
     let mass = integrate_sphere(&mut |w| f64::from(model.pdf(wi, w)), 16, 32, false, 1e-5, 7);
     assert!(mass <= 1.0 + 1e-3, "{label}: ∫pdf = {mass} > 1");
-    let mut rng = common::rng(seed);
-    let mut eval_rng = common::rng(seed + 1);
+    let mut rng = validation::rng(seed);
+    let mut eval_rng = validation::rng(seed + 1);
     let grid = Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(20, 40) };
     let out = chi2_test(
         label,
@@ -114,8 +114,8 @@ fn eval_with_pdf_is_eval_and_pdf() {
     fn check<S: MicrosurfaceSlope, M: Material>(label: &str, slope: S, material: M, seed: u64) {
         let model = SingleScattering::new(slope, material);
         let pf = PositionFree::new(slope, material, Shadowing::Correlated);
-        let mut rng = common::rng(seed);
-        let mut dummy = common::rng(0);
+        let mut rng = validation::rng(seed);
+        let mut dummy = validation::rng(0);
         let mut nonzero = 0;
         for _ in 0..20_000 {
             let (wi, wo) = (random_direction(&mut rng), random_direction(&mut rng));
@@ -150,11 +150,11 @@ fn sample_is_the_position_free_single_sample() {
     let material = Diffuse::new(Vec3::new(0.8, 0.5, 0.2)).unwrap();
     let model = SingleScattering::new(slope, material);
     let pf = PositionFree::new(slope, material, Shadowing::Correlated);
-    let mut dirs = common::rng(31);
+    let mut dirs = validation::rng(31);
     for k in 0..5_000 {
         let wi = random_direction(&mut dirs);
-        let a = model.sample(wi, &mut common::rng(1000 + k));
-        let b = pf.sample_single(wi, &mut common::rng(1000 + k));
+        let a = model.sample(wi, &mut validation::rng(1000 + k));
+        let b = pf.sample_single(wi, &mut validation::rng(1000 + k));
         // the same direction; the weight to an f32 ulp (the one-division G2/G1 of a reflection)
         assert_eq!(a.map(|s| s.wo), b.map(|s| s.0), "at {wi}");
         if let (Some(s), Some((_, w))) = (a, b) {
@@ -173,14 +173,14 @@ fn invalid_directions_give_nothing() {
     let good = dir(0.5, 0.5);
     for bad in [Vec3::NAN, Vec3::ZERO, 2.0 * good, Vec3::new(f32::INFINITY, 0.0, 0.0)] {
         let calls: [(&str, Box<dyn Fn() -> bool>); 5] = [
-            ("eval wi", Box::new(move || model.eval(bad, good, &mut common::rng(1)) == Vec3::ZERO)),
-            ("eval wo", Box::new(move || model.eval(good, bad, &mut common::rng(1)) == Vec3::ZERO)),
+            ("eval wi", Box::new(move || model.eval(bad, good, &mut validation::rng(1)) == Vec3::ZERO)),
+            ("eval wo", Box::new(move || model.eval(good, bad, &mut validation::rng(1)) == Vec3::ZERO)),
             ("pdf", Box::new(move || model.pdf(bad, good) == 0.0)),
             (
                 "eval_with_pdf",
-                Box::new(move || model.eval_with_pdf(good, bad, &mut common::rng(1)) == (Vec3::ZERO, 0.0)),
+                Box::new(move || model.eval_with_pdf(good, bad, &mut validation::rng(1)) == (Vec3::ZERO, 0.0)),
             ),
-            ("sample", Box::new(move || model.sample(bad, &mut common::rng(1)).is_none())),
+            ("sample", Box::new(move || model.sample(bad, &mut validation::rng(1)).is_none())),
         ];
         for (name, call) in calls {
             match std::panic::catch_unwind(std::panic::AssertUnwindSafe(&call)) {

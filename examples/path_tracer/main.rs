@@ -3,11 +3,10 @@
 //! [--out FILE.png] [--furnace]`.
 
 mod png;
-mod tracer;
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
-use tracer::{RenderStats, SHOWCASE_LABELS, render, showcase_scene};
+use validation::tracer::{RenderStats, SHOWCASE_LABELS, render, showcase_scene};
 
 const USAGE: &str = "usage: cargo run --release --example path_tracer -- [--width W] [--height H] [--spp N] [--out FILE.png] [--furnace]
 

@@ -3,17 +3,12 @@
 //!
 //! `cargo run --release --example report -- [--quick] [--out DIR]` writes CSV files, SVG
 //! figures, `summary.md` and the page `index.html` into DIR (default `target/report`) and
-//! prints the summary. The stages, one file each: `configure` (what and how much), `measure`
+//! prints the summary. The stages (`validation::report`), one file each: `configure` (what and how much), `measure`
 //! (per-sample values, timings, references, energy, lobes, cost), `reduce` (errors against
 //! time, efficiency ratios with confidence intervals, lobe panels), `plot` (SVG figures) and
 //! `write` (CSV, Markdown, HTML); `pipeline` runs them in order.
 
-mod configure;
-mod measure;
-mod pipeline;
-mod plot;
-mod reduce;
-mod write;
+use validation::report::{configure, pipeline};
 
 const USAGE: &str = "usage: cargo run --release --example report -- [--quick] [--out DIR]
 

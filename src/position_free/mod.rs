@@ -430,7 +430,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::cosine_hemisphere;
+    use crate::sampling::cosine_hemisphere;
     use crate::material::Conductor;
     use crate::microsurface::ScatteringOrder;
     use crate::slope::Beckmann;

@@ -1,0 +1,103 @@
+//! Every constructor rejects NaN, ±∞ and out-of-range values with
+//! `Error::InvalidParameter { name, value, expected }` naming the offending parameter; the
+//! error's Display names it too, and `Error` is a `std::error::Error`.
+use glam::Vec3;
+use microsurface::{Beckmann, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Dielectric, Diffuse, Ggx};
+use validation::check::assert_rejects;
+
+const NON_FINITE: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
+
+#[test]
+fn roughness_constructors() {
+    for bad in NON_FINITE.into_iter().chain([0.0, -0.0, -1.0, -f32::MIN_POSITIVE]) {
+        assert_rejects(Ggx::new(bad, 0.5), "alpha_x", bad);
+        assert_rejects(Ggx::new(0.5, bad), "alpha_y", bad);
+        assert_rejects(Beckmann::new(bad, 0.5), "alpha_x", bad);
+        assert_rejects(Beckmann::new(0.5, bad), "alpha_y", bad);
+        assert_rejects(Ggx::isotropic(bad), "alpha_x", bad);
+        assert_rejects(Beckmann::isotropic(bad), "alpha_x", bad);
+    }
+    for good in [1e-4, 0.5, 4.0, f32::MIN_POSITIVE, 1e4] {
+        assert!(Ggx::new(good, good).is_ok() && Beckmann::new(good, good).is_ok(), "α = {good}");
+    }
+}
+
+#[test]
+fn dielectric() {
+    for bad in NON_FINITE.into_iter().chain([0.0, -1.5]) {
+        assert_rejects(Dielectric::new(bad), "eta", bad);
+    }
+    for good in [0.25, 1.0, 1.0 + 1e-6, 4.0] {
+        assert!(Dielectric::new(good).is_ok(), "η = {good}");
+    }
+}
+
+#[test]
+fn diffuse() {
+    for bad in NON_FINITE.into_iter().chain([-0.1, 1.0 + f32::EPSILON, 2.0]) {
+        for ch in 0..3 {
+            let mut a = Vec3::splat(0.5);
+            a[ch] = bad;
+            assert_rejects(Diffuse::new(a), "albedo", bad);
+        }
+    }
+    assert!(Diffuse::new(Vec3::ZERO).is_ok() && Diffuse::new(Vec3::ONE).is_ok());
+}
+
+#[test]
+fn complex_ior() {
+    for bad in NON_FINITE.into_iter().chain([0.0, -1.0]) {
+        for ch in 0..3 {
+            let mut e = Vec3::ONE;
+            e[ch] = bad;
+            assert_rejects(ComplexIor::new(e, Vec3::ONE), "eta", bad);
+        }
+    }
+    for bad in NON_FINITE.into_iter().chain([-1e-3]) {
+        for ch in 0..3 {
+            let mut k = Vec3::ONE;
+            k[ch] = bad;
+            assert_rejects(ComplexIor::new(Vec3::ONE, k), "k", bad);
+        }
+    }
+    assert!(ComplexIor::new(Vec3::ONE, Vec3::ZERO).is_ok());
+}
+
+#[test]
+fn classic_brdf() {
+    let ndf = ClassicNdf::Ggx(0.3);
+    let m = ClassicMasking::Exact;
+    for bad in NON_FINITE.into_iter().chain([-0.1, 1.5]) {
+        for ch in 0..3 {
+            let mut c = Vec3::splat(0.5);
+            c[ch] = bad;
+            assert_rejects(ClassicBrdf::new(c, Vec3::splat(0.5), ndf, m), "kd", bad);
+            assert_rejects(ClassicBrdf::new(Vec3::splat(0.5), c, ndf, m), "ks", bad);
+        }
+    }
+    for bad in NON_FINITE.into_iter().chain([0.0, -1.0]) {
+        assert_rejects(ClassicBrdf::new(Vec3::ONE, Vec3::ONE, ClassicNdf::Ggx(bad), m), "alpha", bad);
+        assert_rejects(ClassicBrdf::new(Vec3::ONE, Vec3::ONE, ClassicNdf::Beckmann(bad), m), "alpha", bad);
+    }
+    for bad in NON_FINITE.into_iter().chain([-1.0]) {
+        assert_rejects(
+            ClassicBrdf::new(Vec3::ONE, Vec3::ONE, ClassicNdf::Phong(bad), m),
+            "phong_exponent",
+            bad,
+        );
+    }
+    assert_rejects(ClassicBrdf::new(Vec3::ZERO, Vec3::ZERO, ndf, m), "kd + ks", 0.0);
+    assert!(ClassicBrdf::new(Vec3::ONE, Vec3::ZERO, ClassicNdf::Phong(0.0), m).is_ok());
+}
+
+#[test]
+fn error_trait_and_display() {
+    fn takes_std_error(_: &dyn std::error::Error) {}
+    let err = Ggx::new(f32::NAN, 1.0).unwrap_err();
+    takes_std_error(&err);
+    let boxed: Box<dyn std::error::Error + Send + Sync> = Box::new(err);
+    assert!(boxed.to_string().contains("alpha_x"));
+    assert!(boxed.source().is_none());
+    let shown = Dielectric::new(-2.0).unwrap_err().to_string();
+    assert!(shown.contains("eta") && shown.contains("-2"), "{shown}");
+}

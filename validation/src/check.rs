@@ -1,0 +1,68 @@
+//! Assertions and helpers shared by the deterministic tests: rejected parameters, caught
+//! panics, f32 spacings.
+
+use microsurface::Error;
+
+/// Asserts that `result` is `Error::InvalidParameter` for `name` with the rejected `value`
+/// (the same bits, or both NaN), a non-empty `expected`, and a Display that names `name`.
+#[track_caller]
+pub fn assert_rejects<T: std::fmt::Debug>(result: Result<T, Error>, name: &str, value: f32) {
+    let err = match result {
+        Ok(x) => panic!("`{name}` = {value} was accepted: {x:?}"),
+        Err(err) => err,
+    };
+    match &err {
+        Error::InvalidParameter { name: n, value: v, expected } => {
+            assert_eq!(*n, name, "wrong parameter named for {name} = {value}");
+            assert!(
+                v.to_bits() == value.to_bits() || (v.is_nan() && value.is_nan()),
+                "{name}: reported value {v}, passed {value}"
+            );
+            assert!(!expected.is_empty(), "{name}: empty `expected`");
+        }
+        #[allow(unreachable_patterns)]
+        other => panic!("`{name}` = {value}: unexpected error {other:?}"),
+    }
+    let shown = err.to_string();
+    assert!(shown.contains(name), "Display `{shown}` does not name `{name}`");
+}
+
+/// The message of a caught panic (`String` or `&str` payloads).
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else {
+        "(non-string panic)".to_string()
+    }
+}
+
+/// The spacing of the f32 numbers at |v| (2⁻¹⁴⁹ in and below the subnormal range): for an
+/// f32 value v, `v.next_up() − v`.
+pub fn ulp32(v: f64) -> f64 {
+    let v = v.abs();
+    let e = if v == 0.0 { -1023 } else { ((v.to_bits() >> 52) & 0x7ff) as i32 - 1023 };
+    2f64.powi(e.max(-126) - 23)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ulp32_is_the_f32_spacing() {
+        for v in [0.0f32, f32::from_bits(1), 1e-40, f32::MIN_POSITIVE, 0.1, 0.5, 1.0, 3.0, 1e30] {
+            let expected = if v == 0.0 { f64::from(f32::from_bits(1)) } else { f64::from(v.next_up() - v) };
+            assert_eq!(ulp32(f64::from(v)), expected, "v = {v:e}");
+        }
+    }
+
+    #[test]
+    fn panic_message_reads_both_payloads() {
+        let owned = std::panic::catch_unwind(|| panic!("{}", 42)).unwrap_err();
+        let borrowed = std::panic::catch_unwind(|| panic!("static")).unwrap_err();
+        assert_eq!(panic_message(owned.as_ref()), "42");
+        assert_eq!(panic_message(borrowed.as_ref()), "static");
+    }
+}

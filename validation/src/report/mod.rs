@@ -1,0 +1,15 @@
+//! The crate's report: every estimator's accuracy against run time, the lobes and energy per
+//! scattering order, and the cost of every model, measured on this machine (run by
+//! `examples/report/main.rs` and, in its quick mode, by `tests/examples/report.rs`).
+//!
+//! The stages, one file each: [`configure`] (what and how much), [`measure`] (per-sample
+//! values, timings, references, energy, lobes, cost), [`reduce`] (errors against time,
+//! efficiency ratios with confidence intervals, lobe panels), [`plot`] (SVG figures) and
+//! [`write`](mod@write) (CSV, Markdown, HTML); [`pipeline`] runs them in order.
+
+pub mod configure;
+pub mod measure;
+pub mod pipeline;
+pub mod plot;
+pub mod reduce;
+pub mod write;

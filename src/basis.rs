@@ -11,6 +11,7 @@ use glam::Vec3;
 /// Invalid input ([policy](crate#invalid-input)): an `n` that is not a unit direction
 /// (zero, NaN or ±∞ components, |‖n‖² − 1| > [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives
 /// (`Vec3::NAN`, `Vec3::NAN`) (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
     require!(is_direction(n), (Vec3::NAN, Vec3::NAN); n);
@@ -18,6 +19,7 @@ pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
 }
 
 /// [`orthonormal_basis`] without the argument check, for the crate's own unit normals.
+#[must_use]
 #[inline(always)]
 pub(crate) fn basis(n: Vec3) -> (Vec3, Vec3) {
     let sign = if n.z >= 0.0 { 1.0f32 } else { -1.0 };

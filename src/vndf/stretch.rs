@@ -120,8 +120,13 @@ pub(crate) fn stretch64<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> DVec3 {
 #[inline(always)]
 pub(crate) fn disk_frame(v: Vec3) -> (Vec3, Vec3) {
     let len_xy = (v.x * v.x + v.y * v.y).sqrt();
-    let t1 = if len_xy > 0.0 { Vec3::new(-v.y / len_xy, v.x / len_xy, 0.0) } else { Vec3::Y };
-    (t1, v.cross(t1))
+    if len_xy > 0.0 {
+        let t1 = Vec3::new(-v.y / len_xy, v.x / len_xy, 0.0);
+        (t1, v.cross(t1))
+    } else {
+        // v × y for v = (0, 0, v.z)
+        (Vec3::Y, Vec3::new(-v.z, 0.0, v.x))
+    }
 }
 
 #[cfg(test)]

@@ -27,3 +27,42 @@ pub(crate) fn basis(n: Vec3) -> (Vec3, Vec3) {
     let b = n.x * n.y * a;
     (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// (t, b, n) is a right-handed orthonormal basis for unit normals all over the sphere,
+    /// including the poles and the branch switch at n.z = 0, and n.z = −0 gets the basis of +0.
+    #[test]
+    fn basis_is_right_handed_and_orthonormal() {
+        let mut normals =
+            vec![Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.6, 0.8, 0.0), Vec3::new(0.6, 0.8, -0.0)];
+        for i in 0..48 {
+            for j in 0..=48 {
+                let (phi, theta) =
+                    (i as f32 / 48.0 * core::f32::consts::TAU, j as f32 / 48.0 * core::f32::consts::PI);
+                normals.push(
+                    Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()).normalize(),
+                );
+            }
+        }
+        let mut worst = 0.0f32;
+        for n in normals {
+            let (t, b) = basis(n);
+            for e in [
+                (t.length() - 1.0).abs(),
+                (b.length() - 1.0).abs(),
+                t.dot(b).abs(),
+                t.dot(n).abs(),
+                b.dot(n).abs(),
+                (t.cross(b) - n).length(),
+            ] {
+                worst = worst.max(e);
+            }
+        }
+        eprintln!("basis: worst orthonormality / handedness error {worst:e}");
+        assert!(worst <= 8.0 * f32::EPSILON, "worst error {worst:e} > 8ε");
+        assert_eq!(basis(Vec3::new(0.6, 0.8, -0.0)), basis(Vec3::new(0.6, 0.8, 0.0)));
+    }
+}

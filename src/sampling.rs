@@ -15,6 +15,7 @@ use glam::{Vec2, Vec3};
 ///
 /// Invalid input ([policy](crate#invalid-input)): a uniform that is NaN or outside
 /// [0, 1] gives `Vec2::NAN` (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
     require!(is_uniform(u1) && is_uniform(u2), Vec2::NAN; u1, u2);
@@ -22,6 +23,7 @@ pub fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
 }
 
 /// [`concentric_disk`] without the argument check, for the crate's own uniforms.
+#[must_use]
 #[inline(always)]
 pub(crate) fn disk(u1: f32, u2: f32) -> Vec2 {
     let (r, cos_phi, sin_phi) = concentric_polar(u1, u2);
@@ -53,6 +55,7 @@ fn concentric_polar(u1: f32, u2: f32) -> (f32, f32, f32) {
 ///
 /// Invalid input ([policy](crate#invalid-input)): a uniform that is NaN or outside
 /// [0, 1] gives `Vec3::NAN` (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn sample_cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
     require!(is_uniform(u1) && is_uniform(u2), Vec3::NAN; u1, u2);
@@ -60,6 +63,7 @@ pub fn sample_cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
 }
 
 /// [`sample_cosine_hemisphere`] without the argument check, for the crate's own uniforms.
+#[must_use]
 #[inline(always)]
 pub(crate) fn cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
     let (r, cos_phi, sin_phi) = concentric_polar(u1, u2);

@@ -16,6 +16,7 @@ const VISIBILITY_NUDGES: i32 = 24;
 /// normals within about 1e-7 rad of the visibility boundary (grazing or backfacing ωi, low α).
 /// Those are moved towards ωi by the smallest power-of-two step that makes them visible (and
 /// kept in the upper hemisphere): a displacement of ~1e-7 rad of a mass of order 1e-5.
+#[must_use]
 #[inline(always)]
 pub(crate) fn ensure_visible(wi: Vec3, wm: Vec3) -> Vec3 {
     // for unit vectors the f32 dot product is within 3 ulp of 1, i.e. 2e-7, of the exact one
@@ -43,6 +44,7 @@ const DIRECT_SLOPE_BELOW: f32 = 1e18;
 
 /// The unit normal (−x̃, −ỹ, 1)/‖·‖ of the slopes (x̃, ỹ), without overflow for huge slopes
 /// (an infinite slope gives the horizontal normal).
+#[must_use]
 #[inline(always)]
 pub(crate) fn normal_from_slopes(slope_x: f32, slope_y: f32) -> Vec3 {
     if slope_x.abs() < DIRECT_SLOPE_BELOW && slope_y.abs() < DIRECT_SLOPE_BELOW {
@@ -60,6 +62,7 @@ pub(crate) const DIRECT_SCALE_RANGE: (f32, f32) = (1e-30, 1e30);
 
 /// `v` normalized: directly where |v|² is in a safe range, else by [`normalize_scaled`]
 /// (`fallback` for a zero or non-finite vector).
+#[must_use]
 #[inline(always)]
 pub(crate) fn normalize_fast(v: Vec3, fallback: Vec3) -> Vec3 {
     let len_sq = v.length_squared();
@@ -77,6 +80,7 @@ const NEARLY_UNIT: f32 = 1.0 / 4096.0;
 /// without a square root or a division: v (3 − ‖v‖²)/2 is the Newton step for 1/‖v‖ from 1,
 /// whose relative error (3/8)ε² for ‖v‖² = 1 + ε is below 2.3e-8 for |ε| ≤ 2⁻¹². Other
 /// vectors go through [`normalize_fast`].
+#[must_use]
 #[inline(always)]
 pub(crate) fn renormalize(v: Vec3, fallback: Vec3) -> Vec3 {
     let len_sq = v.length_squared();
@@ -85,6 +89,7 @@ pub(crate) fn renormalize(v: Vec3, fallback: Vec3) -> Vec3 {
 
 /// `v` normalized after dividing by its largest component, so that tiny (even subnormal) and
 /// huge vectors come out unit; `fallback` for a zero or non-finite vector.
+#[must_use]
 #[inline(always)]
 pub(crate) fn normalize_scaled(v: Vec3, fallback: Vec3) -> Vec3 {
     let scale = v.abs().max_element();

@@ -35,6 +35,7 @@ const MAX_ITERATIONS: usize = 64;
 /// cot θ, relative 6e-8, would shift them by a visible fraction of their spread: 5 % at
 /// |cot θ| = 480). +z for ωi = −z, which sees no microsurface. No argument check (the callers
 /// have done it).
+#[must_use]
 #[inline]
 pub(crate) fn sample_visible_normal(beckmann: &Beckmann, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
     let (ax, ay) = (f64::from(beckmann.alpha_x()), f64::from(beckmann.alpha_y()));
@@ -51,6 +52,7 @@ pub(crate) fn sample_visible_normal(beckmann: &Beckmann, wi: Vec3, u1: f32, u2: 
 /// azimuth frame: x̃ from the exact inversion [`visible_slope_x`], ỹ Gaussian and independent
 /// of x̃ ([`gaussian_slope`]). `None` seen from straight below (len_xy = 0, z ≤ 0), where
 /// nothing is visible. Tails cut at 2⁻²⁴ (the crate's tail policy).
+#[must_use]
 #[inline]
 pub(crate) fn visible_slopes(z: f64, len_xy: f64, u1: f32, u2: f32) -> Option<(f64, f64)> {
     let x = if len_xy > 0.0 {
@@ -67,6 +69,7 @@ pub(crate) fn visible_slopes(z: f64, len_xy: f64, u1: f32, u2: f32) -> Option<(f
 /// end of [0, 1] in single precision (relative error below 4e-7, see `erfc_inv_f32`). Both
 /// tails are cut at probability 2⁻²⁴ (the crate's tail policy, `rng`): u = 0 gives
 /// x̃ = −3.744, with 2⁻²⁴ of the density below it, and u = 1 − 2⁻²⁴ gives +3.744.
+#[must_use]
 #[inline]
 pub(crate) fn gaussian_slope(u: f64) -> f64 {
     let u = cut_tails64(u);
@@ -290,6 +293,7 @@ impl GuessTable {
 ///
 /// u is cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy, `rng`): the lowest sample has 2⁻²⁴ of
 /// the visible slopes below it, the highest 2⁻²⁴ between it and κ (where the density vanishes).
+#[must_use]
 #[inline]
 pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
     let u = cut_tails64(u);

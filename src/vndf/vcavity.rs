@@ -260,6 +260,7 @@ impl<S: VCavitySlope> VCavity<S> {
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit
     /// direction gives NaN (a debug assertion in debug builds).
+    #[must_use]
     #[inline]
     pub fn masking(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), f32::NAN; wi, wm);
@@ -274,6 +275,7 @@ impl<S: VCavitySlope> VCavity<S> {
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// NaN (a debug assertion in debug builds).
+    #[must_use]
     #[inline]
     pub fn hit_probability(&self, wi: Vec3) -> f32 {
         self.0.hit_probability(wi)

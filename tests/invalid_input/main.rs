@@ -3,7 +3,7 @@
 //! invalid-input policy for bad directions (`policy`), and −0 is treated like +0
 //! (`negative_zero`).
 
-mod bad_input;
-mod errors;
+mod constructors;
+mod degenerate;
 mod negative_zero;
 mod policy;

@@ -1,5 +1,4 @@
 //! Writing 8-bit sRGB PNG files (with the `png` crate).
-#![allow(dead_code)]
 
 /// Writes 8-bit RGB pixels (row-major, 3 bytes each) as a compressed PNG file.
 pub fn write_rgb8(path: &std::path::Path, width: u32, height: u32, rgb: &[u8]) -> std::io::Result<()> {

@@ -1,9 +1,9 @@
 //! Invalid and degenerate input: constructors reject invalid parameters with
-//! `Error::InvalidParameter` (`errors`, `bad_input`), every entry point follows the
-//! invalid-input policy for bad directions (`policy`), and −0 is treated like +0
-//! (`negative_zero`).
+//! `Error::InvalidParameter` (`constructors`), degenerate but legal inputs give finite results
+//! (`degenerate`), every entry point follows the invalid-input policy for bad directions
+//! (`policy`), and −0 is treated like +0 (`negative_zero`).
 
-mod bad_input;
-mod errors;
+mod constructors;
+mod degenerate;
 mod negative_zero;
 mod policy;

@@ -327,7 +327,7 @@ pub fn render_sweep(
             let label = format!("α {alpha} · {}", row.method.short());
             canvas.text(&fonts, &label, xc, cap_y, 12.5 * big, Weight::Regular, Align::Center, INK);
             if lighting == Lighting::Furnace {
-                let l = format!("L = {:.3} ± {:.3}", sphere.mean, sphere.se);
+                let l = format!("L = {:.4} ± {:.4}", sphere.mean, sphere.se);
                 canvas.text(
                     &fonts,
                     &l,

@@ -242,7 +242,9 @@ fn lobes(results: &Results, material: MaterialKind, budget: &Budget) -> PlotResu
                 ),
                 "Radial circles in sr⁻¹, one scale per row; legends: the albedo of each order (from sampled scatterings of the same model).".to_string(),
                 format!(
-                    "Walk: its eval; position-free: PT. {}–{} evaluations per order and angle, until the SE of the total is ≤ {} % of the panel's peak in a pilot run; largest SE: {:.2} % of the peak.",
+                    "Order 1: walk eval / position-free PT at θo; orders 2, 3+: histograms of the model's own sampled scatterings (bins {:.0}° of θo × ±{:.1}° about the plane, {}–{} per panel). Target SE ≤ {} % of the panel's peak; largest SE: {:.2} %.",
+                    180.0 / budget.lobe_angles as f64,
+                    90.0 / budget.lobe_angles as f64,
                     panels.iter().map(|p| p.samples.0).min().unwrap_or(0),
                     panels.iter().map(|p| p.samples.1).max().unwrap_or(0),
                     100.0 * budget.lobe_rel_se,

@@ -76,8 +76,8 @@ impl Budget {
             Self {
                 samples: 1 << 15,
                 reference_factor: 4,
-                lobe_angles: 37,
-                lobe_samples: 1 << 21,
+                lobe_angles: 31,
+                lobe_samples: 1 << 20,
                 lobe_rel_se: 0.003,
                 lobe_max_samples: 1 << 26,
                 lobe_evals: 1 << 12,

@@ -754,3 +754,62 @@ fn cost(budget: &Budget) -> Vec<CostRow> {
         .flat_map(|surface| with_surface(surface, CostTask { surface, n: budget.cost_calls }))
         .collect()
 }
+
+#[cfg(test)]
+mod lobe_bin_tests {
+    use super::*;
+    use statrs::distribution::{ContinuousCDF, Normal};
+
+    /// The bins tile the slab |ωo·y| ≤ h about the plane of incidence: their solid angles add
+    /// up to its area (2πh over the upper hemisphere, 4πh over the sphere), and the direction
+    /// at every plotted angle falls in its own bin.
+    #[test]
+    fn lobe_bins_tile_the_slab_and_hold_their_angles() {
+        for material in LOBE_MATERIALS {
+            let bins = LobeBins::new(material, 31);
+            let area: f64 = bins.solid_angle.iter().sum();
+            let expected = if bins.full_circle { 4.0 } else { 2.0 } * std::f64::consts::PI * bins.slab;
+            assert!((area / expected - 1.0).abs() < 1e-4, "{material:?}: Σ Ω = {area}, slab {expected}");
+            for (k, s) in lobe_angles(material, 31).into_iter().enumerate() {
+                let wo = Vec3::new(-(s.sin()) as f32, 0.0, s.cos() as f32);
+                assert_eq!(bins.bin(wo), Some(k), "{material:?}: θo = {s}");
+            }
+            let off_plane = Vec3::new(0.0, (2.0 * bins.slab) as f32, 1.0).normalize();
+            assert_eq!(bins.bin(off_plane), None);
+        }
+    }
+
+    /// Uniform directions on the sphere with weight 4π estimate 1 in every bin: each bin's
+    /// solid angle, the poles' included, is the one its samples see (Šidák, family-wise 1e-3).
+    #[test]
+    fn lobe_bins_estimate_a_constant_lobe() {
+        let bins = LobeBins::new(MaterialKind::Dielectric, 31);
+        let n = 1usize << 21;
+        let mut sums = LobeSums::new(bins.len());
+        sums.samples = n;
+        let mut rng = Rng::seed_from_u64(0xB1_25);
+        let w = 4.0 * std::f64::consts::PI;
+        for _ in 0..n {
+            let u1: f64 = rand::RngExt::random(&mut rng);
+            let u2: f64 = rand::RngExt::random(&mut rng);
+            let wo = dir((1.0 - 2.0 * u1).acos(), std::f64::consts::TAU * u2);
+            if let Some(b) = bins.bin(wo) {
+                sums.sum[b][1] += w;
+                sums.sum2[b][1] += w * w;
+                sums.total2[b] += w * w;
+            }
+        }
+        let m = bins.len();
+        let z = Normal::standard().inverse_cdf(1.0 - 0.5 * (1.0 - (1.0 - 1e-3f64).powf(1.0 / m as f64)));
+        for b in 0..m {
+            let (_, total) = sums.bin(b, bins.solid_angle[b]);
+            assert!(total.se < 0.05, "bin {b}: SE {} too large to test anything", total.se);
+            assert!(
+                (total.mean - 1.0).abs() <= z * total.se,
+                "bin {b}: N = {n}, mean {} (expected 1), σ̂/√N = {}, z = {z}",
+                total.mean,
+                total.se
+            );
+        }
+    }
+}

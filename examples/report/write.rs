@@ -424,7 +424,7 @@ fn lobe_caption(results: &Results, budget: &Budget, file: &str, title: &str) -> 
         "{title}: f·|cos θo| (sr⁻¹) per scattering order (1, 2, 3+) and their total in the plane of incidence, against the signed \
          θo, for θi = 0, 1, 1.5 rad (rows) and the Heitz walk and both position-free models (columns). Order 1 is the walk's eval \
          (position-free: PT) at each θo; orders 2 and 3+ are histograms of the model's own sampled scatterings: bin averages over \
-         {:.0}° of θo × ±{:.1}° about the plane (broad lobes that the bins barely smooth). Largest standard error of a \
+         {:.1}° of θo × ±{:.1}° about the plane (broad lobes that the bins barely smooth). Largest standard error of a \
          plotted total: {:.2} % of its panel's peak (target {} %). Legends: each order's albedo from sampled scatterings.",
         180.0 / budget.lobe_angles as f64,
         90.0 / budget.lobe_angles as f64,

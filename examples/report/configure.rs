@@ -125,7 +125,7 @@ impl Budget {
             (
                 "lobe_evals",
                 self.lobe_evals.to_string(),
-                "evaluations of the first order per round at each angle of a lobe",
+                "evaluations of the first order per round at each angle of a lobe (two angles per bin)",
             ),
             (
                 "lobe_max_evals",

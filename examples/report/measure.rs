@@ -357,8 +357,9 @@ pub fn lobe_angles(material: MaterialKind, n: usize) -> Vec<f64> {
 /// at most one bin, and the estimate of a bin is the bin average of f·|cos θo| per order:
 /// (1/N) Σ w·1[ωo ∈ bin, order] / Ω_bin with w = f·|cos θo|/pdf the sample's weight — unbiased
 /// for that average, and far less noisy than per-direction `eval` since every sample counts.
-/// The lobes take orders 2 and 3+ from it (broad lobes, which the bin average barely smooths)
-/// and the first order, the sharpest, from `eval` at the bin's centre (`FirstOrderTask`).
+/// The lobes take orders 2 and 3+ from it (broad lobes, which the bin average barely smooths),
+/// interpolated linearly between the bins' centres, and the first order, the sharpest, from
+/// `eval` at `LOBE_EVAL_REFINEMENT` angles per bin (`FirstOrderTask`).
 struct LobeBins {
     /// Bins over the half plane (the dielectric has twice as many, over the full circle).
     n: usize,
@@ -399,6 +400,27 @@ impl LobeBins {
 
     fn len(&self) -> usize {
         self.solid_angle.len()
+    }
+
+    /// The two bins whose centres enclose the j-th of the angles `lobe_angles` gives for
+    /// `refinement` × n steps, and the linear weight t of the second: periodic over the full
+    /// circle, the end bins' values held constant over the half plane's outer half bins.
+    fn between_centres(&self, j: usize, refinement: usize) -> ([usize; 2], f64) {
+        let m = self.len();
+        // the fine angle's position in units of bins, from the first bin's centre
+        let u = (j as f64 + 0.5) / refinement as f64 - 0.5;
+        let k = u.floor();
+        let t = u - k;
+        if self.full_circle {
+            let k0 = (k as i64).rem_euclid(m as i64) as usize;
+            ([k0, (k0 + 1) % m], t)
+        } else if k < 0.0 {
+            ([0, 0], 0.0)
+        } else if k as usize + 1 >= m {
+            ([m - 1, m - 1], 0.0)
+        } else {
+            ([k as usize, k as usize + 1], t)
+        }
     }
 
     /// The bin of direction `wo` (ωi in the x–z plane at φ = 0), if it is in one.
@@ -501,9 +523,14 @@ impl WithModels for LobeTask<'_> {
     }
 }
 
+/// The first order of a lobe is evaluated at this many angles per histogram bin (the orders
+/// 2 and 3+ are interpolated linearly between the bins' centres there): the first order is the
+/// sharpest, and its `eval` is cheap.
+const LOBE_EVAL_REFINEMENT: usize = 2;
+
 /// The share of a lobe's SE target given to its first order (in quadrature): small, since the
 /// first order's `eval` costs one vertex and has a small variance.
-const FIRST_ORDER_SHARE: f64 = 0.15;
+const FIRST_ORDER_SHARE: f64 = 0.25;
 
 /// Running sums of one estimated quantity.
 #[derive(Debug, Clone, Copy, Default)]
@@ -620,7 +647,7 @@ fn lobes(opts: &Options, budget: &Budget) -> Vec<LobePoint> {
     for (&(material, model, theta_i), sums) in panels.iter().zip(&totals) {
         let bins = bins_of(material);
         let peak = (0..bins.len()).map(|b| sums.bin(b, bins.solid_angle[b]).1.mean).fold(0.0, f64::max);
-        for theta_o in lobe_angles(material, budget.lobe_angles) {
+        for theta_o in lobe_angles(material, LOBE_EVAL_REFINEMENT * budget.lobe_angles) {
             first_jobs.push((material, model, theta_i, theta_o, peak));
         }
     }
@@ -647,11 +674,20 @@ fn lobes(opts: &Options, budget: &Budget) -> Vec<LobePoint> {
     let mut points = Vec::new();
     for ((material, model, theta_i), sums) in panels.into_iter().zip(totals) {
         let bins = bins_of(material);
-        for (b, theta_o) in lobe_angles(material, budget.lobe_angles).into_iter().enumerate() {
-            let (histogram, _) = sums.bin(b, bins.solid_angle[b]);
-            let higher = sums.higher_orders(b, bins.solid_angle[b]);
+        let fine = lobe_angles(material, LOBE_EVAL_REFINEMENT * budget.lobe_angles);
+        for (j, theta_o) in fine.into_iter().enumerate() {
+            let ([b0, b1], t) = bins.between_centres(j, LOBE_EVAL_REFINEMENT);
+            let lerp = |e0: Estimate, e1: Estimate| Estimate {
+                mean: (1.0 - t) * e0.mean + t * e1.mean,
+                se: ((1.0 - t) * e0.se).hypot(t * e1.se),
+            };
+            let (h0, h1) = (sums.bin(b0, bins.solid_angle[b0]).0, sums.bin(b1, bins.solid_angle[b1]).0);
+            let higher = lerp(
+                sums.higher_orders(b0, bins.solid_angle[b0]),
+                sums.higher_orders(b1, bins.solid_angle[b1]),
+            );
             let order1 = first.next().expect("one first-order estimate per point");
-            let orders = [order1, histogram[1], histogram[2]];
+            let orders = [order1, lerp(h0[1], h1[1]), lerp(h0[2], h1[2])];
             // independent estimates: the SEs add in quadrature
             let total = Estimate { mean: order1.mean + higher.mean, se: order1.se.hypot(higher.se) };
             points.push(LobePoint {
@@ -776,6 +812,35 @@ mod lobe_bin_tests {
             }
             let off_plane = Vec3::new(0.0, (2.0 * bins.slab) as f32, 1.0).normalize();
             assert_eq!(bins.bin(off_plane), None);
+        }
+    }
+
+    /// Every fine angle lies between the centres of the two bins it is interpolated from.
+    #[test]
+    fn fine_angles_interpolate_between_enclosing_bin_centres() {
+        for material in LOBE_MATERIALS {
+            let (n, r) = (31, LOBE_EVAL_REFINEMENT);
+            let bins = LobeBins::new(material, n);
+            let centres = lobe_angles(material, n);
+            let width = std::f64::consts::PI / n as f64;
+            for (j, s) in lobe_angles(material, r * n).into_iter().enumerate() {
+                let ([b0, b1], t) = bins.between_centres(j, r);
+                assert!((0.0..1.0).contains(&t), "{material:?} j = {j}: t = {t}");
+                // the interpolated position, unwrapped past the last bin on the full circle
+                let c1 = centres[b1] + if b1 < b0 { std::f64::consts::TAU } else { 0.0 };
+                let at = (1.0 - t) * centres[b0] + t * c1;
+                let expected = if b0 == b1 { centres[b0] } else { s };
+                // the same angle, up to a turn (the full circle wraps)
+                let off = (at - expected).rem_euclid(std::f64::consts::TAU);
+                assert!(
+                    off.min(std::f64::consts::TAU - off) < 1e-12,
+                    "{material:?} j = {j}: {at} vs {expected}"
+                );
+                assert!(b0 == b1 || (c1 - centres[b0] - width).abs() < 1e-12);
+                if b0 == b1 {
+                    assert!((s - centres[b0]).abs() <= 0.5 * width, "{material:?} j = {j}: held bin too far");
+                }
+            }
         }
     }
 

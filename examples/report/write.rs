@@ -233,8 +233,9 @@ fn lobe_table(results: &Results) -> Table {
         rows,
         note: "Orders 2 and 3+ of a panel are a histogram of its model's own sampled scatterings, in bins of θo in the plane of \
                incidence (Δθ × ±Δθ/2 about it): a pilot round gives the SE of its noisiest bin, and the panel gets as many rounds as make \
-               it √(1 − 0.15²) × the target fraction of the panel's peak; order 1 is evaluated at each bin's centre until its SE is \
-               0.15 × the target (the parameters below), or the caps are reached; the figures state the largest SE of a total reached."
+               it √(1 − 0.25²) × the target fraction of the panel's peak; order 1 is evaluated at twice as many angles (orders 2 and 3+ \
+               interpolated linearly between the bins' centres there) until its SE is 0.25 × the target (the parameters below), or the \
+               caps are reached; the figures state the largest SE of a plotted total reached."
             .into(),
     }
 }
@@ -423,7 +424,8 @@ fn lobe_caption(results: &Results, budget: &Budget, file: &str, title: &str) -> 
     format!(
         "{title}: f·|cos θo| (sr⁻¹) per scattering order (1, 2, 3+) and their total in the plane of incidence, against the signed \
          θo, for θi = 0, 1, 1.5 rad (rows) and the Heitz walk and both position-free models (columns). Order 1 is the walk's eval \
-         (position-free: PT) at each θo; orders 2 and 3+ are histograms of the model's own sampled scatterings: bin averages over \
+         (position-free: PT) at each θo; orders 2 and 3+ are histograms of the model's own sampled scatterings, interpolated \
+         linearly between the bins' centres: bin averages over \
          {:.1}° of θo × ±{:.1}° about the plane (broad lobes that the bins barely smooth). Largest standard error of a \
          plotted total: {:.2} % of its panel's peak (target {} %). Legends: each order's albedo from sampled scatterings.",
         180.0 / budget.lobe_angles as f64,

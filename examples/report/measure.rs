@@ -598,7 +598,8 @@ fn lobe_estimator(model: Model) -> Est {
 /// from each model's own sampled scatterings (`LobeBins`, orders 2 and 3+) and evaluated at
 /// each bin's centre (order 1), in two passes: a pilot round of `lobe_samples` scatterings per
 /// panel gives the SE of its noisiest bin of orders 2+; the panel then gets as many further
-/// rounds as make that SE √(1 − s²) `lobe_rel_se` × its peak (SE ∝ 1/√N), at most
+/// rounds as make the SE of the points interpolated from it (0.79 × a bin's) √(1 − s²)
+/// `lobe_rel_se` × its peak (SE ∝ 1/√N), at most
 /// `lobe_max_samples` scatterings in all; the first order (cheap: one vertex) gets evaluations
 /// until its SE is s `lobe_rel_se` × the peak (s = `FIRST_ORDER_SHARE`), at most
 /// `lobe_max_evals`; so the total's SE is at most `lobe_rel_se` × the peak (the report states
@@ -632,8 +633,11 @@ fn lobes(opts: &Options, budget: &Budget) -> Vec<LobePoint> {
     let max_rounds = (budget.lobe_max_samples / budget.lobe_samples).max(1);
     let mut jobs = Vec::new();
     for (i, (p, sums)) in panels.iter().zip(&pilot).enumerate() {
-        let needed =
-            (sums.rel_se(bins_of(p.0)) / budget.lobe_rel_se).powi(2) / (1.0 - FIRST_ORDER_SHARE.powi(2));
+        // a plotted point interpolates two bins at weights 1/4 and 3/4 (`LOBE_EVAL_REFINEMENT` = 2):
+        // its SE is √(1/16 + 9/16) = 0.79 × theirs
+        let interpolated = (0.0625f64 + 0.5625).sqrt();
+        let needed = (interpolated * sums.rel_se(bins_of(p.0)) / budget.lobe_rel_se).powi(2)
+            / (1.0 - FIRST_ORDER_SHARE.powi(2));
         let rounds =
             if needed.is_finite() { (needed.ceil() as usize).clamp(1, max_rounds) } else { max_rounds };
         jobs.extend((1..rounds).map(|r| (i, r as u64)));

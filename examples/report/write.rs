@@ -233,7 +233,7 @@ fn lobe_table(results: &Results) -> Table {
         rows,
         note: "Orders 2 and 3+ of a panel are a histogram of its model's own sampled scatterings, in bins of θo in the plane of \
                incidence (Δθ × ±Δθ/2 about it): a pilot round gives the SE of its noisiest bin, and the panel gets as many rounds as make \
-               it √(1 − 0.25²) × the target fraction of the panel's peak; order 1 is evaluated at twice as many angles (orders 2 and 3+ \
+               the SE of the points interpolated from it (0.79 × a bin's) √(1 − 0.25²) × the target fraction of the panel's peak; order 1 is evaluated at twice as many angles (orders 2 and 3+ \
                interpolated linearly between the bins' centres there) until its SE is 0.25 × the target (the parameters below), or the \
                caps are reached; the figures state the largest SE of a plotted total reached."
             .into(),

@@ -35,14 +35,18 @@ pub struct Budget {
     pub samples: usize,
     /// Evaluations of the converged reference, as a multiple of `samples`.
     pub reference_factor: usize,
-    /// Outgoing angles of a lobe over the upper half plane (twice as many for the dielectric).
+    /// Bins of θo of a lobe over the upper half plane (twice as many for the dielectric).
     pub lobe_angles: usize,
-    /// Evaluations per order and outgoing angle of a lobe: the pilot, and each further round.
+    /// Sampled scatterings per round of a lobe panel (the pilot is one round).
     pub lobe_samples: usize,
-    /// The target standard error of a lobe's total at every angle, relative to its panel's peak.
+    /// The target standard error of a lobe's total in every bin, relative to its panel's peak.
     pub lobe_rel_se: f64,
-    /// The most evaluations per order and angle of a lobe.
+    /// The most sampled scatterings of a lobe panel.
     pub lobe_max_samples: usize,
+    /// Evaluations of the first order per round at each angle of a lobe.
+    pub lobe_evals: usize,
+    /// The most evaluations of the first order at an angle of a lobe.
+    pub lobe_max_evals: usize,
     /// Sampled walks per surface and θi of the energy table.
     pub energy_walks: usize,
     /// Evaluations of the white furnace ∫f cos dωo per surface and θi.
@@ -58,9 +62,11 @@ impl Budget {
                 samples: 1 << 10,
                 reference_factor: 4,
                 lobe_angles: 13,
-                lobe_samples: 64,
+                lobe_samples: 1 << 12,
                 lobe_rel_se: 0.1,
-                lobe_max_samples: 256,
+                lobe_max_samples: 1 << 14,
+                lobe_evals: 64,
+                lobe_max_evals: 256,
                 energy_walks: 1 << 10,
                 furnace_samples: 1 << 10,
                 cost_calls: 2_000,
@@ -69,10 +75,12 @@ impl Budget {
             Self {
                 samples: 1 << 15,
                 reference_factor: 4,
-                lobe_angles: 61,
-                lobe_samples: 1 << 12,
-                lobe_rel_se: 0.01,
-                lobe_max_samples: 1 << 18,
+                lobe_angles: 31,
+                lobe_samples: 1 << 20,
+                lobe_rel_se: 0.003,
+                lobe_max_samples: 1 << 26,
+                lobe_evals: 1 << 12,
+                lobe_max_evals: 1 << 18,
                 energy_walks: 1 << 15,
                 furnace_samples: 1 << 15,
                 cost_calls: 100_000,
@@ -93,21 +101,35 @@ impl Budget {
                 self.reference_factor.to_string(),
                 "reference evaluations as a multiple of samples",
             ),
-            ("lobe_angles", self.lobe_angles.to_string(), "outgoing angles per half plane of a lobe"),
+            (
+                "lobe_angles",
+                self.lobe_angles.to_string(),
+                "bins of θo per half plane of a lobe (Δθ = 180°/n; slab ±Δθ/2 about the plane)",
+            ),
             (
                 "lobe_samples",
                 self.lobe_samples.to_string(),
-                "evaluations per order and angle of a lobe: pilot and each further round",
+                "sampled scatterings per round of a lobe panel (the pilot is one round)",
             ),
             (
                 "lobe_rel_se",
                 self.lobe_rel_se.to_string(),
-                "target SE of a lobe's total, relative to its panel's peak",
+                "target SE of a lobe bin's total, relative to its panel's peak",
             ),
             (
                 "lobe_max_samples",
                 self.lobe_max_samples.to_string(),
-                "the most evaluations per order and angle of a lobe",
+                "the most sampled scatterings of a lobe panel",
+            ),
+            (
+                "lobe_evals",
+                self.lobe_evals.to_string(),
+                "evaluations of the first order per round at each angle of a lobe (two angles per bin)",
+            ),
+            (
+                "lobe_max_evals",
+                self.lobe_max_evals.to_string(),
+                "the most evaluations of the first order at an angle of a lobe",
             ),
             (
                 "energy_walks",
@@ -448,6 +470,7 @@ impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
             weight: f64::from(s.weight.element_sum()) / 3.0,
             reflected: s.wo.z > 0.0,
             bounces: s.bounces,
+            wo: s.wo,
         })
     }
 }
@@ -460,6 +483,8 @@ pub struct Scattered {
     /// Whether ωo is above the macrosurface.
     pub reflected: bool,
     pub bounces: u32,
+    /// The sampled direction.
+    pub wo: Vec3,
 }
 
 /// The direction at polar angle θ and azimuth φ.

@@ -7,7 +7,7 @@ use super::configure::{
     THETAS, WithModels, dir, with_surface,
 };
 use glam::Vec3;
-use microsurface::{MAX_BOUNCES, Material, MicrosurfaceSlope, ScatteringOrder};
+use microsurface::{Material, MicrosurfaceSlope, ScatteringOrder};
 use rand::SeedableRng;
 use std::hint::black_box;
 use std::sync::Mutex;
@@ -83,19 +83,19 @@ pub struct LobePoint {
     pub theta_i: f64,
     /// Signed angle from the normal, positive on the mirror side (φo = π); |θo| > π/2 below.
     pub theta_o: f64,
-    /// Orders 1, 2 and 3+.
+    /// Orders 1 (by `eval` at θo), 2 and 3+ (bin averages of f·|cos θo| over `LobeBins`).
     pub orders: [Estimate; 3],
-    /// Evaluations per order.
+    /// Their sum, with its own SE (a sample counts in one order only, so the orders'
+    /// estimates are correlated).
+    pub total: Estimate,
+    /// Sampled scatterings of the panel.
     pub samples: usize,
 }
 
 impl LobePoint {
-    /// The total over orders (independent estimates: the SEs add in quadrature).
+    /// The total over orders.
     pub fn total(&self) -> Estimate {
-        Estimate {
-            mean: self.orders.iter().map(|e| e.mean).sum(),
-            se: self.orders.iter().map(|e| e.se * e.se).sum::<f64>().sqrt(),
-        }
+        self.total
     }
 }
 
@@ -339,40 +339,6 @@ fn energy(opts: &Options, budget: &Budget) -> Vec<EnergyRow> {
     })
 }
 
-/// The continuation probability q of the random order of `orders_from_3`.
-const ORDER3_CONTINUE: f64 = 0.75;
-
-/// An unbiased estimate of the orders 3 and up of f·|cos θo| from one term: the order
-/// k = 3 + G, G geometric (P(G = g) = (1 − q) q^g, q = `ORDER3_CONTINUE`), capped at
-/// `MAX_BOUNCES` (which then takes the remaining mass q^{cap − 3}), evaluated with
-/// `ScatteringOrder::only(k)` and divided by P(k). Every term is ≥ 0 for non-negative
-/// models, unlike the difference total − order 1 − order 2. Its variance is finite when the
-/// order-k contributions fall faster than √q^k; it costs a walk of 3 + q/(1 − q) = 6 bounces
-/// on average.
-fn orders_from_3(eval: &impl Fn(ScatteringOrder, &mut Rng) -> f64, rng: &mut Rng) -> f64 {
-    let (mut k, mut p) = (3u32, 1.0 - ORDER3_CONTINUE);
-    while k < MAX_BOUNCES {
-        if rand::RngExt::random::<f64>(rng) >= ORDER3_CONTINUE {
-            break;
-        }
-        k += 1;
-        p *= ORDER3_CONTINUE;
-    }
-    if k == MAX_BOUNCES {
-        p *= 1.0 / (1.0 - ORDER3_CONTINUE);
-    }
-    eval(ScatteringOrder::only(k).expect("k ≥ 3"), rng) / p
-}
-
-/// The estimator of a model's lobes: the walk's `eval` and the position-free PT.
-fn lobe_estimator(model: Model) -> Est {
-    match model {
-        Model::Walk => Est::Walk,
-        Model::Uncorrelated => Est::PtUncorrelated,
-        Model::Correlated => Est::PtCorrelated,
-    }
-}
-
 /// The lobe angles: the midpoints of `n` equal steps over the upper half plane (−π/2, π/2),
 /// and for the dielectric of `2n` steps over the whole circle; never horizontal, where f·cos
 /// vanishes and the estimators' weights are least stable.
@@ -381,6 +347,190 @@ pub fn lobe_angles(material: MaterialKind, n: usize) -> Vec<f64> {
     let count = if material == MaterialKind::Dielectric { 2 * n } else { n };
     (0..count).map(|k| -FRAC_PI_2 + PI * (k as f64 + 0.5) / n as f64).collect()
 }
+
+/// The sampled directions of a lobe histogram: bins of θo in the plane of incidence.
+///
+/// A bin is the patch of directions whose signed polar angle in the plane of incidence lies
+/// in one of `lobe_angles`' steps (width Δθ = π/n) and whose distance from that plane is at
+/// most Δθ/2 (|ωo·y| ≤ sin(Δθ/2), the y axis normal to the plane): about Δθ × Δθ at every θo,
+/// on the mirror side (φo = π) or on the side of ωi (φo = 0). Each sampled scattering lands in
+/// at most one bin, and the estimate of a bin is the bin average of f·|cos θo| per order:
+/// (1/N) Σ w·1[ωo ∈ bin, order] / Ω_bin with w = f·|cos θo|/pdf the sample's weight — unbiased
+/// for that average, and far less noisy than per-direction `eval` since every sample counts.
+/// The lobes take orders 2 and 3+ from it (broad lobes, which the bin average barely smooths),
+/// interpolated linearly between the bins' centres, and the first order, the sharpest, from
+/// `eval` at `LOBE_EVAL_REFINEMENT` angles per bin (`FirstOrderTask`).
+struct LobeBins {
+    /// Bins over the half plane (the dielectric has twice as many, over the full circle).
+    n: usize,
+    full_circle: bool,
+    /// sin of the half-width of the slab about the plane of incidence.
+    slab: f64,
+    /// The solid angle of every bin.
+    solid_angle: Vec<f64>,
+}
+
+impl LobeBins {
+    fn new(material: MaterialKind, n: usize) -> Self {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let full_circle = material == MaterialKind::Dielectric;
+        let count = if full_circle { 2 * n } else { n };
+        let width = PI / n as f64;
+        let slab = (0.5 * width).sin();
+        // Ω = ∫ over the bin's signed angles s of 2 asin(min(1, h / sin θ)) sin θ ds, θ = |s|
+        // folded into [0, π] (one side of the plane: the slab's azimuths there), by the midpoint
+        // rule on 64 steps per bin (the integrand is smooth except where sin θ = h, which only
+        // the bins at the poles contain; there it is bounded and 64 steps give < 1e-4).
+        let steps = 64;
+        let solid_angle = (0..count)
+            .map(|k| {
+                let lo = -FRAC_PI_2 + width * k as f64;
+                (0..steps)
+                    .map(|i| {
+                        let s = lo + width * (i as f64 + 0.5) / steps as f64;
+                        let sin_theta = s.sin().abs();
+                        let half = if sin_theta <= slab { FRAC_PI_2 } else { (slab / sin_theta).asin() };
+                        2.0 * half * sin_theta * width / steps as f64
+                    })
+                    .sum()
+            })
+            .collect();
+        Self { n, full_circle, slab, solid_angle }
+    }
+
+    fn len(&self) -> usize {
+        self.solid_angle.len()
+    }
+
+    /// The two bins whose centres enclose the j-th of the angles `lobe_angles` gives for
+    /// `refinement` × n steps, and the linear weight t of the second: periodic over the full
+    /// circle, the end bins' values held constant over the half plane's outer half bins.
+    fn between_centres(&self, j: usize, refinement: usize) -> ([usize; 2], f64) {
+        let m = self.len();
+        // the fine angle's position in units of bins, from the first bin's centre
+        let u = (j as f64 + 0.5) / refinement as f64 - 0.5;
+        let k = u.floor();
+        let t = u - k;
+        if self.full_circle {
+            let k0 = (k as i64).rem_euclid(m as i64) as usize;
+            ([k0, (k0 + 1) % m], t)
+        } else if k < 0.0 {
+            ([0, 0], 0.0)
+        } else if k as usize + 1 >= m {
+            ([m - 1, m - 1], 0.0)
+        } else {
+            ([k as usize, k as usize + 1], t)
+        }
+    }
+
+    /// The bin of direction `wo` (ωi in the x–z plane at φ = 0), if it is in one.
+    fn bin(&self, wo: Vec3) -> Option<usize> {
+        use std::f64::consts::{FRAC_PI_2, PI, TAU};
+        let (x, y, z) = (f64::from(wo.x), f64::from(wo.y), f64::from(wo.z));
+        if y.abs() > self.slab || (!self.full_circle && z <= 0.0) {
+            return None;
+        }
+        // the signed angle of `lobe_angles`: ωo = (−sin s, ·, cos s), positive on the mirror side
+        let theta = z.clamp(-1.0, 1.0).acos();
+        let mut s = if x <= 0.0 { theta } else { -theta };
+        if s < -FRAC_PI_2 {
+            s += TAU;
+        }
+        let k = ((s + FRAC_PI_2) / (PI / self.n as f64)).floor();
+        (k >= 0.0 && (k as usize) < self.len()).then_some(k as usize)
+    }
+}
+
+/// Per-bin, per-order sums of the sampled weights w and of w² (orders 1, 2, 3+), and of the
+/// total's w² (a sample counts in one order only).
+#[derive(Debug, Clone, Default)]
+struct LobeSums {
+    samples: usize,
+    sum: Vec<[f64; 3]>,
+    sum2: Vec<[f64; 3]>,
+    total2: Vec<f64>,
+}
+
+impl LobeSums {
+    fn new(bins: usize) -> Self {
+        Self { samples: 0, sum: vec![[0.0; 3]; bins], sum2: vec![[0.0; 3]; bins], total2: vec![0.0; bins] }
+    }
+
+    fn merge(&mut self, other: &Self) {
+        self.samples += other.samples;
+        for b in 0..self.sum.len() {
+            for k in 0..3 {
+                self.sum[b][k] += other.sum[b][k];
+                self.sum2[b][k] += other.sum2[b][k];
+            }
+            self.total2[b] += other.total2[b];
+        }
+    }
+
+    /// The mean and standard error of Σ w·1[bin, order]/Ω over the samples, from its sums.
+    fn estimate(&self, sum: f64, sum2: f64, solid_angle: f64) -> Estimate {
+        let n = self.samples.max(1) as f64;
+        let mean = sum / n;
+        let var = ((sum2 - n * mean * mean) / (n - 1.0).max(1.0)).max(0.0);
+        Estimate { mean: mean / solid_angle, se: (var / n).sqrt() / solid_angle }
+    }
+
+    /// The estimates of bin b: orders 1, 2, 3+ and the total.
+    fn bin(&self, b: usize, solid_angle: f64) -> ([Estimate; 3], Estimate) {
+        let orders = [0, 1, 2].map(|k| self.estimate(self.sum[b][k], self.sum2[b][k], solid_angle));
+        let total = self.estimate(self.sum[b].iter().sum(), self.total2[b], solid_angle);
+        (orders, total)
+    }
+
+    /// The estimate of bin b's orders 2 and up (a sample counts in one order only).
+    fn higher_orders(&self, b: usize, solid_angle: f64) -> Estimate {
+        self.estimate(self.sum[b][1] + self.sum[b][2], self.sum2[b][1] + self.sum2[b][2], solid_angle)
+    }
+
+    /// The largest SE of a bin's orders 2 and up relative to the largest total (all orders).
+    fn rel_se(&self, bins: &LobeBins) -> f64 {
+        let peak = (0..bins.len()).map(|b| self.bin(b, bins.solid_angle[b]).1.mean).fold(0.0, f64::max);
+        let se = (0..bins.len()).map(|b| self.higher_orders(b, bins.solid_angle[b]).se).fold(0.0, f64::max);
+        if peak > 0.0 { se / peak } else { f64::INFINITY }
+    }
+}
+
+/// `samples` sampled scatterings of one model for one ωi, histogrammed into `bins`.
+struct LobeTask<'a> {
+    model: Model,
+    wi: Vec3,
+    bins: &'a LobeBins,
+    samples: usize,
+    seed: u64,
+}
+
+impl WithModels for LobeTask<'_> {
+    type Out = LobeSums;
+
+    fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
+        let mut rng = Rng::seed_from_u64(self.seed);
+        let mut sums = LobeSums::new(self.bins.len());
+        sums.samples = self.samples;
+        for _ in 0..self.samples {
+            let Some(s) = m.sample(self.model, self.wi, &mut rng) else { continue };
+            let Some(b) = self.bins.bin(s.wo) else { continue };
+            let k = (s.bounces as usize).clamp(1, 3) - 1;
+            sums.sum[b][k] += s.weight;
+            sums.sum2[b][k] += s.weight * s.weight;
+            sums.total2[b] += s.weight * s.weight;
+        }
+        sums
+    }
+}
+
+/// The first order of a lobe is evaluated at this many angles per histogram bin (the orders
+/// 2 and 3+ are interpolated linearly between the bins' centres there): the first order is the
+/// sharpest, and its `eval` is cheap.
+const LOBE_EVAL_REFINEMENT: usize = 2;
+
+/// The share of a lobe's SE target given to its first order (in quadrature): small, since the
+/// first order's `eval` costs one vertex and has a small variance.
+const FIRST_ORDER_SHARE: f64 = 0.25;
 
 /// Running sums of one estimated quantity.
 #[derive(Debug, Clone, Copy, Default)]
@@ -405,109 +555,157 @@ impl Sums {
     }
 }
 
-/// The standard error of the total of three independent estimates.
-fn total_se(sums: &[Sums; 3]) -> f64 {
-    sums.iter().map(|s| s.estimate().se.powi(2)).sum::<f64>().sqrt()
-}
-
-/// More evaluations of orders 1, 2 and 3+ at one point of a lobe, in rounds of `round`
-/// samples, until the SE of the total is at most `target_se` or `max_samples` are reached.
-struct LobeTask {
+/// The first order of f·|cos θo| at one direction by the model's `eval`, in rounds of `round`
+/// evaluations until its SE is at most `target_se` or `max` evaluations are reached.
+struct FirstOrderTask {
     est: Est,
     wi: Vec3,
     wo: Vec3,
-    sums: [Sums; 3],
     round: usize,
     target_se: f64,
-    max_samples: usize,
+    max: usize,
     seed: u64,
 }
 
-impl WithModels for LobeTask {
-    type Out = [Sums; 3];
+impl WithModels for FirstOrderTask {
+    type Out = Sums;
 
     fn go<S: MicrosurfaceSlope, M: Material>(self, m: Models<S, M>) -> Self::Out {
         let mut rng = Rng::seed_from_u64(self.seed);
-        let mut sums = self.sums;
-        let eval = |order: ScatteringOrder, rng: &mut Rng| m.eval(self.est, self.wi, self.wo, order, rng);
-        let (first, second) =
-            (ScatteringOrder::only(1).expect("n > 0"), ScatteringOrder::only(2).expect("n > 0"));
+        let mut sums = Sums::default();
+        let first = ScatteringOrder::only(1).expect("n > 0");
         loop {
             for _ in 0..self.round {
-                sums[0].add(eval(first, &mut rng));
-                sums[1].add(eval(second, &mut rng));
-                sums[2].add(orders_from_3(&eval, &mut rng));
+                sums.add(m.eval(self.est, self.wi, self.wo, first, &mut rng));
             }
-            if total_se(&sums) <= self.target_se || sums[0].n >= self.max_samples {
+            if sums.estimate().se <= self.target_se || sums.n >= self.max {
                 break sums;
             }
         }
     }
 }
 
-/// The lobes per order of the walk and both position-free models (GGX α = 1), in two passes:
-/// a pilot of `lobe_samples` evaluations per point gives each panel's peak, then every point
-/// gets more evaluations until the SE of its total is at most `lobe_rel_se` × its panel's
-/// peak (or `lobe_max_samples` are reached; the report states the SE it reached).
+/// The estimator of a model's first order: the walk's `eval` and the position-free PT.
+fn lobe_estimator(model: Model) -> Est {
+    match model {
+        Model::Walk => Est::Walk,
+        Model::Uncorrelated => Est::PtUncorrelated,
+        Model::Correlated => Est::PtCorrelated,
+    }
+}
+
+/// The lobes per order of the walk and both position-free models (GGX α = 1), histogrammed
+/// from each model's own sampled scatterings (`LobeBins`, orders 2 and 3+) and evaluated at
+/// each bin's centre (order 1), in two passes: a pilot round of `lobe_samples` scatterings per
+/// panel gives the SE of its noisiest bin of orders 2+; the panel then gets as many further
+/// rounds as make the SE of the points interpolated from it (0.79 × a bin's) √(1 − s²)
+/// `lobe_rel_se` × its peak (SE ∝ 1/√N), at most
+/// `lobe_max_samples` scatterings in all; the first order (cheap: one vertex) gets evaluations
+/// until its SE is s `lobe_rel_se` × the peak (s = `FIRST_ORDER_SHARE`), at most
+/// `lobe_max_evals`; so the total's SE is at most `lobe_rel_se` × the peak (the report states
+/// the SE reached).
 fn lobes(opts: &Options, budget: &Budget) -> Vec<LobePoint> {
-    let mut points = Vec::new();
+    let mut panels = Vec::new();
     for material in LOBE_MATERIALS {
         for model in Model::ALL {
             for theta_i in THETAS {
-                for theta_o in lobe_angles(material, budget.lobe_angles) {
-                    points.push((material, model, theta_i, theta_o));
-                }
+                panels.push((material, model, theta_i));
             }
         }
     }
-    let task = |&(material, model, theta_i, theta_o): &(MaterialKind, Model, f64, f64),
-                sums: [Sums; 3],
-                target_se: f64,
-                pass: u64| {
+    let bins = LOBE_MATERIALS.map(|m| LobeBins::new(m, budget.lobe_angles));
+    let bins_of =
+        |material: MaterialKind| &bins[LOBE_MATERIALS.iter().position(|&m| m == material).expect("lobe")];
+    let round = |&(material, model, theta_i): &(MaterialKind, Model, f64), index: u64| {
         let surface = Surface { material, slope: SlopeKind::Ggx, alpha: 1.0 };
-        let seed = ((material as u64) << 40)
-            ^ ((model as u64) << 36)
-            ^ ((theta_i * 1e3) as u64) << 20
-            ^ ((theta_o + 4.0) * 1e5) as u64
-            ^ pass << 56;
+        let seed =
+            ((material as u64) << 40) ^ ((model as u64) << 36) ^ ((theta_i * 1e3) as u64) << 20 ^ index;
         let task = LobeTask {
-            est: lobe_estimator(model),
+            model,
             wi: dir(theta_i, 0.0),
-            wo: Vec3::new(-(theta_o.sin()) as f32, 0.0, theta_o.cos() as f32),
-            sums,
-            round: budget.lobe_samples,
-            target_se,
-            max_samples: budget.lobe_max_samples,
+            bins: bins_of(material),
+            samples: budget.lobe_samples,
             seed,
         };
         with_surface(surface, task)
     };
-    let pilot =
-        parallel("lobes (pilot)", points.clone(), opts, |p| task(&p, [Sums::default(); 3], f64::INFINITY, 0));
-    let panel = |p: &(MaterialKind, Model, f64, f64)| (p.0, p.1, p.2.to_bits());
-    let mut peaks: std::collections::HashMap<(MaterialKind, Model, u64), f64> = Default::default();
-    for (p, sums) in points.iter().zip(&pilot) {
-        let total: f64 = sums.iter().map(|s| s.estimate().mean).sum();
-        let peak = peaks.entry(panel(p)).or_insert(0.0);
-        *peak = peak.max(total);
+    let pilot = parallel("lobes (pilot)", panels.clone(), opts, |p| round(&p, 0));
+    let max_rounds = (budget.lobe_max_samples / budget.lobe_samples).max(1);
+    let mut jobs = Vec::new();
+    for (i, (p, sums)) in panels.iter().zip(&pilot).enumerate() {
+        // a plotted point interpolates two bins at weights 1/4 and 3/4 (`LOBE_EVAL_REFINEMENT` = 2):
+        // its SE is √(1/16 + 9/16) = 0.79 × theirs
+        let interpolated = (0.0625f64 + 0.5625).sqrt();
+        let needed = (interpolated * sums.rel_se(bins_of(p.0)) / budget.lobe_rel_se).powi(2)
+            / (1.0 - FIRST_ORDER_SHARE.powi(2));
+        let rounds =
+            if needed.is_finite() { (needed.ceil() as usize).clamp(1, max_rounds) } else { max_rounds };
+        jobs.extend((1..rounds).map(|r| (i, r as u64)));
     }
-    let jobs: Vec<_> = points.iter().copied().zip(pilot).collect();
-    let refined = parallel("lobes per order", jobs, opts, |(p, sums)| {
-        let target = budget.lobe_rel_se * peaks[&panel(&p)];
-        if total_se(&sums) <= target { sums } else { task(&p, sums, target, 1) }
-    });
+    let more = parallel("lobes per order", jobs.clone(), opts, |(i, r)| round(&panels[i], r));
+    let mut totals = pilot;
+    for ((i, _), sums) in jobs.iter().zip(&more) {
+        totals[*i].merge(sums);
+    }
+    let mut first_jobs = Vec::new();
+    for (&(material, model, theta_i), sums) in panels.iter().zip(&totals) {
+        let bins = bins_of(material);
+        let peak = (0..bins.len()).map(|b| sums.bin(b, bins.solid_angle[b]).1.mean).fold(0.0, f64::max);
+        for theta_o in lobe_angles(material, LOBE_EVAL_REFINEMENT * budget.lobe_angles) {
+            first_jobs.push((material, model, theta_i, theta_o, peak));
+        }
+    }
+    let first =
+        parallel("lobes (first order)", first_jobs, opts, |(material, model, theta_i, theta_o, peak)| {
+            let surface = Surface { material, slope: SlopeKind::Ggx, alpha: 1.0 };
+            let seed = ((material as u64) << 40)
+                ^ ((model as u64) << 36)
+                ^ ((theta_i * 1e3) as u64) << 20
+                ^ ((theta_o + 4.0) * 1e5) as u64
+                ^ 1 << 60;
+            let task = FirstOrderTask {
+                est: lobe_estimator(model),
+                wi: dir(theta_i, 0.0),
+                wo: Vec3::new(-(theta_o.sin()) as f32, 0.0, theta_o.cos() as f32),
+                round: budget.lobe_evals,
+                target_se: budget.lobe_rel_se * FIRST_ORDER_SHARE * peak,
+                max: budget.lobe_max_evals,
+                seed,
+            };
+            with_surface(surface, task).estimate()
+        });
+    let mut first = first.into_iter();
+    let mut points = Vec::new();
+    for ((material, model, theta_i), sums) in panels.into_iter().zip(totals) {
+        let bins = bins_of(material);
+        let fine = lobe_angles(material, LOBE_EVAL_REFINEMENT * budget.lobe_angles);
+        for (j, theta_o) in fine.into_iter().enumerate() {
+            let ([b0, b1], t) = bins.between_centres(j, LOBE_EVAL_REFINEMENT);
+            let lerp = |e0: Estimate, e1: Estimate| Estimate {
+                mean: (1.0 - t) * e0.mean + t * e1.mean,
+                se: ((1.0 - t) * e0.se).hypot(t * e1.se),
+            };
+            let (h0, h1) = (sums.bin(b0, bins.solid_angle[b0]).0, sums.bin(b1, bins.solid_angle[b1]).0);
+            let higher = lerp(
+                sums.higher_orders(b0, bins.solid_angle[b0]),
+                sums.higher_orders(b1, bins.solid_angle[b1]),
+            );
+            let order1 = first.next().expect("one first-order estimate per point");
+            let orders = [order1, lerp(h0[1], h1[1]), lerp(h0[2], h1[2])];
+            // independent estimates: the SEs add in quadrature
+            let total = Estimate { mean: order1.mean + higher.mean, se: order1.se.hypot(higher.se) };
+            points.push(LobePoint {
+                material,
+                model,
+                theta_i,
+                theta_o,
+                orders,
+                total,
+                samples: sums.samples,
+            });
+        }
+    }
     points
-        .into_iter()
-        .zip(refined)
-        .map(|((material, model, theta_i, theta_o), sums)| LobePoint {
-            material,
-            model,
-            theta_i,
-            theta_o,
-            orders: sums.map(|s| s.estimate()),
-            samples: sums[0].n,
-        })
-        .collect()
 }
 
 /// The number of pre-generated outgoing directions the cost loops rotate through (a power of
@@ -595,4 +793,92 @@ fn cost(budget: &Budget) -> Vec<CostRow> {
         .into_iter()
         .flat_map(|surface| with_surface(surface, CostTask { surface, n: budget.cost_calls }))
         .collect()
+}
+
+#[cfg(test)]
+mod lobe_bin_tests {
+    use super::*;
+    use statrs::distribution::{ContinuousCDF, Normal};
+
+    /// The bins tile the slab |ωo·y| ≤ h about the plane of incidence: their solid angles add
+    /// up to its area (2πh over the upper hemisphere, 4πh over the sphere), and the direction
+    /// at every plotted angle falls in its own bin.
+    #[test]
+    fn lobe_bins_tile_the_slab_and_hold_their_angles() {
+        for material in LOBE_MATERIALS {
+            let bins = LobeBins::new(material, 31);
+            let area: f64 = bins.solid_angle.iter().sum();
+            let expected = if bins.full_circle { 4.0 } else { 2.0 } * std::f64::consts::PI * bins.slab;
+            assert!((area / expected - 1.0).abs() < 1e-4, "{material:?}: Σ Ω = {area}, slab {expected}");
+            for (k, s) in lobe_angles(material, 31).into_iter().enumerate() {
+                let wo = Vec3::new(-(s.sin()) as f32, 0.0, s.cos() as f32);
+                assert_eq!(bins.bin(wo), Some(k), "{material:?}: θo = {s}");
+            }
+            let off_plane = Vec3::new(0.0, (2.0 * bins.slab) as f32, 1.0).normalize();
+            assert_eq!(bins.bin(off_plane), None);
+        }
+    }
+
+    /// Every fine angle lies between the centres of the two bins it is interpolated from.
+    #[test]
+    fn fine_angles_interpolate_between_enclosing_bin_centres() {
+        for material in LOBE_MATERIALS {
+            let (n, r) = (31, LOBE_EVAL_REFINEMENT);
+            let bins = LobeBins::new(material, n);
+            let centres = lobe_angles(material, n);
+            let width = std::f64::consts::PI / n as f64;
+            for (j, s) in lobe_angles(material, r * n).into_iter().enumerate() {
+                let ([b0, b1], t) = bins.between_centres(j, r);
+                assert!((0.0..1.0).contains(&t), "{material:?} j = {j}: t = {t}");
+                // the interpolated position, unwrapped past the last bin on the full circle
+                let c1 = centres[b1] + if b1 < b0 { std::f64::consts::TAU } else { 0.0 };
+                let at = (1.0 - t) * centres[b0] + t * c1;
+                let expected = if b0 == b1 { centres[b0] } else { s };
+                // the same angle, up to a turn (the full circle wraps)
+                let off = (at - expected).rem_euclid(std::f64::consts::TAU);
+                assert!(
+                    off.min(std::f64::consts::TAU - off) < 1e-12,
+                    "{material:?} j = {j}: {at} vs {expected}"
+                );
+                assert!(b0 == b1 || (c1 - centres[b0] - width).abs() < 1e-12);
+                if b0 == b1 {
+                    assert!((s - centres[b0]).abs() <= 0.5 * width, "{material:?} j = {j}: held bin too far");
+                }
+            }
+        }
+    }
+
+    /// Uniform directions on the sphere with weight 4π estimate 1 in every bin: each bin's
+    /// solid angle, the poles' included, is the one its samples see (Šidák, family-wise 1e-3).
+    #[test]
+    fn lobe_bins_estimate_a_constant_lobe() {
+        let bins = LobeBins::new(MaterialKind::Dielectric, 31);
+        let n = 1usize << 21;
+        let mut sums = LobeSums::new(bins.len());
+        sums.samples = n;
+        let mut rng = Rng::seed_from_u64(0xB1_25);
+        let w = 4.0 * std::f64::consts::PI;
+        for _ in 0..n {
+            let u1: f64 = rand::RngExt::random(&mut rng);
+            let u2: f64 = rand::RngExt::random(&mut rng);
+            let wo = dir((1.0 - 2.0 * u1).acos(), std::f64::consts::TAU * u2);
+            if let Some(b) = bins.bin(wo) {
+                sums.sum[b][1] += w;
+                sums.sum2[b][1] += w * w;
+                sums.total2[b] += w * w;
+            }
+        }
+        let m = bins.len();
+        let z = Normal::standard().inverse_cdf(1.0 - 0.5 * (1.0 - (1.0 - 1e-3f64).powf(1.0 / m as f64)));
+        for b in 0..m {
+            let (_, total) = sums.bin(b, bins.solid_angle[b]);
+            assert!(total.se < 0.05, "bin {b}: SE {} too large to test anything", total.se);
+            assert!(
+                (total.mean - 1.0).abs() <= z * total.se,
+                "bin {b}: N = {n}, mean {} (expected 1), σ̂/√N = {}, z = {z}",
+                total.mean,
+                total.se
+            );
+        }
+    }
 }

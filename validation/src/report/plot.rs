@@ -217,7 +217,7 @@ fn radial_step(r: f64) -> f64 {
 fn lobes(results: &Results, material: MaterialKind, budget: &Budget) -> PlotResult<Figure> {
     let full_circle = material == MaterialKind::Dielectric;
     let (pw, ph) = (360u32, if full_circle { 430u32 } else { 300u32 });
-    let header_h = 110u32;
+    let header_h = 134u32;
     let (w, h) = (3 * pw, header_h + THETAS.len() as u32 * ph);
     let panels: Vec<&LobePanel> = results.lobes.iter().filter(|p| p.material == material).collect();
     let worst = panels.iter().map(|p| p.max_rel_se).fold(0.0, f64::max);
@@ -242,9 +242,14 @@ fn lobes(results: &Results, material: MaterialKind, budget: &Budget) -> PlotResu
                 ),
                 "Radial circles in sr⁻¹, one scale per row; legends: the albedo of each order (from sampled scatterings of the same model).".to_string(),
                 format!(
-                    "Walk: its eval; position-free: PT. {}–{} evaluations per order and angle, until the SE of the total is ≤ {} % of the panel's peak in a pilot run; largest SE: {:.2} % of the peak.",
-                    panels.iter().map(|p| p.samples.0).min().unwrap_or(0),
-                    panels.iter().map(|p| p.samples.1).max().unwrap_or(0),
+                    "Order 1: eval at θo (walk; position-free: PT). Orders 2, 3+: histograms of the model's own samples, bins {:.1}° of θo × ±{:.1}° about the plane;",
+                    180.0 / budget.lobe_angles as f64,
+                    90.0 / budget.lobe_angles as f64,
+                ),
+                format!(
+                    "{:.1}–{:.1} million samples per panel, for an SE ≤ {} % of the panel's peak; largest SE of a plotted total: {:.2} % of its panel's peak.",
+                    panels.iter().map(|p| p.samples.0).min().unwrap_or(0) as f64 * 1e-6,
+                    panels.iter().map(|p| p.samples.1).max().unwrap_or(0) as f64 * 1e-6,
                     100.0 * budget.lobe_rel_se,
                     100.0 * worst
                 ),

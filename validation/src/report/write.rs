@@ -227,12 +227,15 @@ fn lobe_table(results: &Results) -> Table {
     Table {
         id: "lobe-noise",
         caption: "Lobe noise: the largest standard error of a plotted total, relative to the panel's peak".into(),
-        header: ["material", "model", "θi", "peak f·|cos θo| (sr⁻¹)", "largest SE / peak", "evaluations per order and angle"]
+        header: ["material", "model", "θi", "peak f·|cos θo| (sr⁻¹)", "largest SE / peak", "sampled scatterings"]
             .map(String::from)
             .to_vec(),
         rows,
-        note: "Each point gets evaluations until the SE of its total is at most the target fraction of its panel's peak \
-               (the parameters below), or the cap is reached; the figures state the largest SE reached."
+        note: "Orders 2 and 3+ of a panel are a histogram of its model's own sampled scatterings, in bins of θo in the plane of \
+               incidence (Δθ × ±Δθ/2 about it): a pilot round gives the SE of its noisiest bin, and the panel gets as many rounds as make \
+               the SE of the points interpolated from it (0.79 × a bin's) √(1 − 0.25²) × the target fraction of the panel's peak; order 1 is evaluated at twice as many angles (orders 2 and 3+ \
+               interpolated linearly between the bins' centres there) until its SE is 0.25 × the target (the parameters below), or the \
+               caps are reached; the figures state the largest SE of a plotted total reached."
             .into(),
     }
 }
@@ -359,6 +362,79 @@ fn csv_files(results: &Results) -> Vec<(&'static str, String)> {
     ]
 }
 
+/// The path tracer's sweep images with their captions: rendered by
+/// `cargo run --release --example path_tracer` and committed under `docs/`.
+const RENDERS: [(&str, &str); 2] = [
+    (
+        "sweep.png",
+        "GGX roughness sweep rendered by the example path tracer (next-event estimation, MIS, Russian roulette): \
+         columns α = 0.05 … 1, rows gold (complex IOR per RGB) with single scattering, the exact Heitz walk, Kulla–Conty and Turquin \
+         compensation from the crate's albedo tables, then glass (η = 1.5) with single scattering and the walk (the crate has no \
+         compensated dielectric yet); a sky, a ground colour below the horizon and a spherical light; 64 samples per pixel, sRGB, \
+         clamped to [0, 1]. Single scattering darkens with α: it loses the energy of the higher orders.",
+    ),
+    (
+        "sweep_furnace.png",
+        "The same sweep in the white furnace: a uniform environment of radiance 1, F = 1 conductors and non-absorbing glass \
+         (η = 1.5), no light. A sphere that conserves energy vanishes into the background; under each sphere, L is its mean \
+         radiance over the pixels it fully covers ± the standard error (1 = vanished). Single scattering darkens with α (to L ≈ 0.40 \
+         for the conductor and 0.28 for glass at α = 1); the walk vanishes; Kulla–Conty and Turquin vanish within the tables' \
+         interpolation error (≤ 1.2e-3 of albedo for GGX).",
+    ),
+];
+
+/// Copies the sweep images from `docs/` into `out_dir`; returns the (file, caption) of those
+/// that exist.
+fn copy_renders(out_dir: &std::path::Path, files: &mut Vec<PathBuf>) -> Vec<(&'static str, &'static str)> {
+    let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    RENDERS
+        .into_iter()
+        .filter(|(name, _)| {
+            let to = out_dir.join(name);
+            let copied = std::fs::copy(docs.join(name), &to).is_ok();
+            if copied {
+                files.push(to);
+            }
+            copied
+        })
+        .collect()
+}
+
+/// The HTML section of the renders.
+fn renders_html(renders: &[(&str, &str)]) -> String {
+    let mut h = String::from("<h2 id=\"render\">Rendered roughness sweep and its white furnace</h2>\n");
+    if renders.is_empty() {
+        h.push_str("<p>No render found under docs/: <code>cargo run --release --example path_tracer</code> renders them.</p>\n");
+    }
+    for (file, caption) in renders {
+        let _ = writeln!(
+            h,
+            "<figure><img src=\"{0}\" alt=\"{1}\"/><figcaption>{1}</figcaption></figure>",
+            escape(file),
+            escape(caption)
+        );
+    }
+    h
+}
+
+/// The caption of a lobe figure: what is plotted and the noise reached.
+fn lobe_caption(results: &Results, budget: &Budget, file: &str, title: &str) -> String {
+    let panels = results.lobes.iter().filter(|p| file == format!("lobes_{}.svg", p.material.name()));
+    let worst = panels.map(|p| p.max_rel_se).fold(0.0, f64::max);
+    format!(
+        "{title}: f·|cos θo| (sr⁻¹) per scattering order (1, 2, 3+) and their total in the plane of incidence, against the signed \
+         θo, for θi = 0, 1, 1.5 rad (rows) and the Heitz walk and both position-free models (columns). Order 1 is the walk's eval \
+         (position-free: PT) at each θo; orders 2 and 3+ are histograms of the model's own sampled scatterings, interpolated \
+         linearly between the bins' centres: bin averages over \
+         {:.1}° of θo × ±{:.1}° about the plane (broad lobes that the bins barely smooth). Largest standard error of a \
+         plotted total: {:.2} % of its panel's peak (target {} %). Legends: each order's albedo from sampled scatterings.",
+        180.0 / budget.lobe_angles as f64,
+        90.0 / budget.lobe_angles as f64,
+        100.0 * worst,
+        100.0 * budget.lobe_rel_se
+    )
+}
+
 const STYLE: &str = "body{font-family:sans-serif;max-width:1120px;margin:2em auto;padding:0 1em;color:#222;line-height:1.4}\
 table{border-collapse:collapse;margin:0.5em 0 1em;font-size:0.9em}th,td{border:1px solid #ccc;padding:2px 8px;text-align:right}\
 th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}img{max-width:100%;border:1px solid #eee}\
@@ -375,6 +451,7 @@ pub fn write(
 ) -> std::io::Result<Written> {
     std::fs::create_dir_all(&opts.out_dir)?;
     let mut files = Vec::new();
+    let renders = copy_renders(&opts.out_dir, &mut files);
     let mut put = |name: &str, content: &str| -> std::io::Result<String> {
         let path = opts.out_dir.join(name);
         std::fs::write(&path, content)?;
@@ -458,10 +535,11 @@ pub fn write(
             "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>",
             escape(&f.file),
             escape(&f.title),
-            escape(&f.title)
+            escape(&lobe_caption(results, budget, &f.file, &f.title))
         );
     }
     html.push_str(&lobe.html());
+    html.push_str(&renders_html(&renders));
     html.push_str(&energy.html());
     html.push_str(&cost.html());
     html.push_str("<h2 id=\"files\">Files</h2>\n<ul>\n");

@@ -206,13 +206,29 @@ impl<S: MicrosurfaceSlope> Noncentral<S> {
         self.d_wi_unchecked(wi, wm.as_dvec3()) as f32
     }
 
+    /// D_ωi as the central D_ωi of the unsheared pair: with v = (m.x + x̃n m.z, m.y + ỹn m.z, m.z)
+    /// and k as above, ⟨ωi, ωm⟩ = ⟨k, v⟩, so D_ωi(ωm) = D_S,k̂(v̂)/‖v‖³. This inherits the central
+    /// slope's precision where A(ωi) underflows (a view far behind the mean plane: Beckmann's
+    /// log-space D_ωi); the visibility is decided on the given pair, the central value rescaled
+    /// by the ratio of the two cosines (which differ only by the rounding of k̂).
     #[inline(always)]
     fn d_wi_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
         let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
         }
-        let area = self.projected_area_unchecked(wi);
+        let v = DVec3::new(wm.x + self.mean_x * wm.z, wm.y + self.mean_y * wm.z, wm.z);
+        let len_v = v.length();
+        let m = v / len_v;
+        let k = self.unsheared_view(wi);
+        let len_k = k.length();
+        let view = (k / len_k).as_vec3();
+        let cos_central = view.as_dvec3().dot(m);
+        if cos_central > 0.0 {
+            let scale = cos_im / (cos_central * len_k * len_v);
+            return self.central.d_wi64_unchecked(view, m) * scale / (len_v * len_v * len_v);
+        }
+        let area = len_k * self.central.projected_area64(view);
         if area > 0.0 { cos_im * self.d_unchecked(wm) / area } else { 0.0 }
     }
 

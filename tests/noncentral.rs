@@ -289,11 +289,11 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
 #[test]
 fn density_of_normals_seen_from_far_behind_the_mean_plane() {
     let s = Noncentral::new(Beckmann::isotropic(0.05).unwrap(), Vec2::new(2.0, 0.0)).unwrap();
-    let wi = common::dir(1.2, 0.0).normalize();
+    let wi = validation::dir(1.2, 0.0).normalize();
     assert_eq!(s.projected_area(wi), 0.0, "the case must be one where A underflows");
-    let mut rng = common::rng(900);
+    let mut rng = validation::rng(900);
     for _ in 0..1000 {
-        let wm = s.sample_d_wi(wi, common::uniform32(&mut rng), common::uniform32(&mut rng));
+        let wm = s.sample_d_wi(wi, validation::uniform32(&mut rng), validation::uniform32(&mut rng));
         let density = s.d_wi(wi, wm);
         assert!(wm.z > 0.0 && wi.dot(wm) > 0.0, "{wm}");
         assert!(density > 0.0 && density.is_finite(), "{wm}: D_ωi = {density}");
@@ -301,12 +301,12 @@ fn density_of_normals_seen_from_far_behind_the_mean_plane() {
     // and it is their density (χ² on the whole sphere), for α = 0.2, where the lobe is wide
     // enough for the harness' quadrature (A = 2.6e-32, beyond f32 but not f64)
     let s = Noncentral::new(Beckmann::isotropic(0.2).unwrap(), Vec2::new(2.0, 0.0)).unwrap();
-    let mut rng = common::rng(902);
+    let mut rng = validation::rng(902);
     chi2_test(
         &format!("far behind the mean plane, from {wi}"),
         Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) },
         |m| f64::from(s.d_wi(wi, m)),
-        || Some(s.sample_d_wi(wi, common::uniform32(&mut rng), common::uniform32(&mut rng))),
+        || Some(s.sample_d_wi(wi, validation::uniform32(&mut rng), validation::uniform32(&mut rng))),
         100_000,
         0.01,
         1.0,

@@ -341,8 +341,15 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn f_checked(&self, wo: Vec3, wi: Vec3, key: u64) -> Vec3 {
         let (walk_in, walk_out) = (wo, wi);
         let seed = self.seed;
-        let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
-        let f_cos_wi = self.research_f_cos_out(walk_in, walk_out, &mut rng);
+        let hash = || Hasher::directions(seed, key, wo, wi);
+        let f_cos_wi = if self.technique == Technique::SingleScattering {
+            // deterministic except for diffuse facets: the generator (and its hash) only on use
+            self.research_f_cos_out(walk_in, walk_out, &mut PrimedRng::new(&[], hash))
+        } else {
+            // stochastic: the seeded generator itself, without the primed generator's
+            // bookkeeping on each of the walk's draws
+            self.research_f_cos_out(walk_in, walk_out, &mut hash().generator())
+        };
         let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
         if f.is_finite() { f } else { Vec3::ZERO }
     }

@@ -54,7 +54,7 @@ pub enum Technique {
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
     /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term) for every
     /// roughness; samples whose pdf or f would be subnormal are not returned (at most
-    /// 4π·`f32::MIN_POSITIVE` of probability). See `PositionFree::sample_single` for the f32
+    /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::SingleScattering::sample`] for the f32
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample

@@ -4,9 +4,9 @@
 
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::error::Error;
-use crate::frame::sample_cosine_hemisphere;
 use crate::fresnel::fresnel_schlick;
 use crate::rng::cut_tails;
+use crate::sampling::sample_cosine_hemisphere;
 use crate::special::erfc64;
 use core::f32::consts::{FRAC_1_PI, TAU};
 use glam::{Vec2, Vec3};

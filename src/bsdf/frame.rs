@@ -1,6 +1,6 @@
 //! The local shading frame.
 
-use crate::frame::orthonormal_basis;
+use crate::basis::orthonormal_basis;
 use glam::Vec3;
 
 /// An orthonormal frame (t, b, n) built from a shading normal n, to move directions between

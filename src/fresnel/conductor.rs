@@ -28,12 +28,14 @@ impl ComplexIor {
     }
 
     /// Real part η.
+    #[must_use]
     #[inline]
     pub fn eta(&self) -> Vec3 {
         self.eta
     }
 
     /// Extinction coefficient k.
+    #[must_use]
     #[inline]
     pub fn k(&self) -> Vec3 {
         self.k
@@ -51,6 +53,7 @@ impl ComplexIor {
 /// Invalid input ([policy](crate#invalid-input)): a `cos_theta_i` that is NaN or beyond
 /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives `Vec3::NAN` (a debug
 /// assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn fresnel_conductor(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 {
     require!(is_cosine(cos_theta_i), Vec3::NAN; cos_theta_i);
@@ -58,6 +61,7 @@ pub fn fresnel_conductor(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 {
 }
 
 /// [`fresnel_conductor`] without the argument check, for cosines the crate formed itself.
+#[must_use]
 #[inline(always)]
 pub(crate) fn conductor_reflectance(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 {
     let cos_theta = cos_theta_i.abs().min(1.0);

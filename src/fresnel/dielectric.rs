@@ -14,6 +14,7 @@ use crate::contract::{is_cosine, is_index};
 /// Invalid input ([policy](crate#invalid-input)): a `cos_theta_i` that is NaN or beyond
 /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)), or an `eta` that is not finite
 /// and > 0, gives NaN (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
     require!(is_cosine(cos_theta_i) && is_index(eta), f32::NAN; cos_theta_i, eta);
@@ -21,6 +22,7 @@ pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> f32 {
 }
 
 /// [`fresnel_dielectric`] without the argument check, for the crate's own cosines and indices.
+#[must_use]
 #[inline(always)]
 pub(crate) fn dielectric_reflectance(cos_theta_i: f32, eta: f32) -> f32 {
     let c = f64::from(cos_theta_i.abs().min(1.0));
@@ -38,6 +40,7 @@ pub(crate) fn dielectric_reflectance(cos_theta_i: f32, eta: f32) -> f32 {
 /// Rs = (c − η t)/(c + η t), Rp = (η c − t)/(η c + t), F = (Rs² + Rp²)/2. Callers that know
 /// cos θt from the geometry (a refraction through a known facet) pass it directly instead of
 /// recomputing it from a rounded cos θi near the critical angle.
+#[must_use]
 #[inline]
 pub(crate) fn fresnel_dielectric_cosines(c: f64, t: f64, eta: f64) -> f64 {
     let (num_s, den_s) = (c - eta * t, c + eta * t);

@@ -10,6 +10,7 @@ use glam::Vec3;
 /// Invalid input ([policy](crate#invalid-input)): a `cos_theta` that is NaN or beyond
 /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)), or an `f0` with a component
 /// that is NaN or outside [0, 1], gives `Vec3::NAN` (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn fresnel_schlick(cos_theta: f32, f0: Vec3) -> Vec3 {
     require!(

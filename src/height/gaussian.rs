@@ -28,6 +28,8 @@ impl GaussianHeight {
     pub const H_MAX: f32 = 16.0;
 }
 
+impl crate::sealed::Sealed for GaussianHeight {}
+
 impl MicrosurfaceHeight for GaussianHeight {
     #[inline]
     fn p1(&self, h: f32) -> f32 {

@@ -10,6 +10,8 @@ use crate::contract::is_uniform;
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct UniformHeight;
 
+impl crate::sealed::Sealed for UniformHeight {}
+
 impl MicrosurfaceHeight for UniformHeight {
     #[inline]
     fn p1(&self, h: f32) -> f32 {

@@ -1,10 +1,11 @@
 //! Diffuse (Lambertian) microfacets.
 
 use super::{Material, PhaseSample, g2_reflection};
+use crate::basis::basis;
 use crate::contract::is_direction;
 use crate::error::Error;
-use crate::frame::{basis, cosine_hemisphere};
 use crate::rng::uniform;
+use crate::sampling::cosine_hemisphere;
 use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;

@@ -96,12 +96,15 @@ fn projected_roughness_sq64(alpha_x: f32, alpha_y: f32, w: Vec3) -> f64 {
 
 /// Λ for the upper hemisphere in double precision, a = cot θ / αᵢ ≥ 0:
 /// exp(−a²)/(2a√π) − erfc(a)/2 = exp(−a²) r(a)/(2a√π) with r(a) = 1 − √π a erfcx(a)
-/// ([`one_minus_scaled_erfcx`]), which has no cancellation beyond a = 8 and at most
-/// 2a² ≤ 128 ulps below: relative error below 3e-14. +∞ at a = 0.
+/// ([`one_minus_scaled_erfcx`]): relative error below 4e-13 (that of r, which loses a factor
+/// 1 + 2a² of erfcx's accuracy to cancellation just below a = 8, its series' start; 1e-15
+/// beyond). +∞ at a = 0.
 #[inline(always)]
 fn lambda_up64(a: f64) -> f64 {
     0.5 * INV_SQRT_PI * (-a * a).exp() * one_minus_scaled_erfcx(a) / a
 }
+
+impl crate::sealed::Sealed for Beckmann {}
 
 impl MicrosurfaceSlope for Beckmann {
     #[inline]

@@ -54,6 +54,8 @@ fn lambda_up(q: f32, z: f32) -> f32 {
     (q / (2.0 * z * (z + (z * z + q).sqrt()))).min(f32::MAX)
 }
 
+impl crate::sealed::Sealed for Ggx {}
+
 impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {

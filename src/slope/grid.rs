@@ -473,6 +473,8 @@ impl GridSlope {
     }
 }
 
+impl crate::sealed::Sealed for &GridSlope {}
+
 impl MicrosurfaceSlope for &GridSlope {
     #[inline]
     fn alpha_x(&self) -> f32 {

@@ -21,19 +21,30 @@ pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
-use crate::vector::ensure_visible;
 // the materials' import path of the vector kernels (src/material is another branch's; the
 // kernels live in `crate::vector`)
+use crate::sealed::Sealed;
 pub(crate) use crate::vector::{normalize_fast, renormalize};
-use crate::vndf::Azimuth;
 use glam::{DVec3, Vec2, Vec3};
 
 /// A slope distribution P²²(x̃, ỹ) with roughness (αx, αy) and everything derived from it
 /// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
 ///
-/// Implementors provide the primitives `p22`, `d`, `lambda`, `projected_area` and
-/// `sample_p22_11`; `alpha_i`, `d_wi` and `sample_d_wi` are derived (and may be overridden
-/// with faster or more accurate forms).
+/// Sealed: implemented by the crate's distributions only ([`Ggx`], [`Beckmann`],
+/// `&`[`TabulatedSlope`], [`StretchedTabulated`], `&`[`GridSlope`]). A distribution of one's
+/// own goes through [`TabulatedSlope`] (isotropic: from P²² or D values on rings, or a radial
+/// function) or [`GridSlope`] (anisotropic: from a grid of slope densities), which check their
+/// input, derive Λ, the projected area and D_ωi from it and sample it exactly, so that the
+/// random walks, the position-free estimators and the samplers are valid for it unchanged.
+/// Sealing lets the crate rely on the contract below (which its test suite checks for every
+/// implementation) and add methods without a breaking change.
+///
+/// The contract of every implementation: `p22` integrates to 1 over the slope plane and `d`
+/// is its change of variables to normals; `lambda`, `projected_area` and `d_wi` are the
+/// Smith quantities of that density on the whole sphere (Λ(−ω) = −1 − Λ(ω), projected area
+/// (1 + Λ(ω)) cos θ); `sample_d_wi` samples `d_wi` exactly (chi-square tested) and
+/// `sample_p22_11` samples its stretched, α = 1, visible slopes; the f64 forms agree with the
+/// f32 ones to f32 rounding.
 ///
 /// Invalid input ([policy](crate#invalid-input)), the same for every method and every
 /// implementation of the crate: a direction argument that is zero, has a NaN or ±∞ component,
@@ -42,7 +53,7 @@ use glam::{DVec3, Vec2, Vec3};
 /// from the densities (`p22`, `d`, `d64`, `d_wi`, `d_wi64`), NaN from `lambda`,
 /// `projected_area` and `alpha_i`, and a NaN vector from the samplers (`sample_p22_11`,
 /// `sample_d_wi`). Grazing and below-horizon unit directions are valid everywhere.
-pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
+pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along x.
     fn alpha_x(&self) -> f32;
 
@@ -114,6 +125,11 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     /// Samples visible slopes of the distribution stretched to α = 1, seen from the direction
     /// (sin θ, 0, cos θ), θ ∈ [0, π] (supplement §2.1, `sampleP22_11`).
     ///
+    /// The stretched-space primitive of [`Self::sample_d_wi`], from the same kernel (the
+    /// spherical cap for GGX, the exact inversion for Beckmann, the tables' own sampler):
+    /// rotating its slopes into the azimuth of the stretched ωi and unstretching them samples
+    /// D_ωi. Exposed so that the stretched configuration can be validated on its own.
+    ///
     /// Takes cos θ and sin θ ≥ 0 rather than θ (either may be ±0, treated alike), and two
     /// uniforms in [0, 1). Implementations cut the tails of the quantiles they invert at 2⁻²⁴
     /// (u is used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴); the crate's tail policy): no sample lies
@@ -176,24 +192,18 @@ pub trait MicrosurfaceSlope: Copy + core::fmt::Debug + Send + Sync {
     }
 
     /// Samples a normal ωm from D_ωi exactly, for any ωi on the sphere, from two uniforms in
-    /// [0, 1) (supplement §2.1: stretch to α = 1, sample slopes, rotate, unstretch).
+    /// [0, 1) (supplement §2.1: stretch to α = 1, sample slopes, rotate, unstretch; each
+    /// implementation in its own numerically robust form, see `src/vndf/`).
     ///
-    /// Always returns a unit vector with ωm.z ≥ 0. For ωi = −z, which sees no microsurface,
-    /// returns +z. Tails are cut at 2⁻²⁴ as in [`Self::sample_p22_11`].
-    #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
-        let (ax, ay) = (self.alpha_x(), self.alpha_y());
-        let stretched = Vec3::new(ax * wi.x, ay * wi.y, wi.z).normalize_or(Vec3::Z);
-        let azimuth = Azimuth::of(stretched.x, stretched.y);
-        let s = self.sample_p22_11(stretched.z, azimuth.len_xy, u1, u2);
-        ensure_visible(wi, azimuth.unstretched_normal(ax, ay, s.x, s.y))
-    }
+    /// Always returns a unit vector with ωm.z ≥ 0 and ⟨ωi, ωm⟩ > 0 as [`Self::d_wi`] evaluates
+    /// it. For ωi = −z, which sees no microsurface, returns +z. Tails are cut at 2⁻²⁴ as in
+    /// [`Self::sample_p22_11`].
+    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
 
     // The same quantities without the argument check, for the crate's walks, which call them
     // once or more per bounce with directions they produced themselves (unit up to rounding).
-    // Each defaults to the checked method, so that an implementation outside the crate keeps
-    // its own overrides; the crate's slopes override them with the unchecked bodies.
+    // Each defaults to the checked method; the analytic slopes override them with the
+    // unchecked bodies.
 
     /// [`Self::lambda`] without the argument check (crate-internal hot path).
     #[doc(hidden)]

@@ -4,7 +4,8 @@
 use super::MicrosurfaceSlope;
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
-use crate::vector::{ensure_visible, normal_from_slopes};
+use crate::vector::ensure_visible;
+use crate::vndf::Azimuth;
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -539,18 +540,17 @@ impl TabulatedSlope {
     /// An exactly sampled visible normal for a unit `wi` (f64 inside).
     fn sample_normal(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let w = wi.as_dvec3();
-        let h = (w.x * w.x + w.y * w.y).sqrt();
+        let azimuth = Azimuth::of(w.x, w.y);
+        let h = azimuth.len_xy;
         let len = (h * h + w.z * w.z).sqrt();
         if len.is_nan() || len <= 0.0 {
             return Vec3::Z;
         }
-        let (cos_phi, sin_phi) = if h > 0.0 { (w.x / h, w.y / h) } else { (1.0, 0.0) };
         let Some((x, y)) = self.sample_slopes(w.z / len, h / len, f64::from(u1), f64::from(u2)) else {
             return Vec3::Z;
         };
-        let slope_x = cos_phi * x - sin_phi * y;
-        let slope_y = sin_phi * x + cos_phi * y;
-        ensure_visible(wi, normal_from_slopes(slope_x as f32, slope_y as f32))
+        // the table is isotropic and unstretched: rotate only
+        ensure_visible(wi, azimuth.unstretched_normal(1.0, 1.0, x, y))
     }
 
     /// D in f64 for a normal with horizontal length `h` and height `z`.
@@ -584,6 +584,8 @@ pub(super) fn check_ring_count(rings: usize) -> Result<(), Error> {
     }
     Ok(())
 }
+
+impl crate::sealed::Sealed for &TabulatedSlope {}
 
 impl MicrosurfaceSlope for &TabulatedSlope {
     #[inline]
@@ -715,6 +717,8 @@ impl StretchedTabulated<'_> {
         ((s / len).as_vec3(), len)
     }
 }
+
+impl crate::sealed::Sealed for StretchedTabulated<'_> {}
 
 impl MicrosurfaceSlope for StretchedTabulated<'_> {
     #[inline]

@@ -12,11 +12,11 @@ use crate::special::{PSI_SERIES_FROM, erfc_inv_f32, erfcx64, one_minus_scaled_er
 use crate::vector::ensure_visible;
 use glam::Vec3;
 
-/// The iteration stops once its step is below this fraction of 1 + |x̃| (about the f32 resolution
-/// of x̃). The error after that step is of order C·step² or less, where C, the inverse of the
-/// lobe's width, reaches |cot θ| far below the horizon: a looser stop (3e-5 was tried with
-/// Newton steps) biases those thin lobes measurably.
-const NEWTON_TOLERANCE: f64 = 1e-7;
+/// The Halley–bisection iteration stops once its step is below this fraction of 1 + |x̃| (about
+/// the f32 resolution of x̃). The error after that step is of order C·step² or less, where C, the
+/// inverse of the lobe's width, reaches |cot θ| far below the horizon (see DESIGN.md for why not
+/// looser).
+const HALLEY_TOLERANCE: f64 = 1e-7;
 /// Halley's step n/(1 − c) is taken only for |c| up to this (else Newton's step n): it then
 /// differs from Newton's by a factor in [2/3, 2].
 const HALLEY_MAX_CORRECTION: f64 = 0.5;
@@ -35,6 +35,7 @@ const MAX_ITERATIONS: usize = 64;
 /// cot θ, relative 6e-8, would shift them by a visible fraction of their spread: 5 % at
 /// |cot θ| = 480). +z for ωi = −z, which sees no microsurface. No argument check (the callers
 /// have done it).
+#[must_use]
 #[inline]
 pub(crate) fn sample_visible_normal(beckmann: &Beckmann, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
     let (ax, ay) = (f64::from(beckmann.alpha_x()), f64::from(beckmann.alpha_y()));
@@ -51,6 +52,7 @@ pub(crate) fn sample_visible_normal(beckmann: &Beckmann, wi: Vec3, u1: f32, u2: 
 /// azimuth frame: x̃ from the exact inversion [`visible_slope_x`], ỹ Gaussian and independent
 /// of x̃ ([`gaussian_slope`]). `None` seen from straight below (len_xy = 0, z ≤ 0), where
 /// nothing is visible. Tails cut at 2⁻²⁴ (the crate's tail policy).
+#[must_use]
 #[inline]
 pub(crate) fn visible_slopes(z: f64, len_xy: f64, u1: f32, u2: f32) -> Option<(f64, f64)> {
     let x = if len_xy > 0.0 {
@@ -67,6 +69,7 @@ pub(crate) fn visible_slopes(z: f64, len_xy: f64, u1: f32, u2: f32) -> Option<(f
 /// end of [0, 1] in single precision (relative error below 4e-7, see `erfc_inv_f32`). Both
 /// tails are cut at probability 2⁻²⁴ (the crate's tail policy, `rng`): u = 0 gives
 /// x̃ = −3.744, with 2⁻²⁴ of the density below it, and u = 1 − 2⁻²⁴ gives +3.744.
+#[must_use]
 #[inline]
 pub(crate) fn gaussian_slope(u: f64) -> f64 {
     let u = cut_tails64(u);
@@ -290,6 +293,7 @@ impl GuessTable {
 ///
 /// u is cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy, `rng`): the lowest sample has 2⁻²⁴ of
 /// the visible slopes below it, the highest 2⁻²⁴ between it and κ (where the density vanishes).
+#[must_use]
 #[inline]
 pub(crate) fn visible_slope_x_above(kappa: f64, lower: f64, u: f64) -> f64 {
     let u = cut_tails64(u);
@@ -345,7 +349,7 @@ fn refine(kappa: f64, target: f64, mut x: f64, mut lo: f64, mut hi: f64) -> f64 
         }
         let step = next - x;
         x = next;
-        let tolerance = NEWTON_TOLERANCE * (1.0 + x.abs());
+        let tolerance = HALLEY_TOLERANCE * (1.0 + x.abs());
         // a Newton or Halley step from error e leaves about |g″/(2g′)| e² or less: stop when
         // that estimate (with a safety factor) is below the tolerance, one evaluation early
         if step.abs() <= tolerance
@@ -397,7 +401,7 @@ mod tests {
     /// The documented bound of the fast sampler's CDF error for |κ| ≤ 64.
     const FAST_CDF_MAX_ERROR: f64 = 2e-7;
     /// Its bound for |κ| ≤ 400, where the f32 rounding of x̃ (tolerance of the fallback
-    /// iteration, `NEWTON_TOLERANCE`·(1 + |x̃|)) dominates: below that of the iteration alone.
+    /// iteration, `HALLEY_TOLERANCE`·(1 + |x̃|)) dominates: below that of the iteration alone.
     const FAST_CDF_MAX_ERROR_FAR: f64 = 1e-5;
     /// The largest fraction of the grid's samples allowed to take the fallback iteration.
     const FAST_MAX_FALLBACK_FRACTION: f64 = 0.06;

@@ -19,6 +19,7 @@ use core::f32::consts::TAU;
 /// ρ ∓ t2 = ((1 ∓ hi)(ρ + t) + (1 ∓ lo)(ρ − t))/2 and (ρ + t)(ρ − t) = 1 − r² = 1 − u1 (t the
 /// unwarped coordinate): near the rim (u1 = 1 − 2⁻²⁴) the direct 1 − t1² − t2² is all
 /// rounding and rounds to 0, a normal perpendicular to ωi (density 0).
+#[must_use]
 #[inline(always)]
 pub(crate) fn sample_band(u1: f32, u2: f32, lo: f32, hi: f32) -> BandPoint {
     let u1 = cut_tails(u1);
@@ -63,6 +64,7 @@ pub(crate) struct BandPoint {
 ///
 /// The line a t2 + b t3 = 0 meets the semicircle of radius ρ at t2 = cρ with c = b if a ≤ 0,
 /// −b otherwise (for a unit (a, b)); the kept side contains t2 = ρ iff the sign of a agrees.
+#[must_use]
 #[inline(always)]
 pub(crate) fn half_space_band(a: f32, b: f32, keep_positive: bool) -> (f32, f32) {
     let norm = (a * a + b * b).sqrt();

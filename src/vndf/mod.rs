@@ -64,6 +64,7 @@ pub trait VisibleNormalSampler: Copy + core::fmt::Debug + Send + Sync {
 ///
 /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit direction
 /// gives NaN (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn smith_normalization<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: Vec3) -> f32 {
     require!(is_direction(wi) && is_direction(wm), f32::NAN; wi, wm);

@@ -6,7 +6,7 @@ use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 
 /// The crate's default exact sampler of D_ωi for any slope distribution: the slope's own
-/// [`MicrosurfaceSlope::sample_d_wi`] (spherical caps for GGX, safeguarded log-space Newton
+/// [`MicrosurfaceSlope::sample_d_wi`] (spherical caps for GGX, the safeguarded Halley inversion of the log-CDF
 /// for Beckmann), with density [`MicrosurfaceSlope::d_wi`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SmithVndf<S>(pub S);

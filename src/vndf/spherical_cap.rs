@@ -46,6 +46,7 @@ impl VisibleNormalSampler for GgxSphericalCap {
 /// z > −ωi.z, which is also valid for ωi.z < 0). The stretched ωi is not normalized: the cap
 /// is sampled at its scale (a square root, no division). No argument check (the callers have
 /// done it).
+#[must_use]
 #[inline(always)]
 pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
     let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
@@ -79,6 +80,7 @@ pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec
 /// recomputed by [`cap_near_opposite`] without cancellation (error about ε): a half disk of
 /// radius 1/64 around −v̂ on the cap, 6e-5/(1 + v̂.z) of the samples (0.03 % above the
 /// horizon; about 1.5 % for the thin caps of far backfacing views, v̂.z = −0.998).
+#[must_use]
 #[inline(always)]
 pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
     let u1 = cut_tails(u1);

@@ -64,6 +64,7 @@ pub(crate) struct Azimuth<T> {
 
 impl<T: Real> Azimuth<T> {
     /// The azimuth of the horizontal part (x, y).
+    #[must_use]
     #[inline(always)]
     pub(crate) fn of(x: T, y: T) -> Self {
         let len_xy = (x * x + y * y).sqrt();
@@ -74,6 +75,7 @@ impl<T: Real> Azimuth<T> {
     /// The slopes (x̃, ỹ) of the α = 1 configuration, given in this azimuth's frame (x̃ along
     /// φ), rotated to the surface frame and unstretched by (αx, αy):
     /// (αx (cos φ x̃ − sin φ ỹ), αy (sin φ x̃ + cos φ ỹ)), in the precision T, rounded to f32.
+    #[must_use]
     #[inline(always)]
     pub(crate) fn unstretch(&self, alpha_x: T, alpha_y: T, x: T, y: T) -> Vec2 {
         let slope_x = alpha_x * (self.cos_phi * x - self.sin_phi * y);
@@ -82,6 +84,7 @@ impl<T: Real> Azimuth<T> {
     }
 
     /// [`Self::unstretch`] turned into the unit normal of the slopes (without overflow).
+    #[must_use]
     #[inline(always)]
     pub(crate) fn unstretched_normal(&self, alpha_x: T, alpha_y: T, x: T, y: T) -> Vec3 {
         let s = self.unstretch(alpha_x, alpha_y, x, y);
@@ -90,6 +93,7 @@ impl<T: Real> Azimuth<T> {
 }
 
 /// Stretches a direction by the roughness: (αx x, αy y, z).
+#[must_use]
 #[inline(always)]
 pub(crate) fn stretch<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> Vec3 {
     Vec3::new(slope.alpha_x() * w.x, slope.alpha_y() * w.y, w.z)
@@ -98,6 +102,7 @@ pub(crate) fn stretch<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> Vec3 {
 /// Stretches a direction by the roughness in double precision: Beckmann terms depend on
 /// exp(−z²/q), which amplifies an f32 rounding of q by 2w² (w = |z|/√q reaches hundreds near
 /// the nadir).
+#[must_use]
 #[inline(always)]
 pub(crate) fn stretch64<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> DVec3 {
     DVec3::new(
@@ -111,11 +116,17 @@ pub(crate) fn stretch64<S: MicrosurfaceSlope>(slope: &S, w: Vec3) -> DVec3 {
 /// listing 1): T1 horizontal, T2 = v × T1 in the plane of v and z, so that (T1, T2, v) is a
 /// right-handed orthonormal basis (T1 × T2 = v) and T2 points up (T2.z ≥ 0). For a vertical v
 /// (±z), T1 = +y and T2 = v × T1 = ∓x, the limit of the general form along φ = 0.
+#[must_use]
 #[inline(always)]
 pub(crate) fn disk_frame(v: Vec3) -> (Vec3, Vec3) {
     let len_xy = (v.x * v.x + v.y * v.y).sqrt();
-    let t1 = if len_xy > 0.0 { Vec3::new(-v.y / len_xy, v.x / len_xy, 0.0) } else { Vec3::Y };
-    (t1, v.cross(t1))
+    if len_xy > 0.0 {
+        let t1 = Vec3::new(-v.y / len_xy, v.x / len_xy, 0.0);
+        (t1, v.cross(t1))
+    } else {
+        // v × y for v = (0, 0, v.z)
+        (Vec3::Y, Vec3::new(-v.z, 0.0, v.x))
+    }
 }
 
 #[cfg(test)]

@@ -20,6 +20,9 @@ const BOUNDARY_SLOPE_FACTOR: f32 = 3.0;
 /// Slope distributions with the closed forms the V-cavity model needs: the hit probability
 /// H(i) and restricted samplers (Tokuyoshi, supplement §2.2–2.3).
 ///
+/// Sealed through [`MicrosurfaceSlope`]: implemented for [`Ggx`] and [`Beckmann`], the two
+/// distributions with the closed forms; the tabulated distributions have no V-cavity model.
+///
 /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit direction,
 /// a plane normal `k` whose squared length is not a normal finite f32 (zero, NaN, ∞, or so
 /// short or long that it under- or overflows; its length is otherwise free), or a uniform outside
@@ -257,6 +260,7 @@ impl<S: VCavitySlope> VCavity<S> {
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wm` that is not a unit
     /// direction gives NaN (a debug assertion in debug builds).
+    #[must_use]
     #[inline]
     pub fn masking(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), f32::NAN; wi, wm);
@@ -271,6 +275,7 @@ impl<S: VCavitySlope> VCavity<S> {
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// NaN (a debug assertion in debug builds).
+    #[must_use]
     #[inline]
     pub fn hit_probability(&self, wi: Vec3) -> f32 {
         self.0.hit_probability(wi)

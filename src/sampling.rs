@@ -1,32 +1,10 @@
-//! Local frames and hemisphere sampling.
+//! Warps of the unit square onto the disk and the hemisphere: the concentric disk and
+//! cosine-weighted directions.
 
-use crate::contract::{is_direction, is_uniform};
+use crate::contract::is_uniform;
 use crate::rng::cut_tails;
 use core::f32::consts::FRAC_PI_4;
 use glam::{Vec2, Vec3};
-
-/// Two unit vectors (t, b) completing the unit vector `n` to a right-handed orthonormal basis
-/// (t, b, n), branch-free except for the sign of n.z (Duff et al. 2017, “Building an
-/// Orthonormal Basis, Revisited”, JCGT 6(1)). n.z = −0 is treated like +0 (the upper
-/// hemisphere's basis; Duff et al.'s copysign would pick the lower one's).
-///
-/// Invalid input ([policy](crate#invalid-input)): an `n` that is not a unit direction
-/// (zero, NaN or ±∞ components, |‖n‖² − 1| > [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives
-/// (`Vec3::NAN`, `Vec3::NAN`) (a debug assertion in debug builds).
-#[inline]
-pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
-    require!(is_direction(n), (Vec3::NAN, Vec3::NAN); n);
-    basis(n)
-}
-
-/// [`orthonormal_basis`] without the argument check, for the crate's own unit normals.
-#[inline(always)]
-pub(crate) fn basis(n: Vec3) -> (Vec3, Vec3) {
-    let sign = if n.z >= 0.0 { 1.0f32 } else { -1.0 };
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
-}
 
 /// Maps two uniforms in [0, 1) to the unit disk, preserving relative areas (Shirley and
 /// Chiu 1997, concentric map).
@@ -37,6 +15,7 @@ pub(crate) fn basis(n: Vec3) -> (Vec3, Vec3) {
 ///
 /// Invalid input ([policy](crate#invalid-input)): a uniform that is NaN or outside
 /// [0, 1] gives `Vec2::NAN` (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
     require!(is_uniform(u1) && is_uniform(u2), Vec2::NAN; u1, u2);
@@ -44,6 +23,7 @@ pub fn concentric_disk(u1: f32, u2: f32) -> Vec2 {
 }
 
 /// [`concentric_disk`] without the argument check, for the crate's own uniforms.
+#[must_use]
 #[inline(always)]
 pub(crate) fn disk(u1: f32, u2: f32) -> Vec2 {
     let (r, cos_phi, sin_phi) = concentric_polar(u1, u2);
@@ -75,6 +55,7 @@ fn concentric_polar(u1: f32, u2: f32) -> (f32, f32, f32) {
 ///
 /// Invalid input ([policy](crate#invalid-input)): a uniform that is NaN or outside
 /// [0, 1] gives `Vec3::NAN` (a debug assertion in debug builds).
+#[must_use]
 #[inline]
 pub fn sample_cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
     require!(is_uniform(u1) && is_uniform(u2), Vec3::NAN; u1, u2);
@@ -82,6 +63,7 @@ pub fn sample_cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
 }
 
 /// [`sample_cosine_hemisphere`] without the argument check, for the crate's own uniforms.
+#[must_use]
 #[inline(always)]
 pub(crate) fn cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
     let (r, cos_phi, sin_phi) = concentric_polar(u1, u2);

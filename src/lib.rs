@@ -43,7 +43,8 @@
 //! # Ok::<(), microsurface::Error>(())
 //! ```
 //!
-//! [`Technique`] chooses single scattering (exact, cheapest), the random walk, or the
+//! [`Technique`] chooses single scattering (exact, cheapest: the research layer's
+//! [`SingleScattering`], whose sampler returns its density), the random walk, or the
 //! position-free PT and BDPT estimators; [`ClassicBrdf`] is the classic Lambert plus
 //! Cook–Torrance BRDF. Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes
 //! (`flags().specular`).

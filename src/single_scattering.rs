@@ -57,7 +57,8 @@ pub struct SingleSample {
 /// let gold = SingleScattering::new(Ggx::isotropic(0.5)?, Conductor::new(ComplexIor::GOLD));
 /// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
 /// let wi = Vec3::new(0.6, 0.0, 0.8);
-/// let s = gold.sample(wi, &mut rng).expect("gold reflects");
+/// // `None` when the reflected direction points into the surface (its probability is 1 − ∫pdf)
+/// let s = (0..100).find_map(|_| gold.sample(wi, &mut rng)).expect("gold reflects");
 /// // the sample carries its density, the one `pdf` gives at its direction
 /// assert_eq!(s.pdf, gold.pdf(wi, s.wo));
 /// // and its weight is f·|cos θo|/pdf there

@@ -166,13 +166,16 @@ fn sample_is_the_position_free_single_sample() {
     }
 }
 
+/// A named call that returns whether it gave the documented nothing.
+type Call = (&'static str, Box<dyn Fn() -> bool>);
+
 /// Invalid directions: 0 and `None` in release builds, a debug assertion in debug builds.
 #[test]
 fn invalid_directions_give_nothing() {
     let model = SingleScattering::new(Ggx::isotropic(0.5).unwrap(), Conductor::perfect());
     let good = dir(0.5, 0.5);
     for bad in [Vec3::NAN, Vec3::ZERO, 2.0 * good, Vec3::new(f32::INFINITY, 0.0, 0.0)] {
-        let calls: [(&str, Box<dyn Fn() -> bool>); 5] = [
+        let calls: [Call; 5] = [
             ("eval wi", Box::new(move || model.eval(bad, good, &mut validation::rng(1)) == Vec3::ZERO)),
             ("eval wo", Box::new(move || model.eval(good, bad, &mut validation::rng(1)) == Vec3::ZERO)),
             ("pdf", Box::new(move || model.pdf(bad, good) == 0.0)),
@@ -185,7 +188,8 @@ fn invalid_directions_give_nothing() {
         for (name, call) in calls {
             match std::panic::catch_unwind(std::panic::AssertUnwindSafe(&call)) {
                 Ok(nothing) => {
-                    assert!(!cfg!(debug_assertions), "{name}({bad}): no debug assertion");
+                    let debug = cfg!(debug_assertions);
+                    assert!(!debug, "{name}({bad}): no debug assertion");
                     assert!(nothing, "{name}({bad}) returned something");
                 }
                 Err(e) => {

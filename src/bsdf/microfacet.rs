@@ -54,7 +54,7 @@ pub enum Technique {
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
     /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term) for every
     /// roughness; samples whose pdf or f would be subnormal are not returned (at most
-    /// 4π·`f32::MIN_POSITIVE` of probability). See `PositionFree::sample_single` for the f32
+    /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::SingleScattering::sample`] for the f32
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
@@ -347,8 +347,15 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn f_checked(&self, wo: Vec3, wi: Vec3, key: u64) -> Vec3 {
         let (walk_in, walk_out) = (wo, wi);
         let seed = self.seed;
-        let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
-        let f_cos_wi = self.research_f_cos_out(walk_in, walk_out, &mut rng);
+        let hash = || Hasher::directions(seed, key, wo, wi);
+        let f_cos_wi = if self.technique == Technique::SingleScattering {
+            // deterministic except for diffuse facets: the generator (and its hash) only on use
+            self.research_f_cos_out(walk_in, walk_out, &mut PrimedRng::new(&[], hash))
+        } else {
+            // stochastic: the seeded generator itself, without the primed generator's
+            // bookkeeping on each of the walk's draws
+            self.research_f_cos_out(walk_in, walk_out, &mut hash().generator())
+        };
         let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
         if f.is_finite() { f } else { Vec3::ZERO }
     }

@@ -69,8 +69,9 @@ pub(crate) fn conductor_reflectance(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 
         // grazing: every interface reflects fully (and the formula would be 0/0 at η = 1, k = 0)
         return Vec3::ONE;
     }
-    // the three channels in one SIMD register (Vec3A): the same IEEE operations lane by lane,
-    // so bit-identical to the scalar form, with one division and one square root per step
+    // the three channels in one SIMD register (Vec3A): the same IEEE operations lane by lane as
+    // the scalar Vec3 form (whose powf(0.5) the compiler emitted as a square root), so the same
+    // bits, with one division and one square root instruction per step instead of three
     let c = Vec3A::splat(cos_theta);
     let c2 = c * c;
     let s2 = Vec3A::ONE - c2;

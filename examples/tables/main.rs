@@ -238,7 +238,7 @@ const MAX_DIELECTRIC_ERROR: f64 = 1e-5;
 const QUICK_DIELECTRIC_CELLS: usize = 6;
 /// Random cell-interior points at which `--interpolation` measures the dielectric lookups, per
 /// family and side.
-const INTERPOLATION_POINTS: usize = 400;
+const INTERPOLATION_POINTS: usize = 256;
 
 /// The side light arrives from: outside the relative index of the η axis is η, inside 1/η.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -327,8 +327,8 @@ fn side_of(side: Side) -> microsurface::Incidence {
 }
 
 /// The interpolation error of the dielectric lookups at pseudo-random points inside the cells
-/// against direct quadrature: (max, RMS) of R and of T.
-fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 2] {
+/// against direct quadrature: (max, RMS) of R, of T and of R + T.
+fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 3] {
     let table = dielectric_table_of(family);
     let label = format!("{} {} interpolation", family.name(), side.name());
     let errors = par_map(INTERPOLATION_POINTS, &label, |k| {
@@ -344,14 +344,19 @@ fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 2]
         let eta_side = if side == Side::Outside { eta } else { 1.0 / eta };
         let (er, et) = dielectric_albedo(family, mu, alpha, eta_side, DIELECTRIC_PANELS);
         let v = table.albedo(mu as f32, alpha as f32, eta_side as f32).expect("in range");
-        ((f64::from(v.reflected) - er).abs(), (f64::from(v.transmitted) - et).abs())
+        let e = ((f64::from(v.reflected) - er).abs(), (f64::from(v.transmitted) - et).abs());
+        let total = (f64::from(v.reflected + v.transmitted) - er - et).abs();
+        if std::env::var_os("TABLES_DEBUG").is_some() && e.0.max(e.1) > 0.05 {
+            println!("  μ {mu:e} α {alpha:e} η {eta_side}: quadrature R {er} T {et}, lookup {v:?}");
+        }
+        (e.0, e.1, total)
     });
-    let stats = |e: &dyn Fn(&(f64, f64)) -> f64| {
+    let stats = |e: &dyn Fn(&(f64, f64, f64)) -> f64| {
         let max = errors.iter().map(e).fold(0.0, f64::max);
         let rms = (errors.iter().map(|v| e(v) * e(v)).sum::<f64>() / errors.len() as f64).sqrt();
         (max, rms)
     };
-    [stats(&|v| v.0), stats(&|v| v.1)]
+    [stats(&|v| v.0), stats(&|v| v.1), stats(&|v| v.2)]
 }
 
 /// The Rust source of `src/albedo/dielectric_data.rs`.
@@ -489,10 +494,10 @@ fn main() {
             }
             if dielectric {
                 for side in [Side::Outside, Side::Inside] {
-                    let [(rm, rr), (tm, tr)] = dielectric_interpolation_error(family, side);
+                    let [(rm, rr), (tm, tr), (em, er)] = dielectric_interpolation_error(family, side);
                     println!(
                         "{} dielectric from {}: interpolation error at {INTERPOLATION_POINTS} random points: R max \
-                         {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}",
+                         {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}; R + T max {em:.2e}, RMS {er:.2e}",
                         family.name(),
                         side.name()
                     );

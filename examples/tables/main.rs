@@ -196,6 +196,17 @@ fn source(tables: &[(Family, Tables)]) -> String {
 /// Writes little-endian f32 exports with a description of their layout.
 fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
+    for (family, t) in tables {
+        for (suffix, values) in [("directional", &t.directional), ("average", &t.average)] {
+            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+            std::fs::write(dir.join(format!("{}_{suffix}.f32", family.name())), bytes)?;
+        }
+    }
+    write_readme(dir)
+}
+
+/// Writes `README.txt`, the layout of every export.
+fn write_readme(dir: &std::path::Path) -> std::io::Result<()> {
     let mut readme = String::from(
         "Little-endian f32 arrays, no header.\n\n\
          <family>_directional.f32: 32 x 32 values E[j][i], j (roughness) slowest.\n\
@@ -211,13 +222,10 @@ fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result
          x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2),\n\
          trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n",
     );
-    for (family, t) in tables {
-        for (suffix, values) in [("directional", &t.directional), ("average", &t.average)] {
-            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-            std::fs::write(dir.join(format!("{}_{suffix}.f32", family.name())), bytes)?;
-        }
-    }
-    readme.push_str("\nSee microsurface::AlbedoTable for the definition and the measured errors.\n");
+    readme.push_str(
+        "\nSee microsurface::AlbedoTable and microsurface::DielectricAlbedoTable for the definitions and the \
+         measured errors.\n",
+    );
     std::fs::write(dir.join("README.txt"), readme)
 }
 

@@ -3,6 +3,7 @@
 //! Dielectric single-scattering albedo nodes (see `DielectricAlbedoTable` for the axes).
 
 /// reflected albedo of ggx, light from outside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static GGX_OUTSIDE_REFLECTED: [f32; 4096] = [
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
@@ -518,6 +519,7 @@ pub(crate) static GGX_OUTSIDE_REFLECTED: [f32; 4096] = [
     0.17888898, 0.1635399, 0.14833343, 0.13336258, 0.11869604, 0.10438264, 0.09045456, 0.076929726,
 ];
 /// transmitted albedo of ggx, light from outside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static GGX_OUTSIDE_TRANSMITTED: [f32; 4096] = [
     0.0, 0.0, 2.1899687e-16, 3.7200866e-7, 0.0005453306, 0.014509455, 0.08081204, 0.21669225,
     0.3950188, 0.576231, 0.7321158, 0.84982646, 0.92826915, 0.9735192, 0.9945671, 1.0,
@@ -1033,6 +1035,7 @@ pub(crate) static GGX_OUTSIDE_TRANSMITTED: [f32; 4096] = [
     0.23396562, 0.27899253, 0.3295881, 0.38542673, 0.44590324, 0.51043516, 0.5788849, 0.65070826,
 ];
 /// reflected albedo of ggx, light from inside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static GGX_INSIDE_REFLECTED: [f32; 4096] = [
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
@@ -1548,6 +1551,7 @@ pub(crate) static GGX_INSIDE_REFLECTED: [f32; 4096] = [
     0.6139287, 0.56110936, 0.50723064, 0.45243204, 0.39674494, 0.34024924, 0.2847071, 0.23111469,
 ];
 /// transmitted albedo of ggx, light from inside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static GGX_INSIDE_TRANSMITTED: [f32; 4096] = [
     0.0, 0.0, 2.1899687e-16, 3.7200866e-7, 0.0005453306, 0.014509455, 0.08081204, 0.21669225,
     0.3950188, 0.576231, 0.7321158, 0.84982646, 0.92826915, 0.9735192, 0.9945671, 1.0,
@@ -2063,6 +2067,7 @@ pub(crate) static GGX_INSIDE_TRANSMITTED: [f32; 4096] = [
     0.009045466, 0.01954101, 0.033358227, 0.04321449, 0.050395407, 0.05815465, 0.06601513, 0.07230093,
 ];
 /// reflected albedo of beckmann, light from outside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static BECKMANN_OUTSIDE_REFLECTED: [f32; 4096] = [
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
@@ -2578,6 +2583,7 @@ pub(crate) static BECKMANN_OUTSIDE_REFLECTED: [f32; 4096] = [
     0.24913427, 0.23930097, 0.22827375, 0.21563861, 0.20053941, 0.18118498, 0.15397495, 0.11582122,
 ];
 /// transmitted albedo of beckmann, light from outside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static BECKMANN_OUTSIDE_TRANSMITTED: [f32; 4096] = [
     0.0, 1.2792631e-37, 2.9417486e-9, 0.0004017537, 0.02197393, 0.12911929, 0.32019913, 0.53245497,
     0.71770275, 0.85603404, 0.94417685, 0.9873752, 0.99923736, 0.99999946, 1.0, 1.0,
@@ -3093,6 +3099,7 @@ pub(crate) static BECKMANN_OUTSIDE_TRANSMITTED: [f32; 4096] = [
     0.61916, 0.6402396, 0.65957844, 0.6774086, 0.6938649, 0.7089814, 0.72306055, 0.7415591,
 ];
 /// reflected albedo of beckmann, light from inside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static BECKMANN_INSIDE_REFLECTED: [f32; 4096] = [
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
     0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
@@ -3608,6 +3615,7 @@ pub(crate) static BECKMANN_INSIDE_REFLECTED: [f32; 4096] = [
     0.914447, 0.88139933, 0.8360853, 0.7746668, 0.69411105, 0.5935651, 0.4803845, 0.37681234,
 ];
 /// transmitted albedo of beckmann, light from inside, η slowest, direction fastest.
+#[rustfmt::skip]
 pub(crate) static BECKMANN_INSIDE_TRANSMITTED: [f32; 4096] = [
     0.0, 1.2792631e-37, 2.9417486e-9, 0.0004017537, 0.02197393, 0.12911929, 0.32019913, 0.53245497,
     0.71770275, 0.85603404, 0.94417685, 0.9873752, 0.99923736, 0.99999946, 1.0, 1.0,

@@ -354,9 +354,13 @@ fn invalid_input_gives_nothing() {
 // Compensated dielectrics (`CompensatedDielectric`, Turquin scaling)
 // ---------------------------------------------------------------------------------------------
 
-/// The dielectric tables' stated interpolation error of R + T (`DielectricAlbedoTable`, measured
-/// by the generator): the largest over families and sides.
-const DIELECTRIC_TABLE_ERROR: f64 = 1.0;
+/// The dielectric tables' measured interpolation error of R + T (max at 256 random points,
+/// `cargo run --release --example tables -- --interpolation --only dielectric`), per family
+/// (GGX, Beckmann) and side (outside, inside).
+const DIELECTRIC_TABLE_ERROR: [[f64; 2]; 2] = [[3.26e-1, 7.63e-2], [5.46e-1, 1.04e-1]];
+/// The error of E at a node: quadrature 1e-5 (checked by the generator) and the f32 rounding
+/// of the node's coordinates 2e-5 (`tests/albedo.rs`).
+const NODE_ERROR: f64 = 3e-5;
 
 fn glass(eta: f32) -> Dielectric {
     Dielectric::new(eta).unwrap()
@@ -440,17 +444,21 @@ fn dielectric_sample_matches_pdf_and_weights_match_eval() {
     }
 }
 
-/// The white furnace of non-absorbing glass: with importance transport the mean sample weight
-/// (∫ f |cos θi| dωi over the sphere, reflection and transmission) is 1 within z·SE plus the
-/// table's error relative to E (E_exact/E_table − 1 ≤ ε/E_table(μo)); with radiance transport
-/// the same uniforms give the same samples, and weight × `eta`² is the importance weight (flux
-/// is conserved, radiance is scaled by the squared index ratio). α ∈ {0.05, 0.3, 1}, μo ∈ {0.2,
-/// 0.6, 1}, η ∈ {1.2, 1.5, 2.5}, views from outside and inside, both families (108 cases,
-/// family-wise level 1 %, N = 40 000, SE ≤ 5e-3).
+/// The white furnace of non-absorbing glass at the tables' nodes: with importance transport the
+/// mean sample weight (∫ f |cos θi| dωi over the sphere, reflection and transmission) is 1
+/// within z·SE plus the nodes' error relative to E (quadrature 1e-5, f32 coordinates 2e-5); with
+/// radiance transport the same uniforms give the same samples, and weight × `eta`² is the
+/// importance weight (flux is conserved, radiance is scaled by the squared index ratio).
+/// At nodes because between them the dielectric tables interpolate poorly (up to 0.55 in R + T,
+/// `DESIGN.md`): this checks the compensation itself. α at r = j/15 for j ∈ {5, 10, 15}, η at
+/// u = l/15 for l ∈ {7, 12} (η = 1.44, 2.28), μo at x = i/15 for i ∈ {4, 9, 14}, views from
+/// outside and inside, both families (72 cases, family-wise level 1 %, N = 160 000,
+/// SE ≤ 1e-2: σ̂ reaches 2.4 at α = 1, μo = 0.037, where 1/E is large). Left out: η = 1.08 (l = 3), whose weights 1/E at grazing views have σ̂ up to 7
+/// (α = 1, μo = 0.037), more than a fast test can average.
 #[test]
-fn dielectric_white_furnace_within_table_error() {
-    let z = family_z(0.01, 108);
-    let n = 40_000;
+fn dielectric_white_furnace_at_the_nodes() {
+    let z = family_z(0.01, 72);
+    let n = 160_000;
     let mut worst: f64 = 0.0;
     let mut seed = 2700;
     fn run<S: AlbedoTabulated>(slope: S, eta: f32, mu: f32, n: usize, z: f64, seed: u64, worst: &mut f64) {
@@ -468,33 +476,83 @@ fn dielectric_white_furnace_within_table_error() {
                 let u = Vec2::new(uniform32(&mut rng), uniform32(&mut rng));
                 let a = imp.sample(wo, uc, u);
                 let b = rad.sample(wo, uc, u);
-                assert_eq!(a.map(|x| x.wi), b.map(|x| x.wi), "radiance and importance sample alike");
+                // (one of the two may drop a grazing sample whose f is subnormal in its scaling)
                 if let (Some(a), Some(b)) = (a, b) {
+                    assert_eq!(a.wi, b.wi, "radiance and importance sample alike");
                     assert!(rel_close(a.weight, b.weight * (b.eta * b.eta), 1e-5), "{a:?} vs {b:?}");
                 }
                 stats.push(a.map_or(0.0, |x| f64::from(x.weight.x)));
             }
             let e_table = f64::from(imp.directional_albedo(mu, above).unwrap());
-            let tol = DIELECTRIC_TABLE_ERROR / e_table;
+            let tol = NODE_ERROR / e_table;
             let label = format!(
                 "dielectric white furnace {} α = {alpha} η = {eta} μo = {mu} {}",
                 S::ALBEDO.name(),
                 if above { "outside" } else { "inside" }
             );
-            assert_mean(&label, &stats, 1.0, z, 5e-3, tol);
+            assert_mean(&label, &stats, 1.0, z, 1e-2, tol);
             *worst = worst.max((stats.mean() - 1.0).abs());
         }
     }
-    for a in [0.05f32, 0.3, 1.0] {
-        for mu in [0.2f32, 0.6, 1.0] {
-            for eta in [1.2f32, 1.5, 2.5] {
-                run(ggx(a), eta, mu, n, z, seed, &mut worst);
-                run(beckmann(a), eta, mu, n, z, seed + 2, &mut worst);
+    for j in [5u32, 10, 15] {
+        let r = j as f32 / 15.0;
+        let alpha = r * r;
+        for i in [4u32, 9, 14] {
+            let big_x = (i as f32 / 15.0).powi(2);
+            let mu = big_x * alpha / (1.0 + alpha - big_x);
+            for l in [7u32, 12] {
+                let u = l as f32 / 15.0;
+                let eta = 1.0 + 2.0 * u * u;
+                run(ggx(alpha), eta, mu, n, z, seed, &mut worst);
+                run(beckmann(alpha), eta, mu, n, z, seed + 2, &mut worst);
                 seed += 4;
             }
         }
     }
     println!("dielectric white furnace: largest |albedo − 1| = {worst:.2e} (N = {n} per case, z = {z:.2})");
+}
+
+/// The white furnace of glass between the nodes: the mean weight minus 1 is within z·SE plus
+/// the tables' measured interpolation error of R + T relative to E (`DESIGN.md`: 0.33 GGX and
+/// 0.55 Beckmann from outside, 0.08 / 0.10 from inside), at the glass of the README's table
+/// (η = 1.5, α ∈ {0.1, 0.5}, μo ∈ {0.3, 0.8}).
+#[test]
+fn dielectric_white_furnace_between_the_nodes() {
+    let z = family_z(0.01, 16);
+    let n = 40_000;
+    let mut seed = 2900;
+    for (family, err) in [(0usize, DIELECTRIC_TABLE_ERROR[0]), (1, DIELECTRIC_TABLE_ERROR[1])] {
+        for a in [0.1f32, 0.5] {
+            for mu in [0.3f32, 0.8] {
+                let b: CompensatedDielectric<Ggx> = CompensatedDielectric::new(ggx(a), glass(1.5)).unwrap();
+                let bb: CompensatedDielectric<Beckmann> =
+                    CompensatedDielectric::new(beckmann(a), glass(1.5)).unwrap();
+                for above in [true, false] {
+                    let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, if above { mu } else { -mu });
+                    let mut rng = common::rng(seed);
+                    seed += 1;
+                    let mut stats = Stats::default();
+                    let e_table = if family == 0 {
+                        b.directional_albedo(mu, above)
+                    } else {
+                        bb.directional_albedo(mu, above)
+                    };
+                    for _ in 0..n {
+                        let s = if family == 0 {
+                            draw(&b.with_transport(Transport::Importance), wo, &mut rng)
+                        } else {
+                            draw(&bb.with_transport(Transport::Importance), wo, &mut rng)
+                        };
+                        stats.push(s.map_or(0.0, |x| f64::from(x.weight.x)));
+                    }
+                    let e_table = f64::from(e_table.unwrap());
+                    let label = format!("glass furnace family {family} α = {a} μo = {mu} above {above}");
+                    assert_mean(&label, &stats, 1.0, z, 5e-3, err[usize::from(!above)] / e_table);
+                    println!("{label}: mean {:.4}, SE {:.1e}", stats.mean(), stats.se());
+                }
+            }
+        }
+    }
 }
 
 /// The constructor rejects √(αx αy) > 1 and η outside [1/3, 3] (beyond the tables) with the

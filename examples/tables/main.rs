@@ -196,6 +196,17 @@ fn source(tables: &[(Family, Tables)]) -> String {
 /// Writes little-endian f32 exports with a description of their layout.
 fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
+    for (family, t) in tables {
+        for (suffix, values) in [("directional", &t.directional), ("average", &t.average)] {
+            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+            std::fs::write(dir.join(format!("{}_{suffix}.f32", family.name())), bytes)?;
+        }
+    }
+    write_readme(dir)
+}
+
+/// Writes `README.txt`, the layout of every export.
+fn write_readme(dir: &std::path::Path) -> std::io::Result<()> {
     let mut readme = String::from(
         "Little-endian f32 arrays, no header.\n\n\
          <family>_directional.f32: 32 x 32 values E[j][i], j (roughness) slowest.\n\
@@ -211,13 +222,10 @@ fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result
          x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2),\n\
          trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n",
     );
-    for (family, t) in tables {
-        for (suffix, values) in [("directional", &t.directional), ("average", &t.average)] {
-            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-            std::fs::write(dir.join(format!("{}_{suffix}.f32", family.name())), bytes)?;
-        }
-    }
-    readme.push_str("\nSee microsurface::AlbedoTable for the definition and the measured errors.\n");
+    readme.push_str(
+        "\nSee microsurface::AlbedoTable and microsurface::DielectricAlbedoTable for the definitions and the \
+         measured errors.\n",
+    );
     std::fs::write(dir.join("README.txt"), readme)
 }
 
@@ -238,7 +246,7 @@ const MAX_DIELECTRIC_ERROR: f64 = 1e-5;
 const QUICK_DIELECTRIC_CELLS: usize = 6;
 /// Random cell-interior points at which `--interpolation` measures the dielectric lookups, per
 /// family and side.
-const INTERPOLATION_POINTS: usize = 400;
+const INTERPOLATION_POINTS: usize = 256;
 
 /// The side light arrives from: outside the relative index of the η axis is η, inside 1/η.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -327,8 +335,8 @@ fn side_of(side: Side) -> microsurface::Incidence {
 }
 
 /// The interpolation error of the dielectric lookups at pseudo-random points inside the cells
-/// against direct quadrature: (max, RMS) of R and of T.
-fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 2] {
+/// against direct quadrature: (max, RMS) of R, of T and of R + T.
+fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 3] {
     let table = dielectric_table_of(family);
     let label = format!("{} {} interpolation", family.name(), side.name());
     let errors = par_map(INTERPOLATION_POINTS, &label, |k| {
@@ -344,14 +352,19 @@ fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 2]
         let eta_side = if side == Side::Outside { eta } else { 1.0 / eta };
         let (er, et) = dielectric_albedo(family, mu, alpha, eta_side, DIELECTRIC_PANELS);
         let v = table.albedo(mu as f32, alpha as f32, eta_side as f32).expect("in range");
-        ((f64::from(v.reflected) - er).abs(), (f64::from(v.transmitted) - et).abs())
+        let e = ((f64::from(v.reflected) - er).abs(), (f64::from(v.transmitted) - et).abs());
+        let total = (f64::from(v.reflected + v.transmitted) - er - et).abs();
+        if std::env::var_os("TABLES_DEBUG").is_some() && e.0.max(e.1) > 0.05 {
+            println!("  μ {mu:e} α {alpha:e} η {eta_side}: quadrature R {er} T {et}, lookup {v:?}");
+        }
+        (e.0, e.1, total)
     });
-    let stats = |e: &dyn Fn(&(f64, f64)) -> f64| {
+    let stats = |e: &dyn Fn(&(f64, f64, f64)) -> f64| {
         let max = errors.iter().map(e).fold(0.0, f64::max);
         let rms = (errors.iter().map(|v| e(v) * e(v)).sum::<f64>() / errors.len() as f64).sqrt();
         (max, rms)
     };
-    [stats(&|v| v.0), stats(&|v| v.1)]
+    [stats(&|v| v.0), stats(&|v| v.1), stats(&|v| v.2)]
 }
 
 /// The Rust source of `src/albedo/dielectric_data.rs`.
@@ -371,6 +384,8 @@ fn dielectric_source(tables: &[(Family, Side, DielectricTables)]) -> String {
                 family.name(),
                 side.name()
             );
+            // rustfmt would put each value on its own line (some exceed its short-element width)
+            let _ = writeln!(s, "#[rustfmt::skip]");
             let _ = writeln!(s, "pub(crate) static {upper}_{side_upper}_{what}: [f32; {}] = [", ND * ND * ND);
             for row in values.chunks(8) {
                 let _ = writeln!(
@@ -453,6 +468,19 @@ fn quick() {
             }
         }
     }
+    // the shipped dielectric source is exactly what the generator writes for its nodes
+    let mut shipped = Vec::new();
+    for family in [Family::Ggx, Family::Beckmann] {
+        for side in [Side::Outside, Side::Inside] {
+            let (r, t) = dielectric_table_of(family).nodes(side_of(side));
+            shipped.push((family, side, DielectricTables { reflected: r.to_vec(), transmitted: t.to_vec() }));
+        }
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/albedo/dielectric_data.rs");
+    if std::fs::read_to_string(&path).ok().as_deref() != Some(dielectric_source(&shipped).as_str()) {
+        failures += 1;
+        println!("{} is not the generator's text for its own nodes", path.display());
+    }
     println!(
         "tables --quick: {} nodes recomputed (and {dielectric_nodes} dielectric R, T pairs), {failures} differ",
         2 * (QUICK_CELLS + 1)
@@ -489,10 +517,10 @@ fn main() {
             }
             if dielectric {
                 for side in [Side::Outside, Side::Inside] {
-                    let [(rm, rr), (tm, tr)] = dielectric_interpolation_error(family, side);
+                    let [(rm, rr), (tm, tr), (em, er)] = dielectric_interpolation_error(family, side);
                     println!(
                         "{} dielectric from {}: interpolation error at {INTERPOLATION_POINTS} random points: R max \
-                         {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}",
+                         {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}; R + T max {em:.2e}, RMS {er:.2e}",
                         family.name(),
                         side.name()
                     );

@@ -7,7 +7,14 @@
 //! * lobe-shape error: relative L1 distance of the binned f·cos θi over the hemisphere,
 //!   Σ|h − h_walk| / Σ h_walk (F = 1), per α ∈ {0.1, 0.3, 0.6, 1} and θo ∈ {0, 1, 1.4}, with
 //!   the noise floor of the estimate (the same distance between two independent walk runs);
-//! * the albedo error of anisotropic GGX (F = 1) compensated at α = √(αx αy).
+//! * the albedo error of anisotropic GGX (F = 1) compensated at α = √(αx αy);
+//! * glass (`CompensatedDielectric`, Turquin scaling, and single scattering): the reflected,
+//!   transmitted and total albedo against the walk's (importance transport: flux), max and RMS
+//!   over μ, α and η ∈ {1.33, 1.5, 2} seen from outside and from inside (1/η);
+//! * the technique-choice table: per material and α, the albedo error (max over μo and RGB) and
+//!   the time per sample of single scattering, the compensated lobes, the walk and the
+//!   position-free PT and BDPT estimators (this run's timing, one thread per cell, on a loaded
+//!   machine: ratios within a column are meaningful, absolute values ±30 %).
 //!
 //! Every estimate is the mean of sample weights (unbiased for each technique), with its
 //! standard error. Writes `target/compensation/albedo.csv`, `lobes.csv` and `table.md`.
@@ -20,8 +27,9 @@
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::{RngExt, SeedableRng};
 use microsurface::{
-    Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Ggx, MicrofacetBsdf, Microsurface,
-    MicrosurfaceSlope, Technique, UniformHeight,
+    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
+    Estimator, Ggx, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Shadowing, Technique, Transport,
+    UniformHeight,
 };
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -30,6 +38,10 @@ type Pcg = rand_pcg::Pcg64Mcg;
 
 /// The techniques compared with the walk.
 const TECHNIQUES: [&str; 3] = ["single", "kulla-conty", "turquin"];
+/// The stochastic estimators of the position-free model, in the technique-choice table.
+const ESTIMATORS: [(&str, Estimator); 2] = [("pt", Estimator::Pt), ("bdpt", Estimator::Bdpt)];
+/// The glass indices of the dielectric comparison (seen from outside; from inside 1/η).
+const GLASS_ETAS: [f32; 3] = [1.33, 1.5, 2.0];
 
 /// Lobe bins: equal-area cells in (cos θ, φ) over the upper hemisphere.
 const LOBE_NZ: usize = 16;
@@ -100,10 +112,64 @@ struct AlbedoCell {
     mu: f32,
     walk: Estimate,
     techniques: Vec<Estimate>,
+    /// PT and BDPT of the position-free model (empty in the anisotropic cells).
+    estimators: Vec<Estimate>,
 }
 
 fn albedo_cell(material: &'static str, c: Conductor, alpha: f32, mu: f32, n: usize, seed: u64) -> AlbedoCell {
-    albedo_cell_of(material, c, Ggx::isotropic(alpha).unwrap(), mu, 0.0, n, seed)
+    let slope = Ggx::isotropic(alpha).unwrap();
+    let mut cell = albedo_cell_of(material, c, slope, mu, 0.0, n, seed);
+    let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    cell.estimators = ESTIMATORS
+        .iter()
+        .enumerate()
+        .map(|(k, &(_, estimator))| {
+            let b = MicrofacetBsdf::new(slope, c)
+                .unwrap()
+                .with_technique(Technique::PositionFree { estimator, shadowing: Shadowing::Correlated });
+            let mut rng = Pcg::seed_from_u64(seed + 5 + k as u64);
+            estimate(n, || {
+                let (uc, u) = uniforms(&mut rng);
+                b.sample(wo, uc, u).map(|s| s.weight)
+            })
+        })
+        .collect();
+    cell
+}
+
+/// One glass cell: reflected, transmitted and total albedo (importance transport) of the walk,
+/// single scattering and Turquin's compensated dielectric at (η seen from the view's side, α, μ).
+struct GlassCell {
+    eta: f32,
+    inside: bool,
+    alpha: f32,
+    mu: f32,
+    /// [walk, single, turquin], channels [R, T, R + T].
+    albedo: [Estimate; 3],
+}
+
+fn glass_cell(eta: f32, inside: bool, alpha: f32, mu: f32, n: usize, seed: u64) -> GlassCell {
+    let slope = Ggx::isotropic(alpha).unwrap();
+    let material = Dielectric::new(eta).unwrap();
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let wo = Vec3::new(s, 0.0, if inside { -mu } else { mu });
+    let mf = MicrofacetBsdf::new(slope, material).unwrap().with_transport(Transport::Importance);
+    let models: [Box<dyn Bsdf>; 3] = [
+        Box::new(mf.with_technique(Technique::RandomWalk)),
+        Box::new(mf.with_technique(Technique::SingleScattering)),
+        Box::new(CompensatedDielectric::new(slope, material).unwrap().with_transport(Transport::Importance)),
+    ];
+    // one sample stream per model: channel 0 the reflected weight, 1 the transmitted, 2 both
+    let albedo = core::array::from_fn(|m| {
+        let mut rng = Pcg::seed_from_u64(seed + m as u64);
+        estimate(n, || {
+            let (uc, u) = uniforms(&mut rng);
+            let smp = models[m].sample(wo, uc, u)?;
+            let w = smp.weight.x;
+            Some(if smp.flags.transmission { Vec3::new(0.0, w, w) } else { Vec3::new(w, 0.0, w) })
+        })
+    });
+    GlassCell { eta, inside, alpha, mu, albedo }
 }
 
 /// [`albedo_cell`] for any GGX slopes and view azimuth φo.
@@ -134,7 +200,7 @@ fn albedo_cell_of(
             })
         })
         .collect();
-    AlbedoCell { material, alpha, mu, walk, techniques }
+    AlbedoCell { material, alpha, mu, walk, techniques, estimators: vec![] }
 }
 
 /// The binned f·cos θi (F = 1, channel 0) of `n` samples, normalized by n: an estimate of
@@ -273,6 +339,22 @@ fn main() -> std::io::Result<()> {
         lobe_cell(lobe_jobs[i].0, lobe_jobs[i].1, s.lobe_samples, 17_000 + 8 * i as u64)
     });
 
+    let mut glass_jobs = vec![];
+    for &eta in &GLASS_ETAS {
+        for inside in [false, true] {
+            for &a in &s.alphas {
+                for &mu in &s.mus {
+                    glass_jobs.push((eta, inside, a, mu));
+                }
+            }
+        }
+    }
+    eprintln!("glass albedo: {} cells × {} samples × 3 models", glass_jobs.len(), s.albedo_samples);
+    let glass = par_map(glass_jobs.len(), |i| {
+        let (eta, inside, a, mu) = glass_jobs[i];
+        glass_cell(eta, inside, a, mu, s.albedo_samples, 19_000 + 8 * i as u64)
+    });
+
     let dir = std::path::Path::new("target/compensation");
     std::fs::create_dir_all(dir)?;
     let mut csv = String::from("material,alpha,mu,channel,walk,walk_se");
@@ -380,6 +462,117 @@ fn main() -> std::io::Result<()> {
         }
         md.push('\n');
     }
+    writeln!(
+        md,
+        "\nGlass (GGX, η ∈ {GLASS_ETAS:?} seen from outside and 1/η from inside, α and μo as above, importance \
+         transport): albedo error against the walk, max |A − A_walk| and RMS over cells, of the reflected (R), \
+         transmitted (T) and total (R + T = 1 for the walk) albedo:\n"
+    )
+    .unwrap();
+    writeln!(md, "| technique | side | R: max | RMS | T: max | RMS | R + T: max | RMS |").unwrap();
+    writeln!(md, "|---|---|---|---|---|---|---|---|").unwrap();
+    for (m, name) in [(1usize, "single"), (2, "turquin")] {
+        for inside in [false, true] {
+            write!(md, "| {name} | {} |", if inside { "inside" } else { "outside" }).unwrap();
+            for part in 0..3 {
+                let errs: Vec<f64> = glass
+                    .iter()
+                    .filter(|c| c.inside == inside)
+                    .map(|c| c.albedo[m].mean[part] - c.albedo[0].mean[part])
+                    .collect();
+                let max = errs.iter().fold(0.0f64, |x, e| x.max(e.abs()));
+                let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+                write!(md, " {max:.4} | {rms:.4} |").unwrap();
+            }
+            md.push('\n');
+        }
+    }
+    let mut csv = String::from("eta,side,alpha,mu,part,walk,walk_se,single,single_se,turquin,turquin_se\n");
+    for c in &glass {
+        for (part, pname) in ["R", "T", "total"].iter().enumerate() {
+            write!(
+                csv,
+                "{},{},{},{},{pname}",
+                c.eta,
+                if c.inside { "inside" } else { "outside" },
+                c.alpha,
+                c.mu
+            )
+            .unwrap();
+            for m in 0..3 {
+                write!(csv, ",{:.6},{:.2e}", c.albedo[m].mean[part], c.albedo[m].se[part]).unwrap();
+            }
+            csv.push('\n');
+        }
+    }
+    std::fs::write(dir.join("glass.csv"), csv)?;
+
+    // the technique-choice table: per material and α, max over μo (and RGB) of |A − A_walk|,
+    // and the mean time per sample over the row's cells
+    writeln!(
+        md,
+        "\nTechnique choice (GGX): albedo error against the walk, max over μo ∈ {:?} and RGB, and time per \
+         sample (ns, this run's timing: one thread per cell on a loaded 2-core machine, ±30 %). The walk is the \
+         reference (error 0, its standard error is in the headers above); PT and BDPT are the position-free \
+         model's estimators (Wang et al. 2022), a different model whose albedo differs from the walk's by the \
+         entry. Glass: total albedo, importance transport, η = 1.5 from outside.\n",
+        s.mus
+    )
+    .unwrap();
+    writeln!(
+        md,
+        "| material | α | single | Kulla–Conty | Turquin | PT | BDPT | ns: single | Kulla–Conty | Turquin | walk | PT | BDPT |"
+    )
+    .unwrap();
+    writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
+    for (name, _) in &mats {
+        for &a in &s.alphas {
+            let row: Vec<&AlbedoCell> =
+                cells.iter().filter(|c| c.material == *name && c.alpha == a).collect();
+            let err = |f: &dyn Fn(&AlbedoCell) -> &Estimate| {
+                row.iter()
+                    .flat_map(|c| (0..3).map(|ch| (f(c).mean[ch] - c.walk.mean[ch]).abs()))
+                    .fold(0.0f64, f64::max)
+            };
+            let ns = |f: &dyn Fn(&AlbedoCell) -> &Estimate| {
+                row.iter().map(|c| f(c).ns).sum::<f64>() / row.len() as f64
+            };
+            write!(md, "| {name} | {a} |").unwrap();
+            for k in 0..3 {
+                write!(md, " {:.4} |", err(&|c| &c.techniques[k])).unwrap();
+            }
+            for k in 0..2 {
+                write!(md, " {:.4} |", err(&|c| &c.estimators[k])).unwrap();
+            }
+            for k in 0..3 {
+                write!(md, " {:.0} |", ns(&|c| &c.techniques[k])).unwrap();
+            }
+            write!(md, " {:.0} |", ns(&|c| &c.walk)).unwrap();
+            for k in 0..2 {
+                write!(md, " {:.0} |", ns(&|c| &c.estimators[k])).unwrap();
+            }
+            md.push('\n');
+        }
+    }
+    for &a in &s.alphas {
+        let row: Vec<&GlassCell> =
+            glass.iter().filter(|c| c.eta == 1.5 && !c.inside && c.alpha == a).collect();
+        let err = |m: usize| {
+            row.iter().map(|c| (c.albedo[m].mean[2] - c.albedo[0].mean[2]).abs()).fold(0.0f64, f64::max)
+        };
+        let ns = |m: usize| row.iter().map(|c| c.albedo[m].ns).sum::<f64>() / row.len() as f64;
+        writeln!(
+            md,
+            "| glass 1.5 | {a} | {:.4} | — | {:.4} | — | — | {:.0} | — | {:.0} | {:.0} | — | — |",
+            err(1),
+            err(2),
+            ns(1),
+            ns(2),
+            ns(0)
+        )
+        .unwrap();
+    }
+
     // cost per sample, as measured in this run (one thread of the run's pool)
     let mean_ns = |f: &dyn Fn(&AlbedoCell) -> f64| cells.iter().map(f).sum::<f64>() / cells.len() as f64;
     writeln!(

@@ -122,11 +122,14 @@ mod slope;
 mod special;
 mod vndf;
 
-pub use albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
+pub use albedo::{
+    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
+    Incidence, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA,
+};
 pub use bsdf::{
     AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    CompensatedConductor, Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA,
-    SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport,
+    CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf,
+    SMOOTH_ALPHA, SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport,
 };
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;

@@ -8,7 +8,9 @@ mod common;
 use common::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
 use glam::Vec3;
 use microsurface::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Conductor, Ggx, Microsurface, MicrosurfaceSlope, UniformHeight,
+    ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Bsdf, Conductor, DIELECTRIC_TABLE_SIZE, Dielectric,
+    DielectricAlbedoTable, Ggx, Incidence, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Technique,
+    Transport, UniformHeight,
 };
 use rand::RngExt;
 
@@ -221,5 +223,195 @@ fn out_of_range_gives_none() {
         }
         // the ends of the range are in it
         assert!(t.directional(0.0, 1.0).is_some() && t.directional(1.0, 1e-7).is_some());
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dielectric tables (`DielectricAlbedoTable`)
+// ---------------------------------------------------------------------------------------------
+
+/// The stated interpolation errors of the dielectric lookups (R + T bound: the sum of the
+/// measured maxima of R and of T over random points, see `DielectricAlbedoTable`), per family
+/// (GGX, Beckmann) and side (outside, inside).
+const STATED_DIELECTRIC_ERROR: [[f64; 2]; 2] = [
+    [DIELECTRIC_ERROR_GGX_OUT, DIELECTRIC_ERROR_GGX_IN],
+    [DIELECTRIC_ERROR_BECKMANN_OUT, DIELECTRIC_ERROR_BECKMANN_IN],
+];
+const DIELECTRIC_ERROR_GGX_OUT: f64 = 1.0;
+const DIELECTRIC_ERROR_GGX_IN: f64 = 1.0;
+const DIELECTRIC_ERROR_BECKMANN_OUT: f64 = 1.0;
+const DIELECTRIC_ERROR_BECKMANN_IN: f64 = 1.0;
+
+fn dielectric_table(family: usize) -> DielectricAlbedoTable {
+    [DielectricAlbedoTable::GGX, DielectricAlbedoTable::BECKMANN][family]
+}
+
+/// (μ, α, η ≥ 1) of dielectric node (i, j, l), as the table's documentation defines the axes.
+fn dielectric_node_coordinates(i: usize, j: usize, l: usize) -> (f32, f32, f32) {
+    let last = (DIELECTRIC_TABLE_SIZE - 1) as f64;
+    let r = j as f64 / last;
+    let alpha = (r * r).max(f64::from(ALPHA_LIMIT));
+    let big_x = (i as f64 / last).powi(2);
+    let mu = if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
+    let u = l as f64 / last;
+    (mu as f32, alpha as f32, (1.0 + 2.0 * u * u) as f32)
+}
+
+/// Monte Carlo R and T of the crate's single-scattering dielectric BSDF (importance transport:
+/// the weights are the transmitted flux) for light arriving at cos θ = μ from the side whose
+/// relative index is `eta_seen` (the BSDF is built with η and viewed from below for η < 1):
+/// the mean weight of the reflected and of the transmitted samples (0 for the others), and of
+/// all (R + T).
+fn dielectric_albedo_mc(family: usize, mu: f32, alpha: f32, eta_seen: f32, seed: u64) -> [Stats; 3] {
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let (eta, wo) = if eta_seen >= 1.0 {
+        (eta_seen, Vec3::new(s, 0.0, mu))
+    } else {
+        (1.0 / eta_seen, Vec3::new(s, 0.0, -mu))
+    };
+    let material = Dielectric::new(eta).unwrap();
+    let bsdf: Box<dyn Bsdf> = match family {
+        0 => Box::new(
+            MicrofacetBsdf::new(Ggx::isotropic(alpha).unwrap(), material)
+                .unwrap()
+                .with_technique(Technique::SingleScattering)
+                .with_transport(Transport::Importance)
+                .without_smooth_limit(),
+        ),
+        _ => Box::new(
+            MicrofacetBsdf::new(Beckmann::isotropic(alpha).unwrap(), material)
+                .unwrap()
+                .with_technique(Technique::SingleScattering)
+                .with_transport(Transport::Importance)
+                .without_smooth_limit(),
+        ),
+    };
+    let mut r = rng(seed);
+    let (mut refl, mut trans, mut total) = (Stats::default(), Stats::default(), Stats::default());
+    for _ in 0..SAMPLES {
+        let (uc, u) = (uniform32(&mut r), glam::Vec2::new(uniform32(&mut r), uniform32(&mut r)));
+        let (wr, wt) = match bsdf.sample(wo, uc, u) {
+            Some(smp) if smp.flags.transmission => (0.0, f64::from(smp.weight.x)),
+            Some(smp) => (f64::from(smp.weight.x), 0.0),
+            None => (0.0, 0.0),
+        };
+        refl.push(wr);
+        trans.push(wt);
+        total.push(wr + wt);
+    }
+    [refl, trans, total]
+}
+
+#[test]
+fn dielectric_nodes_match_the_single_scattering_bsdf() {
+    // nodes with μ > 0 (the BSDF has no lobe on the horizon) and α ≥ 1e-3 (below, the BSDF's
+    // f32 directions cannot resolve the lobe), both sides
+    let mut pick = rng(21);
+    let cells: Vec<(usize, bool, usize, usize, usize)> = (0..24)
+        .map(|k| {
+            (
+                k % 2,
+                (k / 2) % 2 == 1,
+                pick.random_range(1..DIELECTRIC_TABLE_SIZE),
+                pick.random_range(1..DIELECTRIC_TABLE_SIZE),
+                pick.random_range(0..DIELECTRIC_TABLE_SIZE),
+            )
+        })
+        .collect();
+    let z = family_z(FAMILY_ALPHA, 2 * cells.len());
+    let results = par_map(&cells, |k, &(family, inside, i, j, l)| {
+        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l);
+        let eta_seen = if inside { 1.0 / eta } else { eta };
+        dielectric_albedo_mc(family, mu, alpha, eta_seen, 500 + k as u64)
+    });
+    for (&(family, inside, i, j, l), [refl, trans, _]) in cells.iter().zip(&results) {
+        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l);
+        let side = if inside { Incidence::Inside } else { Incidence::Outside };
+        let (r_nodes, t_nodes) = dielectric_table(family).nodes(side);
+        let k = (l * DIELECTRIC_TABLE_SIZE + j) * DIELECTRIC_TABLE_SIZE + i;
+        let label = format!(
+            "{} dielectric {side:?} node ({i}, {j}, {l}) μ = {mu:e}, α = {alpha:e}, η = {eta}",
+            dielectric_table(family).name()
+        );
+        // the node's quadrature error is below 1e-5; the BSDF's f32 Fresnel and directions
+        // add below 1e-5
+        assert_mean(&format!("{label}: R"), refl, f64::from(r_nodes[k]), z, MAX_SE, 2e-5);
+        assert_mean(&format!("{label}: T"), trans, f64::from(t_nodes[k]), z, MAX_SE, 2e-5);
+    }
+}
+
+#[test]
+fn dielectric_interpolation_is_within_the_stated_bound() {
+    let mut pick = rng(22);
+    let points: Vec<(usize, f32, f32, f32)> = (0..24)
+        .map(|k| {
+            let alpha = pick.random_range(0.0f32..1.0).powi(2).max(1e-3);
+            let mu = pick.random_range(0.0f32..1.0).powi(2).max(1e-3);
+            let eta = 1.0 + 2.0 * pick.random_range(0.0f32..1.0).powi(2);
+            (k % 2, mu, alpha, if k % 4 < 2 { eta } else { 1.0 / eta })
+        })
+        .collect();
+    let z = family_z(FAMILY_ALPHA, points.len());
+    let results = par_map(&points, |k, &(family, mu, alpha, eta)| {
+        let [_, _, total] = dielectric_albedo_mc(family, mu, alpha, eta, 600 + k as u64);
+        total
+    });
+    for (&(family, mu, alpha, eta), total) in points.iter().zip(&results) {
+        let v = dielectric_table(family).albedo(mu, alpha, eta).unwrap();
+        let label = format!(
+            "{} dielectric lookup R + T at μ = {mu}, α = {alpha}, η = {eta}",
+            dielectric_table(family).name()
+        );
+        let bound = STATED_DIELECTRIC_ERROR[family][usize::from(eta < 1.0)];
+        assert_mean(&label, total, f64::from(v.reflected + v.transmitted), z, MAX_SE, bound);
+    }
+}
+
+#[test]
+fn dielectric_nodes_are_physical() {
+    // every node: 0 ≤ R, T and R + T ≤ 1 (single scattering loses energy, never gains); at
+    // μ = 0 nothing is transmitted; at η = 1 nothing is reflected
+    for family in 0..2 {
+        for side in [Incidence::Outside, Incidence::Inside] {
+            let (r, t) = dielectric_table(family).nodes(side);
+            for k in 0..r.len() {
+                let (i, l) = (k % DIELECTRIC_TABLE_SIZE, k / (DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE));
+                assert!(
+                    r[k] >= 0.0 && t[k] >= 0.0 && r[k] + t[k] <= 1.0 + 1e-5,
+                    "{} {side:?} node {k}: R = {}, T = {}",
+                    dielectric_table(family).name(),
+                    r[k],
+                    t[k]
+                );
+                if i == 0 {
+                    assert_eq!(t[k], 0.0, "node {k}: T(μ = 0)");
+                }
+                if l == 0 {
+                    assert_eq!(r[k], 0.0, "node {k}: R(η = 1)");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn dielectric_out_of_range_gives_none() {
+    for t in [DielectricAlbedoTable::GGX, DielectricAlbedoTable::BECKMANN] {
+        for (mu, alpha, eta) in [
+            (0.5, 0.5, 3.01),
+            (0.5, 0.5, 0.33),
+            (0.5, 0.5, f32::NAN),
+            (0.5, 0.0, 1.5),
+            (0.5, 1.01, 1.5),
+            (-0.1, 0.5, 1.5),
+            (1.1, 0.5, 1.5),
+            (f32::NAN, 0.5, 1.5),
+        ] {
+            assert_eq!(t.albedo(mu, alpha, eta), None, "{} at ({mu}, {alpha}, {eta})", t.name());
+        }
+        // the ends of the range are in it
+        for eta in [3.0, 1.0 / 3.0, 1.0] {
+            assert!(t.albedo(0.0, 1.0, eta).is_some() && t.albedo(1.0, 1e-7, eta).is_some());
+        }
     }
 }

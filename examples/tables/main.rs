@@ -1,17 +1,23 @@
-//! Generates the crate's single-scattering albedo tables (`src/albedo/data.rs`) by
-//! deterministic quadrature, on all cores, and exports them for shaders.
+//! Generates the crate's single-scattering albedo tables (`src/albedo/data.rs`: conductor E and
+//! E_avg; `src/albedo/dielectric_data.rs`: dielectric R and T) by deterministic quadrature, on
+//! all cores, and exports them for shaders.
 //!
 //! ```sh
-//! cargo run --release --example tables            # rebuild src/albedo/data.rs and target/tables/
+//! cargo run --release --example tables            # rebuild both and target/tables/
+//! cargo run --release --example tables -- --only dielectric   # or conductor
 //! cargo run --release --example tables -- --quick # recompute a subset, check it against the shipped tables
 //! ```
 //!
 //! Quadrature is deterministic, so a rebuild reproduces the shipped tables bit for bit
-//! whatever the number of threads. Every node is computed at two resolutions (6 and 12 panels of
-//! 16-point Gauss–Legendre per variable); the run fails if they differ by more than 1e-6.
+//! whatever the number of threads. Every conductor node is computed at two resolutions (6 and
+//! 12 panels of 16-point Gauss–Legendre per variable); the run fails if they differ by more than
+//! 1e-6. Dielectric nodes use 2 panels per variable and piece (see `dielectric.rs`), and every
+//! 7th node is recomputed at 3; the run fails if they differ by more than 1e-5.
 
+mod dielectric;
 mod quadrature;
 
+use dielectric::dielectric_albedo;
 use quadrature::{Family, gauss_legendre, single_scattering_albedo};
 use std::fmt::Write as _;
 use std::io::IsTerminal;
@@ -196,7 +202,14 @@ fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result
          r = j/31, alpha = r^2 (row j = 0: the alpha -> 0 limit profile); x = i/31,\n\
          mu = X alpha/(1 + alpha - X) with X = x^2. Lookup of (mu, alpha):\n\
          x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), bilinear in (x, r) at (31 x, 31 r).\n\
-         <family>_average.f32: 32 values E_avg[j] at r = j/31, linear in r.\n",
+         <family>_average.f32: 32 values E_avg[j] at r = j/31, linear in r.\n\n\
+         <family>_dielectric_<side>_<reflected|transmitted>.f32: 16 x 16 x 16 values V[l][j][i],\n\
+         l (eta) slowest, i (direction) fastest: the single-scattering reflected / transmitted\n\
+         (flux) albedo of a dielectric with light from <side> (outside: relative index eta;\n\
+         inside: 1/eta). u = l/15, eta = 1 + 2 u^2 in [1, 3]; r = j/15, alpha = r^2 (row 0:\n\
+         alpha = 1e-6); x = i/15 with mu as above. Lookup of (mu, alpha, eta):\n\
+         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2),\n\
+         trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n",
     );
     for (family, t) in tables {
         for (suffix, values) in [("directional", &t.directional), ("average", &t.average)] {
@@ -206,6 +219,188 @@ fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result
     }
     readme.push_str("\nSee microsurface::AlbedoTable for the definition and the measured errors.\n");
     std::fs::write(dir.join("README.txt"), readme)
+}
+
+/// Nodes per axis of the dielectric tables (as `microsurface::DIELECTRIC_TABLE_SIZE`).
+const ND: usize = microsurface::DIELECTRIC_TABLE_SIZE;
+/// Quadrature panels (16-point Gauss–Legendre) per variable and piece of the shipped
+/// dielectric nodes, and of their error estimate (the integrand is split at all its kinks and
+/// graded towards its square-root features, so few panels suffice).
+const DIELECTRIC_PANELS: usize = 2;
+const DIELECTRIC_CHECK_PANELS: usize = 3;
+/// The error estimate is computed at every `DIELECTRIC_CHECK_STRIDE`-th node (a fixed subset of
+/// 1/7 of the nodes; 7 is prime to 16, so the subset visits every direction, roughness and η
+/// index): the check at every node would more than double the generator's time.
+const DIELECTRIC_CHECK_STRIDE: usize = 7;
+/// Largest accepted disagreement of the two resolutions of a dielectric node.
+const MAX_DIELECTRIC_ERROR: f64 = 1e-5;
+/// Dielectric nodes recomputed by `--quick` per family and side.
+const QUICK_DIELECTRIC_CELLS: usize = 6;
+/// Random cell-interior points at which `--interpolation` measures the dielectric lookups, per
+/// family and side.
+const INTERPOLATION_POINTS: usize = 256;
+
+/// The side light arrives from: outside the relative index of the η axis is η, inside 1/η.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Side {
+    Outside,
+    Inside,
+}
+
+impl Side {
+    fn name(self) -> &'static str {
+        match self {
+            Side::Outside => "outside",
+            Side::Inside => "inside",
+        }
+    }
+}
+
+/// η ≥ 1 of η-node coordinate u ∈ [0, 1]: η = 1 + 2u².
+fn eta_of(u: f64) -> f64 {
+    1.0 + 2.0 * u * u
+}
+
+/// The α of dielectric roughness node j.
+fn dielectric_alpha_of_node(j: usize) -> f64 {
+    let r = j as f64 / (ND - 1) as f64;
+    (r * r).max(ALPHA_LIMIT)
+}
+
+/// (R, T) at dielectric node k = (l·ND + j)·ND + i (η slowest, direction fastest).
+fn dielectric_node(family: Family, side: Side, k: usize, panels: usize) -> (f64, f64) {
+    let (i, j, l) = (k % ND, (k / ND) % ND, k / (ND * ND));
+    let alpha = dielectric_alpha_of_node(j);
+    let eta = eta_of(l as f64 / (ND - 1) as f64);
+    let eta = if side == Side::Outside { eta } else { 1.0 / eta };
+    dielectric_albedo(family, mu_of(i as f64 / (ND - 1) as f64, alpha), alpha, eta, panels)
+}
+
+/// The dielectric tables of one family and side: R and T nodes.
+struct DielectricTables {
+    reflected: Vec<f32>,
+    transmitted: Vec<f32>,
+}
+
+fn build_dielectric(family: Family, side: Side) -> DielectricTables {
+    let label = format!("{} {} R, T", family.name(), side.name());
+    let cells = par_map(ND * ND * ND, &label, |k| {
+        let (r, t) = dielectric_node(family, side, k, DIELECTRIC_PANELS);
+        let check = if k % DIELECTRIC_CHECK_STRIDE == 0 {
+            let (rc, tc) = dielectric_node(family, side, k, DIELECTRIC_CHECK_PANELS);
+            (r - rc).abs().max((t - tc).abs())
+        } else {
+            0.0
+        };
+        (r, t, check)
+    });
+    let worst = cells.iter().map(|c| c.2).fold(0.0, f64::max);
+    for (k, c) in cells.iter().enumerate() {
+        if c.2 > MAX_DIELECTRIC_ERROR / 4.0 {
+            let (i, j, l) = (k % ND, (k / ND) % ND, k / (ND * ND));
+            println!("  node {k} = ({i}, {j}, {l}): R {:.7}, T {:.7}, disagreement {:.1e}", c.0, c.1, c.2);
+        }
+    }
+    println!(
+        "{label}: largest disagreement of {DIELECTRIC_PANELS} and {DIELECTRIC_CHECK_PANELS} panels (every \
+         {DIELECTRIC_CHECK_STRIDE}th node): {worst:.2e}"
+    );
+    assert!(worst <= MAX_DIELECTRIC_ERROR, "{label}: quadrature error estimate {worst:.2e}");
+    DielectricTables {
+        reflected: cells.iter().map(|c| c.0 as f32).collect(),
+        transmitted: cells.iter().map(|c| c.1 as f32).collect(),
+    }
+}
+
+fn dielectric_table_of(family: Family) -> microsurface::DielectricAlbedoTable {
+    match family {
+        Family::Ggx => microsurface::DielectricAlbedoTable::GGX,
+        Family::Beckmann => microsurface::DielectricAlbedoTable::BECKMANN,
+    }
+}
+
+fn side_of(side: Side) -> microsurface::Incidence {
+    match side {
+        Side::Outside => microsurface::Incidence::Outside,
+        Side::Inside => microsurface::Incidence::Inside,
+    }
+}
+
+/// The interpolation error of the dielectric lookups at pseudo-random points inside the cells
+/// against direct quadrature: (max, RMS) of R and of T.
+fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 2] {
+    let table = dielectric_table_of(family);
+    let label = format!("{} {} interpolation", family.name(), side.name());
+    let errors = par_map(INTERPOLATION_POINTS, &label, |k| {
+        let mut state = (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        let mut next = || {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (x, r, u) = (next(), next(), next());
+        let alpha = (r * r).max(1e-4);
+        let mu = mu_of(x, alpha);
+        let eta = eta_of(u);
+        let eta_side = if side == Side::Outside { eta } else { 1.0 / eta };
+        let (er, et) = dielectric_albedo(family, mu, alpha, eta_side, DIELECTRIC_PANELS);
+        let v = table.albedo(mu as f32, alpha as f32, eta_side as f32).expect("in range");
+        ((f64::from(v.reflected) - er).abs(), (f64::from(v.transmitted) - et).abs())
+    });
+    let stats = |e: &dyn Fn(&(f64, f64)) -> f64| {
+        let max = errors.iter().map(e).fold(0.0, f64::max);
+        let rms = (errors.iter().map(|v| e(v) * e(v)).sum::<f64>() / errors.len() as f64).sqrt();
+        (max, rms)
+    };
+    [stats(&|v| v.0), stats(&|v| v.1)]
+}
+
+/// The Rust source of `src/albedo/dielectric_data.rs`.
+fn dielectric_source(tables: &[(Family, Side, DielectricTables)]) -> String {
+    let mut s = String::from(
+        "//! Generated by `cargo run --release --example tables`: do not edit.\n//!\n//! Dielectric \
+         single-scattering albedo nodes (see `DielectricAlbedoTable` for the axes).\n\n",
+    );
+    for (family, side, t) in tables {
+        for (what, values) in [("REFLECTED", &t.reflected), ("TRANSMITTED", &t.transmitted)] {
+            let upper = family.name().to_uppercase();
+            let side_upper = side.name().to_uppercase();
+            let _ = writeln!(
+                s,
+                "/// {} albedo of {}, light from {}, η slowest, direction fastest.",
+                what.to_lowercase(),
+                family.name(),
+                side.name()
+            );
+            let _ = writeln!(s, "pub(crate) static {upper}_{side_upper}_{what}: [f32; {}] = [", ND * ND * ND);
+            for row in values.chunks(8) {
+                let _ = writeln!(
+                    s,
+                    "    {},",
+                    row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", ")
+                );
+            }
+            let _ = writeln!(s, "];");
+        }
+    }
+    s
+}
+
+/// Writes the dielectric f32 exports.
+fn dielectric_export(
+    tables: &[(Family, Side, DielectricTables)],
+    dir: &std::path::Path,
+) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    for (family, side, t) in tables {
+        for (what, values) in [("reflected", &t.reflected), ("transmitted", &t.transmitted)] {
+            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+            std::fs::write(
+                dir.join(format!("{}_dielectric_{}_{what}.f32", family.name(), side.name())),
+                bytes,
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// `--quick`: recomputes a fixed pseudo-random subset of nodes and checks them bit for bit.
@@ -235,7 +430,33 @@ fn quick() {
             );
         }
     }
-    println!("tables --quick: {} nodes recomputed, {failures} differ", 2 * (QUICK_CELLS + 1));
+    let mut dielectric_nodes = 0;
+    for family in [Family::Ggx, Family::Beckmann] {
+        let table = dielectric_table_of(family);
+        for side in [Side::Outside, Side::Inside] {
+            for _ in 0..QUICK_DIELECTRIC_CELLS {
+                state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                let k = (state >> 33) as usize % (ND * ND * ND);
+                let (r, t) = dielectric_node(family, side, k, DIELECTRIC_PANELS);
+                let (sr, st) = table.nodes(side_of(side));
+                dielectric_nodes += 1;
+                if (r as f32).to_bits() != sr[k].to_bits() || (t as f32).to_bits() != st[k].to_bits() {
+                    failures += 1;
+                    println!(
+                        "{} {} node {k}: recomputed ({r:?}, {t:?}), shipped ({:?}, {:?})",
+                        family.name(),
+                        side.name(),
+                        sr[k],
+                        st[k]
+                    );
+                }
+            }
+        }
+    }
+    println!(
+        "tables --quick: {} nodes recomputed (and {dielectric_nodes} dielectric R, T pairs), {failures} differ",
+        2 * (QUICK_CELLS + 1)
+    );
     assert_eq!(failures, 0, "the shipped tables are not reproduced bit for bit");
 }
 
@@ -243,45 +464,78 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {
         println!(
-            "usage: cargo run --release --example tables [-- --quick | --interpolation]\n\n  (no flag)        rebuild \
-             src/albedo/data.rs and target/tables/*.f32, print the quadrature error estimates\n  --interpolation  \
-             measure the lookups' interpolation error at the cell centres against quadrature\n  --quick          recompute a \
-             subset of nodes and check them against the shipped tables bit for bit"
+            "usage: cargo run --release --example tables [-- --quick | --interpolation] [--only conductor|dielectric]\n\n  \
+             (no flag)        rebuild src/albedo/data.rs, src/albedo/dielectric_data.rs and target/tables/*.f32,\n                   \
+             print the quadrature error estimates\n  --interpolation  measure the lookups' interpolation error against \
+             quadrature\n  --quick          recompute a subset of nodes and check them against the shipped tables bit for \
+             bit\n  --only X         rebuild (or measure) only the conductor (E, E_avg) or only the dielectric tables"
         );
         return;
     }
+    let only = args.iter().position(|a| a == "--only").and_then(|k| args.get(k + 1)).map(String::as_str);
+    let (conductor, dielectric) = (only != Some("dielectric"), only != Some("conductor"));
     if args.iter().any(|a| a == "--quick") {
         quick();
         return;
     }
     if args.iter().any(|a| a == "--interpolation") {
         for family in [Family::Ggx, Family::Beckmann] {
-            let (max, rms, avg) = interpolation_error(family);
-            println!(
-                "{}: interpolation error at cell centres: E max {max:.2e}, RMS {rms:.2e}; E_avg max {avg:.2e}",
-                family.name()
-            );
+            if conductor {
+                let (max, rms, avg) = interpolation_error(family);
+                println!(
+                    "{}: interpolation error at cell centres: E max {max:.2e}, RMS {rms:.2e}; E_avg max {avg:.2e}",
+                    family.name()
+                );
+            }
+            if dielectric {
+                for side in [Side::Outside, Side::Inside] {
+                    let [(rm, rr), (tm, tr)] = dielectric_interpolation_error(family, side);
+                    println!(
+                        "{} dielectric from {}: interpolation error at {INTERPOLATION_POINTS} random points: R max \
+                         {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}",
+                        family.name(),
+                        side.name()
+                    );
+                }
+            }
         }
         return;
     }
     let start = std::time::Instant::now();
-    let tables: Vec<(Family, Tables)> =
-        [Family::Ggx, Family::Beckmann].into_iter().map(|f| (f, build(f))).collect();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let path = root.join("src/albedo/data.rs");
-    let text = source(&tables);
-    let changed = std::fs::read_to_string(&path).map_or(true, |old| old != text);
-    std::fs::write(&path, text).expect("write src/albedo/data.rs");
-    export(&tables, &root.join("target/tables")).expect("write target/tables");
+    let mut changed = false;
+    if conductor {
+        let tables: Vec<(Family, Tables)> =
+            [Family::Ggx, Family::Beckmann].into_iter().map(|f| (f, build(f))).collect();
+        changed |= write_if_changed(&root.join("src/albedo/data.rs"), &source(&tables));
+        export(&tables, &root.join("target/tables")).expect("write target/tables");
+    }
+    if dielectric {
+        let mut tables = Vec::new();
+        for family in [Family::Ggx, Family::Beckmann] {
+            for side in [Side::Outside, Side::Inside] {
+                tables.push((family, side, build_dielectric(family, side)));
+            }
+        }
+        changed |= write_if_changed(&root.join("src/albedo/dielectric_data.rs"), &dielectric_source(&tables));
+        dielectric_export(&tables, &root.join("target/tables")).expect("write target/tables");
+    }
     println!(
-        "wrote {} ({}), target/tables/ in {:.1} s",
-        path.display(),
-        if changed { "changed" } else { "unchanged" },
-        start.elapsed().as_secs_f64()
+        "done in {:.1} s ({} CPU threads)",
+        start.elapsed().as_secs_f64(),
+        std::thread::available_parallelism().map_or(1, |t| t.get())
     );
     if changed {
         println!(
             "the tables changed: rebuild and run with --interpolation to measure the interpolation error"
         );
     }
+}
+
+/// Writes `text` to `path`; whether the file changed.
+fn write_if_changed(path: &std::path::Path, text: &str) -> bool {
+    let changed = std::fs::read_to_string(path).map_or(true, |old| old != text);
+    std::fs::write(path, text).unwrap_or_else(|e| panic!("write {}: {e}", path.display()));
+    println!("wrote {} ({})", path.display(), if changed { "changed" } else { "unchanged" });
+    changed
 }

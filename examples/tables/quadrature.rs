@@ -47,7 +47,7 @@ impl Family {
 const BECKMANN_W_MAX: f64 = 9.0;
 
 /// 16-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; symmetric).
-const GL16: [(f64, f64); 8] = [
+pub const GL16: [(f64, f64); 8] = [
     (0.095_012_509_837_637_44, 0.189_450_610_455_068_5),
     (0.281_603_550_779_258_9, 0.182_603_415_044_923_6),
     (0.458_016_777_657_227_4, 0.169_156_519_395_002_5),

@@ -4,7 +4,7 @@
 
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
-use crate::albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
+use crate::albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, MAX_TABULATED_ALPHA};
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
@@ -36,18 +36,22 @@ const GL16: [(f64, f64); 8] = [
 const FRESNEL_PANELS: usize = 4;
 
 /// A slope family with single-scattering albedo tables: the families a
-/// [`CompensatedConductor`] can be built on.
+/// [`CompensatedConductor`] and a [`super::CompensatedDielectric`] can be built on.
 pub trait AlbedoTabulated: MicrosurfaceSlope {
-    /// The family's tables.
+    /// The family's conductor tables (F = 1).
     const ALBEDO: AlbedoTable;
+    /// The family's dielectric tables (reflected and transmitted, both sides).
+    const DIELECTRIC_ALBEDO: DielectricAlbedoTable;
 }
 
 impl AlbedoTabulated for Ggx {
     const ALBEDO: AlbedoTable = AlbedoTable::GGX;
+    const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::GGX;
 }
 
 impl AlbedoTabulated for Beckmann {
     const ALBEDO: AlbedoTable = AlbedoTable::BECKMANN;
+    const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::BECKMANN;
 }
 
 /// How a [`CompensatedConductor`] restores the energy single scattering loses.

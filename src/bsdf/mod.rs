@@ -19,6 +19,7 @@
 
 mod classic;
 mod compensated;
+mod compensated_dielectric;
 mod frame;
 mod microfacet;
 mod seed;
@@ -26,6 +27,7 @@ mod specular;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use compensated::{AlbedoTabulated, CompensatedConductor, Compensation};
+pub use compensated_dielectric::CompensatedDielectric;
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
 pub use specular::{SpecularEvent, SpecularLimit};

@@ -17,7 +17,7 @@ const USAGE: &str = "usage: cargo run --release --example path_tracer -- [--quic
        cargo run --release --example path_tracer -- --showcase [--width W] [--height H] [--spp N] [--out FILE.png] [--furnace]
 
   (default)      the GGX roughness sweep (α from 0.05 to 1; gold and glass; single scattering,
-                 exact walk, Kulla–Conty and Turquin) and its white-furnace version:
+                 exact walk, Kulla–Conty and Turquin; glass Turquin) and its white furnace:
                  DIR/sweep.png and DIR/sweep_furnace.png
   --quick        small cells at 4 spp (seconds, for CI)
   --spp N        samples per pixel (default 64 for the sweep and the showcase)

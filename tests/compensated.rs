@@ -529,7 +529,7 @@ fn dielectric_white_furnace_between_the_nodes() {
                     CompensatedDielectric::new(beckmann(a), glass(1.5)).unwrap();
                 for above in [true, false] {
                     let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, if above { mu } else { -mu });
-                    let mut rng = common::rng(seed);
+                    let mut rng = validation::rng(seed);
                     seed += 1;
                     let mut stats = Stats::default();
                     let e_table = if family == 0 {

@@ -141,7 +141,7 @@ fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion<Clock>, name: &str, make:
 fn slopes(c: &mut Criterion<Clock>) {
     bench_slope(c, "ggx", |a| Ggx::isotropic(a).expect("valid roughness"));
     bench_slope(c, "beckmann", |a| Beckmann::isotropic(a).expect("valid roughness"));
-    // GGX tabulated on 256 rings at s = α (the table size of tests/tabulated_slope.rs); the
+    // GGX tabulated on 256 rings at s = α (the table size of tests/tabulated/tabulated.rs); the
     // tables are leaked: the trait is implemented for `&TabulatedSlope`
     bench_slope(c, "tabulated_ggx256", |a| {
         let ggx = Ggx::isotropic(a).expect("valid roughness");

@@ -31,13 +31,9 @@ pub struct PhaseSample {
     pub side: Side,
 }
 
-mod sealed {
-    /// The private supertrait that seals [`Material`](super::Material).
-    pub trait Sealed {}
-    impl Sealed for super::Conductor {}
-    impl Sealed for super::Dielectric {}
-    impl Sealed for super::Diffuse {}
-}
+impl crate::sealed::Sealed for Conductor {}
+impl crate::sealed::Sealed for Dielectric {}
+impl crate::sealed::Sealed for Diffuse {}
 
 /// The material of the microfacets: a phase function, the position-free vertex term and the
 /// single-scattering BSDF.
@@ -68,7 +64,7 @@ mod sealed {
 /// [`PhaseSample`] with a NaN `wo` and a zero weight. Grazing and below-horizon unit
 /// directions are valid. Each checked method validates once and calls its unchecked body,
 /// which the crate's walks call directly with the directions they produced themselves.
-pub trait Material: sealed::Sealed + Copy + core::fmt::Debug + Send + Sync {
+pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// Whether light can cross the interface (dielectrics).
     const TRANSMITS: bool;
 

@@ -26,7 +26,7 @@ use rand::Rng;
 /// The walks run in C¹ space: a height enters the Smith model only through its CDF value
 /// C¹(h) (supplement §1.1), so they carry ln C¹ instead of h, and their results are the same
 /// for every height distribution (bit for bit, given the same random numbers). `H` serves the
-/// height-space queries of [`MicrosurfaceGeometry`]; `tests/walk.rs` checks the walks against
+/// height-space queries of [`MicrosurfaceGeometry`]; `tests/walk/random_walk.rs` checks the walks against
 /// the supplement's height-space algorithm run on [`UniformHeight`](crate::UniformHeight) and
 /// [`GaussianHeight`](crate::GaussianHeight).
 #[derive(Debug, Clone, Copy, PartialEq)]

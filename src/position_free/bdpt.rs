@@ -1,7 +1,7 @@
 //! The bidirectional estimator (Wang et al. 2022, §4.2, eqs. 27–29), with the exact
 //! per-strategy path densities and the balance heuristic.
 
-use super::segment::{VertexRole, inv_g1};
+use super::shadowing::{VertexRole, inv_g1};
 use super::{
     Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability,
 };
@@ -14,7 +14,7 @@ use glam::{DVec3, Vec3};
 use rand::Rng;
 
 /// The longest sub-path: paths of up to 2 × 48 + 1 vertices are built. Longer paths carry a
-/// negligible share of the energy (`tests/position_free.rs` bounds it below 1e-4).
+/// negligible share of the energy (`tests/position_free/estimators.rs` bounds it below 1e-4).
 pub const BDPT_MAX_SUBPATH: usize = 48;
 
 /// A vertex of the camera sub-path, after the direction x_j was sampled at path vertex j.

@@ -10,9 +10,9 @@
 
 mod bdpt;
 mod pt;
-mod segment;
+mod shadowing;
 
-pub use segment::Shadowing;
+pub use shadowing::Shadowing;
 
 use crate::contract::is_direction;
 use crate::material::{Event, Interaction, Material, Side};
@@ -22,8 +22,8 @@ use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec3};
 use rand::Rng;
-pub(crate) use segment::VertexRole;
-use segment::{LAMBDA_SATURATION, VertexShadowing, inv_g1};
+pub(crate) use shadowing::VertexRole;
+use shadowing::{LAMBDA_SATURATION, VertexShadowing, inv_g1};
 
 /// Russian roulette starts after this many sampled bounces (it is unbiased at any depth).
 const ROULETTE_FROM_BOUNCE: u32 = 3;
@@ -193,7 +193,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// interface with η ≈ 1 barely turns the ray, and this model's exit probability per vertex
     /// then falls to about 2^−Λ (it forgets the height a vertex was reached at, which the
     /// height-tracing walk keeps), so its paths grow as |η − 1| → 0: no path is lost to
-    /// [`crate::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk_cap.rs`), while within one or
+    /// [`crate::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk/cap.rs`), while within one or
     /// two f32 ulps of 1 nearly all grazing paths are (path lengths measured in DESIGN.md,
     /// “The bounce cap”). η = 1 itself is transparent ([`crate::Material::is_transparent`]).
     ///
@@ -238,7 +238,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// Precision: the weight is w·k_in·S_last with the masking ratio Λo/Λ(−ωi) of a
     /// backfacing ωi formed in f64, from logarithms where Λ underflows
     /// (`relative_shadowing`), so that it equals f·|cos θo|/pdf at the returned f32 direction
-    /// to a few f32 ulps (16 ulps tested, `tests/backfacing_masking.rs`) for every roughness.
+    /// to a few f32 ulps (16 ulps tested, `tests/bsdf/backfacing_masking.rs`) for every roughness.
     /// Resolution: for a backfacing ωi the reflection ωo = −ωi + 2(ωi·ωm)ωm leaves within
     /// 2ωi·ωm of −ωi, and where ωi·ωm ≲ 1e-4 (Beckmann α ≲ 1e-3 below θ ≈ 1.8, α = 0.02 at
     /// θ = 2.9; not GGX, whose visible lobe is wide) the f32 rounding of ωo moves the half

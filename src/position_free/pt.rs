@@ -1,6 +1,6 @@
 //! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
 
-use super::segment::{VertexRole, inv_g1};
+use super::shadowing::{VertexRole, inv_g1};
 use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
 use crate::contract::is_direction;
 use crate::material::Material;

@@ -46,12 +46,12 @@ pub struct Extraction {
 /// ∫_ring j |cos θ − x̃ sin θ| dx̃ dỹ ([`BackscatterShadowing::HeightCorrelated`]). Starting
 /// from p = (1, …, 1), `iterations` multiplications by K (each normalized) give the Perron
 /// vector; the thesis uses four. Measured on the crate's single-scattering conductor (N = 128,
-/// s = α, `tests/extraction.rs`): for Beckmann four are converged (residual ≤ 8e-5, F0 within
+/// s = α, `tests/tabulated/extraction.rs`): for Beckmann four are converged (residual ≤ 8e-5, F0 within
 /// 5e-4); for GGX the residual falls only by ×4–10 per iteration (heavy tail), and four leave
 /// F0 0.8 % and P 0.9 % off at α = 0.5–1, against 0.1–0.2 % after eight.
 ///
 /// Cost: N² closed-form kernel entries and `iterations`·N² multiply-adds (N = 256: see the
-/// test `extraction_cost` in `tests/extraction.rs`).
+/// test `extraction_cost` in `tests/tabulated/extraction.rs`).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] if `scale` is not finite and > 0, if N is 0 or above

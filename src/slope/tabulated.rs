@@ -13,7 +13,7 @@ use glam::{DVec3, Vec2, Vec3};
 pub const MAX_RINGS: usize = 4096;
 
 /// Intervals of the table of the back-face area B over u = |cos θ| ∈ [0, 1] (linear
-/// interpolation; its error is measured in `tests/tabulated_slope.rs`).
+/// interpolation; its error is measured in `tests/tabulated/tabulated.rs`).
 const BACKFACE_INTERVALS: usize = 2048;
 
 /// B is summed exactly (instead of interpolated) when the visibility line cuts at most this

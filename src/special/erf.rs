@@ -4,7 +4,7 @@
 ///
 /// Defined for every finite x, and erf(±∞) = ±1. Evaluated in double precision and rounded
 /// once, so the result is within 1 ulp of the exact value (measured maximum: see
-/// `tests/special_functions.rs`, 1 ulp).
+/// `tests/special/functions.rs`, 1 ulp).
 #[must_use]
 #[inline]
 pub fn erf(x: f32) -> f32 {
@@ -14,7 +14,7 @@ pub fn erf(x: f32) -> f32 {
 /// The complementary error function erfc(x) = 1 − erf(x), accurate in its tails.
 ///
 /// Relative error within 1 ulp where the result is a normal f32 (measured in
-/// `tests/special_functions.rs`); underflows to 0 for x > 10.05.
+/// `tests/special/functions.rs`); underflows to 0 for x > 10.05.
 #[must_use]
 #[inline]
 pub fn erfc(x: f32) -> f32 {

@@ -18,7 +18,7 @@ const HALLEY_STEPS: usize = 2;
 ///
 /// Accuracy: computed in double precision (Winitzki's closed form refined by two Halley
 /// steps on erf, on erfc in the tails) and rounded once. Measured over the whole of (−1, 1),
-/// including the 2¹⁶ f32 neighbours of ±1, in `tests/special_functions.rs` against `statrs`'
+/// including the 2¹⁶ f32 neighbours of ±1, in `tests/special/functions.rs` against `statrs`'
 /// `erf_inv` refined by one Newton step: within 1 ulp (0.501 ulp against the f64 value).
 #[must_use]
 #[inline]

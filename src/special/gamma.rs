@@ -2,7 +2,7 @@
 
 /// The natural logarithm of the gamma function, ln Γ(x), for x > 0.
 ///
-/// Double precision (musl's `lgamma` via `libm`). Measured in `tests/special_functions.rs`
+/// Double precision (musl's `lgamma` via `libm`). Measured in `tests/special/functions.rs`
 /// over x ∈ [1e-3, 1e6]: within 1 ulp of 50-digit reference values (mpmath), and within
 /// 5e-14·max(1, |ln Γ|) of `statrs` (whose own error dominates that difference).
 #[must_use]

@@ -2,7 +2,7 @@
 //! sine and cosine of an azimuth in turns.
 //!
 //! Each public function states its maximum error over its whole domain, measured against
-//! `statrs` in `tests/special_functions.rs`.
+//! `statrs` in `tests/special/functions.rs`.
 
 mod erf;
 mod erfcx;

@@ -12,7 +12,7 @@ const COS: [f32; 6] = [1.0, -1.233_700_6, 0.253_669_5, -0.020_863_481, 0.000_919
 /// 4u is split exactly into a quadrant q ∈ {0, …, 4} and a remainder f = 4u − q ∈ [−½, ½];
 /// sin and cos of πf/2 come from their Taylor polynomials (degrees 9 and 10) and are rotated
 /// by q quarter turns. Maximum absolute error 1.2e-7 over [0, 1] (measured 1.0e-7 against f64
-/// in `tests/special_functions.rs`).
+/// in `tests/special/functions.rs`).
 #[must_use]
 #[inline(always)]
 pub fn sin_cos_turns(u: f32) -> (f32, f32) {

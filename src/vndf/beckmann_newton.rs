@@ -23,7 +23,7 @@ const ERF_NEWTON_MAX_STEPS: usize = 8;
 ///
 /// For incident directions above the horizon only: the erf domain loses the tail's precision
 /// below it, where this sampler defers to the exact safeguarded one ([`SmithVndf`](super::SmithVndf)). Its
-/// accuracy above the horizon is measured by the chi-square tests in `tests/vndf_samplers.rs`.
+/// accuracy above the horizon is measured by the chi-square tests in `tests/vndf/samplers.rs`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BeckmannNewton(pub Beckmann);
 

@@ -101,6 +101,7 @@ fn rotate(v: DVec3, axis: DVec3, angle: f64) -> DVec3 {
 
 /// (θh, θd, φd) of the directions `wi`, `wo` (unit, upper hemisphere), as MERL computes them;
 /// `None` if wi + wo vanishes.
+#[must_use]
 pub fn half_diff_angles(wi: Vec3, wo: Vec3) -> Option<(f64, f64, f64)> {
     let (i, o) = (wi.as_dvec3(), wo.as_dvec3());
     let h = (i + o).try_normalize()?;
@@ -154,6 +155,7 @@ impl MerlBrdf {
     }
 
     /// The file's bytes (values divided by the channel scales).
+    #[must_use]
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(FILE_BYTES);
         for d in [MERL_THETA_H, MERL_THETA_D, MERL_PHI_D] {
@@ -210,6 +212,7 @@ impl MerlBrdf {
     /// The BRDF (RGB, not times a cosine) of the bin holding (wi, wo), as MERL looks it up
     /// (nearest bin, no interpolation); `None` if a channel is missing, if either direction is
     /// at or below the horizon, or if wi = −wo.
+    #[must_use]
     pub fn eval(&self, wi: Vec3, wo: Vec3) -> Option<Vec3> {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return None;
@@ -224,6 +227,7 @@ impl MerlBrdf {
     }
 
     /// The backscattering f_r(o, o) at polar angle `theta` (θd = 0, θh = θ; φ irrelevant).
+    #[must_use]
     pub fn backscatter(&self, theta: f64) -> Option<Vec3> {
         let cell = cell_index(theta, 0.0, 0.0);
         let rgb = [self.values[cell], self.values[CELLS + cell], self.values[2 * CELLS + cell]];

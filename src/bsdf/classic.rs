@@ -95,6 +95,7 @@ impl ClassicBrdf {
     }
 
     /// D(m) for a unit normal in the shading frame.
+    #[must_use]
     pub fn d(&self, m: Vec3) -> f32 {
         let c = m.z;
         if c <= 0.0 {
@@ -122,6 +123,7 @@ impl ClassicBrdf {
     }
 
     /// G1(v) for a direction v above the horizon (0 at or below it).
+    #[must_use]
     pub fn g1(&self, v: Vec3) -> f32 {
         if v.z <= 0.0 {
             return 0.0;

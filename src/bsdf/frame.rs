@@ -29,6 +29,7 @@ pub struct ShadingFrame {
 impl ShadingFrame {
     /// The frame of the normal `n` (normalized here), built branch-free (Duff et al. 2017).
     /// `None` if `n` is zero, NaN or infinite.
+    #[must_use]
     pub fn from_normal(n: Vec3) -> Option<Self> {
         let n = n.try_normalize()?;
         let (t, b) = orthonormal_basis(n);
@@ -37,18 +38,21 @@ impl ShadingFrame {
 
     /// The normal.
     #[inline]
+    #[must_use]
     pub fn normal(&self) -> Vec3 {
         self.n
     }
 
     /// A world-space vector in local coordinates.
     #[inline]
+    #[must_use]
     pub fn to_local(&self, w: Vec3) -> Vec3 {
         Vec3::new(w.dot(self.t), w.dot(self.b), w.dot(self.n))
     }
 
     /// A local vector in world space.
     #[inline]
+    #[must_use]
     pub fn to_world(&self, w: Vec3) -> Vec3 {
         w.x * self.t + w.y * self.b + w.z * self.n
     }

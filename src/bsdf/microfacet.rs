@@ -92,11 +92,13 @@ pub struct EnergyByOrder {
 
 impl EnergyByOrder {
     /// The total albedo.
+    #[must_use]
     pub fn total(&self) -> f64 {
         self.per_order.iter().sum::<f64>() + self.beyond
     }
 
     /// The energy a truncation of the BSDF after `max_order` bounces leaves out.
+    #[must_use]
     pub fn left_out(&self, max_order: u32) -> f64 {
         let kept: f64 = self.per_order.iter().take(max_order as usize).sum();
         self.total() - kept

@@ -64,6 +64,7 @@ pub struct BsdfFlags {
 impl BsdfFlags {
     /// Whether the BSDF has a lobe with a density, where light sampling (NEE) can help.
     #[inline]
+    #[must_use]
     pub fn has_non_specular(&self) -> bool {
         self.glossy || self.diffuse
     }

@@ -49,11 +49,13 @@ pub struct Conductor {
 
 impl Conductor {
     /// A perfect mirror facet, F = 1.
+    #[must_use]
     pub fn perfect() -> Self {
         Self { ior: None }
     }
 
     /// A conductor with the given complex IOR.
+    #[must_use]
     pub fn new(ior: ComplexIor) -> Self {
         Self { ior: Some(ior) }
     }
@@ -84,6 +86,7 @@ impl Conductor {
     /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives `Vec3::NAN` (a debug
     /// assertion in debug builds).
     #[inline(always)]
+    #[must_use]
     pub fn fresnel(&self, cos_theta: f32) -> Vec3 {
         require!(is_cosine(cos_theta), Vec3::NAN; cos_theta);
         self.reflectance(cos_theta)

@@ -75,6 +75,7 @@ impl Dielectric {
 
     /// The relative index η = η_inside/η_outside.
     #[inline]
+    #[must_use]
     pub fn eta(&self) -> f32 {
         self.eta
     }
@@ -92,6 +93,7 @@ impl Dielectric {
 
     /// The same interface seen from inside: η ↦ 1/η.
     #[inline]
+    #[must_use]
     pub fn flipped(&self) -> Self {
         Self { eta: 1.0 / self.eta }
     }

@@ -53,12 +53,14 @@ impl Diffuse {
     }
 
     /// Non-absorptive facets, albedo 1.
+    #[must_use]
     pub fn white() -> Self {
         Self { albedo: Vec3::ONE }
     }
 
     /// The albedo per channel.
     #[inline]
+    #[must_use]
     pub fn albedo(&self) -> Vec3 {
         self.albedo
     }

@@ -248,6 +248,7 @@ impl GridSlope {
     /// `half_cells` per half axis: the unit normal whose slopes are the cell centre (in the
     /// stretched angles, as the ring centres of [`super::TabulatedSlope`]), where
     /// [`crate::extract_anisotropic`] collocates its samples. Cell k = j·2N + i.
+    #[must_use]
     pub fn cell_centre_direction(scale_x: f32, scale_y: f32, half_cells: usize, i: usize, j: usize) -> Vec3 {
         let n = half_cells;
         // the centre of the cell in the stretched angle (wide tail cells are collocated where
@@ -346,6 +347,7 @@ impl GridSlope {
 
     /// The exact projected area ∫(ω.z − x̃ω.x − ỹω.y)₊ P²² dx̃ dỹ for a unit ω (f64, O(N²)
     /// at worst, O(N) typically).
+    #[must_use]
     pub fn projected_area_exact(&self, w: Vec3) -> f64 {
         self.area(w.as_dvec3())
     }

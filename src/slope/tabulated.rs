@@ -322,33 +322,39 @@ impl TabulatedSlope {
     }
 
     /// The number of rings N.
+    #[must_use]
     pub fn rings(&self) -> usize {
         self.p22.len()
     }
 
     /// The slope scale s of the ring grid.
+    #[must_use]
     pub fn scale(&self) -> f32 {
         self.scale as f32
     }
 
     /// The ring boundaries R₀ = 0 < … < R_N.
+    #[must_use]
     pub fn radii(&self) -> &[f64] {
         &self.radii
     }
 
     /// The normalized ring values pₖ of P²².
+    #[must_use]
     pub fn ring_values(&self) -> &[f64] {
         &self.p22
     }
 
     /// The mass ∫P²² of the input before normalization (for [`Self::from_radial_fn`], the mass
     /// inside R_N: 1 minus the truncated tail for a normalized input).
+    #[must_use]
     pub fn input_mass(&self) -> f64 {
         self.input_mass
     }
 
     /// The GGX-equivalent roughness α = 2·projected_area(horizon) = E|x̃|: the GGX α with the
     /// same projected area at grazing incidence. Reported by `alpha_x`/`alpha_y`.
+    #[must_use]
     pub fn alpha(&self) -> f32 {
         self.alpha
     }
@@ -356,6 +362,7 @@ impl TabulatedSlope {
     /// The Beckmann roughness with the same second moment, α = √E[x̃² + ỹ²] (E\[r²\] = α² for
     /// Beckmann), computed exactly from the rings: E\[r²\] = Σₖ pₖ π(Rₖ₊₁⁴ − Rₖ⁴)/2 (Dupuy 2015,
     /// Listing 4.4, which converts a radial table to Beckmann roughness by its second moment).
+    #[must_use]
     pub fn beckmann_alpha(&self) -> f32 {
         let m2: f64 = self
             .p22
@@ -371,6 +378,7 @@ impl TabulatedSlope {
 
     /// The normal angle θₖ = atan(s·tan θ′) of the centre of ring k (θ′ the stretched angle at
     /// k + ½): where [`crate::extract_isotropic`] collocates the backscattering samples.
+    #[must_use]
     pub fn ring_centre_angle(scale: f32, rings: usize, k: usize) -> f64 {
         (f64::from(scale) * grid_angle(k as f64 + 0.5, rings).tan()).atan()
     }
@@ -385,6 +393,7 @@ impl TabulatedSlope {
     }
 
     /// The radial density P²² at slope radius `r` ≥ 0 (f64).
+    #[must_use]
     pub fn p22_radial(&self, r: f64) -> f64 {
         if r.is_nan() || r < 0.0 {
             return 0.0;
@@ -395,6 +404,7 @@ impl TabulatedSlope {
     /// The exact projected area ∫⟨ω, ωm⟩₊ D(ωm) dωm of the table for ω = (sin θ, 0, cos θ),
     /// as the closed-form sum over rings (O(N), f64): the reference of the interpolated
     /// [`MicrosurfaceSlope::projected_area`].
+    #[must_use]
     pub fn projected_area_exact(&self, w: Vec3) -> f64 {
         let w = w.as_dvec3();
         let h = (w.x * w.x + w.y * w.y).sqrt();

@@ -6,20 +6,13 @@
 //! convergence is checked), not statistical: the bounds are the measured values with a margin,
 //! stated at each assertion.
 
-#[path = "../examples/leadr/surface.rs"]
-#[allow(dead_code)]
-mod surface;
-#[path = "../examples/leadr/validate.rs"]
-#[allow(dead_code)]
-mod validate;
-
-use glam::{DVec2, Vec2, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3};
 use microsurface::{
     Beckmann, CovarianceTreatment, Error, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO,
     MIN_LEADR_ALPHA, SlopeMoments,
 };
-use surface::{NormalMip, direction, procedural_height_map};
-use validate::{Lobe, filter_error, filter_errors};
+use validation::leadr::surface::{NormalMip, direction, procedural_height_map};
+use validation::leadr::validate::{filter_error, filter_errors, texel_lobe};
 
 /// The validation map: 64 × 64 texels, RMS slope 0.2 per axis, fixed seed.
 fn validation_map() -> HeightMap {
@@ -40,12 +33,11 @@ fn errors(
     theta: f64,
 ) -> (f64, f64) {
     let n = 1usize << level;
-    let reference: Vec<Lobe> = (0..n * n)
-        .map(|i| Lobe::leadr(&leadr.lobe(0, (x * n + i % n) as isize, (y * n + i / n) as isize)))
-        .collect();
+    let reference: Vec<LeadrLobe> =
+        (0..n * n).map(|i| leadr.lobe(0, (x * n + i % n) as isize, (y * n + i / n) as isize)).collect();
     let wi = direction(theta, 30.0).as_dvec3();
-    let filtered = Lobe::leadr(&leadr.lobe(level, x as isize, y as isize));
-    let naive = Lobe::texel(normals.slope(level, x as isize, y as isize), f64::from(alpha));
+    let filtered = leadr.lobe(level, x as isize, y as isize);
+    let naive = texel_lobe(normals.slope(level, x as isize, y as isize), alpha);
     let e = filter_errors(wi, &reference, &[filtered, naive], 1.0);
     (e[0].relative_l1, e[1].relative_l1)
 }
@@ -91,8 +83,8 @@ fn leadr_beats_the_naive_normal_mip() {
 fn error_metric_quadrature_converges() {
     let map = validation_map();
     let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(0.1).unwrap()).unwrap();
-    let reference: Vec<Lobe> = (0..64).map(|i| Lobe::leadr(&leadr.lobe(0, i % 8, i / 8))).collect();
-    let filtered = Lobe::leadr(&leadr.lobe(3, 0, 0));
+    let reference: Vec<LeadrLobe> = (0..64).map(|i| leadr.lobe(0, i % 8, i / 8)).collect();
+    let filtered = leadr.lobe(3, 0, 0);
     for theta in [0.0, 60.0] {
         let wi = direction(theta, 30.0).as_dvec3();
         let (a, b) =
@@ -326,10 +318,45 @@ fn invalid_lookups_follow_the_policy() {
     );
 }
 
-/// The validation's closed-form lobe is the crate's noncentral correlated Beckmann
-/// ([`LeadrLobe::slope`]): D (eq. 3.2) and G1 (eq. 3.3) agree to 1e-5 relative at 2 000 random
-/// direction pairs of lobes with mean slopes, anisotropy and correlation, and so the BRDF
-/// D G1 G1/(4 cos θi cos θo) the validation measures is the crate's.
+/// An independent oracle for the crate's noncentral lobe: the slope density N(mean, Σ)
+/// (Dupuy 2015, eq. 3.2) and Smith's G1 (eq. 3.3) in closed form, A(k) = E[(k.z − k.xy·h̃)⁺]
+/// = s φ(c/s) + c Φ(c/s) for the Gaussian of mean c = k.z − k.xy·mean, variance s² = k.xyᵀ Σ k.xy.
+struct ClosedForm {
+    mean: DVec2,
+    cov: [f64; 3],
+}
+
+impl ClosedForm {
+    fn new(lobe: &LeadrLobe) -> Self {
+        Self { mean: lobe.mean_slope().as_dvec2(), cov: lobe.covariance().map(f64::from) }
+    }
+
+    fn p22(&self, s: DVec2) -> f64 {
+        let [xx, yy, xy] = self.cov;
+        let det = xx * yy - xy * xy;
+        let d = s - self.mean;
+        let q = (yy * d.x * d.x + xx * d.y * d.y - 2.0 * xy * d.x * d.y) / det;
+        (-0.5 * q).exp() / (2.0 * std::f64::consts::PI * det.sqrt())
+    }
+
+    fn g1(&self, k: DVec3) -> f64 {
+        if k.z <= 0.0 {
+            return 0.0;
+        }
+        let c = k.z - k.x * self.mean.x - k.y * self.mean.y;
+        let [xx, yy, xy] = self.cov;
+        let s = (k.x * k.x * xx + k.y * k.y * yy + 2.0 * k.x * k.y * xy).sqrt();
+        let t = c / s;
+        let area = s * (-0.5 * t * t).exp() / (2.0 * std::f64::consts::PI).sqrt()
+            + c * 0.5 * libm::erfc(-t * std::f64::consts::FRAC_1_SQRT_2);
+        k.z / area
+    }
+}
+
+/// The crate's noncentral correlated Beckmann ([`LeadrLobe::slope`], which the filtering
+/// validation evaluates) against the independent closed form [`ClosedForm`]: D (eq. 3.2) and
+/// G1 (eq. 3.3) agree to 1e-5 relative at 2 000 random direction pairs of lobes with mean
+/// slopes, anisotropy and correlation.
 #[test]
 fn closed_form_matches_the_crate_noncentral_slope() {
     use rand::{RngExt, SeedableRng};
@@ -345,8 +372,8 @@ fn closed_form_matches_the_crate_noncentral_slope() {
     ];
     let mut worst = (0.0f64, 0.0f64);
     for lobe in &lobes {
-        let crate_slope = lobe.slope().unwrap();
-        let closed = Lobe::leadr(lobe);
+        let crate_slope = lobe.slope();
+        let closed = ClosedForm::new(lobe);
         for _ in 0..2_000 / lobes.len() {
             let wi = direction(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>());
             let wh = direction(60.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>());
@@ -446,4 +473,47 @@ fn slope_map_transforms_moments() {
     };
     assert_eq!(name(m.transformed(Mat2::from_cols(Vec2::new(f32::NAN, 0.0), Vec2::Y))), "slope_map");
     assert_eq!(name(m.transformed(Mat2::from_diagonal(Vec2::splat(1e30)))), "slope_map");
+}
+
+/// Every finite uv is a valid, wrapping lookup: far-out coordinates (±1e30, ±1e10 + 0.25, which
+/// f32 rounds to ±1e10, and exactly representable ±(2²⁰ + 0.25)) give the lookup at uv mod 1,
+/// bilinear and trilinear. Before the fix, floor(uv · width) saturated the texel index and the
+/// neighbour's index overflowed (a panic in debug builds, the wrong texel in release).
+#[test]
+fn far_out_uv_wraps() {
+    let map = LeadrMap::from_height_map(&procedural_height_map(8, 0.3, 5), Beckmann::isotropic(0.2).unwrap())
+        .unwrap();
+    let far = [1e30f32, -1e30, 1e10 + 0.25, -1e10 - 0.25, 1_048_576.25, -1_048_576.25];
+    for &u in &far {
+        for &v in &[0.375f32, u, -u] {
+            let uv = Vec2::new(u, v);
+            let wrapped = Vec2::new(f64::from(u).rem_euclid(1.0) as f32, f64::from(v).rem_euclid(1.0) as f32);
+            for level in [0, 1, 3] {
+                let got = std::panic::catch_unwind(|| map.level(level).bilinear(uv));
+                let got = got.unwrap_or_else(|_| panic!("level {level}: bilinear({uv}) panicked"));
+                assert_eq!(got, map.level(level).bilinear(wrapped), "level {level}: uv {uv} vs {wrapped}");
+            }
+            assert_eq!(map.trilinear(uv, 1.5), map.trilinear(wrapped, 1.5), "trilinear: uv {uv}");
+        }
+    }
+}
+
+/// Every lobe [`LeadrLobe::from_moments`] makes is a valid crate lobe, even of extreme finite
+/// moments (|E| up to f32::MAX): `slope()` is infallible, and its D and G1 are finite.
+#[test]
+fn extreme_moments_give_valid_slopes() {
+    let big = f32::MAX;
+    for e in [
+        [big, -big, big, big, 0.0],
+        [big, big, 0.0, 0.0, big],
+        [-big, big, big, -big, -big],
+        [1e19, -1e19, 1e38, 1e38, -1e38],
+        [0.0, 0.0, big, 1e-30, 0.0],
+        [0.0, 0.0, 0.0, 0.0, 0.0],
+    ] {
+        let lobe = LeadrLobe::from_moments(&SlopeMoments::new(e[0], e[1], e[2], e[3], e[4]).unwrap());
+        let slope = lobe.slope();
+        let (d, g) = (slope.d(slope.mean_normal()), slope.g1(Vec3::Z));
+        assert!(d.is_finite() && g.is_finite() && g >= 0.0, "{e:?} → {lobe:?}: D {d}, G1 {g}");
+    }
 }

@@ -108,7 +108,8 @@ impl NormalMip {
     fn bilinear(&self, level: usize, uv: Vec2) -> DVec3 {
         let (w, normals) = &self.levels[level.min(self.levels.len() - 1)];
         let wi = *w as isize;
-        let p = uv.as_dvec2() * *w as f64 - 0.5;
+        // wrapped first, as `MomentLevel::bilinear`: any finite uv is a lookup
+        let p = uv.as_dvec2().rem_euclid(DVec2::ONE) * *w as f64 - 0.5;
         let (x0, y0) = (p.x.floor(), p.y.floor());
         let (fx, fy) = (p.x - x0, p.y - y0);
         let at = |x: isize, y: isize| normals[(y.rem_euclid(wi) * wi + x.rem_euclid(wi)) as usize];

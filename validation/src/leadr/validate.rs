@@ -1,13 +1,12 @@
-//! The single-scattering BRDF of a noncentral correlated Beckmann lobe in closed form, and the
-//! relative L1 error of a filtered lobe against the average of the fine texels' BRDFs (the
-//! supersampled ground truth). Shared by `examples/leadr` and `tests/leadr.rs`.
+//! The relative L1 error of a filtered LEADR lobe against the average of the fine texels' BRDFs
+//! (the supersampled ground truth), measured on the crate's own lobes: every BRDF value is
+//! [`Noncentral::eval_single_scattering`] of [`LeadrLobe::slope`] with a perfect mirror
+//! ([`Conductor::perfect`]), f = D(ωh) G1(ωi) G1(ωo)/(4 cos θi cos θo) (Dupuy 2015, eqs.
+//! 3.2–3.3, the separable Torrance–Sparrow form of §2.1).
 
 use glam::{DVec2, DVec3};
-use microsurface::LeadrLobe;
-use std::f64::consts::{FRAC_1_SQRT_2, PI};
+use microsurface::{Beckmann, Conductor, LeadrLobe, Noncentral, SlopeMoments};
 
-/// 1/√(2π).
-const INV_SQRT_TAU: f64 = 0.398_942_280_401_432_7;
 /// Half-width of the slope-space quadrature box, in standard deviations of each lobe.
 const BOX_SIGMAS: f64 = 6.0;
 /// Quadrature nodes per standard deviation of the narrowest lobe (midpoint rule; for Gaussian
@@ -17,94 +16,33 @@ pub const NODES_PER_SIGMA: f64 = 2.5;
 /// A cap on the nodes per axis.
 const MAX_NODES: usize = 700;
 
-/// A noncentral, anisotropic, correlated Beckmann slope distribution N(mean, Σ) (Dupuy 2015,
-/// eq. 3.2) with Smith masking (eq. 3.3) and the single-scattering BRDF of a perfect mirror
-/// microsurface (F = 1): f = D(ωh) G1(ωi) G1(ωo) / (4 cos θi cos θo), the separable
-/// Torrance–Sparrow form the thesis uses (§2.1, listing 3.2 per direction).
-#[derive(Debug, Clone, Copy)]
-pub struct Lobe {
-    mean: DVec2,
-    cov: [f64; 3],
-    inv: [f64; 3],
-    norm: f64,
+/// The lobe of a texel of mesosurface slope `mean` on an isotropic Beckmann base of roughness
+/// `alpha` (the naive filter's lobe): the LEADR lobe of that texel's moments.
+pub fn texel_lobe(mean: DVec2, alpha: f32) -> LeadrLobe {
+    let base = Beckmann::isotropic(alpha).expect("a valid base roughness");
+    LeadrLobe::from_moments(&SlopeMoments::from_slope(mean.as_vec2(), base).expect("a finite slope"))
 }
 
-impl Lobe {
-    /// The lobe of slope mean `mean` and covariance [Σxx, Σyy, Σxy] (positive definite).
-    pub fn new(mean: DVec2, cov: [f64; 3]) -> Self {
-        let [xx, yy, xy] = cov;
-        let det = xx * yy - xy * xy;
-        assert!(det > 0.0 && xx > 0.0, "a positive-definite covariance: {cov:?}");
-        Self { mean, cov, inv: [yy / det, xx / det, -xy / det], norm: 1.0 / (2.0 * PI * det.sqrt()) }
-    }
+/// f·cos θo of the mirror microsurface of `lobe` for light from `wi` leaving along `wo`
+/// ([`Noncentral::eval_single_scattering`] with F = 1), in f64.
+pub fn f_cos(lobe: &LeadrLobe, wi: DVec3, wo: DVec3) -> f64 {
+    let f = lobe.slope().eval_single_scattering(&Conductor::perfect(), wi.as_vec3(), wo.as_vec3());
+    f64::from(f.x)
+}
 
-    /// The lobe LEADR gives a texel.
-    pub fn leadr(lobe: &LeadrLobe) -> Self {
-        Self::new(lobe.mean_slope().as_dvec2(), lobe.covariance().map(f64::from))
-    }
+/// The box (min, max corners) holding `BOX_SIGMAS` standard deviations of the slopes.
+fn slope_box(lobe: &LeadrLobe) -> (DVec2, DVec2) {
+    let [xx, yy, _] = lobe.covariance().map(f64::from);
+    let half = DVec2::new(xx.sqrt(), yy.sqrt()) * BOX_SIGMAS;
+    let mean = lobe.mean_slope().as_dvec2();
+    (mean - half, mean + half)
+}
 
-    /// A texel of mesosurface slope `mean` on an isotropic Beckmann base of roughness `alpha`
-    /// (the fine texels of the reference, and the naive filter's lobe).
-    pub fn texel(mean: DVec2, alpha: f64) -> Self {
-        let v = 0.5 * alpha * alpha;
-        Self::new(mean, [v, v, 0.0])
-    }
-
-    /// The slope density.
-    pub fn p22(&self, s: DVec2) -> f64 {
-        let d = s - self.mean;
-        let [a, b, c] = self.inv;
-        self.norm * (-0.5 * (a * d.x * d.x + b * d.y * d.y + 2.0 * c * d.x * d.y)).exp()
-    }
-
-    /// The projected area A(k) = ∫ P²²(h̃) (k.z − k.x h̃x − k.y h̃y)⁺ dh̃ = E[u⁺] for the Gaussian
-    /// u of mean c = k.z − k.xy·mean and variance s² = k.xyᵀ Σ k.xy: s φ(t) + c Φ(t), t = c/s.
-    pub fn area(&self, k: DVec3) -> f64 {
-        let c = k.z - k.x * self.mean.x - k.y * self.mean.y;
-        let [xx, yy, xy] = self.cov;
-        let s2 = k.x * k.x * xx + k.y * k.y * yy + 2.0 * k.x * k.y * xy;
-        if s2 <= 0.0 {
-            return c.max(0.0);
-        }
-        let s = s2.sqrt();
-        let t = c / s;
-        s * INV_SQRT_TAU * (-0.5 * t * t).exp() + c * 0.5 * libm::erfc(-t * FRAC_1_SQRT_2)
-    }
-
-    /// G1(k) = cos θk / A(k) (eq. 3.3), 0 below the base plane.
-    pub fn g1(&self, k: DVec3) -> f64 {
-        if k.z <= 0.0 { 0.0 } else { k.z / self.area(k) }
-    }
-
-    /// f·cos θo of the mirror microsurface for light from `wi` leaving along `wo`.
-    pub fn f_cos(&self, wi: DVec3, wo: DVec3) -> f64 {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return 0.0;
-        }
-        let h = (wi + wo).normalize();
-        let d = self.p22(DVec2::new(-h.x / h.z, -h.y / h.z)) / (h.z * h.z * h.z * h.z);
-        d * self.g1(wi) * self.g1(wo) / (4.0 * wi.z)
-    }
-
-    /// The slope-space integrand of the directional albedo for light from `wi`: f·cos θo times
-    /// the Jacobian |dωo/dh̃| = 4 (ωi·ωh) cos³θh of the mirror map h̃ ↦ ωo, i.e.
-    /// P²²(h̃) G1(ωi) G1(ωo) (ωi·ωh)/(cos θi cos θh), for the given G1(ωi).
-    fn albedo_density(&self, g1_wi: f64, wi: DVec3, slope: DVec2, h: DVec3, wo: DVec3, cos_ih: f64) -> f64 {
-        self.p22(slope) * g1_wi * self.g1(wo) * cos_ih / (wi.z * h.z)
-    }
-
-    /// The box (min, max corners) holding `BOX_SIGMAS` standard deviations of the slopes.
-    fn slope_box(&self) -> (DVec2, DVec2) {
-        let half = DVec2::new(self.cov[0].sqrt(), self.cov[1].sqrt()) * BOX_SIGMAS;
-        (self.mean - half, self.mean + half)
-    }
-
-    /// The smallest standard deviation of the slopes along any direction.
-    fn min_sigma(&self) -> f64 {
-        let [xx, yy, xy] = self.cov;
-        let (m, r) = (0.5 * (xx + yy), (0.5 * (xx - yy)).hypot(xy));
-        (m - r).max(0.0).sqrt()
-    }
+/// The smallest standard deviation of the slopes along any direction.
+fn min_sigma(lobe: &LeadrLobe) -> f64 {
+    let [xx, yy, xy] = lobe.covariance().map(f64::from);
+    let (m, r) = (0.5 * (xx + yy), (0.5 * (xx - yy)).hypot(xy));
+    (m - r).max(0.0).sqrt()
 }
 
 /// The error of a filtered lobe against the supersampled ground truth for light from `wi`.
@@ -120,7 +58,7 @@ pub struct FilterError {
 
 /// The relative L1 error over outgoing directions of `filtered` against the average of the
 /// `reference` lobes' BRDFs, for light from `wi` ([`filter_errors`] for one candidate).
-pub fn filter_error(wi: DVec3, reference: &[Lobe], filtered: &Lobe, refine: f64) -> FilterError {
+pub fn filter_error(wi: DVec3, reference: &[LeadrLobe], filtered: &LeadrLobe, refine: f64) -> FilterError {
     filter_errors(wi, reference, &[*filtered], refine)[0]
 }
 
@@ -130,21 +68,27 @@ pub fn filter_error(wi: DVec3, reference: &[Lobe], filtered: &Lobe, refine: f64)
 /// (ωi + ωo).z > 0, which holds for every ωo above the horizon), over a box holding
 /// `BOX_SIGMAS` standard deviations of every lobe. `refine` multiplies the node density (1 for
 /// the stated default, 2 to check convergence).
-pub fn filter_errors(wi: DVec3, reference: &[Lobe], candidates: &[Lobe], refine: f64) -> Vec<FilterError> {
+pub fn filter_errors(
+    wi: DVec3,
+    reference: &[LeadrLobe],
+    candidates: &[LeadrLobe],
+    refine: f64,
+) -> Vec<FilterError> {
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     let mut sigma = f64::INFINITY;
     for l in reference.iter().chain(candidates) {
-        let (a, b) = l.slope_box();
+        let (a, b) = slope_box(l);
         lo = lo.min(a);
         hi = hi.max(b);
-        sigma = sigma.min(l.min_sigma());
+        sigma = sigma.min(min_sigma(l));
     }
     let step_wanted = sigma / (NODES_PER_SIGMA * refine);
     let extent = hi - lo;
     let nodes = ((extent.max_element() / step_wanted).ceil() as usize).clamp(16, MAX_NODES);
     let step = extent / nodes as f64;
-    let g1_ref: Vec<f64> = reference.iter().map(|l| l.g1(wi)).collect();
-    let g1_candidates: Vec<f64> = candidates.iter().map(|l| l.g1(wi)).collect();
+    let reference: Vec<_> = reference.iter().map(LeadrLobe::slope).collect();
+    let candidates: Vec<_> = candidates.iter().map(LeadrLobe::slope).collect();
+    let (mirror, wi32) = (Conductor::perfect(), wi.as_vec3());
     let mut diff = vec![0.0; candidates.len()];
     let mut total = 0.0;
     for j in 0..nodes {
@@ -159,14 +103,14 @@ pub fn filter_errors(wi: DVec3, reference: &[Lobe], candidates: &[Lobe], refine:
             if wo.z <= 0.0 {
                 continue;
             }
-            let reference_value = reference
-                .iter()
-                .zip(&g1_ref)
-                .map(|(l, &g)| l.albedo_density(g, wi, slope, h, wo, cos_ih))
-                .sum::<f64>()
-                / reference.len() as f64;
-            for ((d, c), &g) in diff.iter_mut().zip(candidates).zip(&g1_candidates) {
-                *d += (c.albedo_density(g, wi, slope, h, wo, cos_ih) - reference_value).abs();
+            // f·cos θo times the Jacobian |dωo/dh̃| = 4 (ωi·ωh) cos³θh of the mirror map h̃ ↦ ωo
+            let jacobian = 4.0 * cos_ih * h.z * h.z * h.z;
+            let wo32 = wo.as_vec3();
+            let density =
+                |l: &Noncentral<_>| f64::from(l.eval_single_scattering(&mirror, wi32, wo32).x) * jacobian;
+            let reference_value = reference.iter().map(density).sum::<f64>() / reference.len() as f64;
+            for (d, c) in diff.iter_mut().zip(&candidates) {
+                *d += (density(c) - reference_value).abs();
             }
             total += reference_value;
         }

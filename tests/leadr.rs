@@ -48,19 +48,31 @@ fn errors(
 ///
 /// Measured (mean over the 4 texels; worst per-texel ratio LEADR/naive over all cells 0.49):
 /// α = 0.1: LEADR 0.29–0.34, naive 0.95–1.36; α = 0.3: LEADR 0.058–0.14, naive 0.20–0.40.
+///
+/// The bounds, and what they protect against. The errors are deterministic (a fixed map, a
+/// midpoint quadrature converged to 1e-3, [`error_metric_quadrature_converges`]), so the
+/// margins only have to absorb that and floating-point library differences; they are kept
+/// small enough to catch modelling defects (each measured by substituting the defect's lobe):
+/// - per texel, LEADR < 0.6 × naive (measured worst 0.49): LEADR keeps the spread of the
+///   slopes that the naive MIP throws away, by a clear factor;
+/// - per (α, level), the mean LEADR error ≤ the measured maximum over θ ≤ 60° + 0.02
+///   (α = 0.1) or + 0.01 (α = 0.3), 6–14 % of the values and 10–20 × the quadrature's
+///   convergence. A covariance off by a factor 2 (the ½ of Σ = ½ α² dropped or doubled) gives
+///   0.49–0.66 and fails every cell; a dropped correlation ρ fails level 3 (α = 0.1: 0.341
+///   against the bound 0.33; α = 0.3: 0.102 against 0.097).
 #[test]
 fn leadr_beats_the_naive_normal_mip() {
     let map = validation_map();
     let normals = NormalMip::new(&map);
-    // bounds on the mean LEADR error: measured maximum + about 20 %
-    for (alpha, bound) in [(0.1f32, 0.40), (0.3, 0.17)] {
+    // (α, [bound on the mean LEADR error at levels 2, 3, 4]); measured maxima
+    // α = 0.1: 0.338, 0.307, 0.308; α = 0.3: 0.070, 0.087, 0.136
+    for (alpha, bounds) in [(0.1f32, [0.36, 0.33, 0.33]), (0.3, [0.08, 0.097, 0.147])] {
         let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(alpha).unwrap()).unwrap();
-        for level in [2usize, 3, 4] {
+        for (level, bound) in [2usize, 3, 4].into_iter().zip(bounds) {
             for theta in [0.0, 30.0, 60.0] {
                 let (mut mean_leadr, mut mean_naive) = (0.0, 0.0);
                 for texel in TEXELS {
                     let (e, e_naive) = errors(&leadr, &normals, alpha, level, texel, theta);
-                    // the margin: measured worst ratio 0.49
                     assert!(
                         e < 0.6 * e_naive,
                         "α {alpha} level {level} θ {theta}° texel {texel:?}: LEADR {e:.4} vs naive {e_naive:.4}"
@@ -74,6 +86,37 @@ fn leadr_beats_the_naive_normal_mip() {
                 );
             }
         }
+    }
+}
+
+/// The breakdown at grazing views the README states, pinned on the README's (the example's)
+/// 128² map: at α = 0.1, level 2 (16 sharp, distinct fine lobes), LEADR's mean error exceeds the
+/// naive MIP's at 75° and 85° (measured ratios 1.42 and 1.69), while up to 60° it is 0.29–0.37 of
+/// it. Smith masking is not linear in the slope distribution, so the one wide lobe's G1 and the
+/// average of the fine texels' G1 part. Deterministic; the thresholds are the README's claim
+/// (ratio > 1 at grazing views, < 0.5 at 0–60°), not fitted to the measurement.
+#[test]
+fn leadr_breaks_down_at_grazing_views() {
+    let map = procedural_height_map(128, 0.2, 1);
+    let normals = NormalMip::new(&map);
+    let alpha = 0.1;
+    let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(alpha).unwrap()).unwrap();
+    let mean_ratio = |theta: f64| {
+        let (mut mean_leadr, mut mean_naive) = (0.0, 0.0);
+        for texel in TEXELS {
+            let (e, e_naive) = errors(&leadr, &normals, alpha, 2, texel, theta);
+            mean_leadr += e;
+            mean_naive += e_naive;
+        }
+        (mean_leadr / mean_naive, mean_leadr / TEXELS.len() as f64, mean_naive / TEXELS.len() as f64)
+    };
+    for theta in [0.0, 60.0] {
+        let (ratio, l, n) = mean_ratio(theta);
+        assert!(ratio < 0.5, "θ {theta}°: LEADR/naive {ratio:.3} (LEADR {l:.4}, naive {n:.4})");
+    }
+    for theta in [75.0, 85.0] {
+        let (ratio, l, n) = mean_ratio(theta);
+        assert!(ratio > 1.0, "θ {theta}°: LEADR/naive {ratio:.3} (LEADR {l:.4}, naive {n:.4})");
     }
 }
 
@@ -483,7 +526,8 @@ fn slope_map_transforms_moments() {
 fn far_out_uv_wraps() {
     let map = LeadrMap::from_height_map(&procedural_height_map(8, 0.3, 5), Beckmann::isotropic(0.2).unwrap())
         .unwrap();
-    let far = [1e30f32, -1e30, 1e10 + 0.25, -1e10 - 0.25, 1_048_576.25, -1_048_576.25];
+    let exact = 2f32.powi(20) + 0.25; // representable: the f32 spacing at 2²⁰ is 0.125
+    let far = [1e30f32, -1e30, 1e10 + 0.25, -1e10 - 0.25, exact, -exact];
     for &u in &far {
         for &v in &[0.375f32, u, -u] {
             let uv = Vec2::new(u, v);

@@ -2,6 +2,8 @@
 //! D against eq. 2.26, the normalization and projected-area identities, the rotation identity,
 //! the sampler's chi-square fit and the constructors' rejections.
 
+
+
 use glam::Vec3;
 use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope};
 
@@ -110,10 +112,10 @@ fn constructors_reject_invalid_parameters() {
     assert!(Elliptical::<Ggx>::from_bivariate(0.3, 0.2, 0.999_999).is_ok());
 }
 
-use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
-use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::integrate_sphere;
+use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
+use std::f64::consts::PI;
 
 /// Correlations of the identity tests, up to |ρ| = 0.99.
 const RHOS: [f32; 5] = [-0.99, -0.6, 0.0, 0.8, 0.99];
@@ -227,8 +229,7 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
             );
         }
         for (v, (theta, psi)) in [(0.4, 0.3), (1.2, 2.0), (1.45, -2.5)].into_iter().enumerate() {
-            let (wi, wi_aligned) =
-                (validation::dir(theta, psi), validation::dir(theta, psi - f64::from(phi)));
+            let (wi, wi_aligned) = (validation::dir(theta, psi), validation::dir(theta, psi - f64::from(phi)));
             for (material, name) in [(0, "gold"), (1, "glass")] {
                 let seed = 1000 + 10 * v as u64 + material;
                 let per_order = |slope_is_elliptical: bool| {

@@ -2,10 +2,10 @@
 //! tangent plane (Dupuy 2015, thesis §2.3).
 
 use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction, is_direction64, is_uniform};
+use crate::vector::ensure_visible;
 use crate::albedo::{AlbedoTable, DielectricAlbedoTable};
 use crate::bsdf::AlbedoTabulated;
 use crate::error::Error;
-use crate::vector::ensure_visible;
 use glam::{DVec3, Vec2, Vec3};
 
 /// A slope distribution with independent roughnesses along x and y, from which

@@ -6,20 +6,13 @@
 //! convergence is checked), not statistical: the bounds are the measured values with a margin,
 //! stated at each assertion.
 
-#[path = "../examples/leadr/surface.rs"]
-#[allow(dead_code)]
-mod surface;
-#[path = "../examples/leadr/validate.rs"]
-#[allow(dead_code)]
-mod validate;
-
-use glam::{DVec2, Vec2, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3};
 use microsurface::{
     Beckmann, CovarianceTreatment, Error, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO,
     MIN_LEADR_ALPHA, SlopeMoments,
 };
-use surface::{NormalMip, direction, procedural_height_map};
-use validate::{Lobe, filter_error, filter_errors};
+use validation::leadr::surface::{NormalMip, direction, procedural_height_map};
+use validation::leadr::validate::{filter_error, filter_errors, texel_lobe};
 
 /// The validation map: 64 × 64 texels, RMS slope 0.2 per axis, fixed seed.
 fn validation_map() -> HeightMap {
@@ -40,12 +33,11 @@ fn errors(
     theta: f64,
 ) -> (f64, f64) {
     let n = 1usize << level;
-    let reference: Vec<Lobe> = (0..n * n)
-        .map(|i| Lobe::leadr(&leadr.lobe(0, (x * n + i % n) as isize, (y * n + i / n) as isize)))
-        .collect();
+    let reference: Vec<LeadrLobe> =
+        (0..n * n).map(|i| leadr.lobe(0, (x * n + i % n) as isize, (y * n + i / n) as isize)).collect();
     let wi = direction(theta, 30.0).as_dvec3();
-    let filtered = Lobe::leadr(&leadr.lobe(level, x as isize, y as isize));
-    let naive = Lobe::texel(normals.slope(level, x as isize, y as isize), f64::from(alpha));
+    let filtered = leadr.lobe(level, x as isize, y as isize);
+    let naive = texel_lobe(normals.slope(level, x as isize, y as isize), alpha);
     let e = filter_errors(wi, &reference, &[filtered, naive], 1.0);
     (e[0].relative_l1, e[1].relative_l1)
 }
@@ -56,19 +48,31 @@ fn errors(
 ///
 /// Measured (mean over the 4 texels; worst per-texel ratio LEADR/naive over all cells 0.49):
 /// α = 0.1: LEADR 0.29–0.34, naive 0.95–1.36; α = 0.3: LEADR 0.058–0.14, naive 0.20–0.40.
+///
+/// The bounds, and what they protect against. The errors are deterministic (a fixed map, a
+/// midpoint quadrature converged to 1e-3, [`error_metric_quadrature_converges`]), so the
+/// margins only have to absorb that and floating-point library differences; they are kept
+/// small enough to catch modelling defects (each measured by substituting the defect's lobe):
+/// - per texel, LEADR < 0.6 × naive (measured worst 0.49): LEADR keeps the spread of the
+///   slopes that the naive MIP throws away, by a clear factor;
+/// - per (α, level), the mean LEADR error ≤ the measured maximum over θ ≤ 60° + 0.02
+///   (α = 0.1) or + 0.01 (α = 0.3), 6–14 % of the values and 10–20 × the quadrature's
+///   convergence. A covariance off by a factor 2 (the ½ of Σ = ½ α² dropped or doubled) gives
+///   0.49–0.66 and fails every cell; a dropped correlation ρ fails level 3 (α = 0.1: 0.341
+///   against the bound 0.33; α = 0.3: 0.102 against 0.097).
 #[test]
 fn leadr_beats_the_naive_normal_mip() {
     let map = validation_map();
     let normals = NormalMip::new(&map);
-    // bounds on the mean LEADR error: measured maximum + about 20 %
-    for (alpha, bound) in [(0.1f32, 0.40), (0.3, 0.17)] {
+    // (α, [bound on the mean LEADR error at levels 2, 3, 4]); measured maxima
+    // α = 0.1: 0.338, 0.307, 0.308; α = 0.3: 0.070, 0.087, 0.136
+    for (alpha, bounds) in [(0.1f32, [0.36, 0.33, 0.33]), (0.3, [0.08, 0.097, 0.147])] {
         let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(alpha).unwrap()).unwrap();
-        for level in [2usize, 3, 4] {
+        for (level, bound) in [2usize, 3, 4].into_iter().zip(bounds) {
             for theta in [0.0, 30.0, 60.0] {
                 let (mut mean_leadr, mut mean_naive) = (0.0, 0.0);
                 for texel in TEXELS {
                     let (e, e_naive) = errors(&leadr, &normals, alpha, level, texel, theta);
-                    // the margin: measured worst ratio 0.49
                     assert!(
                         e < 0.6 * e_naive,
                         "α {alpha} level {level} θ {theta}° texel {texel:?}: LEADR {e:.4} vs naive {e_naive:.4}"
@@ -85,14 +89,45 @@ fn leadr_beats_the_naive_normal_mip() {
     }
 }
 
+/// The breakdown at grazing views the README states, pinned on the README's (the example's)
+/// 128² map: at α = 0.1, level 2 (16 sharp, distinct fine lobes), LEADR's mean error exceeds the
+/// naive MIP's at 75° and 85° (measured ratios 1.42 and 1.69), while up to 60° it is 0.29–0.37 of
+/// it. Smith masking is not linear in the slope distribution, so the one wide lobe's G1 and the
+/// average of the fine texels' G1 part. Deterministic; the thresholds are the README's claim
+/// (ratio > 1 at grazing views, < 0.5 at 0–60°), not fitted to the measurement.
+#[test]
+fn leadr_breaks_down_at_grazing_views() {
+    let map = procedural_height_map(128, 0.2, 1);
+    let normals = NormalMip::new(&map);
+    let alpha = 0.1;
+    let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(alpha).unwrap()).unwrap();
+    let mean_ratio = |theta: f64| {
+        let (mut mean_leadr, mut mean_naive) = (0.0, 0.0);
+        for texel in TEXELS {
+            let (e, e_naive) = errors(&leadr, &normals, alpha, 2, texel, theta);
+            mean_leadr += e;
+            mean_naive += e_naive;
+        }
+        (mean_leadr / mean_naive, mean_leadr / TEXELS.len() as f64, mean_naive / TEXELS.len() as f64)
+    };
+    for theta in [0.0, 60.0] {
+        let (ratio, l, n) = mean_ratio(theta);
+        assert!(ratio < 0.5, "θ {theta}°: LEADR/naive {ratio:.3} (LEADR {l:.4}, naive {n:.4})");
+    }
+    for theta in [75.0, 85.0] {
+        let (ratio, l, n) = mean_ratio(theta);
+        assert!(ratio > 1.0, "θ {theta}°: LEADR/naive {ratio:.3} (LEADR {l:.4}, naive {n:.4})");
+    }
+}
+
 /// The quadrature of the error metric has converged: doubling the node density changes the
 /// relative L1 error by less than 1e-3 (measured 3e-4 and below) and the albedo by less than 1e-6.
 #[test]
 fn error_metric_quadrature_converges() {
     let map = validation_map();
     let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(0.1).unwrap()).unwrap();
-    let reference: Vec<Lobe> = (0..64).map(|i| Lobe::leadr(&leadr.lobe(0, i % 8, i / 8))).collect();
-    let filtered = Lobe::leadr(&leadr.lobe(3, 0, 0));
+    let reference: Vec<LeadrLobe> = (0..64).map(|i| leadr.lobe(0, i % 8, i / 8)).collect();
+    let filtered = leadr.lobe(3, 0, 0);
     for theta in [0.0, 60.0] {
         let wi = direction(theta, 30.0).as_dvec3();
         let (a, b) =
@@ -326,10 +361,45 @@ fn invalid_lookups_follow_the_policy() {
     );
 }
 
-/// The validation's closed-form lobe is the crate's noncentral correlated Beckmann
-/// ([`LeadrLobe::slope`]): D (eq. 3.2) and G1 (eq. 3.3) agree to 1e-5 relative at 2 000 random
-/// direction pairs of lobes with mean slopes, anisotropy and correlation, and so the BRDF
-/// D G1 G1/(4 cos θi cos θo) the validation measures is the crate's.
+/// An independent oracle for the crate's noncentral lobe: the slope density N(mean, Σ)
+/// (Dupuy 2015, eq. 3.2) and Smith's G1 (eq. 3.3) in closed form, A(k) = E[(k.z − k.xy·h̃)⁺]
+/// = s φ(c/s) + c Φ(c/s) for the Gaussian of mean c = k.z − k.xy·mean, variance s² = k.xyᵀ Σ k.xy.
+struct ClosedForm {
+    mean: DVec2,
+    cov: [f64; 3],
+}
+
+impl ClosedForm {
+    fn new(lobe: &LeadrLobe) -> Self {
+        Self { mean: lobe.mean_slope().as_dvec2(), cov: lobe.covariance().map(f64::from) }
+    }
+
+    fn p22(&self, s: DVec2) -> f64 {
+        let [xx, yy, xy] = self.cov;
+        let det = xx * yy - xy * xy;
+        let d = s - self.mean;
+        let q = (yy * d.x * d.x + xx * d.y * d.y - 2.0 * xy * d.x * d.y) / det;
+        (-0.5 * q).exp() / (2.0 * std::f64::consts::PI * det.sqrt())
+    }
+
+    fn g1(&self, k: DVec3) -> f64 {
+        if k.z <= 0.0 {
+            return 0.0;
+        }
+        let c = k.z - k.x * self.mean.x - k.y * self.mean.y;
+        let [xx, yy, xy] = self.cov;
+        let s = (k.x * k.x * xx + k.y * k.y * yy + 2.0 * k.x * k.y * xy).sqrt();
+        let t = c / s;
+        let area = s * (-0.5 * t * t).exp() / (2.0 * std::f64::consts::PI).sqrt()
+            + c * 0.5 * libm::erfc(-t * std::f64::consts::FRAC_1_SQRT_2);
+        k.z / area
+    }
+}
+
+/// The crate's noncentral correlated Beckmann ([`LeadrLobe::slope`], which the filtering
+/// validation evaluates) against the independent closed form [`ClosedForm`]: D (eq. 3.2) and
+/// G1 (eq. 3.3) agree to 1e-5 relative at 2 000 random direction pairs of lobes with mean
+/// slopes, anisotropy and correlation.
 #[test]
 fn closed_form_matches_the_crate_noncentral_slope() {
     use rand::{RngExt, SeedableRng};
@@ -345,8 +415,8 @@ fn closed_form_matches_the_crate_noncentral_slope() {
     ];
     let mut worst = (0.0f64, 0.0f64);
     for lobe in &lobes {
-        let crate_slope = lobe.slope().unwrap();
-        let closed = Lobe::leadr(lobe);
+        let crate_slope = lobe.slope();
+        let closed = ClosedForm::new(lobe);
         for _ in 0..2_000 / lobes.len() {
             let wi = direction(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>());
             let wh = direction(60.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>());
@@ -446,4 +516,48 @@ fn slope_map_transforms_moments() {
     };
     assert_eq!(name(m.transformed(Mat2::from_cols(Vec2::new(f32::NAN, 0.0), Vec2::Y))), "slope_map");
     assert_eq!(name(m.transformed(Mat2::from_diagonal(Vec2::splat(1e30)))), "slope_map");
+}
+
+/// Every finite uv is a valid, wrapping lookup: far-out coordinates (±1e30, ±1e10 + 0.25, which
+/// f32 rounds to ±1e10, and exactly representable ±(2²⁰ + 0.25)) give the lookup at uv mod 1,
+/// bilinear and trilinear. Before the fix, floor(uv · width) saturated the texel index and the
+/// neighbour's index overflowed (a panic in debug builds, the wrong texel in release).
+#[test]
+fn far_out_uv_wraps() {
+    let map = LeadrMap::from_height_map(&procedural_height_map(8, 0.3, 5), Beckmann::isotropic(0.2).unwrap())
+        .unwrap();
+    let exact = 2f32.powi(20) + 0.25; // representable: the f32 spacing at 2²⁰ is 0.125
+    let far = [1e30f32, -1e30, 1e10 + 0.25, -1e10 - 0.25, exact, -exact];
+    for &u in &far {
+        for &v in &[0.375f32, u, -u] {
+            let uv = Vec2::new(u, v);
+            let wrapped = Vec2::new(f64::from(u).rem_euclid(1.0) as f32, f64::from(v).rem_euclid(1.0) as f32);
+            for level in [0, 1, 3] {
+                let got = std::panic::catch_unwind(|| map.level(level).bilinear(uv));
+                let got = got.unwrap_or_else(|_| panic!("level {level}: bilinear({uv}) panicked"));
+                assert_eq!(got, map.level(level).bilinear(wrapped), "level {level}: uv {uv} vs {wrapped}");
+            }
+            assert_eq!(map.trilinear(uv, 1.5), map.trilinear(wrapped, 1.5), "trilinear: uv {uv}");
+        }
+    }
+}
+
+/// Every lobe [`LeadrLobe::from_moments`] makes is a valid crate lobe, even of extreme finite
+/// moments (|E| up to f32::MAX): `slope()` is infallible, and its D and G1 are finite.
+#[test]
+fn extreme_moments_give_valid_slopes() {
+    let big = f32::MAX;
+    for e in [
+        [big, -big, big, big, 0.0],
+        [big, big, 0.0, 0.0, big],
+        [-big, big, big, -big, -big],
+        [1e19, -1e19, 1e38, 1e38, -1e38],
+        [0.0, 0.0, big, 1e-30, 0.0],
+        [0.0, 0.0, 0.0, 0.0, 0.0],
+    ] {
+        let lobe = LeadrLobe::from_moments(&SlopeMoments::new(e[0], e[1], e[2], e[3], e[4]).unwrap());
+        let slope = lobe.slope();
+        let (d, g) = (slope.d(slope.mean_normal()), slope.g1(Vec3::Z));
+        assert!(d.is_finite() && g.is_finite() && g >= 0.0, "{e:?} → {lobe:?}: D {d}, G1 {g}");
+    }
 }

@@ -8,15 +8,12 @@
 //! (tone-mapped values).
 
 mod render;
-mod surface;
-#[allow(dead_code)] // shared with tests/leadr.rs, which uses the rest
-mod validate;
 
 use glam::DVec3;
 use microsurface::{Beckmann, LeadrMap};
 use render::Scene;
-use surface::{NormalMip, direction, procedural_height_map};
-use validate::{Lobe, filter_errors};
+use validation::leadr::surface::{NormalMip, direction, procedural_height_map};
+use validation::leadr::validate::{filter_errors, texel_lobe};
 
 /// RMS slope per axis of the procedural displacement.
 const RMS_SLOPE: f64 = 0.2;
@@ -135,13 +132,11 @@ fn table(map: &microsurface::HeightMap, normals: &NormalMip, quick: bool) {
                 let wi = direction(theta, 30.0).as_dvec3();
                 let (mut e_leadr, mut e_naive) = (0.0, 0.0);
                 for (x, y) in TEXELS {
-                    let reference: Vec<Lobe> = (0..n * n)
-                        .map(|i| {
-                            Lobe::leadr(&leadr.lobe(0, (x * n + i % n) as isize, (y * n + i / n) as isize))
-                        })
+                    let reference: Vec<_> = (0..n * n)
+                        .map(|i| leadr.lobe(0, (x * n + i % n) as isize, (y * n + i / n) as isize))
                         .collect();
-                    let filtered = Lobe::leadr(&leadr.lobe(level, x as isize, y as isize));
-                    let naive = Lobe::texel(normals.slope(level, x as isize, y as isize), f64::from(alpha));
+                    let filtered = leadr.lobe(level, x as isize, y as isize);
+                    let naive = texel_lobe(normals.slope(level, x as isize, y as isize), alpha);
                     let e = filter_errors(wi, &reference, &[filtered, naive], 1.0);
                     e_leadr += e[0].relative_l1 / TEXELS.len() as f64;
                     e_naive += e[1].relative_l1 / TEXELS.len() as f64;

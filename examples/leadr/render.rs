@@ -2,10 +2,10 @@
 //! texels (the ground truth LEADR approximates), LEADR (trilinear moments), and the naive
 //! normal-map MIP with the base roughness.
 
-use crate::surface::NormalMip;
-use crate::validate::Lobe;
 use glam::{DVec2, DVec3, Vec2};
 use microsurface::{LeadrLobe, LeadrMap};
+use validation::leadr::surface::NormalMip;
+use validation::leadr::validate::{f_cos, texel_lobe};
 
 /// The scene.
 pub struct Scene<'a> {
@@ -63,12 +63,12 @@ impl Scene<'_> {
     }
 
     /// Radiance from the BRDF of `lobe` (light from `light`, seen from −d): f cos θl.
-    fn shade(&self, lobe: &Lobe, d: DVec3) -> f64 {
+    fn shade(&self, lobe: &LeadrLobe, d: DVec3) -> f64 {
         let view = -d;
         if view.z <= 0.0 {
             return 0.0;
         }
-        lobe.f_cos(self.light, view) / view.z * self.light.z
+        f_cos(lobe, self.light, view) / view.z * self.light.z
     }
 
     /// Texture coordinates of a plane point.
@@ -102,12 +102,12 @@ impl Scene<'_> {
                 let (leadr, naive) = if footprint < 1.0 {
                     // magnified: the pixel sees one fine texel, which both filters return as is
                     let t = (p / texel).floor();
-                    let fine = Lobe::leadr(&self.leadr.lobe(0, t.x as isize, t.y as isize));
+                    let fine = self.leadr.lobe(0, t.x as isize, t.y as isize);
                     (fine, fine)
                 } else {
                     let moments = self.leadr.trilinear(uv, lod as f32);
-                    let naive = Lobe::texel(self.normals.trilinear_slope(uv, lod as f32), self.alpha);
-                    (Lobe::leadr(&LeadrLobe::from_moments(&moments)), naive)
+                    let naive = texel_lobe(self.normals.trilinear_slope(uv, lod as f32), self.alpha as f32);
+                    (LeadrLobe::from_moments(&moments), naive)
                 };
                 images[1][i] = self.shade(&leadr, d);
                 images[2][i] = self.shade(&naive, d);
@@ -123,7 +123,7 @@ impl Scene<'_> {
                         let Some(q) = self.hit(ds) else { continue };
                         let t = (q / texel).floor();
                         let fine = self.leadr.lobe(0, t.x as isize, t.y as isize);
-                        sum += self.shade(&Lobe::leadr(&fine), ds);
+                        sum += self.shade(&fine, ds);
                     }
                 }
                 images[0][i] = sum / (k * k) as f64;

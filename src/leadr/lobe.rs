@@ -1,7 +1,6 @@
 //! The noncentral anisotropic Beckmann lobe of a LEAN/LEADR texel.
 
 use super::SlopeMoments;
-use crate::error::Error;
 use crate::slope::{Beckmann, Elliptical, Noncentral};
 use glam::Vec2;
 
@@ -52,7 +51,7 @@ pub enum CovarianceTreatment {
 /// assert!((lobe.alpha_x() - 0.3).abs() < 1e-6 && (lobe.alpha_y() - 0.1).abs() < 1e-6);
 /// assert!(lobe.rho().abs() < 1e-5 && lobe.mean_slope() == Vec2::new(0.1, -0.2));
 /// // the crate's noncentral slope distribution, for D, G1 and visible-normal sampling
-/// let slope = lobe.slope()?;
+/// let slope = lobe.slope();
 /// let wi = microsurface::glam::Vec3::new(0.5, 0.0, 0.866);
 /// assert!(slope.g1(wi) > 0.0 && slope.d(slope.mean_normal()) > 0.0);
 /// # Ok::<(), microsurface::Error>(())
@@ -64,6 +63,7 @@ pub struct LeadrLobe {
     alpha_y: f32,
     rho: f32,
     treatment: CovarianceTreatment,
+    slope: Noncentral<Elliptical<Beckmann>>,
 }
 
 impl LeadrLobe {
@@ -99,14 +99,15 @@ impl LeadrLobe {
             )
         };
         let [xx, yy, xy] = cov;
-        let rho = (xy / (xx * yy).sqrt()).clamp(-1.0, 1.0);
-        Self {
-            mean_slope: moments.mean(),
-            alpha_x: (2.0 * xx).sqrt() as f32,
-            alpha_y: (2.0 * yy).sqrt() as f32,
-            rho: rho as f32,
-            treatment,
-        }
+        let rho = (xy / (xx * yy).sqrt()).clamp(-1.0, 1.0) as f32;
+        let (alpha_x, alpha_y) = ((2.0 * xx).sqrt() as f32, (2.0 * yy).sqrt() as f32);
+        let mean_slope = moments.mean();
+        // roughness ≥ MIN_LEADR_ALPHA and finite, |ρ| < 1 (the eigenvalue ratio floor), a
+        // finite mean: both constructors' domains
+        let slope = Elliptical::<Beckmann>::from_bivariate(alpha_x, alpha_y, rho)
+            .and_then(|central| Noncentral::new(central, mean_slope))
+            .expect("a floored covariance and finite moments are a valid lobe");
+        Self { mean_slope, alpha_x, alpha_y, rho, treatment, slope }
     }
 
     /// The mean slope (x̃n, ỹn) of the mesosurface.
@@ -139,14 +140,10 @@ impl LeadrLobe {
     /// [`Noncentral::new`], whose D (eq. 3.2), projected area and G1 (eq. 3.3) and visible
     /// normals (eq. 3.4) are those of the lobe.
     ///
-    /// # Errors
-    /// Those of the two constructors; a lobe from [`Self::from_moments`] satisfies both
-    /// (roughness ≥ [`MIN_LEADR_ALPHA`] and finite, |ρ| < 1, a finite mean).
-    pub fn slope(&self) -> Result<Noncentral<Elliptical<Beckmann>>, Error> {
-        Noncentral::new(
-            Elliptical::<Beckmann>::from_bivariate(self.alpha_x, self.alpha_y, self.rho)?,
-            self.mean_slope,
-        )
+    /// Built once by [`Self::from_moments`], whose lobes are always in the constructors'
+    /// domains (roughness ≥ [`MIN_LEADR_ALPHA`] and finite, |ρ| < 1, a finite mean).
+    pub fn slope(&self) -> Noncentral<Elliptical<Beckmann>> {
+        self.slope
     }
 
     /// The slope covariance Σ = ½ [[αx², ρ αx αy], [ρ αx αy, αy²]] as [Σxx, Σyy, Σxy].

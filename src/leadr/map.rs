@@ -37,16 +37,20 @@ impl MomentLevel {
         &self.texels
     }
 
-    /// The moments at texture coordinates `uv` ∈ [0, 1)² (wrapping), interpolated bilinearly
-    /// between texel centres (texel (x, y) is centred at ((x + ½)/width, (y + ½)/height)).
-    /// Moments filter linearly, so this is exact LEADR filtering of the four texels with the
-    /// bilinear weights.
+    /// The moments at texture coordinates `uv`, interpolated bilinearly between texel centres
+    /// (texel (x, y) is centred at ((x + ½)/width, (y + ½)/height)). Moments filter linearly, so
+    /// this is exact LEADR filtering of the four texels with the bilinear weights.
+    ///
+    /// The map tiles: every finite `uv` is valid and is first wrapped to uv mod 1 (`rem_euclid` in
+    /// f64, exact for every f32; a tiny negative uv rounds to 1, the same texels), so that far-out coordinates (1e30) index
+    /// texels without overflow.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a non-finite `uv` trips a debug
     /// assertion; release builds return texel (0, 0) (moments have no "nothing").
     pub fn bilinear(&self, uv: Vec2) -> SlopeMoments {
         require!(uv.is_finite(), self.texels[0]; uv);
-        let p = uv.as_dvec2() * glam::DVec2::new(self.width as f64, self.height as f64) - 0.5;
+        let wrapped = uv.as_dvec2().rem_euclid(glam::DVec2::ONE);
+        let p = wrapped * glam::DVec2::new(self.width as f64, self.height as f64) - 0.5;
         let (x0, y0) = (p.x.floor(), p.y.floor());
         let (fx, fy) = (p.x - x0, p.y - y0);
         let (x0, y0) = (x0 as isize, y0 as isize);
@@ -185,7 +189,8 @@ impl LeadrMap {
         LeadrLobe::from_moments(&self.level(level).texel(x, y))
     }
 
-    /// The moments at texture coordinates `uv` (wrapping) and fractional MIP level `lod`
+    /// The moments at texture coordinates `uv` (any finite uv, wrapped as in
+    /// [`MomentLevel::bilinear`]) and fractional MIP level `lod`
     /// (clamped to [0, coarsest]): trilinear filtering, bilinear within the two nearest
     /// levels and linear between them, exact for moments.
     ///

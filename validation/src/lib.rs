@@ -18,8 +18,8 @@
 //! reference model ([`reference`](mod@reference)), one set of statistical assertions (seeded generators,
 //! Šidák-corrected z, mean within z·SE with SE small enough: the crate root), the pooling of
 //! low-expectation cells ([`chi2::pool`]), and the code of the examples that the tests also
-//! run: the report ([`report`]), the path tracer ([`tracer`]) and the stability report
-//! ([`stability`]).
+//! run: the report ([`report`]), the path tracer ([`tracer`]), the stability report
+//! ([`stability`]) and the LEADR validation ([`leadr`](mod@leadr)).
 //!
 //! # Examples
 //!
@@ -38,6 +38,7 @@
 pub mod check;
 pub mod chi2;
 pub mod clock;
+pub mod leadr;
 pub mod quadrature;
 pub mod reference;
 pub mod report;

@@ -1,6 +1,5 @@
 //! The procedural displacement map of the LEADR validation, and the naive alternative to
-//! LEADR (a MIP pyramid of averaged normals). Shared by `examples/leadr` and `tests/leadr.rs`
-//! (through `#[path = ...]`).
+//! LEADR (a MIP pyramid of averaged normals). Shared by `examples/leadr` and `tests/leadr.rs`.
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use microsurface::HeightMap;
@@ -14,10 +13,10 @@ const HEIGHT_SPECTRUM: f64 = 1.0;
 
 /// A periodic displacement map of `size × size` texels over the unit square (texel side
 /// 1/size): a sum of `SINES` plane waves with integer wave vectors (so that it tiles), of
-/// wavelengths from the whole map down to 4 texels (log-uniform), heights ∝ |k|^−1.5 (so that
-/// each octave adds about the same slope variance, and coarse texels hold a wide, near-Gaussian
-/// spread of slopes) and random phases; scaled so that the RMS of the central-difference slopes
-/// is `rms_slope` per axis. Deterministic for a `seed`.
+/// wavelengths from the whole map down to 4 texels (log-uniform), heights ∝ |k|^−1
+/// (`HEIGHT_SPECTRUM`: each octave adds about the same slope variance, and coarse texels hold
+/// a wide, near-Gaussian spread of slopes) and random phases; scaled so that the RMS of the
+/// central-difference slopes is `rms_slope` per axis. Deterministic for a `seed`.
 pub fn procedural_height_map(size: usize, rms_slope: f64, seed: u64) -> HeightMap {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
     let max_k = (size / 4).max(1) as f64;
@@ -108,7 +107,8 @@ impl NormalMip {
     fn bilinear(&self, level: usize, uv: Vec2) -> DVec3 {
         let (w, normals) = &self.levels[level.min(self.levels.len() - 1)];
         let wi = *w as isize;
-        let p = uv.as_dvec2() * *w as f64 - 0.5;
+        // wrapped first, as `MomentLevel::bilinear`: any finite uv is a lookup
+        let p = uv.as_dvec2().rem_euclid(DVec2::ONE) * *w as f64 - 0.5;
         let (x0, y0) = (p.x.floor(), p.y.floor());
         let (fx, fy) = (p.x - x0, p.y - y0);
         let at = |x: isize, y: isize| normals[(y.rem_euclid(wi) * wi + x.rem_euclid(wi)) as usize];

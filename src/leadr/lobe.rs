@@ -1,7 +1,9 @@
 //! The noncentral anisotropic Beckmann lobe of a LEAN/LEADR texel.
 
 use super::SlopeMoments;
+use crate::bsdf::NoncentralBsdf;
 use crate::error::Error;
+use crate::material::Conductor;
 use crate::slope::{Beckmann, Elliptical, Noncentral};
 use glam::Vec2;
 
@@ -147,6 +149,16 @@ impl LeadrLobe {
             Elliptical::<Beckmann>::from_bivariate(self.alpha_x, self.alpha_y, self.rho)?,
             self.mean_slope,
         )
+    }
+
+    /// The lobe's single-scattering BSDF with `conductor`, for renderers: the
+    /// [`NoncentralBsdf`] of [`Self::slope`] (Dupuy 2015, §3.4: the filtered texel shaded with
+    /// the noncentral microfacet BRDF).
+    ///
+    /// # Errors
+    /// Those of [`Self::slope`] and [`NoncentralBsdf::new`].
+    pub fn bsdf(&self, conductor: Conductor) -> Result<NoncentralBsdf<Elliptical<Beckmann>>, Error> {
+        NoncentralBsdf::new(self.slope()?, conductor)
     }
 
     /// The slope covariance Σ = ½ [[αx², ρ αx αy], [ρ αx αy, αy²]] as [Σxx, Σyy, Σxy].

@@ -61,8 +61,8 @@ impl NoncentralMaterial for Conductor {
 ///   [`Noncentral::eval_single_scattering`]`(wo, wi)` (the light path traced from the viewer,
 ///   as [`MicrofacetBsdf`](crate::MicrofacetBsdf) does) divided by cos θi in f32.
 /// * Sampling: ωh from the visible normals of wo (eq. 3.4, exact), wi its mirror image; the
-///   density is D_wo(ωh)/(4⟨wi, ωh⟩) and the weight F·G1(wi) = f·cos θi/pdf (to a few f32 ulps:
-///   the half vector eval recomputes from (wo, wi) differs from the sampled one by rounding).
+///   density is D_wo(ωh)/(4⟨wi, ωh⟩) and the weight F·G1(wi) = f·cos θi/pdf to relative 1e-5
+///   (the half vector eval recomputes from (wo, wi) differs from the sampled one by rounding).
 ///   Reflections that would leave below the base plane are masked by it: `sample` returns
 ///   `None` for them, and ∫pdf < 1 by their probability. G1 can exceed 1 on a sheared
 ///   surface (views tilted away from the mean normal), so a weight can exceed F.

@@ -2,10 +2,10 @@
 //! (Dupuy 2015, thesis §3.2).
 
 use super::{MicrosurfaceSlope, is_direction, is_direction64, is_uniform, normalize_fast};
-use crate::vector::ensure_visible;
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::microsurface::WalkSample;
+use crate::vector::ensure_visible;
 use glam::{DVec3, Vec2, Vec3};
 
 /// A sheared microsurface (Dupuy 2015, thesis §3.2): the slopes of the central distribution `S`
@@ -40,7 +40,8 @@ use glam::{DVec3, Vec2, Vec3};
 /// [`Microsurface`](crate::Microsurface), [`PositionFree`](crate::PositionFree) and
 /// [`MicrofacetBsdf`](crate::MicrofacetBsdf); its single-scattering BRDF is
 /// [`Noncentral::eval_single_scattering`] (with [`Noncentral::sample_single_scattering`] and
-/// [`Noncentral::pdf_single_scattering`]).
+/// [`Noncentral::pdf_single_scattering`]), and renderers use it through
+/// [`NoncentralBsdf`](crate::NoncentralBsdf).
 ///
 /// # Single scattering: separable G2
 /// The thesis' correlated G2 (eq. 2.13), 1/G2 = 1/G1(ωi) + 1/G1(ωo) − 1, is not positive for

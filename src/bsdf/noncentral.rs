@@ -51,13 +51,32 @@ impl NoncentralMaterial for Conductor {
     }
 }
 
+/// The masking-shadowing of a [`NoncentralBsdf`]: the thesis' G1 (eq. 3.3), or that G1 clamped
+/// to 1 so that the lobe conserves energy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NoncentralMasking {
+    /// G1(ω) = cos θ/A(ω) (Dupuy 2015, eq. 3.3), normalized to the base plane's projected
+    /// area: it exceeds 1 for views tilted away from the mean normal, and so can the albedo
+    /// (perfect conductor, GGX α = 0.1, x̃n = (1, 0), θo = 1.2 at φo = 0: 5.9). The model
+    /// [`Noncentral::eval_single_scattering`] and the LEADR validation use.
+    #[default]
+    BasePlane,
+    /// min(1, G1(ω)) for both directions: the part of a tilted texel that its neighbours
+    /// would occlude is lost instead of scattered, so the albedo is ≤ 1 (F ≤ 1) and f stays
+    /// symmetric. Sampling is unchanged (the visible normals of wo); the weight is
+    /// F·min(1, G1(wi))·min(1, G1(wo))/G1(wo).
+    Clamped,
+}
+
 /// The single-scattering BSDF of a sheared microsurface [`Noncentral<S>`] with a conductor, for
 /// renderers (the [`Bsdf`] trait): the LEADR lobe of a filtered normal or displacement map
 /// (Dupuy 2015, thesis §3.3–3.4; [`LeadrLobe::bsdf`](crate::LeadrLobe::bsdf)).
 ///
 /// * f(wo, wi) = F(⟨wi, ωh⟩) D(ωh) G1(wo) G1(wi) / (4 cos θo cos θi), ωh = (wo + wi)/‖·‖, with D
 ///   by eq. 3.2, G1 by eq. 3.3 and the separable G2 (see [`Noncentral`]) for wo and wi above
-///   the base plane, 0 otherwise. f is symmetric in (wo, wi); [`Bsdf::eval`] is
+///   the base plane, 0 otherwise ([`NoncentralMasking::BasePlane`], the default;
+///   [`NoncentralBsdf::with_masking`] chooses the energy-conserving
+///   [`NoncentralMasking::Clamped`]). f is symmetric in (wo, wi); [`Bsdf::eval`] is
 ///   [`Noncentral::eval_single_scattering`]`(wo, wi)` (the light path traced from the viewer,
 ///   as [`MicrofacetBsdf`](crate::MicrofacetBsdf) does) divided by cos θi in f32.
 /// * Sampling: ωh from the visible normals of wo (eq. 3.4, exact), wi its mirror image; the
@@ -65,7 +84,8 @@ impl NoncentralMaterial for Conductor {
 ///   (the half vector eval recomputes from (wo, wi) differs from the sampled one by rounding).
 ///   Reflections that would leave below the base plane are masked by it: `sample` returns
 ///   `None` for them, and ∫pdf < 1 by their probability. G1 can exceed 1 on a sheared
-///   surface (views tilted away from the mean normal), so a weight can exceed F.
+///   surface (views tilted away from the mean normal), so a weight can exceed F and the
+///   albedo 1 (see [`NoncentralMasking`]).
 /// * Views below the base plane (wo.z ≤ 0, e.g. a normal map's backfacing shading frame) see
 ///   nothing: f, pdf are 0 and `sample` gives `None` (the thesis' G1 is 0 there).
 /// * No specular limit: unlike `MicrofacetBsdf` below [`SMOOTH_ALPHA`](crate::SMOOTH_ALPHA),
@@ -98,6 +118,7 @@ impl NoncentralMaterial for Conductor {
 pub struct NoncentralBsdf<S, M = Conductor> {
     surface: Noncentral<S>,
     material: M,
+    masking: NoncentralMasking,
 }
 
 impl<S: MicrosurfaceSlope, M: NoncentralMaterial> NoncentralBsdf<S, M> {
@@ -117,7 +138,29 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> NoncentralBsdf<S, M> {
                 expected: "x̃n² + ỹn² finite",
             });
         }
-        Ok(Self { surface, material })
+        Ok(Self { surface, material, masking: NoncentralMasking::default() })
+    }
+
+    /// The same BSDF with another masking-shadowing.
+    #[must_use]
+    pub fn with_masking(self, masking: NoncentralMasking) -> Self {
+        Self { masking, ..self }
+    }
+
+    /// The masking-shadowing.
+    #[inline]
+    pub fn masking(&self) -> NoncentralMasking {
+        self.masking
+    }
+
+    /// The factor min(1, G1(ω))/G1(ω) = min(1, A(ω)/cos θ) of the clamped masking for ω above
+    /// the base plane, 1 for the base-plane masking.
+    #[inline(always)]
+    fn clamp_scale(&self, w: Vec3) -> f32 {
+        match self.masking {
+            NoncentralMasking::BasePlane => 1.0,
+            NoncentralMasking::Clamped => (1.0 / self.surface.g1(w)).min(1.0),
+        }
     }
 
     /// The sheared microsurface.
@@ -140,6 +183,10 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> NoncentralBsdf<S, M> {
             return Vec3::ZERO;
         }
         let f = self.material.eval_single(&self.surface, wo, wi) / wi.z;
+        let f = match self.masking {
+            NoncentralMasking::BasePlane => f,
+            NoncentralMasking::Clamped => f * (self.clamp_scale(wo) * self.clamp_scale(wi)),
+        };
         if f.is_finite() { f } else { Vec3::ZERO }
     }
 
@@ -173,8 +220,11 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> Bsdf for NoncentralBsdf<S, M> 
         if !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z <= 0.0 {
             return None;
         }
-        let s = self.material.sample_single(&self.surface, wo, u)?;
+        let mut s = self.material.sample_single(&self.surface, wo, u)?;
         let wi = s.wo;
+        if self.masking == NoncentralMasking::Clamped {
+            s.weight *= self.clamp_scale(wo) * self.clamp_scale(wi);
+        }
         let pdf = self.pdf_checked(wo, wi);
         // as MicrofacetBsdf: the density and f = weight·pdf/cos θi must be normal f32 numbers
         // (eval could not reproduce a subnormal f), and a weight saturated by G1 = f32::MAX

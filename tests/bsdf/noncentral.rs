@@ -220,6 +220,8 @@ fn noncentral_invalid_input() {
     ];
     for (i, b) in models.iter().enumerate() {
         check_bad_input(&format!("noncentral #{i}"), b, true, false, 7300 + i as u64);
+        let clamped = b.with_masking(NoncentralMasking::Clamped);
+        check_bad_input(&format!("noncentral clamped #{i}"), &clamped, true, false, 7320 + i as u64);
     }
     let ggx_models = [bsdf(ell_ggx(0.3, 0.2, 0.5), Vec2::new(5.0, 5.0), gold())];
     check_bad_input("noncentral GGX", &ggx_models[0], true, false, 7310);

@@ -57,7 +57,7 @@ impl NoncentralMaterial for Conductor {
 pub enum NoncentralMasking {
     /// G1(ω) = cos θ/A(ω) (Dupuy 2015, eq. 3.3), normalized to the base plane's projected
     /// area: it exceeds 1 for views tilted away from the mean normal, and so can the albedo
-    /// (perfect conductor, GGX α = 0.1, x̃n = (1, 0), θo = 1.2 at φo = 0: 5.9). The model
+    /// (perfect conductor, GGX α = 0.1, x̃n = (1, 0), θo = 1.2 at φo = 0: 5.8). The model
     /// [`Noncentral::eval_single_scattering`] and the LEADR validation use.
     #[default]
     BasePlane,

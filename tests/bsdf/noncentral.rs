@@ -271,7 +271,7 @@ fn noncentral_weight_is_f_cos_over_pdf() {
 
 /// The energy of the two maskings for a perfect conductor seen from behind the tilted mean
 /// plane (α = 0.1, x̃n = (1, 0), θo = 1.2, φo = 0), at normal incidence and at θo = 0.6 towards n: the base-plane G1
-/// of the thesis reflects more than it receives there (measured 5.9), the clamped masking
+/// of the thesis reflects more than it receives there (measured 5.8), the clamped masking
 /// never does (every weight ≤ 1), and its f is F D min(1, G1(wo)) min(1, G1(wi))/(4 cos θo cos θi).
 #[test]
 fn noncentral_clamped_masking_conserves_energy() {

@@ -144,7 +144,8 @@ pub use basis::orthonormal_basis;
 pub use bsdf::{
     AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
     CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf,
-    SMOOTH_ALPHA, SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport,
+    NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SMOOTH_ALPHA, SampleFlags, ShadingFrame,
+    SpecularEvent, SpecularLimit, Technique, Transport,
 };
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;

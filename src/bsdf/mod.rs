@@ -22,6 +22,7 @@ mod compensated;
 mod compensated_dielectric;
 mod frame;
 mod microfacet;
+mod noncentral;
 mod seed;
 mod specular;
 
@@ -30,6 +31,7 @@ pub use compensated::{AlbedoTabulated, CompensatedConductor, Compensation};
 pub use compensated_dielectric::CompensatedDielectric;
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
+pub use noncentral::{NoncentralBsdf, NoncentralMasking, NoncentralMaterial};
 pub use specular::{SpecularEvent, SpecularLimit};
 
 use glam::{Vec2, Vec3};

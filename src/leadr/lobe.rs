@@ -1,6 +1,9 @@
 //! The noncentral anisotropic Beckmann lobe of a LEAN/LEADR texel.
 
 use super::SlopeMoments;
+use crate::bsdf::NoncentralBsdf;
+use crate::error::Error;
+use crate::material::Conductor;
 use crate::slope::{Beckmann, Elliptical, Noncentral};
 use glam::Vec2;
 
@@ -144,6 +147,16 @@ impl LeadrLobe {
     /// domains (roughness ≥ [`MIN_LEADR_ALPHA`] and finite, |ρ| < 1, a finite mean).
     pub fn slope(&self) -> Noncentral<Elliptical<Beckmann>> {
         self.slope
+    }
+
+    /// The lobe's single-scattering BSDF with `conductor`, for renderers: the
+    /// [`NoncentralBsdf`] of [`Self::slope`] (Dupuy 2015, §3.4: the filtered texel shaded with
+    /// the noncentral microfacet BRDF).
+    ///
+    /// # Errors
+    /// Those of [`NoncentralBsdf::new`] (a mean slope whose squared length overflows f32).
+    pub fn bsdf(&self, conductor: Conductor) -> Result<NoncentralBsdf<Elliptical<Beckmann>>, Error> {
+        NoncentralBsdf::new(self.slope(), conductor)
     }
 
     /// The slope covariance Σ = ½ [[αx², ρ αx αy], [ρ αx αy, αy²]] as [Σxx, Σyy, Σxy].

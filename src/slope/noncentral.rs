@@ -40,7 +40,8 @@ use glam::{DVec3, Vec2, Vec3};
 /// [`Microsurface`](crate::Microsurface), [`PositionFree`](crate::PositionFree) and
 /// [`MicrofacetBsdf`](crate::MicrofacetBsdf); its single-scattering BRDF is
 /// [`Noncentral::eval_single_scattering`] (with [`Noncentral::sample_single_scattering`] and
-/// [`Noncentral::pdf_single_scattering`]).
+/// [`Noncentral::pdf_single_scattering`]), and renderers use it through
+/// [`NoncentralBsdf`](crate::NoncentralBsdf).
 ///
 /// # Single scattering: separable G2
 /// The thesis' correlated G2 (eq. 2.13), 1/G2 = 1/G1(ωi) + 1/G1(ωo) − 1, is not positive for

@@ -40,7 +40,7 @@ fn nothing_or_debug_panic<T>(label: &str, call: impl FnOnce() -> T, is_nothing: 
 /// for reflection-only models (`backfacing_view_valid`: the microfacet BSDFs accept
 /// backfacing views, see the normal-mapping tests); finite, non-negative values for random
 /// and grazing directions.
-fn check_bad_input<B: Bsdf>(
+pub(super) fn check_bad_input<B: Bsdf>(
     label: &str,
     b: &B,
     reflection_only: bool,

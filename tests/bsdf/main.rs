@@ -36,6 +36,7 @@ mod energy_by_order;
 mod fixtures;
 mod integrator;
 mod invalid_directions;
+mod noncentral;
 mod reciprocity;
 mod shading_frame;
 mod weights;

@@ -165,10 +165,12 @@ impl BsdfValue {
 /// ```
 pub trait Bsdf: Send + Sync {
     /// The lobes of this BSDF.
+    #[must_use]
     fn flags(&self) -> BsdfFlags;
 
     /// The BSDF f for light arriving from `wi` and leaving towards `wo`, with the caller's
     /// `key` mixed into the seed of a stochastic estimate.
+    #[must_use]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue;
 
     /// Samples a direction `wi` for the view direction `wo` from the caller's uniforms `uc`
@@ -176,33 +178,39 @@ pub trait Bsdf: Send + Sync {
     /// [0, 1), with the caller's `key` mixed into the seed of the random numbers a
     /// stochastic technique draws after its first bounce. `None` if nothing is sampled
     /// (absorption, a direction that cannot leave the surface).
+    #[must_use]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample>;
 
     /// The density with which `sample` would return `wi` (exact or approximate, as the
     /// samples' `exact_pdf` flag says); 0 for a specular BSDF. Deterministic.
+    #[must_use]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
 
     /// [`Bsdf::eval_keyed`] and [`Bsdf::pdf`] in one call, for models where they share
     /// work (the exact single-scattering models evaluate one half vector and one D for both).
     #[inline]
+    #[must_use]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
         (self.eval_keyed(wo, wi, key), self.pdf(wo, wi))
     }
 
     /// [`Bsdf::eval_keyed`] with key 0.
     #[inline]
+    #[must_use]
     fn eval(&self, wo: Vec3, wi: Vec3) -> BsdfValue {
         self.eval_keyed(wo, wi, 0)
     }
 
     /// [`Bsdf::sample_keyed`] with key 0.
     #[inline]
+    #[must_use]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         self.sample_keyed(wo, uc, u, 0)
     }
 
     /// [`Bsdf::eval_with_pdf_keyed`] with key 0.
     #[inline]
+    #[must_use]
     fn eval_with_pdf(&self, wo: Vec3, wi: Vec3) -> (BsdfValue, f32) {
         self.eval_with_pdf_keyed(wo, wi, 0)
     }

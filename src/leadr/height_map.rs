@@ -53,21 +53,25 @@ impl HeightMap {
     }
 
     /// Width in texels.
+    #[must_use]
     pub fn width(&self) -> usize {
         self.width
     }
 
     /// Height in texels.
+    #[must_use]
     pub fn height(&self) -> usize {
         self.height
     }
 
     /// The side of a texel.
+    #[must_use]
     pub fn texel_size(&self) -> f32 {
         self.texel_size
     }
 
     /// The height of texel (x, y), the coordinates taken modulo the size (the map tiles).
+    #[must_use]
     pub fn height_at(&self, x: isize, y: isize) -> f32 {
         let xi = x.rem_euclid(self.width as isize) as usize;
         let yi = y.rem_euclid(self.height as isize) as usize;
@@ -78,6 +82,7 @@ impl HeightMap {
     /// ((ξ(x+1, y) − ξ(x−1, y)), (ξ(x, y+1) − ξ(x, y−1))) / (2 · texel size), which the thesis
     /// prefers to one-sided differences for smoother shading (§3.4, fig. 3.6). Computed in
     /// f64; coordinates wrap.
+    #[must_use]
     pub fn slope(&self, x: usize, y: usize) -> Vec2 {
         let (x, y) = (x as isize, y as isize);
         let h = |dx, dy| f64::from(self.height_at(x + dx, y + dy));

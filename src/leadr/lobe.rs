@@ -82,6 +82,7 @@ impl LeadrLobe {
     /// arithmetic (a mixture's covariance is the mean of the covariances plus that of the
     /// means), so the floor only catches rounding, moments given by hand, and base
     /// roughness below [`MIN_LEADR_ALPHA`]. The result is always finite.
+    #[must_use]
     pub fn from_moments(moments: &SlopeMoments) -> Self {
         let [xx, yy, xy] = moments.covariance64();
         let (half_sum, half_diff) = (0.5 * (xx + yy), 0.5 * (xx - yy));
@@ -114,26 +115,31 @@ impl LeadrLobe {
     }
 
     /// The mean slope (x̃n, ỹn) of the mesosurface.
+    #[must_use]
     pub fn mean_slope(&self) -> Vec2 {
         self.mean_slope
     }
 
     /// Roughness along x, ≥ [`MIN_LEADR_ALPHA`].
+    #[must_use]
     pub fn alpha_x(&self) -> f32 {
         self.alpha_x
     }
 
     /// Roughness along y, ≥ [`MIN_LEADR_ALPHA`].
+    #[must_use]
     pub fn alpha_y(&self) -> f32 {
         self.alpha_y
     }
 
     /// The correlation of the slopes, |ρ| ≤ 1 − [`MIN_EIGENVALUE_RATIO`]/2.
+    #[must_use]
     pub fn rho(&self) -> f32 {
         self.rho
     }
 
     /// Whether the covariance of the moments was used as is.
+    #[must_use]
     pub fn treatment(&self) -> CovarianceTreatment {
         self.treatment
     }
@@ -145,6 +151,7 @@ impl LeadrLobe {
     ///
     /// Built once by [`Self::from_moments`], whose lobes are always in the constructors'
     /// domains (roughness ≥ [`MIN_LEADR_ALPHA`] and finite, |ρ| < 1, a finite mean).
+    #[must_use]
     pub fn slope(&self) -> Noncentral<Elliptical<Beckmann>> {
         self.slope
     }
@@ -160,6 +167,7 @@ impl LeadrLobe {
     }
 
     /// The slope covariance Σ = ½ [[αx², ρ αx αy], [ρ αx αy, αy²]] as [Σxx, Σyy, Σxy].
+    #[must_use]
     pub fn covariance(&self) -> [f32; 3] {
         let (ax, ay, rho) = (f64::from(self.alpha_x), f64::from(self.alpha_y), f64::from(self.rho));
         [0.5 * ax * ax, 0.5 * ay * ay, 0.5 * rho * ax * ay].map(|c| c as f32)

@@ -16,16 +16,19 @@ pub struct MomentLevel {
 
 impl MomentLevel {
     /// Width in texels.
+    #[must_use]
     pub fn width(&self) -> usize {
         self.width
     }
 
     /// Height in texels.
+    #[must_use]
     pub fn height(&self) -> usize {
         self.height
     }
 
     /// The moments of texel (x, y), coordinates wrapping (the map tiles).
+    #[must_use]
     pub fn texel(&self, x: isize, y: isize) -> SlopeMoments {
         let xi = x.rem_euclid(self.width as isize) as usize;
         let yi = y.rem_euclid(self.height as isize) as usize;
@@ -33,6 +36,7 @@ impl MomentLevel {
     }
 
     /// The texels, row-major (x fastest).
+    #[must_use]
     pub fn texels(&self) -> &[SlopeMoments] {
         &self.texels
     }
@@ -47,6 +51,7 @@ impl MomentLevel {
     ///
     /// Invalid input ([policy](crate#invalid-input)): a non-finite `uv` trips a debug
     /// assertion; release builds return texel (0, 0) (moments have no "nothing").
+    #[must_use]
     pub fn bilinear(&self, uv: Vec2) -> SlopeMoments {
         require!(uv.is_finite(), self.texels[0]; uv);
         let wrapped = uv.as_dvec2().rem_euclid(glam::DVec2::ONE);
@@ -174,17 +179,20 @@ impl LeadrMap {
     }
 
     /// The number of levels, log₂(max(width, height)) + 1.
+    #[must_use]
     pub fn level_count(&self) -> usize {
         self.levels.len()
     }
 
     /// Level `level` (0 is the input's resolution); the coarsest for a larger index.
+    #[must_use]
     pub fn level(&self, level: usize) -> &MomentLevel {
         &self.levels[level.min(self.levels.len() - 1)]
     }
 
     /// The lobe of texel (x, y) of level `level` (coordinates wrap; the coarsest level for a
     /// larger index).
+    #[must_use]
     pub fn lobe(&self, level: usize, x: isize, y: isize) -> LeadrLobe {
         LeadrLobe::from_moments(&self.level(level).texel(x, y))
     }

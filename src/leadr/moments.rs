@@ -116,6 +116,7 @@ impl SlopeMoments {
 
     /// The moments of the union of equally weighted texels: their average, accumulated in f64
     /// (eqs. 3.10–3.14). `None` for an empty slice.
+    #[must_use]
     pub fn average(texels: &[SlopeMoments]) -> Option<Self> {
         if texels.is_empty() {
             return None;
@@ -162,6 +163,7 @@ impl SlopeMoments {
     }
 
     /// The mean slope (E₁, E₂), the mesosurface's slope (x̃n, ỹn) (eqs. 3.5–3.6).
+    #[must_use]
     pub fn mean(&self) -> Vec2 {
         Vec2::new(self.e1, self.e2)
     }
@@ -169,6 +171,7 @@ impl SlopeMoments {
     /// The slope covariance [Σxx, Σyy, Σxy] = [E₃ − E₁², E₄ − E₂², E₅ − E₁E₂], formed in f64
     /// (and rounded to f32). It may fail to be positive definite; see
     /// [`LeadrLobe::from_moments`](crate::LeadrLobe::from_moments).
+    #[must_use]
     pub fn covariance(&self) -> [f32; 3] {
         self.covariance64().map(|c| c as f32)
     }
@@ -180,6 +183,7 @@ impl SlopeMoments {
     }
 
     /// The moments as an array [E₁, …, E₅].
+    #[must_use]
     pub fn to_array(&self) -> [f32; 5] {
         [self.e1, self.e2, self.e3, self.e4, self.e5]
     }

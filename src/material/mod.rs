@@ -75,6 +75,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// interaction's sides. Stochastic (unbiased) for the diffuse material, exact otherwise
     /// (the formulas are on each material's type).
     #[inline]
+    #[must_use]
     fn eval_phase<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng) -> Vec3 {
         require!(it.has_unit_directions(), Vec3::ZERO; it);
         self.eval_phase_unchecked(slope, it, rng)
@@ -82,6 +83,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 
     /// Samples ωo from the phase function p(ωi, ·) for a ray arriving on `side`.
     #[inline]
+    #[must_use]
     fn sample_phase<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
@@ -99,6 +101,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// for diffuse facets, whose density has no closed form, a documented deterministic
     /// approximation (used only for MIS weights, never to divide a contribution).
     #[inline]
+    #[must_use]
     fn pdf_phase<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
         require!(it.has_unit_directions(), 0.0; it);
         self.pdf_phase_unchecked(slope, it)
@@ -110,6 +113,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// by the full-spherical masking G1(ωi) = |cos θi|/A(ωi) of the incident direction (A is
     /// the projected area). Per channel; stochastic (unbiased) for diffuse facets.
     #[inline]
+    #[must_use]
     fn vertex<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng) -> Vec3 {
         require!(it.has_unit_directions(), Vec3::ZERO; it);
         self.vertex_unchecked(slope, it, rng)
@@ -121,6 +125,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// for the three. The bidirectional position-free estimator needs all three for every
     /// connection. Returns (vertex, pdf ωi → ωo, pdf ωo → ωi).
     #[inline]
+    #[must_use]
     fn connection<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
@@ -137,6 +142,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// walking the interface's crossings, whose number grows without bound at grazing
     /// incidence, and their evaluations are 0 (the BSDF is a Dirac). False by default.
     #[inline]
+    #[must_use]
     fn is_transparent(&self) -> bool {
         false
     }
@@ -146,6 +152,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// otherwise. It is the factor by which radiance transport differs from importance
     /// transport across the interface.
     #[inline]
+    #[must_use]
     fn relative_eta_sq(&self, from: Side, to: Side) -> f32 {
         let _ = (from, to);
         1.0
@@ -153,6 +160,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 
     /// The single-scattering BSDF times |cos θo|, for ωi above the surface. Stochastic
     /// (unbiased) for the diffuse material, exact otherwise.
+    #[must_use]
     fn eval_single_scattering<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
@@ -167,6 +175,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 
     /// [`Material::eval_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
+    #[must_use]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
@@ -176,6 +185,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 
     /// [`Material::sample_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
+    #[must_use]
     fn sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,
@@ -186,10 +196,12 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 
     /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
+    #[must_use]
     fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32;
 
     /// [`Material::vertex`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
+    #[must_use]
     fn vertex_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng)
     -> Vec3;
 
@@ -197,6 +209,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// default the three separate unchecked calls.
     #[doc(hidden)]
     #[inline]
+    #[must_use]
     fn connection_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,

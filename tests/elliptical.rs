@@ -2,8 +2,6 @@
 //! D against eq. 2.26, the normalization and projected-area identities, the rotation identity,
 //! the sampler's chi-square fit and the constructors' rejections.
 
-
-
 use glam::Vec3;
 use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope};
 
@@ -112,10 +110,10 @@ fn constructors_reject_invalid_parameters() {
     assert!(Elliptical::<Ggx>::from_bivariate(0.3, 0.2, 0.999_999).is_ok());
 }
 
-use validation::chi2::{Chi2Grid, chi2_test};
-use validation::quadrature::integrate_sphere;
 use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
 use std::f64::consts::PI;
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
 
 /// Correlations of the identity tests, up to |ρ| = 0.99.
 const RHOS: [f32; 5] = [-0.99, -0.6, 0.0, 0.8, 0.99];
@@ -229,7 +227,8 @@ fn rotation_identity_for_d_lambda_and_walk_albedo_per_order() {
             );
         }
         for (v, (theta, psi)) in [(0.4, 0.3), (1.2, 2.0), (1.45, -2.5)].into_iter().enumerate() {
-            let (wi, wi_aligned) = (validation::dir(theta, psi), validation::dir(theta, psi - f64::from(phi)));
+            let (wi, wi_aligned) =
+                (validation::dir(theta, psi), validation::dir(theta, psi - f64::from(phi)));
             for (material, name) in [(0, "gold"), (1, "glass")] {
                 let seed = 1000 + 10 * v as u64 + material;
                 let per_order = |slope_is_elliptical: bool| {
@@ -364,6 +363,53 @@ fn compensated_conductor_is_rotation_invariant() {
                 (fe - fa).abs().max_element() <= 1e-4 * fa.max_element() + 1e-6,
                 "{scheme:?} {wo} {wi}: {fe} vs {fa}"
             );
+        }
+    }
+}
+
+/// `MicrofacetBsdf`'s roughness limits depend on the ellipse, not on the frame's rotation: the
+/// walk-length limit rejects α₁ = 13 at every φα (the marginals at φα = π/4 are only
+/// ≈ 13/√2 < 10), and the Dirac switch below `SMOOTH_ALPHA` = 1e-3 does not flip at π/4 for an
+/// ellipse whose largest radius is above it (the marginals there are ≈ 1.2e-3/√2).
+#[test]
+fn bsdf_roughness_limits_are_rotation_invariant() {
+    use glam::Vec2;
+    use microsurface::{Bsdf, MicrofacetBsdf};
+    let gold = Conductor::new(ComplexIor::GOLD);
+    let wo = Vec3::new(0.6, 0.0, 0.8);
+    for phi in [0.0, std::f32::consts::FRAC_PI_4, 2.0] {
+        for (a1, a2) in [(13.0, 0.05), (0.05, 13.0)] {
+            let slope = Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap();
+            assert_eq!(slope.alpha_max(), 13.0, "({a1}, {a2}, φ {phi})");
+            match MicrofacetBsdf::new(slope, gold) {
+                Err(Error::InvalidParameter { name: "alpha", .. }) => {}
+                other => panic!("({a1}, {a2}, φ {phi}): expected the walk limit, got {other:?}"),
+            }
+        }
+        for (a1, a2, specular) in [(1.2e-3, 1e-4, false), (9e-4, 1e-4, true)] {
+            let slope = Elliptical::<Beckmann>::from_ellipse(a1, a2, phi).unwrap();
+            let bsdf = MicrofacetBsdf::new(slope, gold).unwrap();
+            let s = bsdf.sample(wo, 0.3, Vec2::new(0.6, 0.1)).expect("gold reflects");
+            assert_eq!(s.flags.specular, specular, "({a1}, {a2}, φ {phi}): specular flag");
+        }
+    }
+}
+
+/// The bivariate form that `from_ellipse` derives is always accepted by `from_bivariate`, down
+/// to ellipses too thin for an f32 ρ (|ρ| rounds to 1 from α₂/α₁ ≈ 2⁻¹² on at φα = π/4).
+#[test]
+fn thin_ellipses_round_trip_through_the_bivariate_form() {
+    for (a1, a2) in [(1.0, 1e-4), (1e-4, 1.0), (1.0, 1e-7), (3.0, 2e-4), (0.5, 0.5 * 2f32.powi(-12))] {
+        for phi in [std::f32::consts::FRAC_PI_4, -std::f32::consts::FRAC_PI_4, 0.3, 1.2, 2.5] {
+            let e = Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap();
+            let (ax, ay, rho) = e.bivariate();
+            assert!(rho.abs() < 1.0, "({a1}, {a2}, φ {phi}): ρ = {rho}");
+            let back = Elliptical::<Ggx>::from_bivariate(ax, ay, rho)
+                .unwrap_or_else(|err| panic!("({a1}, {a2}, φ {phi}) → ({ax}, {ay}, {rho}): {err:?}"));
+            // the major radius survives; the minor one is what the f32 ρ can represent
+            let (b1, _, _) = back.ellipse();
+            let big = a1.max(a2);
+            assert!((b1 - big).abs() <= 1e-5 * big, "({a1}, {a2}, φ {phi}): α₁ {b1}");
         }
     }
 }

@@ -2,13 +2,11 @@
 //! normalization (eq. 3.1) and mean normal, the projected area against quadrature, G1 against
 //! eq. 3.3, the sampler's chi-square fit (eq. 3.4) and the constructor's rejections.
 
-
-
-use validation::chi2::{Chi2Grid, chi2_test};
-use validation::quadrature::integrate_sphere;
 use glam::{Vec2, Vec3};
 use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope, Noncentral};
 use std::f64::consts::PI;
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
 
 /// Views (θ, φ): above the horizon facing and away from the tilt, grazing, below.
 const VIEWS: [(f64, f64); 5] = [(0.0, 0.0), (1.0, 0.3), (1.3, 3.5), (1.55, 2.0), (2.2, -1.0)];
@@ -153,7 +151,12 @@ fn sampler_chi2() {
             .unwrap();
     let eg = Noncentral::new(Elliptical::<Ggx>::from_bivariate(0.2, 0.5, -0.7).unwrap(), Vec2::new(0.0, 1.5))
         .unwrap();
-    let views = [validation::dir(0.6, 0.4), validation::dir(1.4, 3.6), validation::dir(2.1, 1.0), validation::dir(1.2, 0.3)];
+    let views = [
+        validation::dir(0.6, 0.4),
+        validation::dir(1.4, 3.6),
+        validation::dir(2.1, 1.0),
+        validation::dir(1.2, 0.3),
+    ];
     let views: Vec<Vec3> = views.iter().map(|w| w.normalize()).collect();
     validation::par_map(&[0usize, 1, 2, 3], |_, &j| match j {
         0 => {

@@ -8,16 +8,14 @@
 //!   position-free model with correlated shadowing (`PositionFree::eval_single_scattering`);
 //! * invalid directions give 0 / `None` (a debug assertion in debug builds).
 
-
-
-use validation::chi2::{Chi2Grid, chi2_test};
-use validation::quadrature::integrate_sphere;
-use validation::{dir, sidak, uniform32, z_two_sided};
 use glam::Vec3;
 use microsurface::{
     Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, MicrosurfaceSlope, PositionFree,
     Shadowing, SingleScattering,
 };
+use validation::chi2::{Chi2Grid, chi2_test};
+use validation::quadrature::integrate_sphere;
+use validation::{dir, sidak, uniform32, z_two_sided};
 
 /// Samples per chi-square test.
 const CHI2_N: usize = 200_000;
@@ -181,7 +179,9 @@ fn invalid_directions_give_nothing() {
             ("pdf", Box::new(move || model.pdf(bad, good) == 0.0)),
             (
                 "eval_with_pdf",
-                Box::new(move || model.eval_with_pdf(good, bad, &mut validation::rng(1)) == (Vec3::ZERO, 0.0)),
+                Box::new(move || {
+                    model.eval_with_pdf(good, bad, &mut validation::rng(1)) == (Vec3::ZERO, 0.0)
+                }),
             ),
             ("sample", Box::new(move || model.sample(bad, &mut validation::rng(1)).is_none())),
         ];

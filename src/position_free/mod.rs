@@ -430,9 +430,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::cosine_hemisphere;
     use crate::material::Conductor;
     use crate::microsurface::ScatteringOrder;
+    use crate::sampling::cosine_hemisphere;
     use crate::slope::Beckmann;
     use rand::SeedableRng;
     use rand_pcg::Pcg64Mcg;

@@ -64,6 +64,17 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along y.
     fn alpha_y(&self) -> f32;
 
+    /// The largest principal roughness α_max: the largest radius of the slopes' scale ellipse,
+    /// invariant under a rotation of the tangent frame (unlike αx and αy, the marginals, which
+    /// for a rotated ellipse lie in [α_max/√2, α_max]). The default is max(αx, αy), exact for
+    /// axis-aligned distributions; [`Elliptical`] returns max(α₁, α₂) (Dupuy 2015, eqs.
+    /// 2.32–2.33). [`MicrofacetBsdf`](crate::MicrofacetBsdf) compares it against its smooth and
+    /// walk-length limits.
+    #[inline]
+    fn alpha_max(&self) -> f32 {
+        self.alpha_x().max(self.alpha_y())
+    }
+
     /// The slope density P²²(x̃, ỹ), with slopes x̃ = −m.x/m.z and ỹ = −m.y/m.z.
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32;
 

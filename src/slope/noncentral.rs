@@ -2,10 +2,10 @@
 //! (Dupuy 2015, thesis §3.2).
 
 use super::{MicrosurfaceSlope, is_direction, is_direction64, is_uniform, normalize_fast};
-use crate::vector::ensure_visible;
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::microsurface::WalkSample;
+use crate::vector::ensure_visible;
 use glam::{DVec3, Vec2, Vec3};
 
 /// A sheared microsurface (Dupuy 2015, thesis §3.2): the slopes of the central distribution `S`

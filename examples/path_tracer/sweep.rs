@@ -9,12 +9,12 @@
 //! quadrature) and printed in the image: 1 for an energy-conserving model.
 
 use crate::label::{Align, BLACK, Canvas, Fonts, Rgb8, WHITE, Weight, srgb8};
-use validation::tracer::{Camera, Environment, Light, Material, RenderStats, Scene, Sphere, render};
 use glam::Vec3;
 use microsurface::{
     CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
     MicrofacetBsdf, Technique,
 };
+use validation::tracer::{Camera, Environment, Light, Material, RenderStats, Scene, Sphere, render};
 
 /// The roughnesses of the columns.
 pub const ALPHAS: [f32; 7] = [0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0];

@@ -19,7 +19,7 @@ pub(crate) const ETA: f32 = 1.5;
 /// Roughness of the multiple-scattering tests (enough for a visible second order).
 pub(crate) const ALPHA_MS: f32 = 0.6;
 /// The number of chi-square tests of this file that must pass (the Šidák family).
-pub(crate) const CHI2_FAMILY: usize = 29;
+pub(crate) const CHI2_FAMILY: usize = 33;
 /// Share of the single-bounce phase function in the proposal of the albedo estimates.
 pub(crate) const PHASE_SHARE: f64 = 0.7;
 

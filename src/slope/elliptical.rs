@@ -6,7 +6,7 @@ use crate::albedo::{AlbedoTable, DielectricAlbedoTable};
 use crate::bsdf::AlbedoTabulated;
 use crate::error::Error;
 use crate::vector::ensure_visible;
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec3};
 
 /// A slope distribution with independent roughnesses along x and y, from which
 /// [`Elliptical`] builds the rotated (correlated) one: [`Ggx`] and [`Beckmann`].
@@ -340,12 +340,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         let (x, y) = (f64::from(w.x / scale), f64::from(w.y / scale));
         let q = self.sigma_xx * x * x + 2.0 * self.sigma_xy * x * y + self.sigma_yy * y * y;
         (q / (x * x + y * y)).sqrt() as f32
-    }
-
-    /// The axis-aligned visible slopes at α = 1 (the standard distribution is isotropic).
-    #[inline]
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        self.axis_aligned.sample_p22_11(cos_theta, sin_theta, u1, u2)
     }
 
     #[inline]

@@ -11,8 +11,18 @@ use validation::quadrature::integrate_sphere;
 /// Views (θ, φ): above the horizon facing and away from the tilt, grazing, below.
 const VIEWS: [(f64, f64); 5] = [(0.0, 0.0), (1.0, 0.3), (1.3, 3.5), (1.55, 2.0), (2.2, -1.0)];
 
+/// The quadrature's absolute tolerance on the hemisphere; ∫ D_ωi is asserted to 20× it.
+const QUAD_TOL: f64 = 1e-6;
+
 fn hemisphere(f: &mut impl FnMut(Vec3) -> f64) -> f64 {
-    integrate_sphere(f, 24, 48, true, 1e-6, 6)
+    integrate_sphere(f, 24, 48, true, QUAD_TOL, 6)
+}
+
+/// ∫ D_ωi over the hemisphere to the absolute accuracy of [`hemisphere`]: D_ωi is ⟨ω, m⟩⁺D
+/// divided by A(ω), so the tolerance is scaled by A (at the same depth) instead of the bound
+/// growing as 1/A.
+fn visible_normals(f: &mut impl FnMut(Vec3) -> f64, area: f64) -> f64 {
+    integrate_sphere(f, 24, 48, true, QUAD_TOL * area.min(1.0), 6)
 }
 
 fn identities<S: MicrosurfaceSlope>(label: &str, s: &Noncentral<S>) {
@@ -38,8 +48,8 @@ fn identities<S: MicrosurfaceSlope>(label: &str, s: &Noncentral<S>) {
         let a = f64::from(s.projected_area(w));
         assert!((quad - a).abs() < 1e-5 * (1.0 + a), "{label} {w}: ∫⟨ω,m⟩⁺D = {quad}, A = {a}");
         if a > 1e-3 {
-            let visible = hemisphere(&mut |m| f64::from(s.d_wi(w, m)));
-            assert!((visible - 1.0).abs() < 2e-5 / a, "{label} {w}: ∫ D_ωi = {visible} (A = {a:.3e})");
+            let visible = visible_normals(&mut |m| f64::from(s.d_wi(w, m)), a);
+            assert!((visible - 1.0).abs() < 20.0 * QUAD_TOL, "{label} {w}: ∫ D_ωi = {visible} (A = {a:.3e})");
         }
     }
 }
@@ -238,8 +248,10 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
         validation::dir(1.2, 2.8).normalize(),
         validation::dir(1.0, -0.3).normalize(),
     ];
-    let alpha = validation::sidak(0.01, views.len());
-    let z = validation::family_z(0.01, views.len());
+    // one 1 % budget for both families (a χ² test and a mean test per view): Šidák over 2 × views
+    let tests = 2 * views.len();
+    let alpha = validation::sidak(0.01, tests);
+    let z = validation::family_z(0.01, tests);
     validation::par_map(&views, |i, &wi| {
         let mass =
             integrate_sphere(&mut |wo| f64::from(s.pdf_single_scattering(wi, wo)), 24, 48, true, 1e-6, 7);

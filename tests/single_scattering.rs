@@ -20,7 +20,7 @@ use validation::{dir, sidak, uniform32, z_two_sided};
 /// Samples per chi-square test.
 const CHI2_N: usize = 200_000;
 /// The chi-square tests of this file (one family, level 0.01).
-const CHI2_FAMILY: usize = 5;
+const CHI2_FAMILY: usize = 7;
 
 /// Relative closeness of two RGB values (per channel, relative to the larger channel).
 fn rel_close(a: Vec3, b: Vec3, tol: f32) -> bool {
@@ -103,6 +103,16 @@ fn samples_follow_their_density_and_carry_it() {
     check_sampler("gold GGX from below θ 1.9", &SingleScattering::new(ggx, gold), dir(1.9, 0.5), 13);
     check_sampler("glass GGX θ 0.5", &SingleScattering::new(ggx, glass), dir(0.5, 2.0), 14);
     check_sampler("glass Beckmann inside θ 2.6", &SingleScattering::new(beckmann, glass), dir(2.6, 0.2), 15);
+    // correlated slopes (ρ ≠ 0, φα ≠ 0)
+    let e_ggx = microsurface::Elliptical::<Ggx>::from_bivariate(0.5, 0.3, 0.7).unwrap();
+    let e_beckmann = microsurface::Elliptical::<Beckmann>::from_ellipse(0.2, 0.6, -1.1).unwrap();
+    check_sampler("gold elliptical GGX θ 1.1", &SingleScattering::new(e_ggx, gold), dir(1.1, 2.5), 16);
+    check_sampler(
+        "glass elliptical Beckmann θ 0.7",
+        &SingleScattering::new(e_beckmann, glass),
+        dir(0.7, -0.4),
+        17,
+    );
 }
 
 /// `eval_with_pdf` is `(eval, pdf)` bit for bit (deterministic materials), and `eval` is the

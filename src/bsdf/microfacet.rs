@@ -159,14 +159,15 @@ pub struct MicrofacetBsdf<S, M> {
 
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     /// A BSDF with the random-walk technique (all orders of multiple scattering), radiance
-    /// transport and seed 0. Effectively smooth surfaces (max(αx, αy) < [`SMOOTH_ALPHA`]) of
+    /// transport and seed 0. Effectively smooth surfaces (the largest principal roughness
+    /// [`MicrosurfaceSlope::alpha_max`] < [`SMOOTH_ALPHA`], whatever the frame's rotation) of
     /// conductors and dielectrics, and dielectrics of η = 1 at any roughness, are Dirac lobes.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] (`"alpha"`) if max(αx, αy) > [`MAX_WALK_ALPHA`], where walks
-    /// stop being bounded in time.
+    /// [`Error::InvalidParameter`] (`"alpha"`) if [`MicrosurfaceSlope::alpha_max`] >
+    /// [`MAX_WALK_ALPHA`], where walks stop being bounded in time.
     pub fn new(slope: S, material: M) -> Result<Self, Error> {
-        let alpha = slope.alpha_x().max(slope.alpha_y());
+        let alpha = slope.alpha_max();
         // a slope's roughness is finite and > 0 (its constructor checks it)
         if alpha > MAX_WALK_ALPHA {
             return Err(Error::InvalidParameter {

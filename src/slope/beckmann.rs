@@ -104,6 +104,30 @@ fn lambda_up64(a: f64) -> f64 {
     0.5 * INV_SQRT_PI * (-a * a).exp() * one_minus_scaled_erfcx(a) / a
 }
 
+impl Beckmann {
+    /// The stretched-space primitive of [`MicrosurfaceSlope::sample_d_wi`] (supplement §2.1,
+    /// `sampleP22_11`): visible slopes of the distribution stretched to α = 1, seen from
+    /// (sin θ, 0, cos θ), θ ∈ [0, π]; rotating them into the azimuth of the stretched ωi and
+    /// unstretching by (αx, αy) samples D_ωi. Takes cos θ and sin θ ≥ 0 (either may be ±0)
+    /// and two uniforms in [0, 1], used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴).
+    ///
+    /// Exact inversion of the visible-slope CDF (a safeguarded Halley iteration on its logarithm); ỹ is Gaussian and
+    /// independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
+    /// visible, returns the zero slope.
+    #[inline]
+    pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        require!(
+            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
+            Vec2::NAN;
+            cos_theta, sin_theta, u1, u2
+        );
+        match visible_slopes(f64::from(cos_theta), f64::from(sin_theta), u1, u2) {
+            Some((x, y)) => Vec2::new(x as f32, y as f32),
+            None => Vec2::ZERO,
+        }
+    }
+}
+
 impl crate::sealed::Sealed for Beckmann {}
 
 impl MicrosurfaceSlope for Beckmann {
@@ -248,21 +272,5 @@ impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_visible_normal(self, wi, u1, u2)
-    }
-
-    /// Exact inversion of the visible-slope CDF (a safeguarded Halley iteration on its logarithm); ỹ is Gaussian and
-    /// independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
-    /// visible, returns the zero slope.
-    #[inline]
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        require!(
-            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
-            Vec2::NAN;
-            cos_theta, sin_theta, u1, u2
-        );
-        match visible_slopes(f64::from(cos_theta), f64::from(sin_theta), u1, u2) {
-            Some((x, y)) => Vec2::new(x as f32, y as f32),
-            None => Vec2::ZERO,
-        }
     }
 }

@@ -6,7 +6,7 @@ use crate::albedo::{AlbedoTable, DielectricAlbedoTable};
 use crate::bsdf::AlbedoTabulated;
 use crate::error::Error;
 use crate::vector::ensure_visible;
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec3};
 
 /// A slope distribution with independent roughnesses along x and y, from which
 /// [`Elliptical`] builds the rotated (correlated) one: [`Ggx`] and [`Beckmann`].
@@ -68,8 +68,9 @@ impl AxisAlignedSlope for Beckmann {
 /// single scattering and [`MicrofacetBsdf`](crate::MicrofacetBsdf) accept it as any other slope
 /// (they reflect in real microfacet space), and [`CompensatedConductor`](crate::CompensatedConductor)
 /// reads its albedo tables at √(α₁ α₂) (the rotation-invariant geometric mean, what √(αx αy) is
-/// for an axis-aligned slope); `MicrofacetBsdf`'s smooth and walk-length limits
-/// compare max(αx, αy) ∈ [α_max/√2, α_max], α_max = max(α₁, α₂), against their thresholds.
+/// for an axis-aligned slope); `MicrofacetBsdf`'s smooth and walk-length limits compare
+/// [`MicrosurfaceSlope::alpha_max`] = max(α₁, α₂), the same for every φα, against their
+/// thresholds.
 /// It does not implement [`VCavitySlope`](crate::VCavitySlope), whose closed forms are written
 /// in the stretched frame of an axis-aligned distribution.
 ///
@@ -103,9 +104,18 @@ pub struct Elliptical<S> {
     sigma_yy: f64,
 }
 
+/// The largest |ρ| that [`Elliptical::from_ellipse`] derives: 1 − 2⁻²⁴, the largest f32 below 1.
+const MAX_RHO: f32 = 1.0 - f32::EPSILON / 2.0;
+
 impl<S: AxisAlignedSlope> Elliptical<S> {
     /// The distribution of the ellipse with radii `alpha_1` (along (cos φα, sin φα)) and
     /// `alpha_2`, at angle `phi` = φα (radians, any finite value).
+    ///
+    /// The derived correlation ρ (eq. 2.31) is rounded to f32 and kept in
+    /// [−(1 − 2⁻²⁴), 1 − 2⁻²⁴], so that [`Elliptical::bivariate`] is always accepted by
+    /// [`Elliptical::from_bivariate`]. The round trip reproduces the ellipse to f32 rounding of
+    /// (αx, αy, ρ); for ellipses so thin that 1 − |ρ| < 2⁻²⁴ (α₂/α₁ ≲ 2⁻¹² at φα = π/4) the
+    /// bivariate form cannot represent them in f32 and describes a slightly wider one.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] if `alpha_1` or `alpha_2` is NaN, infinite or ≤ 0 (`"alpha_1"`,
@@ -125,7 +135,8 @@ impl<S: AxisAlignedSlope> Elliptical<S> {
         let sigma_xy = (s1 - s2) * cos_phi * sin_phi;
         let alpha_x = Error::check_positive("alpha_x", sigma_xx.sqrt() as f32)?;
         let alpha_y = Error::check_positive("alpha_y", sigma_yy.sqrt() as f32)?;
-        let rho = (sigma_xy / (sigma_xx * sigma_yy).sqrt()).clamp(-1.0, 1.0) as f32;
+        // |ρ| ≤ 1 in f64 (Cauchy–Schwarz) but rounds to ±1 in f32 for very thin ellipses
+        let rho = ((sigma_xy / (sigma_xx * sigma_yy).sqrt()) as f32).clamp(-MAX_RHO, MAX_RHO);
         Ok(Self {
             axis_aligned: S::axis_aligned(alpha_1, alpha_2)?,
             ellipse: (alpha_1, alpha_2, phi),
@@ -249,6 +260,12 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         self.bivariate.1
     }
 
+    /// max(α₁, α₂), the ellipse's largest radius (eqs. 2.32–2.33), whatever φα.
+    #[inline]
+    fn alpha_max(&self) -> f32 {
+        self.ellipse.0.max(self.ellipse.1)
+    }
+
     /// Eq. 2.27: the axis-aligned density of the slopes rotated by −φα.
     #[inline]
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
@@ -323,12 +340,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         let (x, y) = (f64::from(w.x / scale), f64::from(w.y / scale));
         let q = self.sigma_xx * x * x + 2.0 * self.sigma_xy * x * y + self.sigma_yy * y * y;
         (q / (x * x + y * y)).sqrt() as f32
-    }
-
-    /// The axis-aligned visible slopes at α = 1 (the standard distribution is isotropic).
-    #[inline]
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        self.axis_aligned.sample_p22_11(cos_theta, sin_theta, u1, u2)
     }
 
     #[inline]

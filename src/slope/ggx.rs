@@ -54,6 +54,34 @@ fn lambda_up(q: f32, z: f32) -> f32 {
     (q / (2.0 * z * (z + (z * z + q).sqrt()))).min(f32::MAX)
 }
 
+impl Ggx {
+    /// The stretched-space primitive of [`MicrosurfaceSlope::sample_d_wi`] (supplement §2.1,
+    /// `sampleP22_11`): visible slopes of the distribution stretched to α = 1, seen from
+    /// (sin θ, 0, cos θ), θ ∈ [0, π]; rotating them into the azimuth of the stretched ωi and
+    /// unstretching by (αx, αy) samples D_ωi. Takes cos θ and sin θ ≥ 0 (either may be ±0)
+    /// and two uniforms in [0, 1], used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴).
+    ///
+    /// Visible slopes at α = 1 from the spherical-cap sampler. Slopes of normals that round
+    /// to cos θm = 0 are computed with cos θm = `f32::MIN_POSITIVE` (finite, probability 0).
+    /// Seen from straight below (θ = π), where nothing is visible (the cap is empty), returns
+    /// the zero slope, like [`Beckmann`](super::Beckmann).
+    #[inline]
+    pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        require!(
+            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
+            Vec2::NAN;
+            cos_theta, sin_theta, u1, u2
+        );
+        // slopes are invariant under scaling, so the unnormalized normal serves
+        let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), 1.0, u1, u2);
+        if m == Vec3::ZERO {
+            return Vec2::ZERO;
+        }
+        let z = m.z.max(MIN_SLOPE_COS * m.length());
+        Vec2::new(-m.x / z, -m.y / z)
+    }
+}
+
 impl crate::sealed::Sealed for Ggx {}
 
 impl MicrosurfaceSlope for Ggx {
@@ -157,26 +185,6 @@ impl MicrosurfaceSlope for Ggx {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         let root = (w.z * w.z + q).sqrt();
         if w.z >= 0.0 { 0.5 * (w.z + root) } else { q / (2.0 * (root - w.z)) }
-    }
-
-    /// Visible slopes at α = 1 from the spherical-cap sampler. Slopes of normals that round
-    /// to cos θm = 0 are computed with cos θm = `f32::MIN_POSITIVE` (finite, probability 0).
-    /// Seen from straight below (θ = π), where nothing is visible (the cap is empty), returns
-    /// the zero slope, like [`Beckmann`](super::Beckmann).
-    #[inline]
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        require!(
-            is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),
-            Vec2::NAN;
-            cos_theta, sin_theta, u1, u2
-        );
-        // slopes are invariant under scaling, so the unnormalized normal serves
-        let m = sample_visible_hemisphere(Vec3::new(sin_theta, 0.0, cos_theta), 1.0, u1, u2);
-        if m == Vec3::ZERO {
-            return Vec2::ZERO;
-        }
-        let z = m.z.max(MIN_SLOPE_COS * m.length());
-        Vec2::new(-m.x / z, -m.y / z)
     }
 
     /// Exact for every ωi: stretch ωi to α = 1, sample the visible hemisphere with the

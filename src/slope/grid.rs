@@ -475,6 +475,22 @@ impl GridSlope {
     }
 }
 
+impl GridSlope {
+    /// Visible slopes from (sin θ/αx, 0, cos θ) normalized (the stretched direction
+    /// unstretched), divided by (αx, αy): consistent with the trait's default `sample_d_wi`
+    /// only for directions in the xz plane; [`MicrosurfaceSlope::sample_d_wi`] is overridden
+    /// and exact for every direction.
+    pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        let (ax, ay) = (f64::from(self.alpha.0), f64::from(self.alpha.1));
+        let w = DVec3::new(f64::from(sin_theta) / ax, 0.0, f64::from(cos_theta));
+        let Some(w) = w.try_normalize() else { return Vec2::ZERO };
+        match self.sample_slopes(w, f64::from(u1), f64::from(u2)) {
+            Some((x, y)) => Vec2::new((x / ax) as f32, (y / ay) as f32),
+            None => Vec2::ZERO,
+        }
+    }
+}
+
 impl crate::sealed::Sealed for &GridSlope {}
 
 impl MicrosurfaceSlope for &GridSlope {
@@ -536,20 +552,6 @@ impl MicrosurfaceSlope for &GridSlope {
         require!(is_direction(w), f32::NAN; w);
         let b = self.backface_of(w);
         (if w.z >= 0.0 { f64::from(w.z) + b } else { b }) as f32
-    }
-
-    /// Visible slopes from (sin θ/αx, 0, cos θ) normalized (the stretched direction
-    /// unstretched), divided by (αx, αy): consistent with the trait's default `sample_d_wi`
-    /// only for directions in the xz plane; [`MicrosurfaceSlope::sample_d_wi`] is overridden
-    /// and exact for every direction.
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        let (ax, ay) = (f64::from(self.alpha.0), f64::from(self.alpha.1));
-        let w = DVec3::new(f64::from(sin_theta) / ax, 0.0, f64::from(cos_theta));
-        let Some(w) = w.try_normalize() else { return Vec2::ZERO };
-        match self.sample_slopes(w, f64::from(u1), f64::from(u2)) {
-            Some((x, y)) => Vec2::new((x / ax) as f32, (y / ay) as f32),
-            None => Vec2::ZERO,
-        }
     }
 
     /// Exact for every ωi; +z for ωi = −z. Invalid input ([policy](crate#invalid-input)): a

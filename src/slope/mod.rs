@@ -29,7 +29,7 @@ use crate::error::Error;
 // kernels live in `crate::vector`)
 use crate::sealed::Sealed;
 pub(crate) use crate::vector::{normalize_fast, renormalize};
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec3};
 
 /// A slope distribution P²²(x̃, ỹ) with roughness (αx, αy) and everything derived from it
 /// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
@@ -46,23 +46,35 @@ use glam::{DVec3, Vec2, Vec3};
 /// The contract of every implementation: `p22` integrates to 1 over the slope plane and `d`
 /// is its change of variables to normals; `lambda`, `projected_area` and `d_wi` are the
 /// Smith quantities of that density on the whole sphere (Λ(−ω) = −1 − Λ(ω), projected area
-/// (1 + Λ(ω)) cos θ); `sample_d_wi` samples `d_wi` exactly (chi-square tested) and
-/// `sample_p22_11` samples its stretched, α = 1, visible slopes; the f64 forms agree with the
-/// f32 ones to f32 rounding.
+/// (1 + Λ(ω)) cos θ); `sample_d_wi` samples `d_wi` exactly (chi-square tested); the f64 forms
+/// agree with the f32 ones to f32 rounding. (The stretched-space primitives `sample_p22_11`
+/// are inherent methods of the axis-aligned slopes, not part of this contract: for a
+/// correlated [`Elliptical`] the stretch by (αx, αy) does not sample D_ωi.)
 ///
 /// Invalid input ([policy](crate#invalid-input)), the same for every method and every
 /// implementation of the crate: a direction argument that is zero, has a NaN or ±∞ component,
 /// or is not unit within [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE), a NaN slope, or
 /// a uniform outside [0, 1] trips a debug assertion in debug builds; release builds return 0
 /// from the densities (`p22`, `d`, `d64`, `d_wi`, `d_wi64`), NaN from `lambda`,
-/// `projected_area` and `alpha_i`, and a NaN vector from the samplers (`sample_p22_11`,
-/// `sample_d_wi`). Grazing and below-horizon unit directions are valid everywhere.
+/// `projected_area` and `alpha_i`, and a NaN vector from `sample_d_wi`. Grazing and
+/// below-horizon unit directions are valid everywhere.
 pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along x.
     fn alpha_x(&self) -> f32;
 
     /// Roughness along y.
     fn alpha_y(&self) -> f32;
+
+    /// The largest principal roughness α_max: the largest radius of the slopes' scale ellipse,
+    /// invariant under a rotation of the tangent frame (unlike αx and αy, the marginals, which
+    /// for a rotated ellipse lie in [α_max/√2, α_max]). The default is max(αx, αy), exact for
+    /// axis-aligned distributions; [`Elliptical`] returns max(α₁, α₂) (Dupuy 2015, eqs.
+    /// 2.32–2.33). [`MicrofacetBsdf`](crate::MicrofacetBsdf) compares it against its smooth and
+    /// walk-length limits.
+    #[inline]
+    fn alpha_max(&self) -> f32 {
+        self.alpha_x().max(self.alpha_y())
+    }
 
     /// The slope density P²²(x̃, ỹ), with slopes x̃ = −m.x/m.z and ỹ = −m.y/m.z.
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32;
@@ -126,20 +138,6 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         f64::from(self.projected_area_unchecked(w))
     }
 
-    /// Samples visible slopes of the distribution stretched to α = 1, seen from the direction
-    /// (sin θ, 0, cos θ), θ ∈ [0, π] (supplement §2.1, `sampleP22_11`).
-    ///
-    /// The stretched-space primitive of [`Self::sample_d_wi`], from the same kernel (the
-    /// spherical cap for GGX, the exact inversion for Beckmann, the tables' own sampler):
-    /// rotating its slopes into the azimuth of the stretched ωi and unstretching them samples
-    /// D_ωi. Exposed so that the stretched configuration can be validated on its own.
-    ///
-    /// Takes cos θ and sin θ ≥ 0 rather than θ (either may be ±0, treated alike), and two
-    /// uniforms in [0, 1). Implementations cut the tails of the quantiles they invert at 2⁻²⁴
-    /// (u is used as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴); the crate's tail policy): no sample lies
-    /// beyond the last 2⁻²⁴ of the model.
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2;
-
     /// D for a normal given in double precision, evaluated in double precision. The default
     /// rounds the normal to f32; [`Ggx`] and [`Beckmann`] evaluate it in f64. The materials form
     /// their half vectors in f64 and call this: D amplifies the rounding of its argument in its
@@ -200,8 +198,9 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// implementation in its own numerically robust form, see `src/vndf/`).
     ///
     /// Always returns a unit vector with ωm.z ≥ 0 and ⟨ωi, ωm⟩ > 0 as [`Self::d_wi`] evaluates
-    /// it. For ωi = −z, which sees no microsurface, returns +z. Tails are cut at 2⁻²⁴ as in
-    /// [`Self::sample_p22_11`].
+    /// it. For ωi = −z, which sees no microsurface, returns +z. The quantiles it inverts use
+    /// u as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴) (the crate's tail policy): no sample lies beyond the last
+    /// 2⁻²⁴ of the model.
     fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
 
     // The same quantities without the argument check, for the crate's walks, which call them

@@ -601,6 +601,25 @@ pub(super) fn check_ring_count(rings: usize) -> Result<(), Error> {
     Ok(())
 }
 
+impl TabulatedSlope {
+    /// Visible slopes of the table stretched by 1/α (α = [`TabulatedSlope::alpha`]), seen from
+    /// the stretched direction (sin θ, 0, cos θ): the table's exact sampler from the
+    /// unstretched direction (sin θ/α, 0, cos θ), its slopes divided by α. The trait's default
+    /// `sample_d_wi` composed with this is exact; the override below skips the stretching.
+    pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
+        let a = f64::from(self.alpha);
+        let (sx, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));
+        let len = (sx * sx + z * z).sqrt();
+        if len.is_nan() || len <= 0.0 {
+            return Vec2::ZERO;
+        }
+        match self.sample_slopes(z / len, sx / len, f64::from(u1), f64::from(u2)) {
+            Some((x, y)) => Vec2::new((x / a) as f32, (y / a) as f32),
+            None => Vec2::ZERO,
+        }
+    }
+}
+
 impl crate::sealed::Sealed for &TabulatedSlope {}
 
 impl MicrosurfaceSlope for &TabulatedSlope {
@@ -657,23 +676,6 @@ impl MicrosurfaceSlope for &TabulatedSlope {
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         (if w.z >= 0.0 { z + b } else { b }) as f32
-    }
-
-    /// Visible slopes of the table stretched by 1/α (α = [`TabulatedSlope::alpha`]), seen from
-    /// the stretched direction (sin θ, 0, cos θ): the table's exact sampler from the
-    /// unstretched direction (sin θ/α, 0, cos θ), its slopes divided by α. The trait's default
-    /// `sample_d_wi` composed with this is exact; the override below skips the stretching.
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        let a = f64::from(self.alpha);
-        let (sx, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));
-        let len = (sx * sx + z * z).sqrt();
-        if len.is_nan() || len <= 0.0 {
-            return Vec2::ZERO;
-        }
-        match self.sample_slopes(z / len, sx / len, f64::from(u1), f64::from(u2)) {
-            Some((x, y)) => Vec2::new((x / a) as f32, (y / a) as f32),
-            None => Vec2::ZERO,
-        }
     }
 
     /// Exact for every ωi (see the type's documentation); +z for ωi = −z. Invalid
@@ -788,12 +790,6 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
         require!(is_direction(w), f32::NAN; w);
         let (s, len) = self.stretch(w);
         (len * f64::from((&self.table).projected_area(s))) as f32
-    }
-
-    /// The table's `sample_p22_11` (the stretched space of α = 1 is the same).
-    #[inline]
-    fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        (&self.table).sample_p22_11(cos_theta, sin_theta, u1, u2)
     }
 
     /// Exact for every ωi: the table's visible slopes from ω_s/‖ω_s‖, scaled by (sx, sy); +z

@@ -22,7 +22,7 @@ fn pdf_mass<B: Bsdf>(b: &B, wo: Vec3) -> f64 {
 /// `pdf` (scaled by `pdf_scale`, 1 except in the negative controls), its refusals (`None`)
 /// match the mass ∫pdf leaves out (binomial, z·SE + the quadrature's 1e-3), and every
 /// sample's weight is eval·|cos θi|/pdf (relative 1e-4). Returns (p-value, ∫pdf).
-pub(super) fn chi2_exact<B: Bsdf>(
+pub(crate) fn chi2_exact<B: Bsdf>(
     label: &str,
     b: &B,
     wo: Vec3,

@@ -32,6 +32,7 @@ mod classic;
 mod deep_tails;
 mod densities;
 mod determinism;
+mod elliptical;
 mod energy_by_order;
 mod fixtures;
 mod integrator;

@@ -19,7 +19,7 @@ use microsurface::{
     fresnel_conductor, fresnel_dielectric, fresnel_schlick, orthonormal_basis, sample_cosine_hemisphere,
     smith_normalization,
 };
-use microsurface::{Interaction, Side};
+use microsurface::{Elliptical, Interaction, Noncentral, Side};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::fmt::Debug;
@@ -194,30 +194,80 @@ fn check_slope<S: MicrosurfaceSlope>(r: &mut Report, name: &str, s: S) {
         r.expect_nothing(&format!("{l}: d_wi64(bad, good)"), || s.d_wi64(b, good().as_dvec3()), zero64);
         r.expect_nothing(&format!("{l}: d_wi64(good, bad)"), || s.d_wi64(good(), b.as_dvec3()), zero64);
         r.expect_nothing(&format!("{l}: sample_d_wi"), || s.sample_d_wi(b, 0.5, 0.5), nan_vec);
-        // (sin θ, cos θ) pairs of a bad direction in the plane y = 0
-        r.expect_nothing(
-            &format!("{l}: sample_p22_11"),
-            || s.sample_p22_11(b.z, b.x.abs(), 0.5, 0.5),
-            nan_vec2,
-        );
     }
     r.expect_nothing(&format!("{name}: d64 of a NaN DVec3"), || s.d64(DVec3::NAN), zero64);
-    r.expect_nothing(
-        &format!("{name}: sample_p22_11 with sin θ < 0"),
-        || s.sample_p22_11(0.8, -0.6, 0.5, 0.5),
-        nan_vec2,
-    );
     for u in BAD_UNIFORMS {
         let l = format!("{name} u = {u}");
         r.expect_nothing(&format!("{l}: sample_d_wi u1"), || s.sample_d_wi(good(), u, 0.5), nan_vec);
         r.expect_nothing(&format!("{l}: sample_d_wi u2"), || s.sample_d_wi(good(), 0.5, u), nan_vec);
-        r.expect_nothing(&format!("{l}: sample_p22_11 u1"), || s.sample_p22_11(0.8, 0.6, u, 0.5), nan_vec2);
-        r.expect_nothing(&format!("{l}: sample_p22_11 u2"), || s.sample_p22_11(0.8, 0.6, 0.5, u), nan_vec2);
     }
     r.expect_nothing(&format!("{name}: p22(NaN, 0)"), || s.p22(f32::NAN, 0.0), zero32);
     r.expect_nothing(&format!("{name}: p22(0, NaN)"), || s.p22(0.0, f32::NAN), zero32);
     // infinite slopes are valid (horizontal normals): density 0
     r.expect_valid(&format!("{name}: p22(∞, 0)"), || s.p22(f32::INFINITY, 0.0), zero32);
+}
+
+/// The stretched-space primitive `sample_p22_11` of the axis-aligned slopes (an inherent
+/// method: it is not part of the `MicrosurfaceSlope` contract).
+fn check_p22_11(r: &mut Report, name: &str, f: impl Fn(f32, f32, f32, f32) -> Vec2) {
+    for b in bad_directions() {
+        // (sin θ, cos θ) pairs of a bad direction in the plane y = 0
+        r.expect_nothing(&format!("{name} ω = {b}: sample_p22_11"), || f(b.z, b.x.abs(), 0.5, 0.5), nan_vec2);
+    }
+    r.expect_nothing(&format!("{name}: sample_p22_11 with sin θ < 0"), || f(0.8, -0.6, 0.5, 0.5), nan_vec2);
+    for u in BAD_UNIFORMS {
+        let l = format!("{name} u = {u}");
+        r.expect_nothing(&format!("{l}: sample_p22_11 u1"), || f(0.8, 0.6, u, 0.5), nan_vec2);
+        r.expect_nothing(&format!("{l}: sample_p22_11 u2"), || f(0.8, 0.6, 0.5, u), nan_vec2);
+    }
+}
+
+/// The inherent queries of a noncentral slope (Dupuy 2015, thesis §3.2): D, G1, D_ωi, the
+/// sampler and single scattering.
+fn check_noncentral<S: MicrosurfaceSlope>(r: &mut Report, name: &str, s: Noncentral<S>) {
+    let gold = Conductor::new(ComplexIor::GOLD);
+    for b in bad_directions() {
+        let l = format!("{name} ω = {b}");
+        r.expect_nothing(&format!("{l}: d"), || s.d(b), zero32);
+        r.expect_nothing(&format!("{l}: d64"), || s.d64(b.as_dvec3()), zero64);
+        r.expect_nothing(&format!("{l}: g1"), || s.g1(b), nan32);
+        r.expect_nothing(&format!("{l}: projected_area"), || s.projected_area(b), nan32);
+        r.expect_nothing(&format!("{l}: d_wi(bad, good)"), || s.d_wi(b, good()), zero32);
+        r.expect_nothing(&format!("{l}: d_wi(good, bad)"), || s.d_wi(good(), b), zero32);
+        r.expect_nothing(&format!("{l}: sample_d_wi"), || s.sample_d_wi(b, 0.5, 0.5), nan_vec);
+        for (wi, wo, slot) in [(b, good(), "ωi"), (good(), b, "ωo")] {
+            r.expect_nothing(
+                &format!("{l} {slot}: eval_single_scattering"),
+                || s.eval_single_scattering(&gold, wi, wo),
+                zero,
+            );
+            r.expect_nothing(
+                &format!("{l} {slot}: pdf_single_scattering"),
+                || s.pdf_single_scattering(wi, wo),
+                zero32,
+            );
+        }
+        r.expect_nothing(
+            &format!("{l}: sample_single_scattering"),
+            || s.sample_single_scattering(&gold, b, 0.5, 0.5),
+            Option::is_none,
+        );
+    }
+    for u in BAD_UNIFORMS {
+        let l = format!("{name} u = {u}");
+        r.expect_nothing(&format!("{l}: sample_d_wi u1"), || s.sample_d_wi(good(), u, 0.5), nan_vec);
+        r.expect_nothing(&format!("{l}: sample_d_wi u2"), || s.sample_d_wi(good(), 0.5, u), nan_vec);
+        r.expect_nothing(
+            &format!("{l}: sample_single_scattering u1"),
+            || s.sample_single_scattering(&gold, good(), u, 0.5),
+            Option::is_none,
+        );
+        r.expect_nothing(
+            &format!("{l}: sample_single_scattering u2"),
+            || s.sample_single_scattering(&gold, good(), 0.5, u),
+            Option::is_none,
+        );
+    }
 }
 
 fn check_height<H: MicrosurfaceHeight>(r: &mut Report, name: &str, h: H) {
@@ -465,6 +515,22 @@ fn slopes_and_heights() {
     let mut r = Report::default();
     check_slope(&mut r, "GGX", Ggx::new(0.5, 0.2).unwrap());
     check_slope(&mut r, "Beckmann", Beckmann::new(0.5, 0.2).unwrap());
+    let (ggx, beckmann) = (Ggx::new(0.5, 0.2).unwrap(), Beckmann::new(0.5, 0.2).unwrap());
+    check_p22_11(&mut r, "GGX", |c, s, u1, u2| ggx.sample_p22_11(c, s, u1, u2));
+    check_p22_11(&mut r, "Beckmann", |c, s, u1, u2| beckmann.sample_p22_11(c, s, u1, u2));
+    check_slope(&mut r, "elliptical GGX", Elliptical::<Ggx>::from_bivariate(0.5, 0.2, 0.6).unwrap());
+    check_slope(&mut r, "elliptical Beckmann", Elliptical::<Beckmann>::from_ellipse(0.5, 0.2, 0.7).unwrap());
+    check_noncentral(
+        &mut r,
+        "noncentral Beckmann",
+        Noncentral::new(Beckmann::new(0.5, 0.2).unwrap(), Vec2::new(0.4, -0.3)).unwrap(),
+    );
+    check_noncentral(
+        &mut r,
+        "noncentral elliptical GGX",
+        Noncentral::new(Elliptical::<Ggx>::from_bivariate(0.5, 0.2, -0.6).unwrap(), Vec2::new(-0.5, 0.2))
+            .unwrap(),
+    );
     check_height(&mut r, "uniform", UniformHeight);
     check_height(&mut r, "Gaussian", GaussianHeight);
     r.finish("slopes_and_heights", 500);
@@ -483,6 +549,9 @@ fn materials_walks_and_position_free() {
     check_material(&mut r, "GGX dielectric", ggx, Dielectric::new(1.5).unwrap());
     check_material(&mut r, "Beckmann gold", beckmann, Conductor::new(gold));
     check_material(&mut r, "Beckmann dielectric", beckmann, Dielectric::new(1.0 / 1.5).unwrap());
+    let elliptical = Elliptical::<Ggx>::from_bivariate(0.5, 0.3, 0.5).unwrap();
+    check_material(&mut r, "elliptical GGX gold", elliptical, Conductor::new(gold));
+    check_material(&mut r, "elliptical GGX dielectric", elliptical, Dielectric::new(1.5).unwrap());
     for c in BAD_COSINES {
         r.expect_nothing(&format!("Conductor::fresnel({c})"), || Conductor::new(gold).fresnel(c), nan_vec);
     }

@@ -137,8 +137,8 @@ mod vector;
 mod vndf;
 
 pub use albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
-    Incidence, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA,
+    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable, EtaRange,
+    MAX_TABULATED_ALPHA, MAX_TABULATED_ETA,
 };
 pub use basis::orthonormal_basis;
 pub use bsdf::{

@@ -6,7 +6,7 @@
 use glam::Vec3;
 use microsurface::{
     ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Bsdf, Conductor, DIELECTRIC_TABLE_SIZE, Dielectric,
-    DielectricAlbedoTable, Ggx, Incidence, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Technique,
+    DielectricAlbedoTable, EtaRange, Ggx, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Technique,
     Transport, UniformHeight,
 };
 use rand::RngExt;
@@ -325,7 +325,7 @@ fn dielectric_nodes_match_the_single_scattering_bsdf() {
     });
     for (&(family, inside, i, j, l), [refl, trans, _]) in cells.iter().zip(&results) {
         let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l);
-        let side = if inside { Incidence::Inside } else { Incidence::Outside };
+        let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
         let (r_nodes, t_nodes) = dielectric_table(family).nodes(side);
         let k = (l * DIELECTRIC_TABLE_SIZE + j) * DIELECTRIC_TABLE_SIZE + i;
         let label = format!(
@@ -371,7 +371,7 @@ fn dielectric_nodes_are_physical() {
     // every node: 0 ≤ R, T and R + T ≤ 1 (single scattering loses energy, never gains); at
     // μ = 0 nothing is transmitted; at η = 1 nothing is reflected
     for family in 0..2 {
-        for side in [Incidence::Outside, Incidence::Inside] {
+        for side in [EtaRange::AtLeastOne, EtaRange::AtMostOne] {
             let (r, t) = dielectric_table(family).nodes(side);
             for k in 0..r.len() {
                 let (i, l) = (k % DIELECTRIC_TABLE_SIZE, k / (DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE));
@@ -419,7 +419,7 @@ fn dielectric_out_of_range_gives_none() {
 fn dielectric_lookup_reproduces_the_nodes() {
     for family in 0..2 {
         for inside in [false, true] {
-            let side = if inside { Incidence::Inside } else { Incidence::Outside };
+            let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
             let (r_nodes, t_nodes) = dielectric_table(family).nodes(side);
             for l in [0, 1, 7, 15] {
                 for j in [1, 7, 15] {

@@ -327,10 +327,11 @@ fn dielectric_table_of(family: Family) -> microsurface::DielectricAlbedoTable {
     }
 }
 
-fn side_of(side: Side) -> microsurface::Incidence {
+/// The table light from `side` reads (outside η ≥ 1, inside 1/η ≤ 1).
+fn range_of(side: Side) -> microsurface::EtaRange {
     match side {
-        Side::Outside => microsurface::Incidence::Outside,
-        Side::Inside => microsurface::Incidence::Inside,
+        Side::Outside => microsurface::EtaRange::AtLeastOne,
+        Side::Inside => microsurface::EtaRange::AtMostOne,
     }
 }
 
@@ -453,7 +454,7 @@ fn quick() {
                 state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
                 let k = (state >> 33) as usize % (ND * ND * ND);
                 let (r, t) = dielectric_node(family, side, k, DIELECTRIC_PANELS);
-                let (sr, st) = table.nodes(side_of(side));
+                let (sr, st) = table.nodes(range_of(side));
                 dielectric_nodes += 1;
                 if (r as f32).to_bits() != sr[k].to_bits() || (t as f32).to_bits() != st[k].to_bits() {
                     failures += 1;
@@ -472,7 +473,7 @@ fn quick() {
     let mut shipped = Vec::new();
     for family in [Family::Ggx, Family::Beckmann] {
         for side in [Side::Outside, Side::Inside] {
-            let (r, t) = dielectric_table_of(family).nodes(side_of(side));
+            let (r, t) = dielectric_table_of(family).nodes(range_of(side));
             shipped.push((family, side, DielectricTables { reflected: r.to_vec(), transmitted: t.to_vec() }));
         }
     }

@@ -1,6 +1,7 @@
 //! The reflected and transmitted single-scattering albedo tables of dielectric microsurfaces
 //! and their interpolation.
 
+use super::axis::{node_cell, scale_invariant_direction};
 use super::dielectric_data as data;
 use super::table::MAX_TABULATED_ALPHA;
 
@@ -17,15 +18,35 @@ const NODES: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE * DIELECTRIC_
 /// A row of the η axis: 16 × 16 nodes.
 const ROW: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;
 
-/// The side of a dielectric interface light arrives from, for an interface of relative index
-/// η = η_inside/η_outside ≥ 1 (glass in air): from outside it sees η, from inside 1/η.
+/// The η-axis coordinate u = √((η − 1)/2) ∈ [0, 1] of a relative index η ∈ [1, 3] (η = 1 + 2u²).
+#[inline(always)]
+fn eta_coordinate(eta_at_least_one: f32) -> f32 {
+    ((eta_at_least_one - 1.0) * 0.5).max(0.0).sqrt().min(1.0)
+}
+
+/// Which of a family's two dielectric tables: the one of relative indices η ≥ 1 (light
+/// arriving from the side of the lower index, external incidence) or the one of η ≤ 1 (from
+/// the side of the higher index, internal incidence, with total internal reflection beyond the
+/// critical angle). For an interface of index η ≥ 1 (glass in air) light from
+/// [`crate::Side::Outside`] reads [`EtaRange::AtLeastOne`] at η and light from
+/// [`crate::Side::Inside`] reads [`EtaRange::AtMostOne`] at 1/η; [`EtaRange::of`] selects by
+/// the relative index seen by the light.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Incidence {
-    /// From the side of the lower index: relative index η ≥ 1.
-    Outside,
-    /// From the side of the higher index: relative index 1/η ≤ 1 (total internal reflection
-    /// beyond the critical angle).
-    Inside,
+pub enum EtaRange {
+    /// Relative indices η ∈ [1, [`MAX_TABULATED_ETA`]].
+    AtLeastOne,
+    /// Relative indices η ∈ [1/[`MAX_TABULATED_ETA`], 1].
+    AtMostOne,
+}
+
+impl EtaRange {
+    /// The table of the relative index η seen by the light: [`EtaRange::AtLeastOne`] for
+    /// η ≥ 1, [`EtaRange::AtMostOne`] otherwise (NaN included).
+    #[must_use]
+    #[inline]
+    pub fn of(eta: f32) -> Self {
+        if eta >= 1.0 { Self::AtLeastOne } else { Self::AtMostOne }
+    }
 }
 
 /// The single-scattering albedo of a dielectric interface, split by where the light goes.
@@ -65,7 +86,8 @@ pub struct DielectricAlbedo {
 /// integral (2 and 3 quadrature panels agree to 3.9e-6 at every 7th node). **Between the nodes
 /// the interpolation is poor**: the direction axis, shared with [`crate::AlbedoTable`], is
 /// scale-invariant in μ/α, but the Fresnel term depends on μ itself, T falls to its limit 0
-/// only slowly as μ → 0, and R changes fast in η near 1. Measured at random points against
+/// only slowly as μ → 0, R changes fast in η near 1, and from inside the onset of total
+/// internal reflection at μ = √(1 − η²) moves across the direction axis with η. Measured at random points against
 /// quadrature, R + T errs by up to 0.33 (GGX) and 0.55 (Beckmann) from outside, 0.08 and 0.10
 /// from inside (RMS 0.039 / 0.058 and 0.008 / 0.013); R and T alone by up to 0.9. Use the
 /// nodes, or treat lookups between them with that error.
@@ -125,9 +147,8 @@ impl DielectricAlbedoTable {
             return None;
         }
         let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let x = (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
-        let u = ((eta_ge_1 - 1.0) * 0.5).max(0.0).sqrt().min(1.0);
-        let at = [x * LAST, alpha.sqrt() * LAST, u * LAST];
+        let x = scale_invariant_direction(mu, alpha);
+        let at = [x * LAST, alpha.sqrt() * LAST, eta_coordinate(eta_ge_1) * LAST];
         Some(DielectricAlbedo { reflected: trilinear(tables[0], at), transmitted: trilinear(tables[1], at) })
     }
 
@@ -135,10 +156,10 @@ impl DielectricAlbedoTable {
     /// r = j/15, u = l/15 (η = 1 + 2u² from outside, its inverse from inside), for export to
     /// shaders.
     #[must_use]
-    pub fn nodes(&self, incidence: Incidence) -> (&'static [f32], &'static [f32]) {
-        let t = match incidence {
-            Incidence::Outside => &self.outside,
-            Incidence::Inside => &self.inside,
+    pub fn nodes(&self, range: EtaRange) -> (&'static [f32], &'static [f32]) {
+        let t = match range {
+            EtaRange::AtLeastOne => &self.outside,
+            EtaRange::AtMostOne => &self.inside,
         };
         (t[0], t[1])
     }
@@ -147,8 +168,7 @@ impl DielectricAlbedoTable {
 /// The cell index ∈ [0, 14] and fraction of a fractional node coordinate t ∈ [0, 15].
 #[inline(always)]
 fn cell(t: f32) -> (usize, f32) {
-    let i = (t as usize).min(DIELECTRIC_TABLE_SIZE - 2);
-    (i, t - i as f32)
+    node_cell(t, DIELECTRIC_TABLE_SIZE)
 }
 
 /// Trilinear interpolation of a 16³ grid (η slowest, direction fastest) at fractional node
@@ -188,9 +208,8 @@ impl DielectricAlbedoTable {
             return None;
         }
         let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let u = ((eta_ge_1 - 1.0) * 0.5).max(0.0).sqrt().min(1.0);
         let (j, fj) = cell(alpha.sqrt() * LAST);
-        let (l, fl) = cell(u * LAST);
+        let (l, fl) = cell(eta_coordinate(eta_ge_1) * LAST);
         let blend = |grid: &[f32; NODES]| {
             let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
             for (i, o) in out.iter_mut().enumerate() {

@@ -75,7 +75,7 @@ impl AlbedoTable {
         if !((0.0..=1.0).contains(&mu) && alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA) {
             return None;
         }
-        let x = (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
+        let x = super::scale_invariant_direction(mu, alpha);
         Some(bilinear(self.directional, x * LAST, alpha.sqrt() * LAST))
     }
 

@@ -4,7 +4,10 @@
 
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
-use crate::albedo::{ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, MAX_TABULATED_ALPHA};
+use crate::albedo::{
+    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, MAX_TABULATED_ALPHA, node_cell,
+    scale_invariant_direction,
+};
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
@@ -274,10 +277,7 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// The cell i ∈ [0, 30] of the direction axis that holds μ, and the fraction within it.
     #[inline(always)]
     fn cell(&self, mu: f32) -> (usize, f32) {
-        let x = (mu * (1.0 + self.alpha) / (mu + self.alpha)).min(1.0).sqrt();
-        let t = x * LAST;
-        let i = (t as usize).min(ALBEDO_TABLE_SIZE - 2);
-        (i, t - i as f32)
+        node_cell(scale_invariant_direction(mu, self.alpha) * LAST, ALBEDO_TABLE_SIZE)
     }
 
     /// The density of the Kulla–Conty lobe's sampler at wi (upper hemisphere):

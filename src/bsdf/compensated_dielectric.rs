@@ -6,9 +6,11 @@
 use super::compensated::AlbedoTabulated;
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction};
-use crate::albedo::{DIELECTRIC_TABLE_SIZE, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
+use crate::albedo::{
+    DIELECTRIC_TABLE_SIZE, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, node_cell, scale_invariant_direction,
+};
 use crate::error::Error;
-use crate::material::Dielectric;
+use crate::material::{Dielectric, Side};
 use crate::slope::MicrosurfaceSlope;
 use glam::{Vec2, Vec3};
 
@@ -136,20 +138,23 @@ impl<S: MicrosurfaceSlope> CompensatedDielectric<S> {
         self.alpha
     }
 
-    /// E(μo) = R + T as this BSDF interpolates it for a view above (`above`) or below the
-    /// surface, for μo ∈ [0, 1]; `None` outside (NaN included).
-    pub fn directional_albedo(&self, mu: f32, above: bool) -> Option<f32> {
-        (0.0..=1.0).contains(&mu).then(|| self.albedo_at(mu, usize::from(!above)))
+    /// E(μo) = R + T as this BSDF interpolates it for a view on `side` of the surface
+    /// ([`Side::Outside`]: above it, seeing η; [`Side::Inside`]: below it, seeing 1/η), for
+    /// μo = |cos θo| ∈ [0, 1]; `None` outside (NaN included).
+    pub fn directional_albedo(&self, mu: f32, side: Side) -> Option<f32> {
+        (0.0..=1.0).contains(&mu).then(|| self.albedo_at(mu, side))
     }
 
-    /// E at |cos θo| = μ for the view side `side` (0 above, 1 below): linear interpolation on
-    /// the direction axis x = √(μ (1 + α)/(μ + α)). Branch-free.
+    /// E at |cos θo| = μ for a view on `side`: linear interpolation on the tables' direction
+    /// axis x = √(μ (1 + α)/(μ + α)). Branch-free.
     #[inline(always)]
-    fn albedo_at(&self, mu: f32, side: usize) -> f32 {
-        let x = (mu * (1.0 + self.alpha) / (mu + self.alpha)).min(1.0).sqrt();
-        let t = x * LAST;
-        let i = (t as usize).min(DIELECTRIC_TABLE_SIZE - 2);
-        let f = t - i as f32;
+    fn albedo_at(&self, mu: f32, side: Side) -> f32 {
+        let side = match side {
+            Side::Outside => 0,
+            Side::Inside => 1,
+        };
+        let x = scale_invariant_direction(mu, self.alpha);
+        let (i, f) = node_cell(x * LAST, DIELECTRIC_TABLE_SIZE);
         let row = &self.albedo[side];
         row[i] + f * (row[i + 1] - row[i])
     }
@@ -160,7 +165,7 @@ impl<S: MicrosurfaceSlope> CompensatedDielectric<S> {
         if wo.z == 0.0 || self.single.is_specular() {
             return 1.0;
         }
-        1.0 / self.albedo_at(wo.z.abs(), usize::from(wo.z < 0.0))
+        1.0 / self.albedo_at(wo.z.abs(), Side::above_or_inside(wo.z))
     }
 
     /// f·factor, or 0 where it is not a finite f32 (see the special cases).

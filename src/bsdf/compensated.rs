@@ -119,7 +119,7 @@ pub enum Compensation {
 /// few ulps of μ² of probability between neighbouring cells). Turquin samples and has the density of
 /// the single-scattering lobe.
 ///
-/// **Special cases.** Effectively smooth surfaces (max(αx, αy) < [`super::SMOOTH_ALPHA`]) are
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
 /// the Dirac mirror of the single-scattering BSDF, uncompensated (the energy the single
 /// bounce loses vanishes with α). View directions below the horizon (a backfacing shading
 /// normal, which single scattering supports) have no tabulated albedo: the lobe is then the

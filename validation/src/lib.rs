@@ -48,6 +48,6 @@ pub mod stochastic;
 pub mod tracer;
 
 pub use stats::{
-    Stats, TestRng, assert_mean, assert_two_sample, dir, family_z, par_map, rng, sidak, uniform_sphere,
-    uniform32, uniform64, z_two_sided,
+    Stats, TestRng, assert_mean, assert_refusal_rate, assert_two_sample, dir, family_z, par_map, rng, sidak,
+    uniform_sphere, uniform32, uniform64, z_two_sided,
 };

@@ -95,6 +95,21 @@ pub fn assert_mean(label: &str, stats: &Stats, expected: f64, z: f64, max_se: f6
     );
 }
 
+/// Asserts that a sampler refuses (returns nothing) as often as its density says: the refusal
+/// rate failures/N is binomial with p = 1 − `mass`, so |failures/N − p| ≤ z·√(p(1 − p)/N) +
+/// `mass_tol`, where `mass` = ∫pdf comes from a quadrature whose deterministic error is
+/// `mass_tol` (never the statistical error). Prints N, the rate, p, SE and z on failure.
+pub fn assert_refusal_rate(label: &str, failures: usize, n: usize, mass: f64, mass_tol: f64, z: f64) {
+    let p_none = (1.0 - mass).clamp(0.0, 1.0);
+    let se = (p_none * (1.0 - p_none) / n as f64).sqrt();
+    let frac = failures as f64 / n as f64;
+    assert!(
+        (frac - p_none).abs() <= z * se + mass_tol,
+        "{label}: sample refused {frac:.5} of the time, 1 − ∫pdf = {p_none:.5} \
+         (N = {n}, SE = {se:.2e}, z = {z:.2}, quadrature tolerance {mass_tol:.1e})"
+    );
+}
+
 /// Asserts that two independent estimates agree: |m1 − m2| ≤ z·√(SE1² + SE2²), and that the
 /// combined SE is at most `max_se`.
 pub fn assert_two_sample(label: &str, a: &Stats, b: &Stats, z: f64, max_se: f64) {

@@ -29,6 +29,25 @@ use rand::Rng;
 /// height-space queries of [`MicrosurfaceGeometry`]; `tests/walk/random_walk.rs` checks the walks against
 /// the supplement's height-space algorithm run on [`UniformHeight`](crate::UniformHeight) and
 /// [`GaussianHeight`](crate::GaussianHeight).
+///
+/// # Examples
+/// ```
+/// use microsurface::{Dielectric, Ggx, Microsurface, ScatteringOrder, UniformHeight};
+/// use microsurface::glam::Vec3;
+/// use microsurface::rand::SeedableRng;
+///
+/// let glass = Microsurface::new(UniformHeight, Ggx::isotropic(0.4)?, Dielectric::new(1.5)?);
+/// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+/// let wi = Vec3::new(0.5, 0.0, 0.866);
+/// // a walk sample leaves above (reflection) or below (transmission) the macrosurface
+/// let s = glass.sample(wi, &mut rng).expect("light entering glass leaves it");
+/// assert!(s.wo.is_normalized() && s.bounces >= 1);
+/// // f·|cos θo| of the second order alone, for the transmitted direction straight down
+/// let second = ScatteringOrder::only(2).expect("orders start at 1");
+/// let f_cos = glass.eval(wi, -Vec3::Z, second, &mut rng);
+/// assert!(f_cos.is_finite() && f_cos.min_element() >= 0.0);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Microsurface<H, S, M> {
     geometry: MicrosurfaceGeometry<H, S>,

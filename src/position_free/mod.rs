@@ -67,6 +67,22 @@ pub enum Estimator {
 /// inside for ωi.z < 0; an opaque material accepts ωi below the horizon as light arriving
 /// from below the macrosurface (a backfacing view under a normal map), every estimator
 /// included.
+///
+/// # Examples
+/// ```
+/// use microsurface::{Conductor, Estimator, Ggx, PositionFree, ScatteringOrder, Shadowing};
+/// use microsurface::glam::Vec3;
+/// use microsurface::rand::SeedableRng;
+///
+/// let surface = PositionFree::new(Ggx::isotropic(1.0)?, Conductor::perfect(), Shadowing::Correlated);
+/// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+/// let (wi, wo) = (Vec3::new(0.6, 0.0, 0.8), Vec3::Z);
+/// // BDPT and PT estimate the same BSDF (f·|cos θo|), here all orders
+/// let bdpt = surface.eval(wi, wo, Estimator::Bdpt, ScatteringOrder::All, &mut rng);
+/// let pt = surface.eval(wi, wo, Estimator::Pt, ScatteringOrder::All, &mut rng);
+/// assert!(bdpt.x > 0.0 && pt.x > 0.0);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PositionFree<S, M> {
     slope: S,

@@ -24,6 +24,20 @@ const AREA_LOG_SPACE_BELOW: f64 = 1e-280;
 /// exactly by inverting the visible-slope CDF (Jakob 2014, extended to θ ∈ [0, π]) with a
 /// safeguarded Halley iteration on the log-CDF, without the supplement's truncation of the
 /// tail (`erf_min = −0.9999`).
+///
+/// # Examples
+/// ```
+/// use microsurface::{Beckmann, MicrosurfaceSlope};
+/// use microsurface::glam::Vec3;
+///
+/// let beckmann = Beckmann::isotropic(0.5)?;
+/// // Λ(−ω) = −1 − Λ(ω) on the whole sphere, also for a view below the horizon
+/// let w = Vec3::new(0.8, 0.0, -0.6);
+/// assert!((beckmann.lambda(-w) + 1.0 + beckmann.lambda(w)).abs() < 1e-6);
+/// let wm = beckmann.sample_d_wi(w, 0.5, 0.5);
+/// assert!(wm.dot(w) > 0.0);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Beckmann {
     alpha_x: f32,

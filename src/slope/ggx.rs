@@ -21,6 +21,22 @@ const MIN_SLOPE_COS: f32 = f32::MIN_POSITIVE;
 /// Visible normals are sampled exactly on the whole sphere with the spherical-cap method of
 /// Dupuy and Benyoub 2023 (“Sampling Visible GGX Normals with Spherical Caps”), which also
 /// holds for incident directions below the horizon.
+///
+/// # Examples
+/// ```
+/// use microsurface::{Ggx, MicrosurfaceSlope};
+/// use microsurface::glam::Vec3;
+///
+/// let ggx = Ggx::new(0.3, 0.1)?;
+/// let wi = Vec3::new(0.6, 0.0, 0.8);
+/// // the projected area of the microsurface is (1 + Λ) cos θ, and a sampled visible normal
+/// // faces the incident direction
+/// assert!((ggx.projected_area(wi) - (1.0 + ggx.lambda(wi)) * wi.z).abs() < 1e-6);
+/// let wm = ggx.sample_d_wi(wi, 0.3, 0.6);
+/// assert!(wm.dot(wi) > 0.0 && ggx.d_wi(wi, wm) > 0.0);
+/// assert!(Ggx::isotropic(-1.0).is_err());
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ggx {
     alpha_x: f32,

@@ -113,7 +113,7 @@ fn constructors_reject_invalid_parameters() {
 use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
 use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
-use validation::quadrature::integrate_sphere;
+use validation::quadrature::{Domain, integrate_sphere};
 
 /// Correlations of the identity tests, up to |ρ| = 0.99.
 const RHOS: [f32; 5] = [-0.99, -0.6, 0.0, 0.8, 0.99];
@@ -127,14 +127,14 @@ const QUAD_TOL: f64 = 1e-6;
 
 /// The quadrature of ∫ f over the upper hemisphere: 24 × 48 cells, adaptive to depth 6.
 fn hemisphere(f: &mut impl FnMut(Vec3) -> f64) -> f64 {
-    integrate_sphere(f, 24, 48, true, QUAD_TOL, 6)
+    integrate_sphere(f, 24, 48, Domain::UpperHemisphere, QUAD_TOL, 6)
 }
 
 /// ∫ D_ωi over the hemisphere to the absolute accuracy of [`hemisphere`]: D_ωi is ⟨ω, m⟩⁺D
 /// divided by A(ω), so the tolerance is scaled by A (at the same depth) instead of the bound
 /// growing as 1/A.
 fn visible_normals(f: &mut impl FnMut(Vec3) -> f64, area: f64) -> f64 {
-    integrate_sphere(f, 24, 48, true, QUAD_TOL * area.min(1.0), 6)
+    integrate_sphere(f, 24, 48, Domain::UpperHemisphere, QUAD_TOL * area.min(1.0), 6)
 }
 
 fn identities<S: MicrosurfaceSlope>(label: &str, slope: &S) {

@@ -26,7 +26,7 @@ use microsurface::{
 use microsurface::{Interaction, Side};
 use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
-use validation::quadrature::integrate_sphere;
+use validation::quadrature::{Domain, integrate_sphere};
 use validation::{Stats, TestRng};
 
 const ALPHAS: [(f32, f32); 3] = [(0.3, 0.3), (1.0, 1.0), (1.0, 0.1)];
@@ -177,7 +177,7 @@ fn energy_conservation_exact_quadrature_4_3_1() {
         let mut f = |wo: Vec3| {
             if wi_out { surface.eval(wi, wo, &mut rng) } else { surface.total(wi, wo, false, &mut rng) }
         };
-        let integral = integrate_sphere(&mut f, 32, 64, false, 1e-5, 6);
+        let integral = integrate_sphere(&mut f, 32, 64, Domain::Sphere, 1e-5, 6);
         assert!(
             (integral - 1.0).abs() <= QUAD_TOL,
             "{}: ∫p(ωi, ωo)dωo = {integral:.6} ≠ 1 (θi = {theta}, ωi outside = {wi_out})",
@@ -381,7 +381,7 @@ fn sampling_chi2_exact_4_3_3() {
         if surface.kind() == Kind::Dielectric {
             // probability of staying on ωi's side = ∫ p(ωi, ωo, same side) dωo (quadrature)
             let mut g = |wo: Vec3| surface.sided(wi, wo, wi_out, wi_out, &mut dummy);
-            let p_same = integrate_sphere(&mut g, 32, 64, false, 1e-5, 6);
+            let p_same = integrate_sphere(&mut g, 32, 64, Domain::Sphere, 1e-5, 6);
             let mut stats = Stats::default();
             // the indicator's mean and SE, from the counts
             for k in 0..CHI2_N {

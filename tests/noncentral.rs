@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope, Noncentral};
 use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
-use validation::quadrature::integrate_sphere;
+use validation::quadrature::{Domain, integrate_sphere};
 
 /// Views (θ, φ): above the horizon facing and away from the tilt, grazing, below.
 const VIEWS: [(f64, f64); 5] = [(0.0, 0.0), (1.0, 0.3), (1.3, 3.5), (1.55, 2.0), (2.2, -1.0)];
@@ -15,14 +15,14 @@ const VIEWS: [(f64, f64); 5] = [(0.0, 0.0), (1.0, 0.3), (1.3, 3.5), (1.55, 2.0),
 const QUAD_TOL: f64 = 1e-6;
 
 fn hemisphere(f: &mut impl FnMut(Vec3) -> f64) -> f64 {
-    integrate_sphere(f, 24, 48, true, QUAD_TOL, 6)
+    integrate_sphere(f, 24, 48, Domain::UpperHemisphere, QUAD_TOL, 6)
 }
 
 /// ∫ D_ωi over the hemisphere to the absolute accuracy of [`hemisphere`]: D_ωi is ⟨ω, m⟩⁺D
 /// divided by A(ω), so the tolerance is scaled by A (at the same depth) instead of the bound
 /// growing as 1/A.
 fn visible_normals(f: &mut impl FnMut(Vec3) -> f64, area: f64) -> f64 {
-    integrate_sphere(f, 24, 48, true, QUAD_TOL * area.min(1.0), 6)
+    integrate_sphere(f, 24, 48, Domain::UpperHemisphere, QUAD_TOL * area.min(1.0), 6)
 }
 
 fn identities<S: MicrosurfaceSlope>(label: &str, s: &Noncentral<S>) {
@@ -253,8 +253,14 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
     let alpha = validation::sidak(0.01, tests);
     let z = validation::family_z(0.01, tests);
     validation::par_map(&views, |i, &wi| {
-        let mass =
-            integrate_sphere(&mut |wo| f64::from(s.pdf_single_scattering(wi, wo)), 24, 48, true, 1e-6, 7);
+        let mass = integrate_sphere(
+            &mut |wo| f64::from(s.pdf_single_scattering(wi, wo)),
+            24,
+            48,
+            Domain::UpperHemisphere,
+            1e-6,
+            7,
+        );
         let mut rng = validation::rng(500 + i as u64);
         chi2_test(
             &format!("single scattering from {wi}"),
@@ -277,7 +283,7 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
             &mut |wo| f64::from(s.eval_single_scattering(&conductor, wi, wo).x),
             24,
             48,
-            true,
+            Domain::UpperHemisphere,
             1e-6,
             7,
         );

@@ -10,7 +10,7 @@ pub(crate) use microsurface::{
 };
 pub(crate) use std::f64::consts::PI;
 pub(crate) use validation::chi2::{Chi2Grid, chi2_test};
-pub(crate) use validation::quadrature::integrate_sphere;
+pub(crate) use validation::quadrature::{Domain, integrate_sphere};
 pub(crate) use validation::{
     Stats, TestRng, assert_two_sample, dir, family_z, par_map, sidak, uniform_sphere, uniform32, uniform64,
 };

@@ -105,7 +105,14 @@ fn single_scattering_pixels_match_a_numerical_integral() {
                 let f = bsdf.eval(wo, wi).f;
                 f64::from(f[c]) * f64::from(wi.z) * f64::from(sky.radiance(frame.to_world(wi))[c])
             };
-            *r = validation::quadrature::integrate_sphere(&mut integrand, 16, 32, true, 1e-6, 8);
+            *r = validation::quadrature::integrate_sphere(
+                &mut integrand,
+                16,
+                32,
+                validation::quadrature::Domain::UpperHemisphere,
+                1e-6,
+                8,
+            );
         }
         // the path tracer at the pixel centre
         let mut channels = [Stats::default(); 3];

@@ -102,17 +102,29 @@ pub fn integrate_grid(
     total
 }
 
-/// ∫ f(ω) dω over the whole sphere (or the upper hemisphere if `upper_only`), as a sum of
-/// adaptively refined cells of a `nz` × `nphi` grid in (cos θ, φ).
+/// The part of the sphere [`integrate_sphere`] covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Domain {
+    /// The whole sphere, cos θ ∈ [−1, 1].
+    Sphere,
+    /// The upper hemisphere, cos θ ∈ [0, 1].
+    UpperHemisphere,
+}
+
+/// ∫ f(ω) dω over `domain`, as a sum of adaptively refined cells of a `nz` × `nphi` grid in
+/// (cos θ, φ), with the absolute tolerance `abs_tol` shared among the cells.
 pub fn integrate_sphere(
     f: &mut impl FnMut(glam::Vec3) -> f64,
     nz: usize,
     nphi: usize,
-    upper_only: bool,
+    domain: Domain,
     abs_tol: f64,
     max_depth: u32,
 ) -> f64 {
-    let z_lo = if upper_only { 0.0 } else { -1.0 };
+    let z_lo = match domain {
+        Domain::Sphere => -1.0,
+        Domain::UpperHemisphere => 0.0,
+    };
     let mut g = |z: f64, phi: f64| {
         let s = (1.0 - z * z).max(0.0).sqrt();
         f(glam::Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32))

@@ -1,7 +1,6 @@
 //! An 8-bit sRGB canvas with anti-aliased text: the labels of the sweep images, drawn with
 //! `ab_glyph` from DejaVu Sans, which the `dejavu` crate embeds (no system font needed; the
 //! DejaVu licence is permissive, derived from Bitstream Vera's).
-#![allow(dead_code)]
 
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 

@@ -10,8 +10,8 @@ mod sweep;
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
-use sweep::{Layout, Lighting, render_sweep};
-use validation::tracer::{RenderStats, SHOWCASE_LABELS, render, showcase_scene};
+use sweep::{Layout, render_sweep};
+use validation::tracer::{Lighting, RenderStats, SHOWCASE_LABELS, render, showcase_scene};
 
 const USAGE: &str = "usage: cargo run --release --example path_tracer -- [--quick] [--spp N] [--out-dir DIR]
        cargo run --release --example path_tracer -- --showcase [--width W] [--height H] [--spp N] [--out FILE.png] [--furnace]
@@ -108,7 +108,7 @@ fn run_sweep(
 fn main() {
     use std::io::IsTerminal;
     let mut args = std::env::args().skip(1);
-    let (mut width, mut height, mut spp, mut furnace) = (480u32, 200u32, None, false);
+    let (mut width, mut height, mut spp, mut lighting) = (480u32, 200u32, None, Lighting::Studio);
     let (mut showcase, mut quick) = (false, false);
     let mut out = std::path::PathBuf::from("target/path_tracer.png");
     let mut out_dir = std::path::PathBuf::from("target/path_tracer");
@@ -127,7 +127,7 @@ fn main() {
             "--spp" => spp = Some(number()),
             "--out" => out = value().into(),
             "--out-dir" => out_dir = value().into(),
-            "--furnace" => furnace = true,
+            "--furnace" => lighting = Lighting::Furnace,
             "--showcase" => showcase = true,
             "--quick" => quick = true,
             "-h" | "--help" => {
@@ -145,7 +145,7 @@ fn main() {
         return;
     }
     let spp = spp.unwrap_or(if quick { 4 } else { 64 });
-    let (scene, camera) = showcase_scene(furnace);
+    let (scene, camera) = showcase_scene(lighting);
     let stats = RenderStats::default();
     let start = Instant::now();
     let (image, _) = std::thread::scope(|s| {
@@ -164,5 +164,8 @@ fn main() {
         out.display(),
         stats.rejected.load(Ordering::Relaxed)
     );
-    println!("spheres, left to right: {}", SHOWCASE_LABELS[..if furnace { 7 } else { 8 }].join(" | "));
+    println!(
+        "spheres, left to right: {}",
+        SHOWCASE_LABELS[..if lighting == Lighting::Furnace { 7 } else { 8 }].join(" | ")
+    );
 }

@@ -14,22 +14,15 @@ use microsurface::{
     CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
     MicrofacetBsdf, Technique,
 };
-use validation::tracer::{Camera, Environment, Light, Material, RenderStats, Scene, Sphere, render};
+use validation::tracer::{
+    Camera, Environment, Light, Lighting, Material, RenderStats, Scene, Sphere, render,
+};
 
 /// The roughnesses of the columns.
 pub const ALPHAS: [f32; 7] = [0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0];
 
 /// The index of refraction of the glass spheres.
 const GLASS_ETA: f32 = 1.5;
-
-/// The lighting of a sweep.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Lighting {
-    /// A sky, a ground colour below the horizon and a spherical area light.
-    Studio,
-    /// The white furnace: radiance 1 from every direction; conductors get F = 1.
-    Furnace,
-}
 
 /// What a sphere is made of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -30,14 +30,14 @@ fn options() -> Option<configure::Options> {
     use std::io::IsTerminal;
     let mut args = std::env::args().skip(1);
     let mut opts = configure::Options {
-        quick: false,
+        size: configure::RunSize::Full,
         out_dir: configure::default_out_dir(),
         threads: std::thread::available_parallelism().map_or(2, |n| n.get()),
         progress: std::io::stderr().is_terminal(),
     };
     while let Some(arg) = args.next() {
         match arg.as_str() {
-            "--quick" => opts.quick = true,
+            "--quick" => opts.size = configure::RunSize::Quick,
             "--out" => {
                 opts.out_dir = args.next().unwrap_or_else(|| usage_error("--out needs a directory")).into()
             }

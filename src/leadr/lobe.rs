@@ -20,6 +20,20 @@ pub const MIN_LEADR_ALPHA: f32 = 1e-4;
 pub const MIN_EIGENVALUE_RATIO: f32 = 1e-6;
 
 /// Whether [`LeadrLobe::from_moments`] had to change the covariance of its moments.
+///
+/// # Examples
+/// ```
+/// use microsurface::{Beckmann, CovarianceTreatment, LeadrLobe, SlopeMoments};
+/// use microsurface::glam::Vec2;
+///
+/// let base = Beckmann::isotropic(0.2)?;
+/// let moments = SlopeMoments::from_slope(Vec2::new(0.1, 0.0), base)?;
+/// assert_eq!(LeadrLobe::from_moments(&moments).treatment(), CovarianceTreatment::AsGiven);
+/// // E[x̃²] = E[x̃]² and E[ỹ²] = E[ỹ]²: no variance at all, which no lobe has
+/// let degenerate = SlopeMoments::new(0.1, 0.0, 0.01, 0.0, 0.0)?;
+/// assert_eq!(LeadrLobe::from_moments(&degenerate).treatment(), CovarianceTreatment::EigenvalueFloored);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CovarianceTreatment {
     /// The covariance was positive definite with eigenvalues above the floor, used as is.

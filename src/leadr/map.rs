@@ -7,6 +7,18 @@ use crate::slope::Beckmann;
 use glam::{Vec2, Vec3};
 
 /// One level of a [`LeadrMap`]: `width × height` texels of moments, row-major.
+///
+/// # Examples
+/// ```
+/// use microsurface::{Beckmann, HeightMap, LeadrMap};
+///
+/// // a flat 4 × 4 map: every level keeps the base roughness, variance α²/2 per axis
+/// let map = LeadrMap::from_height_map(&HeightMap::new(4, 4, 0.25, vec![0.0; 16])?, Beckmann::isotropic(0.1)?)?;
+/// let top = map.level(map.level_count() - 1);
+/// assert_eq!((top.width(), top.height()), (1, 1));
+/// assert!((top.texel(0, 0).covariance()[0] - 0.005).abs() < 1e-6);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct MomentLevel {
     width: usize,

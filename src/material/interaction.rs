@@ -7,6 +7,16 @@ use glam::Vec3;
 
 /// Whether an event keeps the side of the interface (a reflection) or crosses it (a
 /// transmission through a dielectric).
+///
+/// # Examples
+/// ```
+/// use microsurface::{Event, Interaction, Side};
+/// use microsurface::glam::Vec3;
+///
+/// let (wi, wo) = (Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.6, 0.0, -0.8));
+/// assert_eq!(Interaction::new(wi, wo, Side::Outside, Side::Inside).event(), Event::Transmission);
+/// assert_eq!(Interaction::new(wi, -wo, Side::Outside, Side::Outside).event(), Event::Reflection);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Event {
     /// ωi and ωo lie on the same side.

@@ -129,6 +129,7 @@ impl Beckmann {
     /// independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
     /// visible, returns the zero slope.
     #[inline]
+    #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         require!(
             is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),

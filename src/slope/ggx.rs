@@ -82,6 +82,7 @@ impl Ggx {
     /// Seen from straight below (θ = π), where nothing is visible (the cap is empty), returns
     /// the zero slope, like [`Beckmann`](super::Beckmann).
     #[inline]
+    #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         require!(
             is_direction(Vec3::new(sin_theta, 0.0, cos_theta)) && sin_theta >= 0.0 && is_uniform(u1) && is_uniform(u2),

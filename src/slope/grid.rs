@@ -480,6 +480,7 @@ impl GridSlope {
     /// unstretched), divided by (αx, αy): consistent with the trait's default `sample_d_wi`
     /// only for directions in the xz plane; [`MicrosurfaceSlope::sample_d_wi`] is overridden
     /// and exact for every direction.
+    #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         let (ax, ay) = (f64::from(self.alpha.0), f64::from(self.alpha.1));
         let w = DVec3::new(f64::from(sin_theta) / ax, 0.0, f64::from(cos_theta));

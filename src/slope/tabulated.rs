@@ -606,6 +606,7 @@ impl TabulatedSlope {
     /// the stretched direction (sin θ, 0, cos θ): the table's exact sampler from the
     /// unstretched direction (sin θ/α, 0, cos θ), its slopes divided by α. The trait's default
     /// `sample_d_wi` composed with this is exact; the override below skips the stretching.
+    #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         let a = f64::from(self.alpha);
         let (sx, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));

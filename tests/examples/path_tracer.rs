@@ -6,7 +6,7 @@
 use glam::Vec3;
 use microsurface::{Bsdf, ComplexIor, Conductor, Ggx, MicrofacetBsdf, ShadingFrame, Technique};
 use validation::tracer::{
-    self, Camera, Environment, Hit, RenderStats, Scene, Sphere, render, showcase_scene,
+    self, Camera, Environment, Hit, Lighting, RenderStats, Scene, Sphere, render, showcase_scene,
 };
 use validation::{Stats, family_z};
 
@@ -15,7 +15,7 @@ use validation::{Stats, family_z};
 /// drew from a shared or thread-local generator would not).
 #[test]
 fn renders_are_identical_for_any_thread_count() {
-    let (scene, camera) = showcase_scene(false);
+    let (scene, camera) = showcase_scene(Lighting::Studio);
     let (width, height, spp) = (48u32, 12u32, 2u32);
     let stats = RenderStats::default();
     let one = render(&scene, &camera, (width, height), spp, 11, 1, &stats);
@@ -28,7 +28,7 @@ fn renders_are_identical_for_any_thread_count() {
 
 #[test]
 fn white_furnace_spheres_vanish() {
-    let (scene, camera) = showcase_scene(true);
+    let (scene, camera) = showcase_scene(Lighting::Furnace);
     let (width, height, spp) = (96u32, 40u32, 32u32);
     let stats = RenderStats::default();
     let (image, errors) = render(&scene, &camera, (width, height), spp, 7, 2, &stats);

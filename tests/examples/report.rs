@@ -4,12 +4,12 @@
 //! exist.
 
 use std::path::Path;
-use validation::report::configure::{Config, Est, LOBE_MATERIALS, Options};
+use validation::report::configure::{Config, Est, LOBE_MATERIALS, Options, RunSize};
 use validation::report::{configure, pipeline};
 
 fn quick_report() -> (pipeline::Report, std::path::PathBuf) {
     let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));
-    let opts = Options { quick: true, out_dir: out_dir.clone(), threads: 2, progress: false };
+    let opts = Options { size: RunSize::Quick, out_dir: out_dir.clone(), threads: 2, progress: false };
     (pipeline::run(&opts).expect("the report runs"), out_dir)
 }
 

@@ -401,10 +401,21 @@ pub fn sphere_x(i: usize) -> f32 {
     (i as f32 - 3.5) * 1.15
 }
 
-/// Spheres in a row on a diffuse floor, lit by a spherical light and a sky. With `furnace`,
-/// the floor, the light and the classic sphere go, the environment is a constant 1 and every
-/// material is non-absorptive (and multiple-scattering): every sphere must vanish.
-pub fn showcase_scene(furnace: bool) -> (Scene, Camera) {
+/// The lighting of a scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lighting {
+    /// A sky, a ground colour below the horizon and a spherical area light.
+    Studio,
+    /// The white furnace: radiance 1 from every direction; conductors get F = 1.
+    Furnace,
+}
+
+/// Spheres in a row on a diffuse floor, lit by a spherical light and a sky. In the
+/// [`Lighting::Furnace`], the floor, the light and the classic sphere go, the environment is a
+/// constant 1 and every material is non-absorptive (and multiple-scattering): every sphere must
+/// vanish.
+pub fn showcase_scene(lighting: Lighting) -> (Scene, Camera) {
+    let furnace = lighting == Lighting::Furnace;
     let gold = (!furnace).then_some(ComplexIor::GOLD);
     let albedo = if furnace { Vec3::ONE } else { Vec3::new(0.8, 0.35, 0.2) };
     let mut materials = vec![

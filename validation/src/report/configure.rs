@@ -13,14 +13,23 @@ pub type Rng = rand_pcg::Pcg64Mcg;
 /// What to compute and where to write it.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// A small run for CI (seconds instead of minutes).
-    pub quick: bool,
+    /// How much to compute.
+    pub size: RunSize,
     /// Output directory.
     pub out_dir: PathBuf,
     /// Worker threads.
     pub threads: usize,
     /// Print a progress bar on stderr (`main` sets it only when stderr is a terminal).
     pub progress: bool,
+}
+
+/// How much a run computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunSize {
+    /// A small run for CI (seconds instead of minutes): `--quick`.
+    Quick,
+    /// The published figures.
+    Full,
 }
 
 /// The default output directory.
@@ -56,8 +65,8 @@ pub struct Budget {
 }
 
 impl Budget {
-    pub fn new(quick: bool) -> Self {
-        if quick {
+    pub fn new(size: RunSize) -> Self {
+        if size == RunSize::Quick {
             Self {
                 samples: 1 << 10,
                 reference_factor: 4,

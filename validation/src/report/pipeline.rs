@@ -19,7 +19,7 @@ pub struct Report {
 /// Runs every stage and writes the files into `opts.out_dir`.
 pub fn run(opts: &Options) -> std::io::Result<Report> {
     let start = Instant::now();
-    let budget = Budget::new(opts.quick);
+    let budget = Budget::new(opts.size);
     let measurements = super::measure::measure(opts, &budget);
     let results = super::reduce::reduce(measurements);
     let figures =

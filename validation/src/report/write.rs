@@ -1,7 +1,7 @@
 //! Stage 5, write: the CSV files, `summary.md`, the SVG figures and the HTML page
 //! `index.html` (every figure and table, the machine and the run's parameters).
 
-use super::configure::{Budget, Config, Est, Model, Options};
+use super::configure::{Budget, Config, Est, Model, Options, RunSize};
 use super::measure::{TIMING_CHUNKS, cost_surfaces};
 use super::plot::Figure;
 use super::reduce::{RatioKind, Results};
@@ -482,7 +482,7 @@ pub fn write(
     names.push(put("summary.md", &markdown)?);
 
     let mut parameters: Vec<(String, String)> = vec![
-        ("mode".into(), if opts.quick { "--quick".into() } else { "full".into() }),
+        ("mode".into(), if opts.size == RunSize::Quick { "--quick".into() } else { "full".into() }),
         ("run time (s, measurement and plotting)".into(), format!("{seconds:.1}")),
     ];
     for (name, value, meaning) in budget.describe() {

@@ -5,6 +5,7 @@
 
 use std::path::Path;
 use validation::report::configure::{Config, Est, LOBE_MATERIALS, Options, RunSize};
+use validation::report::tables::{Family, Tabulated};
 use validation::report::{configure, pipeline};
 
 fn quick_report() -> (pipeline::Report, std::path::PathBuf) {
@@ -22,6 +23,8 @@ fn expected_files() -> Vec<String> {
         "energy.csv",
         "cost.csv",
         "lobes.csv",
+        "albedo_tables.csv",
+        "albedo_tables.svg",
         "summary.md",
         "index.html",
     ]
@@ -68,7 +71,9 @@ fn check_svgs(files: &[std::path::PathBuf]) {
         }
         let text = svg_text(&doc);
         let name = f.file_name().unwrap().to_string_lossy();
-        let needed: &[&str] = if name.starts_with("error_vs_time") {
+        let needed: &[&str] = if name == "albedo_tables.svg" {
+            &["|error|", "μ = cos θ", "α = 0.4", "conductor E", "dielectric R + T", "Beckmann"]
+        } else if name.starts_with("error_vs_time") {
             &[
                 "time (s, one thread)",
                 "relative RMSE",
@@ -102,7 +107,7 @@ fn check_svgs(files: &[std::path::PathBuf]) {
             }
         }
     }
-    assert_eq!(count, Config::ALL.len() + LOBE_MATERIALS.len(), "SVG figures");
+    assert_eq!(count, Config::ALL.len() + LOBE_MATERIALS.len() + 1, "SVG figures (with albedo_tables.svg)");
 }
 
 fn check_html(dir: &Path) {
@@ -182,6 +187,20 @@ fn quick_report_is_complete_finite_and_consistent() {
     }
     check_svgs(&report.files);
     check_html(&dir);
+
+    // the conductor tables between their nodes keep the interpolation bound their docs state
+    // (`AlbedoTable::directional`: 1.2e-3 GGX, 3.7e-3 Beckmann), up to the quadrature's ≲ 1e-5
+    for c in results.tables.iter().filter(|c| c.tabulated == Tabulated::Conductor) {
+        let bound = if c.family == Family::Ggx { 1.2e-3 } else { 3.7e-3 } + 1e-5;
+        assert!(
+            c.max_error() <= bound,
+            "{:?} α {}: table error {:.2e} > {bound:.2e}",
+            c.family,
+            c.alpha,
+            c.max_error()
+        );
+        assert!(c.points.len() == report.budget.table_points, "{:?}", c.points);
+    }
 
     // error falls with run time for every stochastic estimator: the RMSE at the largest batch
     // is below the RMSE of single samples wherever the estimator has any variance

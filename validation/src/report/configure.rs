@@ -62,6 +62,10 @@ pub struct Budget {
     pub furnace_samples: usize,
     /// Calls per model and estimator of the cost table.
     pub cost_calls: usize,
+    /// Direction cosines per curve of the albedo tables' interpolation error.
+    pub table_points: usize,
+    /// The roughnesses of the albedo-table curves.
+    pub table_alphas: &'static [f32],
 }
 
 impl Budget {
@@ -79,6 +83,8 @@ impl Budget {
                 energy_walks: 1 << 10,
                 furnace_samples: 1 << 10,
                 cost_calls: 2_000,
+                table_points: 4,
+                table_alphas: &[0.4],
             }
         } else {
             Self {
@@ -93,6 +99,8 @@ impl Budget {
                 energy_walks: 1 << 15,
                 furnace_samples: 1 << 15,
                 cost_calls: 100_000,
+                table_points: 25,
+                table_alphas: &super::tables::TABLE_ALPHAS,
             }
         }
     }
@@ -151,6 +159,16 @@ impl Budget {
                 "evaluations of the white furnace per surface and θi",
             ),
             ("cost_calls", self.cost_calls.to_string(), "calls per model and estimator (cost table)"),
+            (
+                "table_points",
+                self.table_points.to_string(),
+                "direction cosines per curve (albedo table error)",
+            ),
+            (
+                "table_alphas",
+                format!("{:?}", self.table_alphas),
+                "roughnesses of the albedo table error curves",
+            ),
         ]
     }
 }

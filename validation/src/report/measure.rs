@@ -6,6 +6,7 @@ use super::configure::{
     Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, Models, Options, Rng, SlopeKind, Surface,
     THETAS, WithModels, dir, with_surface,
 };
+use super::tables::{self, TableCurve};
 use glam::Vec3;
 use microsurface::{Material, MicrosurfaceSlope, ScatteringOrder};
 use rand::SeedableRng;
@@ -117,6 +118,7 @@ pub struct Measurements {
     pub energy: Vec<EnergyRow>,
     pub lobes: Vec<LobePoint>,
     pub cost: Vec<CostRow>,
+    pub tables: Vec<TableCurve>,
 }
 
 /// Runs every measurement.
@@ -128,7 +130,16 @@ pub fn measure(opts: &Options, budget: &Budget) -> Measurements {
         energy: energy(opts, budget),
         lobes: lobes(opts, budget),
         cost: cost(budget),
+        tables: table_errors(opts, budget),
     }
+}
+
+/// The albedo tables against quadrature of the model they tabulate, between their nodes.
+fn table_errors(opts: &Options, budget: &Budget) -> Vec<TableCurve> {
+    let points = budget.table_points;
+    parallel("albedo tables", tables::jobs(budget.table_alphas), opts, |(family, tabulated, alpha)| {
+        tables::curve(family, tabulated, alpha, points)
+    })
 }
 
 /// Runs `jobs` on `threads` workers, reporting progress on stderr.

@@ -4,7 +4,8 @@
 //!
 //! The stages, one file each: [`configure`] (what and how much), [`measure`] (per-sample
 //! values, timings, references, energy, lobes, cost), [`reduce`] (errors against time,
-//! efficiency ratios with confidence intervals, lobe panels), [`plot`] (SVG figures) and
+//! efficiency ratios with confidence intervals, lobe panels), [`tables`] (the albedo tables'
+//! interpolation error), [`plot`] (SVG figures) and
 //! [`write`](mod@write) (CSV, Markdown, HTML); [`pipeline`] runs them in order.
 
 pub mod configure;
@@ -12,4 +13,5 @@ pub mod measure;
 pub mod pipeline;
 pub mod plot;
 pub mod reduce;
+pub mod tables;
 pub mod write;

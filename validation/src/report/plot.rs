@@ -4,6 +4,7 @@
 
 use super::configure::{Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, THETAS};
 use super::reduce::{LobePanel, Results};
+use super::tables::{self, Family, Tabulated};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -95,6 +96,7 @@ pub fn figures(results: &Results, budget: &Budget) -> PlotResult<Vec<Figure>> {
     for material in LOBE_MATERIALS {
         figures.push(lobes(results, material, budget)?);
     }
+    figures.push(table_errors(results, budget)?);
     Ok(figures)
 }
 
@@ -359,4 +361,84 @@ fn lobe_panel(area: &Area, panel: &LobePanel, r_max: f64, full_circle: bool) -> 
         ))?;
     }
     Ok(())
+}
+
+/// The floor of the table-error axis: errors below it (at the nodes) are drawn on it.
+const TABLE_ERROR_FLOOR: f64 = 1e-7;
+
+/// The albedo tables' interpolation error: |table − quadrature| against μ, one curve per α,
+/// rows the slope families, columns the tables.
+fn table_errors(results: &Results, budget: &Budget) -> PlotResult<Figure> {
+    let (w, h) = (1380u32, 760u32);
+    let title =
+        "Albedo tables: interpolation error against quadrature of the model they tabulate".to_string();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (header, grid) = root.split_vertically(118);
+        text_lines(
+            &header,
+            &[
+                title.clone(),
+                format!(
+                    "|table − quadrature| at {} log-spaced μ = cos θ per curve, at roughnesses between the nodes; the quadrature integrates the crate's single-scattering",
+                    budget.table_points
+                ),
+                "MicrofacetBsdf over the visible normals (adaptive, ≲ 1e-7). Dielectrics: R + T, importance transport; inside = the relative index 1/η. Log–log axes.".to_string(),
+            ],
+            (12, 8),
+            15,
+            22,
+        )?;
+        for (k, alpha) in tables::TABLE_ALPHAS.iter().enumerate() {
+            legend_entry(&header, (12 + k as i32 * 170, 86), PALETTE[k], false, &format!("α = {alpha}"))?;
+        }
+        let panels = grid.split_evenly((Family::ALL.len(), Tabulated::ALL.len()));
+        for (i, family) in Family::ALL.into_iter().enumerate() {
+            for (j, tabulated) in Tabulated::ALL.into_iter().enumerate() {
+                let curves: Vec<_> = results
+                    .tables
+                    .iter()
+                    .filter(|c| c.family == family && c.tabulated == tabulated)
+                    .collect();
+                let worst = curves.iter().map(|c| c.max_error()).fold(0.0, f64::max);
+                let caption = format!("{}, {}: max {:.1e}", family.label(), tabulated.label(), worst);
+                let mut chart = ChartBuilder::on(&panels[i * Tabulated::ALL.len() + j])
+                    .caption(caption, (FONT, 16))
+                    .margin(6)
+                    .margin_right(14)
+                    .x_label_area_size(42)
+                    .y_label_area_size(62)
+                    .build_cartesian_2d(
+                        (tables::MIN_MU * 0.98..1.02).log_scale(),
+                        (TABLE_ERROR_FLOOR * 0.98..1.02).log_scale(),
+                    )?;
+                chart
+                    .configure_mesh()
+                    .x_desc("μ = cos θ")
+                    .y_desc("|error|")
+                    .x_labels(4)
+                    .y_labels(8)
+                    .x_label_formatter(&|v| power_of_ten(*v))
+                    .y_label_formatter(&|v| power_of_ten(*v))
+                    .label_style((FONT, 14))
+                    .axis_desc_style((FONT, 15))
+                    .light_line_style(WHITE)
+                    .bold_line_style(LIGHT)
+                    .draw()?;
+                for curve in curves {
+                    let k = tables::TABLE_ALPHAS.iter().position(|&a| a == curve.alpha).unwrap_or(0);
+                    let points: Vec<(f64, f64)> = curve
+                        .points
+                        .iter()
+                        .map(|&(mu, t, q)| (mu, (t - q).abs().max(TABLE_ERROR_FLOOR)))
+                        .collect();
+                    chart.draw_series(LineSeries::new(points, PALETTE[k].stroke_width(2)))?;
+                }
+            }
+        }
+        root.present()?;
+    }
+    Ok(Figure { file: "albedo_tables.svg".into(), svg, title })
 }

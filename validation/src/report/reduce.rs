@@ -3,6 +3,7 @@
 
 use super::configure::{Case, Config, Est, MaterialKind, Model, THETAS};
 use super::measure::{CostRow, EnergyRow, Estimate, LobePoint, Measurements, Timing};
+use super::tables::TableCurve;
 use std::collections::HashMap;
 
 /// One point of an error-against-time curve: the RMSE of the mean of `samples` evaluations
@@ -115,6 +116,7 @@ pub struct Results {
     pub energy: Vec<EnergyRow>,
     pub lobes: Vec<LobePanel>,
     pub cost: Vec<CostRow>,
+    pub tables: Vec<TableCurve>,
 }
 
 impl Results {
@@ -201,7 +203,7 @@ pub fn reduce(m: Measurements) -> Results {
         choices.push(choice(config, &index));
     }
     let lobes = lobe_panels(&m.lobes, &m.energy);
-    Results { efficiency, ratios, choices, energy: m.energy, lobes, cost: m.cost }
+    Results { efficiency, ratios, choices, energy: m.energy, lobes, cost: m.cost, tables: m.tables }
 }
 
 /// Relative variance of an estimate's value: (se/x)².

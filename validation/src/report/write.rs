@@ -352,6 +352,22 @@ fn csv_files(results: &Results) -> Vec<(&'static str, String)> {
             c.mean_bounces.map_or(String::new(), |b| format!("{b:.3}"))
         );
     }
+    let mut tables = String::from("family,table,alpha,mu,table_value,quadrature,error\n");
+    for c in &results.tables {
+        for &(mu, t, q) in &c.points {
+            let _ = writeln!(
+                tables,
+                "{},{:?},{},{:.6e},{:.7},{:.7},{:.3e}",
+                c.family.label(),
+                c.tabulated,
+                c.alpha,
+                mu,
+                t,
+                q,
+                t - q
+            );
+        }
+    }
     vec![
         ("errors.csv", errors),
         ("efficiency.csv", eff),
@@ -359,6 +375,7 @@ fn csv_files(results: &Results) -> Vec<(&'static str, String)> {
         ("energy.csv", energy),
         ("lobes.csv", lobes),
         ("cost.csv", cost),
+        ("albedo_tables.csv", tables),
     ]
 }
 
@@ -540,6 +557,20 @@ pub fn write(
         );
     }
     html.push_str(&lobe.html());
+    html.push_str(
+        "<h2 id=\"albedo-tables\">Albedo tables</h2>\n<p>The shipped single-scattering albedo tables (the input of the \
+        compensated lobes) between their nodes, against an adaptive quadrature of the model they tabulate. Data: \
+        <a href=\"albedo_tables.csv\">albedo_tables.csv</a>.</p>\n",
+    );
+    for f in figures.iter().filter(|f| f.file == "albedo_tables.svg") {
+        let _ = writeln!(
+            html,
+            "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>",
+            escape(&f.file),
+            escape(&f.title),
+            escape(&f.title)
+        );
+    }
     html.push_str(&renders_html(&renders));
     html.push_str(&energy.html());
     html.push_str(&cost.html());

@@ -5,8 +5,8 @@
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, MAX_TABULATED_ALPHA, node_cell,
-    scale_invariant_direction,
+    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
+    ORDER_TABLES, ScatteringOrderTable, node_cell, scale_invariant_direction,
 };
 use crate::error::Error;
 use crate::material::Conductor;
@@ -45,6 +45,8 @@ pub trait AlbedoTabulated: MicrosurfaceSlope {
     const ALBEDO: AlbedoTable;
     /// The family's dielectric tables (reflected and transmitted, both sides).
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable;
+    /// The family's per-order energies of the F = 1 walk.
+    const ORDERS: ScatteringOrderTable;
 
     /// The isotropic roughness the tables are read at: √(αx αy), the geometric mean of the
     /// principal radii (for an [`Elliptical`](crate::Elliptical) slope √(α₁ α₂), which is
@@ -58,11 +60,13 @@ pub trait AlbedoTabulated: MicrosurfaceSlope {
 impl AlbedoTabulated for Ggx {
     const ALBEDO: AlbedoTable = AlbedoTable::GGX;
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::GGX;
+    const ORDERS: ScatteringOrderTable = ScatteringOrderTable::GGX;
 }
 
 impl AlbedoTabulated for Beckmann {
     const ALBEDO: AlbedoTable = AlbedoTable::BECKMANN;
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::BECKMANN;
+    const ORDERS: ScatteringOrderTable = ScatteringOrderTable::BECKMANN;
 }
 
 /// How a [`CompensatedConductor`] restores the energy single scattering loses.
@@ -88,6 +92,19 @@ pub enum Compensation {
     /// the **view direction** ωo (as the report prescribes): for F = 1 the albedo is exactly 1,
     /// the lobe keeps the single-scattering shape, and it is not reciprocal.
     Turquin,
+    /// A reciprocal additive lobe whose energy per RGB channel is the walk's per-order model
+    /// of the energy single scattering leaves out ([`ScatteringOrderTable`]):
+    ///
+    /// f_ms(ωo, ωi) = g(μo) g(μi) / (π ḡ),   ḡ = 2∫₀¹ g(μ) μ dμ,
+    /// g(μ) = (1 − E(μ)) Σ_k e_k(μ) F̄^k / Σ_k e_k(μ),   F̄ = F_avg,
+    ///
+    /// per channel, with e_k the F = 1 walk's energy of order k = 2 … 6 and the tail (weighted
+    /// as the geometric continuation of orders 6 and above: e_6 F̄⁶ ρF̄/(1 − ρF̄),
+    /// ρ = e_tail/(e_6 + e_tail), which is e_tail at F̄ = 1). Its albedo is exactly g(μo): the
+    /// energy of each order k weighted by F̄ᵏ (each bounce reflects F_avg), the split of
+    /// 1 − E(μ) between the orders taken from the walk instead of Kulla and Conty's
+    /// geometric series in E_avg. For F = 1 it is [`Compensation::KullaConty`].
+    PerOrder,
 }
 
 /// A conductor microfacet BRDF with energy compensation: the exact single-scattering lobe of
@@ -158,6 +175,9 @@ pub struct CompensatedConductor<S> {
     complement_average: f64,
     /// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi.
     profile: Profile,
+    /// The additive lobe as a product h(μo) h(μi) per channel: h at the direction nodes
+    /// (Kulla–Conty: √(F_ms/(π (1 − E_avg))) (1 − E); per order: g/√(π ḡ)).
+    lobe: [Vec3; ALBEDO_TABLE_SIZE],
     /// F_avg per channel.
     fresnel_average: Vec3,
     /// F0 per channel.
@@ -201,11 +221,22 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
         let fresnel_ms = (f_avg * f_avg * e_avg / (DVec3::ONE - f_avg * complement_average)).as_vec3();
         let scale = match scheme {
             // no energy lost (every node of the row is 1): nothing to restore
-            Compensation::KullaConty if complement_average <= 0.0 => Vec3::ZERO,
-            Compensation::KullaConty => {
+            Compensation::KullaConty | Compensation::PerOrder if complement_average <= 0.0 => Vec3::ZERO,
+            Compensation::KullaConty | Compensation::PerOrder => {
                 (fresnel_ms.as_dvec3() / (core::f64::consts::PI * complement_average)).as_vec3()
             }
             Compensation::Turquin => fresnel_normal,
+        };
+        let lobe = match scheme {
+            Compensation::Turquin => [Vec3::ZERO; ALBEDO_TABLE_SIZE],
+            Compensation::KullaConty => {
+                let root = scale.as_dvec3().map(f64::sqrt);
+                core::array::from_fn(|i| (root * f64::from(complement[i])).as_vec3())
+            }
+            Compensation::PerOrder if single.is_specular() || complement_average <= 0.0 => {
+                [Vec3::ZERO; ALBEDO_TABLE_SIZE]
+            }
+            Compensation::PerOrder => per_order_lobe(&S::ORDERS, alpha, &complement, f_avg),
         };
         Ok(Self {
             single,
@@ -214,6 +245,7 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
             complement,
             complement_average,
             profile,
+            lobe,
             fresnel_average,
             fresnel_normal,
             fresnel_ms,
@@ -310,23 +342,38 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         if wo.z > 0.0 { self.complement_at(wo.z) } else { 0.0 }
     }
 
-    /// The compensation added to f_ss (Kulla–Conty) for a view complement `c_o`.
+    /// 1 − E(μo) and the additive lobe's factor h(μo) of a view direction above the horizon
+    /// from one cell lookup; (0, 0) otherwise (no compensation).
     #[inline(always)]
-    fn kc_lobe(&self, c_o: f32, wi: Vec3) -> Vec3 {
-        if wi.z > 0.0 && c_o > 0.0 { self.scale * (c_o * self.complement_at(wi.z)) } else { Vec3::ZERO }
+    fn view(&self, wo: Vec3) -> (f32, Vec3) {
+        if wo.z <= 0.0 {
+            return (0.0, Vec3::ZERO);
+        }
+        let (i, f) = self.cell(wo.z);
+        let (a, b) = (self.complement[i], self.complement[i + 1]);
+        (a + f * (b - a), self.lobe[i].lerp(self.lobe[i + 1], f))
     }
 
-    /// The Kulla–Conty lobe f_ms and the mixture density at wi from one table lookup (the same
+    /// The additive lobe h(μo) h(μi) for the view factor `h_o`.
+    #[inline(always)]
+    fn kc_lobe(&self, h_o: Vec3, wi: Vec3) -> Vec3 {
+        if wi.z > 0.0 {
+            let (i, f) = self.cell(wi.z);
+            h_o * self.lobe[i].lerp(self.lobe[i + 1], f)
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// The additive lobe f_ms and the mixture density at wi from one table lookup (the same
     /// arithmetic as [`Self::kc_lobe`] and [`Self::mixture_pdf`], bit for bit).
     #[inline(always)]
-    fn kc_lobe_and_pdf(&self, c_o: f32, p: f32, pdf_ss: f32, wi: Vec3) -> (Vec3, f32) {
+    fn kc_lobe_and_pdf(&self, h_o: Vec3, p: f32, pdf_ss: f32, wi: Vec3) -> (Vec3, f32) {
         if wi.z <= 0.0 {
             return (Vec3::ZERO, p * pdf_ss + (1.0 - p) * 0.0);
         }
         let (i, f) = self.cell(wi.z);
-        let (a, b) = (self.complement[i], self.complement[i + 1]);
-        let c_i = a + f * (b - a);
-        let lobe = if c_o > 0.0 { self.scale * (c_o * c_i) } else { Vec3::ZERO };
+        let lobe = h_o * self.lobe[i].lerp(self.lobe[i + 1], f);
         (lobe, p * pdf_ss + (1.0 - p) * (self.profile.density[i] * wi.z * FRAC_1_PI))
     }
 
@@ -370,10 +417,9 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
             return v;
         }
-        let c_o = self.view_complement(wo);
         let f = match self.scheme {
-            Compensation::KullaConty => v.f + self.kc_lobe(c_o, wi),
-            Compensation::Turquin => v.f * self.turquin_factor(c_o),
+            Compensation::KullaConty | Compensation::PerOrder => v.f + self.kc_lobe(self.view(wo).1, wi),
+            Compensation::Turquin => v.f * self.turquin_factor(self.view_complement(wo)),
         };
         BsdfValue { f, exact: true }
     }
@@ -383,24 +429,26 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) {
             return self.single.sample_keyed(wo, uc, u, key);
         }
-        let c_o = self.view_complement(wo);
+        let (c_o, h_o) = self.view(wo);
         match self.scheme {
             Compensation::Turquin => {
                 let s = self.single.sample_keyed(wo, uc, u, key)?;
                 let weight = s.weight * self.turquin_factor(c_o);
                 weight.is_finite().then_some(BsdfSample { weight, ..s })
             }
-            Compensation::KullaConty if c_o == 0.0 => self.single.sample_keyed(wo, uc, u, key),
-            Compensation::KullaConty => {
+            Compensation::KullaConty | Compensation::PerOrder if c_o == 0.0 => {
+                self.single.sample_keyed(wo, uc, u, key)
+            }
+            Compensation::KullaConty | Compensation::PerOrder => {
                 let p = 1.0 - c_o;
                 if uc < p {
                     let s = self.single.sample_keyed(wo, (uc / p).min(ONE_MINUS_ULP), u, key)?;
-                    let (lobe, pdf) = self.kc_lobe_and_pdf(c_o, p, s.pdf, s.wi);
+                    let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, s.pdf, s.wi);
                     Self::finish(wo, s.wi, s.weight * s.pdf + lobe * s.wi.z.abs(), pdf)
                 } else {
                     let wi = self.sample_profile(u)?;
                     let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-                    let (lobe, pdf) = self.kc_lobe_and_pdf(c_o, p, pdf_ss, wi);
+                    let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, pdf_ss, wi);
                     Self::finish(wo, wi, (v.f + lobe) * wi.z, pdf)
                 }
             }
@@ -427,10 +475,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
             return (v, pdf_ss);
         }
-        let c_o = self.view_complement(wo);
+        let (c_o, h_o) = self.view(wo);
         match self.scheme {
-            Compensation::KullaConty => {
-                let f = v.f + self.kc_lobe(c_o, wi);
+            Compensation::KullaConty | Compensation::PerOrder => {
+                let f = v.f + self.kc_lobe(h_o, wi);
                 let pdf = if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) };
                 (BsdfValue { f, exact: true }, pdf)
             }
@@ -531,6 +579,64 @@ fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f64) -> (f64, Prof
         }
     }
     (total, profile)
+}
+
+/// The factor h = g/√(π ḡ) of the per-order lobe g(μo) g(μi)/(π ḡ) at the direction nodes
+/// ([`Compensation::PerOrder`]): the order tables' two roughness rows around r = √α blended
+/// as [`blended_complement`] blends E's, g = (1 − E) Σ_k e_k F̄^k/Σ_k e_k per channel (pure
+/// order 2 where the walk recorded no higher order), ḡ in closed form for g linear in x per
+/// cell ([`average_of_complement`]). In f64.
+fn per_order_lobe(
+    orders: &ScatteringOrderTable,
+    alpha: f32,
+    complement: &[f32; ALBEDO_TABLE_SIZE],
+    f_avg: DVec3,
+) -> [Vec3; ALBEDO_TABLE_SIZE] {
+    let t = alpha.sqrt() * LAST;
+    let (j, f) = node_cell(t, ALBEDO_TABLE_SIZE);
+    let f = f64::from(f);
+    let mut g = [[0.0f32; ALBEDO_TABLE_SIZE]; 3];
+    for i in 0..ALBEDO_TABLE_SIZE {
+        let e: [f64; ORDER_TABLES] = core::array::from_fn(|k| {
+            let nodes = orders.directional_nodes(k);
+            let (lo, hi) = (
+                f64::from(nodes[j * ALBEDO_TABLE_SIZE + i]),
+                f64::from(nodes[(j + 1) * ALBEDO_TABLE_SIZE + i]),
+            );
+            lo + f * (hi - lo)
+        });
+        let total: f64 = e.iter().sum();
+        for (c, g) in g.iter_mut().enumerate() {
+            let fbar = f_avg[c];
+            let ratio = if total > 0.0 {
+                let (last, tail) = (e[ORDER_TABLES - 2], e[ORDER_TABLES - 1]);
+                let mut weighted: f64 = e[..ORDER_TABLES - 1]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &ek)| ek * fbar.powi(k as i32 + 2))
+                    .sum();
+                if last + tail > 0.0 {
+                    // the tail as the geometric continuation e_K ρ^m of order K = 6
+                    let rho = tail / (last + tail);
+                    weighted +=
+                        last * fbar.powi(LAST_TABULATED_ORDER as i32) * rho * fbar / (1.0 - rho * fbar);
+                }
+                weighted / total
+            } else {
+                fbar * fbar
+            };
+            g[i] = (f64::from(complement[i]) * ratio) as f32;
+        }
+    }
+    let mut h = [Vec3::ZERO; ALBEDO_TABLE_SIZE];
+    for (c, g) in g.iter().enumerate() {
+        let (average, _) = average_of_complement(g, f64::from(alpha));
+        let norm = if average > 0.0 { 1.0 / (core::f64::consts::PI * average).sqrt() } else { 0.0 };
+        for (h, &gi) in h.iter_mut().zip(g) {
+            h[c] = (f64::from(gi) * norm) as f32;
+        }
+    }
+    h
 }
 
 /// F_avg = 2∫₀¹ F(μ) μ dμ per channel, by composite Gauss–Legendre.

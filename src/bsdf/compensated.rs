@@ -178,6 +178,8 @@ pub struct CompensatedConductor<S> {
     /// The additive lobe as a product h(μo) h(μi) per channel: h at the direction nodes
     /// (Kulla–Conty: √(F_ms/(π (1 − E_avg))) (1 − E); per order: g/√(π ḡ)).
     lobe: [Vec3; ALBEDO_TABLE_SIZE],
+    /// ∫ h(μi) μi dωi per channel: the additive lobe's albedo at μo is h(μo) times this.
+    lobe_norm: Vec3,
     /// F_avg per channel.
     fresnel_average: Vec3,
     /// F0 per channel.
@@ -238,6 +240,17 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
             }
             Compensation::PerOrder => per_order_lobe(&S::ORDERS, alpha, &complement, f_avg),
         };
+        let lobe_norm = match scheme {
+            Compensation::Turquin => Vec3::ZERO,
+            _ => {
+                let mut norm = DVec3::ZERO;
+                for c in 0..3 {
+                    let h: [f32; ALBEDO_TABLE_SIZE] = core::array::from_fn(|i| lobe[i][c]);
+                    norm[c] = core::f64::consts::PI * average_of_complement(&h, f64::from(alpha)).0;
+                }
+                norm.as_vec3()
+            }
+        };
         Ok(Self {
             single,
             scheme,
@@ -246,6 +259,7 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
             complement_average,
             profile,
             lobe,
+            lobe_norm,
             fresnel_average,
             fresnel_normal,
             fresnel_ms,
@@ -279,6 +293,18 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// E_avg = 2∫₀¹ E(μ) μ dμ of the interpolated E (exact for it, in f64).
     pub fn average_albedo(&self) -> f32 {
         (1.0 - self.complement_average) as f32
+    }
+
+    /// The albedo ∫ f_ms cos θi dωi of the additive lobe for a view at cos θo = μ, per RGB
+    /// channel: F_ms (1 − E(μ)) for [`Compensation::KullaConty`], the per-order model g(μ)
+    /// (interpolated linearly in x between the nodes) for [`Compensation::PerOrder`]. `None`
+    /// for [`Compensation::Turquin`] (no additive lobe) and unless μ ∈ [0, 1].
+    pub fn multiple_scattering_albedo(&self, mu: f32) -> Option<Vec3> {
+        if self.scheme == Compensation::Turquin || !(0.0..=1.0).contains(&mu) {
+            return None;
+        }
+        let (i, f) = self.cell(mu);
+        Some(self.lobe[i].lerp(self.lobe[i + 1], f) * self.lobe_norm)
     }
 
     /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel (Gauss–Legendre, error below 1e-7).

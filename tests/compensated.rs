@@ -439,7 +439,7 @@ fn backfacing_views_are_single_scattering() {
 fn invalid_input_gives_nothing() {
     let ok = dir(0.5, 0.2);
     let bad = [Vec3::NAN, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0)];
-    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
+    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
         let b = CompensatedConductor::new(ggx(0.4), gold(), scheme).unwrap();
         let check = |label: &str, call: &dyn Fn() -> bool| {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(call));

@@ -6,7 +6,7 @@ use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::albedo::{
     ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
-    ORDER_TABLES, ScatteringOrderTable, node_cell, scale_invariant_direction,
+    ORDER_TABLES, ScatteringOrderTable, node_cell,
 };
 use crate::error::Error;
 use crate::material::Conductor;
@@ -127,8 +127,10 @@ pub enum Compensation {
 /// E_exact(μo) − E_table(μo) (at most 1.2e-3 for GGX and 3.7e-3 for Beckmann; Turquin's scaled
 /// lobe by that error divided by E(μo)).
 ///
-/// **Sampling** (Kulla–Conty): with probability p = E(μo) (the energies of the two lobes for
-/// F = 1) the caller's uniforms drive the exact visible-normal sample of the single-scattering
+/// **Sampling** (Kulla–Conty and per-order): with probability p = E(μo) (the energies of the
+/// two lobes for F = 1; E here interpolated linearly between the uniform nodes μ = i/31, so
+/// that the lookup needs no division or root, any p ∈ (0, 1] giving an exact mixture) the
+/// caller's uniforms drive the exact visible-normal sample of the single-scattering
 /// lobe (uc rescaled to uc/p), otherwise u samples the added lobe's profile (1 − E(μi)) μi
 /// tabulated per cell of the direction axis (a cell by its mass, μi² uniform in it, φ uniform:
 /// density d_cell μi/π); the density is the mixture pdf = p pdf_ss + (1 − p) d_cell μi/π, exact
@@ -142,9 +144,19 @@ pub enum Compensation {
 /// normal, which single scattering supports) have no tabulated albedo: the lobe is then the
 /// single-scattering lobe alone; so is it for light directions below the horizon.
 ///
-/// **Cost.** Construction integrates F_avg (64 Fresnel evaluations) and the average (31 cells):
-/// about a microsecond; build the BSDF once per material, it is `Copy`. Eval adds one (Turquin)
-/// or two (Kulla–Conty) 1D table lookups to the single-scattering eval.
+/// **Cost.** Construction integrates F_avg (64 Fresnel evaluations) and the average (31 cells;
+/// the per-order scheme three more and the blend of six order tables): a few microseconds;
+/// build the BSDF once per material, it is `Copy`. Eval adds one (Turquin) or two (Kulla–Conty,
+/// per-order) branch-free 1D table lookups to the single-scattering eval, pdf one
+/// direction-axis lookup and one uniform-μ lookup (measured in `README.md`).
+///
+/// **Per-order** ([`Compensation::PerOrder`]) restores each channel's energy from the walk's
+/// per-order energies ([`ScatteringOrderTable`], standard error ≤ 1.95e-3 per node) instead of
+/// Kulla and Conty's series in E_avg: for F = 1 it is the Kulla–Conty lobe; for coloured metals
+/// it follows the walk where the series does not (GGX gold, copper, aluminium at α = 1: albedo
+/// within 0.5 % of the walk against 3–4 % for Kulla–Conty, `examples/compensation`), but its
+/// F̄ = F_avg per bounce misses the grazing-facet Fresnel of the higher orders for grazing views
+/// at small α (gold at α = 0.1, μo = 0.1: 3 % low, as Kulla–Conty).
 ///
 /// # Examples
 /// ```
@@ -169,6 +181,15 @@ pub struct CompensatedConductor<S> {
     scheme: Compensation,
     /// The tables' roughness √(αx αy).
     alpha: f32,
+    /// Whether the scheme has an additive lobe with energy (Kulla–Conty or per-order, not
+    /// a mirror, 1 − E_avg > 0): its sampler is a mixture.
+    mixing: bool,
+    /// 31² (1 + α): the direction node coordinate is 31 x = √(min(μ · this/(μ + α), 31²)).
+    node_scale: f32,
+    /// The probability of the single-scattering lobe in the sampling mixture, at the uniform
+    /// nodes μ = i/31 (E(μ) there; linear in μ between them): a table without a division or a
+    /// square root per lookup.
+    single_probability: [f32; ALBEDO_TABLE_SIZE],
     /// 1 − E at the direction nodes x = i/31, for this α.
     complement: [f32; ALBEDO_TABLE_SIZE],
     /// 1 − E_avg of the interpolated E.
@@ -251,10 +272,23 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
                 norm.as_vec3()
             }
         };
+        let node_scale = LAST * LAST * (1.0 + alpha);
+        let mut single_probability = [1.0; ALBEDO_TABLE_SIZE];
+        if !single.is_specular() {
+            for (i, p) in single_probability.iter_mut().enumerate() {
+                let mu = i as f32 / LAST;
+                let (k, f) = node_cell(direction_node(mu, alpha, node_scale), ALBEDO_TABLE_SIZE);
+                *p = 1.0 - (complement[k] + f * (complement[k + 1] - complement[k]));
+            }
+        }
+        let mixing = scheme != Compensation::Turquin && !single.is_specular() && complement_average > 0.0;
         Ok(Self {
             single,
             scheme,
+            mixing,
             alpha,
+            node_scale,
+            single_probability,
             complement,
             complement_average,
             profile,
@@ -335,7 +369,25 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// The cell i ∈ [0, 30] of the direction axis that holds μ, and the fraction within it.
     #[inline(always)]
     fn cell(&self, mu: f32) -> (usize, f32) {
-        node_cell(scale_invariant_direction(mu, self.alpha) * LAST, ALBEDO_TABLE_SIZE)
+        table_cell(direction_node(mu, self.alpha, self.node_scale))
+    }
+
+    /// Whether the sampler mixes in the additive lobe's profile for the view `wo`: a view
+    /// above the horizon of an additive lobe with energy.
+    #[inline(always)]
+    fn mixes(&self, wo: Vec3) -> bool {
+        self.mixing && wo.z > 0.0
+    }
+
+    /// The probability p of the single-scattering lobe in the sampling mixture for a view
+    /// above the horizon at cos θo = μ: E(μ) at the nodes μ = i/31, linear between them
+    /// (within the conductor table's uniform-μ interpolation error of E, ≤ 7.4e-2; any p in
+    /// (0, 1] gives an exact mixture, this one keeps the weights near the lobes' energies).
+    #[inline(always)]
+    fn mixture_probability(&self, mu: f32) -> f32 {
+        let (i, f) = table_cell(mu * LAST);
+        let (a, b) = (self.single_probability[i], self.single_probability[i + 1]);
+        a + f * (b - a)
     }
 
     /// The density of the Kulla–Conty lobe's sampler at wi (upper hemisphere):
@@ -368,16 +420,15 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         if wo.z > 0.0 { self.complement_at(wo.z) } else { 0.0 }
     }
 
-    /// 1 − E(μo) and the additive lobe's factor h(μo) of a view direction above the horizon
-    /// from one cell lookup; (0, 0) otherwise (no compensation).
+    /// The additive lobe's factor h(μo) of a view direction above the horizon, 0 otherwise
+    /// (no compensation).
     #[inline(always)]
-    fn view(&self, wo: Vec3) -> (f32, Vec3) {
+    fn view_lobe(&self, wo: Vec3) -> Vec3 {
         if wo.z <= 0.0 {
-            return (0.0, Vec3::ZERO);
+            return Vec3::ZERO;
         }
         let (i, f) = self.cell(wo.z);
-        let (a, b) = (self.complement[i], self.complement[i + 1]);
-        (a + f * (b - a), self.lobe[i].lerp(self.lobe[i + 1], f))
+        self.lobe[i].lerp(self.lobe[i + 1], f)
     }
 
     /// The additive lobe h(μo) h(μi) for the view factor `h_o`.
@@ -444,7 +495,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             return v;
         }
         let f = match self.scheme {
-            Compensation::KullaConty | Compensation::PerOrder => v.f + self.kc_lobe(self.view(wo).1, wi),
+            Compensation::KullaConty | Compensation::PerOrder => v.f + self.kc_lobe(self.view_lobe(wo), wi),
             Compensation::Turquin => v.f * self.turquin_factor(self.view_complement(wo)),
         };
         BsdfValue { f, exact: true }
@@ -455,18 +506,17 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) {
             return self.single.sample_keyed(wo, uc, u, key);
         }
-        let (c_o, h_o) = self.view(wo);
         match self.scheme {
             Compensation::Turquin => {
                 let s = self.single.sample_keyed(wo, uc, u, key)?;
-                let weight = s.weight * self.turquin_factor(c_o);
+                let weight = s.weight * self.turquin_factor(self.view_complement(wo));
                 weight.is_finite().then_some(BsdfSample { weight, ..s })
             }
-            Compensation::KullaConty | Compensation::PerOrder if c_o == 0.0 => {
+            Compensation::KullaConty | Compensation::PerOrder if !self.mixes(wo) => {
                 self.single.sample_keyed(wo, uc, u, key)
             }
             Compensation::KullaConty | Compensation::PerOrder => {
-                let p = 1.0 - c_o;
+                let (p, h_o) = (self.mixture_probability(wo.z), self.view_lobe(wo));
                 if uc < p {
                     let s = self.single.sample_keyed(wo, (uc / p).min(ONE_MINUS_ULP), u, key)?;
                     let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, s.pdf, s.wi);
@@ -484,15 +534,12 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let pdf_ss = self.single.pdf(wo, wi);
-        // Turquin samples the single-scattering lobe (which validates the directions)
-        if self.scheme == Compensation::Turquin {
+        // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe,
+        // whose pdf validates the directions
+        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) {
             return pdf_ss;
         }
-        if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
-            return pdf_ss;
-        }
-        let c_o = self.view_complement(wo);
-        if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) }
+        self.mixture_pdf(self.mixture_probability(wo.z), pdf_ss, wi)
     }
 
     #[inline]
@@ -501,16 +548,37 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
             return (v, pdf_ss);
         }
-        let (c_o, h_o) = self.view(wo);
         match self.scheme {
             Compensation::KullaConty | Compensation::PerOrder => {
-                let f = v.f + self.kc_lobe(h_o, wi);
-                let pdf = if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) };
+                let f = v.f + self.kc_lobe(self.view_lobe(wo), wi);
+                let pdf = if self.mixes(wo) {
+                    self.mixture_pdf(self.mixture_probability(wo.z), pdf_ss, wi)
+                } else {
+                    pdf_ss
+                };
                 (BsdfValue { f, exact: true }, pdf)
             }
-            Compensation::Turquin => (BsdfValue { f: v.f * self.turquin_factor(c_o), exact: true }, pdf_ss),
+            Compensation::Turquin => {
+                (BsdfValue { f: v.f * self.turquin_factor(self.view_complement(wo)), exact: true }, pdf_ss)
+            }
         }
     }
+}
+
+/// The cell i ∈ [0, 30] of a fractional node coordinate t ∈ [0, 31] and the fraction within
+/// it (t = 31 extrapolates cell 30 to its end). Through u32: a cheaper conversion than to usize
+/// (the callers' t is never negative or NaN).
+#[inline(always)]
+fn table_cell(t: f32) -> (usize, f32) {
+    let i = (t as u32).min(ALBEDO_TABLE_SIZE as u32 - 2);
+    (i as usize, t - i as f32)
+}
+
+/// The fractional direction node 31 x = 31 √(μ (1 + α)/(μ + α)) ∈ [0, 31] of μ ∈ [0, 1]
+/// (`node_scale` = 31² (1 + α)), with the square of the node scale folded into the root.
+#[inline(always)]
+fn direction_node(mu: f32, alpha: f32, node_scale: f32) -> f32 {
+    (mu * node_scale / (mu + alpha)).min(LAST * LAST).sqrt()
 }
 
 /// 1 − E at the direction nodes for roughness α: the table's two roughness rows around

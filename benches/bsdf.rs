@@ -261,9 +261,9 @@ fn sample_vs_vndf(c: &mut Criterion<Clock>) {
     g.finish();
 }
 
-/// The energy-compensated gold (`CompensatedConductor`, Kulla–Conty and Turquin) against the
+/// The energy-compensated gold (`CompensatedConductor`, Kulla–Conty, Turquin, per-order) against the
 /// single-scattering gold it is built on, static dispatch (the target: at most 1.3× its cost).
-/// Ids `gold/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin}`.
+/// Ids `gold/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin|per-order}`.
 fn compensated(c: &mut Criterion<Clock>) {
     let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
     let gold = Conductor::new(ComplexIor::GOLD);
@@ -272,6 +272,7 @@ fn compensated(c: &mut Criterion<Clock>) {
         .with_technique(Technique::SingleScattering);
     let kc = CompensatedConductor::new(slope, gold, Compensation::KullaConty).expect("α ≤ 1");
     let turquin = CompensatedConductor::new(slope, gold, Compensation::Turquin).expect("α ≤ 1");
+    let per_order = CompensatedConductor::new(slope, gold, Compensation::PerOrder).expect("α ≤ 1");
     let x = inputs(false, 300);
     macro_rules! bench {
         ($g:expr, $name:expr, $model:expr, $call:ident) => {
@@ -291,16 +292,19 @@ fn compensated(c: &mut Criterion<Clock>) {
     bench!(g, "single", &single, eval);
     bench!(g, "kulla-conty", &kc, eval);
     bench!(g, "turquin", &turquin, eval);
+    bench!(g, "per-order", &per_order, eval);
     g.finish();
     let mut g = c.benchmark_group("gold/compensated/pdf");
     bench!(g, "single", &single, pdf);
     bench!(g, "kulla-conty", &kc, pdf);
     bench!(g, "turquin", &turquin, pdf);
+    bench!(g, "per-order", &per_order, pdf);
     g.finish();
     let mut g = c.benchmark_group("gold/compensated/sample");
     bench!(g, "single", &single, sample);
     bench!(g, "kulla-conty", &kc, sample);
     bench!(g, "turquin", &turquin, sample);
+    bench!(g, "per-order", &per_order, sample);
     g.finish();
 }
 

@@ -1,5 +1,5 @@
 //! Measures the error of the energy-compensated conductors (`CompensatedConductor`:
-//! Kulla–Conty and Turquin) and of plain single scattering against the exact multiple-scattering
+//! Kulla–Conty, Turquin and the per-order lobe from the walk's tables) and of plain single scattering against the exact multiple-scattering
 //! model (the random walk of Heitz et al. 2016), GGX:
 //!
 //! * directional albedo error A_technique(μ) − A_walk(μ) per RGB channel, max and RMS over a
@@ -13,8 +13,8 @@
 //!   over μ, α and η ∈ {1.33, 1.5, 2} seen from outside and from inside (1/η);
 //! * the technique-choice table: per material and α, the albedo error (max over μo and RGB) and
 //!   the time per sample of single scattering, the compensated lobes, the walk and the
-//!   position-free PT and BDPT estimators (this run's timing, one thread per cell, on a loaded
-//!   machine: ratios within a column are meaningful, absolute values ±30 %).
+//!   position-free PT and BDPT estimators (timed one technique at a time after the error runs,
+//!   the median over short chunks of samples, which filters out preemption on a shared machine).
 //!
 //! Every estimate is the mean of sample weights (unbiased for each technique), with its
 //! standard error. Writes `target/compensation/albedo.csv`, `lobes.csv` and `table.md`.
@@ -37,7 +37,9 @@ use std::time::Instant;
 type Pcg = rand_pcg::Pcg64Mcg;
 
 /// The techniques compared with the walk.
-const TECHNIQUES: [&str; 3] = ["single", "kulla-conty", "turquin"];
+const TECHNIQUES: [&str; 4] = ["single", "kulla-conty", "turquin", "per-order"];
+/// Their names in the tables' headers.
+const TECHNIQUE_TITLES: [&str; 4] = ["single", "Kulla–Conty", "Turquin", "per-order"];
 /// The stochastic estimators of the position-free model, in the technique-choice table.
 const ESTIMATORS: [(&str, Estimator); 2] = [("pt", Estimator::Pt), ("bdpt", Estimator::Bdpt)];
 /// The glass indices of the dielectric comparison (seen from outside; from inside 1/η).
@@ -71,20 +73,19 @@ fn technique(name: &str, slope: Ggx, c: Conductor) -> Box<dyn Bsdf> {
         }
         "kulla-conty" => Box::new(CompensatedConductor::new(slope, c, Compensation::KullaConty).unwrap()),
         "turquin" => Box::new(CompensatedConductor::new(slope, c, Compensation::Turquin).unwrap()),
+        "per-order" => Box::new(CompensatedConductor::new(slope, c, Compensation::PerOrder).unwrap()),
         _ => unreachable!(),
     }
 }
 
-/// Mean and standard error per channel of `n` weights, and the time per sample (ns).
+/// Mean and standard error per channel of `n` weights.
 struct Estimate {
     mean: [f64; 3],
     se: [f64; 3],
-    ns: f64,
 }
 
 fn estimate(n: usize, mut draw: impl FnMut() -> Option<Vec3>) -> Estimate {
     let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
-    let t = Instant::now();
     for _ in 0..n {
         if let Some(w) = draw() {
             for c in 0..3 {
@@ -94,11 +95,10 @@ fn estimate(n: usize, mut draw: impl FnMut() -> Option<Vec3>) -> Estimate {
             }
         }
     }
-    let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
     let nf = n as f64;
     let mean = s.map(|v| v / nf);
     let se = core::array::from_fn(|c| ((s2[c] / nf - mean[c] * mean[c]).max(0.0) / (nf - 1.0)).sqrt());
-    Estimate { mean, se, ns }
+    Estimate { mean, se }
 }
 
 fn uniforms(rng: &mut Pcg) -> (f32, Vec2) {
@@ -284,6 +284,84 @@ fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     out.into_inner().unwrap().into_iter().map(Option::unwrap).collect()
 }
 
+/// Samples per timed chunk: short enough that most chunks run without being preempted on a
+/// shared machine, so that the median chunk is the unloaded cost.
+const COST_CHUNK: usize = 512;
+
+/// ns per `sample` of `b`, cycling over the views `wos`: the median over chunks of
+/// [`COST_CHUNK`] samples of `n` samples in all.
+fn time_samples(b: &dyn Bsdf, wos: &[Vec3], n: usize, seed: u64) -> f64 {
+    let mut rng = Pcg::seed_from_u64(seed);
+    let draws: Vec<(f32, Vec2)> = (0..COST_CHUNK).map(|_| uniforms(&mut rng)).collect();
+    let mut times: Vec<f64> = (0..n.div_ceil(COST_CHUNK))
+        .map(|chunk| {
+            let t = Instant::now();
+            let mut acc = Vec3::ZERO;
+            for (k, &(uc, u)) in draws.iter().enumerate() {
+                let wo = std::hint::black_box(wos[(k + chunk) % wos.len()]);
+                if let Some(smp) = b.sample(wo, uc, u) {
+                    acc += smp.weight;
+                }
+            }
+            std::hint::black_box(acc);
+            t.elapsed().as_secs_f64() * 1e9 / COST_CHUNK as f64
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+/// The views of the cost runs (azimuth 0).
+fn views(mus: &[f32], below: bool) -> Vec<Vec3> {
+    mus.iter()
+        .map(|&mu| Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, if below { -mu } else { mu }))
+        .collect()
+}
+
+/// ns per sample of [single, Kulla–Conty, Turquin, per-order, walk, PT, BDPT] for a conductor.
+fn conductor_cost(c: Conductor, alpha: f32, mus: &[f32], n: usize) -> [f64; 7] {
+    let slope = Ggx::isotropic(alpha).unwrap();
+    let wos = views(mus, false);
+    let mf = MicrofacetBsdf::new(slope, c).unwrap();
+    let stochastic: [Box<dyn Bsdf>; 3] = [
+        Box::new(mf.with_technique(Technique::RandomWalk)),
+        Box::new(mf.with_technique(Technique::PositionFree {
+            estimator: Estimator::Pt,
+            shadowing: Shadowing::Correlated,
+        })),
+        Box::new(mf.with_technique(Technique::PositionFree {
+            estimator: Estimator::Bdpt,
+            shadowing: Shadowing::Correlated,
+        })),
+    ];
+    let mut out = [0.0; 7];
+    for (k, name) in TECHNIQUES.iter().enumerate() {
+        out[k] = time_samples(technique(name, slope, c).as_ref(), &wos, n, 30_000 + k as u64);
+    }
+    for (k, b) in stochastic.iter().enumerate() {
+        out[4 + k] = time_samples(b.as_ref(), &wos, n / 10, 30_010 + k as u64);
+    }
+    out
+}
+
+/// ns per sample of [single, Turquin, walk] for glass η = 1.5 seen from outside.
+fn glass_cost(alpha: f32, mus: &[f32], n: usize) -> [f64; 3] {
+    let slope = Ggx::isotropic(alpha).unwrap();
+    let material = Dielectric::new(1.5).unwrap();
+    let wos = views(mus, false);
+    let mf = MicrofacetBsdf::new(slope, material).unwrap().with_transport(Transport::Importance);
+    [
+        time_samples(&mf.with_technique(Technique::SingleScattering), &wos, n, 30_020),
+        time_samples(
+            &CompensatedDielectric::new(slope, material).unwrap().with_transport(Transport::Importance),
+            &wos,
+            n,
+            30_021,
+        ),
+        time_samples(&mf.with_technique(Technique::RandomWalk), &wos, n / 10, 30_022),
+    ]
+}
+
 fn main() -> std::io::Result<()> {
     let quick = std::env::args().any(|a| a == "--quick");
     let s = if quick {
@@ -406,8 +484,8 @@ fn main() -> std::io::Result<()> {
             .fold(0.0, f64::max)
     )
     .unwrap();
-    writeln!(md, "| material | single: max | RMS | Kulla–Conty: max | RMS | Turquin: max | RMS |").unwrap();
-    writeln!(md, "|---|---|---|---|---|---|---|").unwrap();
+    writeln!(md, "| material |{}", TECHNIQUE_TITLES.map(|t| format!(" {t}: max | RMS |")).concat()).unwrap();
+    writeln!(md, "|---|{}", "---|---|".repeat(TECHNIQUES.len())).unwrap();
     for (name, _) in &mats {
         write!(md, "| {name} |").unwrap();
         for k in 0..TECHNIQUES.len() {
@@ -428,8 +506,8 @@ fn main() -> std::io::Result<()> {
          φo ∈ {{0, π/4, π/2}}:\n"
     )
     .unwrap();
-    writeln!(md, "| αx, αy | single: max | RMS | Kulla–Conty: max | RMS | Turquin: max | RMS |").unwrap();
-    writeln!(md, "|---|---|---|---|---|---|---|").unwrap();
+    writeln!(md, "| αx, αy |{}", TECHNIQUE_TITLES.map(|t| format!(" {t}: max | RMS |")).concat()).unwrap();
+    writeln!(md, "|---|{}", "---|---|".repeat(TECHNIQUES.len())).unwrap();
     for (k, (ax, ay)) in anisotropic.iter().enumerate() {
         write!(md, "| {ax}, {ay} |").unwrap();
         for t in 0..TECHNIQUES.len() {
@@ -453,8 +531,8 @@ fn main() -> std::io::Result<()> {
         s.lobe_samples
     )
     .unwrap();
-    writeln!(md, "| α | θo | floor | single | Kulla–Conty | Turquin |").unwrap();
-    writeln!(md, "|---|---|---|---|---|---|").unwrap();
+    writeln!(md, "| α | θo | floor |{}", TECHNIQUE_TITLES.map(|t| format!(" {t} |")).concat()).unwrap();
+    writeln!(md, "|---|---|---|{}", "---|".repeat(TECHNIQUES.len())).unwrap();
     for l in &lobes {
         write!(md, "| {} | {} | {:.3} |", l.alpha, l.theta, l.floor).unwrap();
         for e in &l.errors {
@@ -507,24 +585,42 @@ fn main() -> std::io::Result<()> {
     }
     std::fs::write(dir.join("glass.csv"), csv)?;
 
+    // the cost of each technique, timed serially (one thread busy) after the error runs
+    eprintln!(
+        "cost: {} rows × 7 techniques, timed one after the other",
+        mats.len() * s.alphas.len() + s.alphas.len()
+    );
+    let cost_samples = if quick { 40_000 } else { 200_000 };
+    let costs: Vec<[f64; 7]> = mats
+        .iter()
+        .flat_map(|&(_, c)| s.alphas.iter().map(move |&a| (c, a)))
+        .map(|(c, a)| conductor_cost(c, a, &s.mus, cost_samples))
+        .collect();
+    let glass_costs: Vec<[f64; 3]> = s.alphas.iter().map(|&a| glass_cost(a, &s.mus, cost_samples)).collect();
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+
     // the technique-choice table: per material and α, max over μo (and RGB) of |A − A_walk|,
-    // and the mean time per sample over the row's cells
+    // and the time per sample
     writeln!(
         md,
         "\nTechnique choice (GGX): albedo error against the walk, max over μo ∈ {:?} and RGB, and time per \
-         sample (ns, this run's timing: one thread per cell on a loaded 2-core machine, ±30 %). The walk is the \
-         reference (error 0, its standard error is in the headers above); PT and BDPT are the position-free \
-         model's estimators (Wang et al. 2022), a different model whose albedo differs from the walk's by the \
-         entry. Glass: total albedo, importance transport, η = 1.5 from outside.\n",
-        s.mus
+         sample (ns per `Bsdf::sample` through `Box<dyn Bsdf>`, median over chunks of {COST_CHUNK} samples of {cost_samples} \
+         (a tenth for walk, PT and BDPT) cycling over the μo, each technique timed alone after the error \
+         runs; load average {}). The walk is the reference (error 0, its standard error is in the headers above); \
+         PT and BDPT are the position-free model's estimators (Wang et al. 2022), a different model whose albedo \
+         differs from the walk's by the entry. Glass: total albedo, importance transport, η = 1.5 from outside.\n",
+        s.mus,
+        load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
     )
     .unwrap();
     writeln!(
         md,
-        "| material | α | single | Kulla–Conty | Turquin | PT | BDPT | ns: single | Kulla–Conty | Turquin | walk | PT | BDPT |"
+        "| material | α |{} PT | BDPT | ns: single | Kulla–Conty | Turquin | per-order | walk | PT | BDPT |",
+        TECHNIQUE_TITLES.map(|t| format!(" {t} |")).concat()
     )
     .unwrap();
-    writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
+    writeln!(md, "|---|---|{}", "---|".repeat(TECHNIQUES.len() + 2 + 7)).unwrap();
+    let mut row_index = 0;
     for (name, _) in &mats {
         for &a in &s.alphas {
             let row: Vec<&AlbedoCell> =
@@ -534,57 +630,37 @@ fn main() -> std::io::Result<()> {
                     .flat_map(|c| (0..3).map(|ch| (f(c).mean[ch] - c.walk.mean[ch]).abs()))
                     .fold(0.0f64, f64::max)
             };
-            let ns = |f: &dyn Fn(&AlbedoCell) -> &Estimate| {
-                row.iter().map(|c| f(c).ns).sum::<f64>() / row.len() as f64
-            };
             write!(md, "| {name} | {a} |").unwrap();
-            for k in 0..3 {
+            for k in 0..TECHNIQUES.len() {
                 write!(md, " {:.4} |", err(&|c| &c.techniques[k])).unwrap();
             }
             for k in 0..2 {
                 write!(md, " {:.4} |", err(&|c| &c.estimators[k])).unwrap();
             }
-            for k in 0..3 {
-                write!(md, " {:.0} |", ns(&|c| &c.techniques[k])).unwrap();
+            for ns in costs[row_index] {
+                write!(md, " {ns:.0} |").unwrap();
             }
-            write!(md, " {:.0} |", ns(&|c| &c.walk)).unwrap();
-            for k in 0..2 {
-                write!(md, " {:.0} |", ns(&|c| &c.estimators[k])).unwrap();
-            }
+            row_index += 1;
             md.push('\n');
         }
     }
-    for &a in &s.alphas {
+    for (&a, ns) in s.alphas.iter().zip(&glass_costs) {
         let row: Vec<&GlassCell> =
             glass.iter().filter(|c| c.eta == 1.5 && !c.inside && c.alpha == a).collect();
         let err = |m: usize| {
             row.iter().map(|c| (c.albedo[m].mean[2] - c.albedo[0].mean[2]).abs()).fold(0.0f64, f64::max)
         };
-        let ns = |m: usize| row.iter().map(|c| c.albedo[m].ns).sum::<f64>() / row.len() as f64;
         writeln!(
             md,
-            "| glass 1.5 | {a} | {:.4} | — | {:.4} | — | — | {:.0} | — | {:.0} | {:.0} | — | — |",
+            "| glass 1.5 | {a} | {:.4} | — | {:.4} | — | — | — | {:.0} | — | {:.0} | — | {:.0} | — | — |",
             err(1),
             err(2),
-            ns(1),
-            ns(2),
-            ns(0)
+            ns[0],
+            ns[1],
+            ns[2]
         )
         .unwrap();
     }
-
-    // cost per sample, as measured in this run (one thread of the run's pool)
-    let mean_ns = |f: &dyn Fn(&AlbedoCell) -> f64| cells.iter().map(f).sum::<f64>() / cells.len() as f64;
-    writeln!(
-        md,
-        "\nMean time per sample in this run (all cells, one thread each): walk {:.0} ns, single {:.0} ns, \
-         Kulla–Conty {:.0} ns, Turquin {:.0} ns.",
-        mean_ns(&|c| c.walk.ns),
-        mean_ns(&|c| c.techniques[0].ns),
-        mean_ns(&|c| c.techniques[1].ns),
-        mean_ns(&|c| c.techniques[2].ns)
-    )
-    .unwrap();
     std::fs::write(dir.join("table.md"), &md)?;
     println!("{md}");
     eprintln!("wrote {} in {:.1} s", dir.display(), start.elapsed().as_secs_f64());

@@ -138,7 +138,8 @@ mod vndf;
 
 pub use albedo::{
     ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable, EtaRange,
-    MAX_TABULATED_ALPHA, MAX_TABULATED_ETA,
+    LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, ORDER_TABLE_MAX_STANDARD_ERROR,
+    ORDER_TABLES, ScatteringOrderTable, TabulatedOrder,
 };
 pub use basis::orthonormal_basis;
 pub use bsdf::{

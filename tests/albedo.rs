@@ -6,8 +6,8 @@
 use glam::Vec3;
 use microsurface::{
     ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Bsdf, Conductor, DIELECTRIC_TABLE_SIZE, Dielectric,
-    DielectricAlbedoTable, EtaRange, Ggx, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Technique,
-    Transport, UniformHeight,
+    DielectricAlbedoTable, EtaRange, Ggx, MicrofacetBsdf, Microsurface, MicrosurfaceSlope,
+    ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable, Technique, Transport, UniformHeight,
 };
 use rand::RngExt;
 use validation::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
@@ -206,6 +206,125 @@ fn public_reference_values() {
     assert!((e - 0.307).abs() < 1e-3, "E(1, 1) = {e}");
     let e_avg = AlbedoTable::GGX.average(1.0).unwrap();
     assert!((e_avg - 0.409).abs() < 2e-3, "E_avg(1) = {e_avg}");
+}
+
+/// Walks per recomputed per-order cell (as the generator: 2¹⁶).
+const ORDER_WALKS: usize = 1 << 16;
+
+/// The per-order counts (orders 2 … 6, tail) of `ORDER_WALKS` F = 1 walks at (μ, α), or with a
+/// cosine-weighted μ when `mu` is `None`.
+fn order_counts(family: usize, mu: Option<f32>, alpha: f32, seed: u64) -> [u64; ORDER_TABLES] {
+    let mut r = rng(seed);
+    let mut counts = [0u64; ORDER_TABLES];
+    for _ in 0..ORDER_WALKS {
+        let m = mu.unwrap_or_else(|| (1.0 - r.random::<f32>()).sqrt());
+        if m <= 0.0 {
+            continue;
+        }
+        let wi = Vec3::new((1.0 - m * m).max(0.0).sqrt(), 0.0, m);
+        let bounces = match family {
+            0 => Microsurface::new(UniformHeight, Ggx::isotropic(alpha).unwrap(), Conductor::perfect())
+                .sample(wi, &mut r)
+                .map(|s| s.bounces),
+            _ => Microsurface::new(UniformHeight, Beckmann::isotropic(alpha).unwrap(), Conductor::perfect())
+                .sample(wi, &mut r)
+                .map(|s| s.bounces),
+        };
+        if let Some(k) = bounces.filter(|&k| k >= 2) {
+            counts[(k as usize - 2).min(ORDER_TABLES - 1)] += 1;
+        }
+    }
+    counts
+}
+
+fn order_table(family: usize) -> ScatteringOrderTable {
+    [ScatteringOrderTable::GGX, ScatteringOrderTable::BECKMANN][family]
+}
+
+/// A random subset of the per-order cells (5 directional and 1 average cell per family, drawn
+/// from a fixed seed), recomputed by independent walks (other seeds, the test's own generator),
+/// agrees with the shipped nodes within z times the combined standard error
+/// √(SE_shipped² + SE_test²) (binomial, each ≤ 1.95e-3; z Šidák over the 72 comparisons,
+/// family-wise 1e-3).
+#[test]
+fn order_tables_match_independent_walks() {
+    let mut pick = rng(2600);
+    let mut cells = vec![];
+    for family in 0..2 {
+        for _ in 0..5 {
+            cells.push((family, Some(pick.random_range(0..ALBEDO_TABLE_SIZE * ALBEDO_TABLE_SIZE))));
+        }
+        cells.push((family, None));
+    }
+    let average_rows: Vec<usize> = (0..2).map(|_| pick.random_range(0..ALBEDO_TABLE_SIZE)).collect();
+    let z = family_z(FAMILY_ALPHA, cells.len() * ORDER_TABLES);
+    let results = par_map(&cells, |k, &(family, cell)| {
+        let (mu, alpha) = match cell {
+            Some(c) => {
+                let (mu, alpha) = node_coordinates(c % ALBEDO_TABLE_SIZE, c / ALBEDO_TABLE_SIZE);
+                (Some(mu), alpha)
+            }
+            None => (None, node_coordinates(0, average_rows[family]).1),
+        };
+        order_counts(family, mu, alpha, 2700 + k as u64)
+    });
+    let se = |e: f64| (e * (1.0 - e) / ORDER_WALKS as f64).sqrt();
+    for (&(family, cell), counts) in cells.iter().zip(&results) {
+        let t = order_table(family);
+        for (k, &count) in counts.iter().enumerate() {
+            let (shipped, label) = match cell {
+                Some(c) => (t.directional_nodes(k)[c], format!("node {c}")),
+                None => (
+                    t.average_nodes(k)[average_rows[family]],
+                    format!("average row {}", average_rows[family]),
+                ),
+            };
+            let (ours, shipped) = (count as f64 / ORDER_WALKS as f64, f64::from(shipped));
+            let combined = se(ours).hypot(se(shipped));
+            assert!(combined <= 2.0f64.sqrt() * f64::from(ORDER_TABLE_MAX_STANDARD_ERROR));
+            assert!(
+                (ours - shipped).abs() <= z * combined + 1e-7,
+                "{} order table {k} {label}: independent {ours:.5} (N = {ORDER_WALKS}), shipped {shipped:.5}, \
+                 combined SE {combined:.2e}, z = {z:.2}",
+                t.name()
+            );
+        }
+    }
+}
+
+/// At every node the per-order energies and the single-scattering albedo (quadrature) sum to 1
+/// (the F = 1 walk conserves energy) within z·SE, SE = √(E (1 − E)/2¹⁶) the standard error of
+/// Σ_k e_k = 1 − (the walk's order-1 fraction), plus the table's 1e-6 quadrature error and
+/// the f32 rounding of the nodes (1e-6): z Šidák over the 2 × (1024 + 32) nodes, family-wise
+/// 1e-3. Each SE ≤ 1.95e-3. Column x = 0 (μ = 0) is exactly 1 + 0.
+#[test]
+fn order_tables_complete_the_single_scattering_albedo() {
+    let n = ALBEDO_TABLE_SIZE;
+    let z = family_z(FAMILY_ALPHA, 2 * (n * n + n));
+    let mut worst: f64 = 0.0;
+    for family in 0..2 {
+        let (ss, orders) = (table(family), order_table(family));
+        let check = |e: f64, higher: f64, label: &str| {
+            let se = (e * (1.0 - e) / ORDER_WALKS as f64).sqrt();
+            assert!(se <= f64::from(ORDER_TABLE_MAX_STANDARD_ERROR), "{label}: SE {se:.2e}");
+            let d = e + higher - 1.0;
+            assert!(
+                d.abs() <= z * se + 2e-6,
+                "{} {label}: E = {e:.6} + Σ e_k = {higher:.6} − 1 = {d:.2e}, SE {se:.2e}, z = {z:.2}, N = {ORDER_WALKS}",
+                ss.name()
+            );
+            d.abs() / se.max(1e-12)
+        };
+        for c in 0..n * n {
+            let higher: f64 = (0..ORDER_TABLES).map(|k| f64::from(orders.directional_nodes(k)[c])).sum();
+            worst = worst.max(check(f64::from(ss.directional_nodes()[c]), higher, &format!("node {c}")));
+        }
+        for j in 0..n {
+            let higher: f64 = (0..ORDER_TABLES).map(|k| f64::from(orders.average_nodes(k)[j])).sum();
+            worst = worst.max(check(f64::from(ss.average_nodes()[j]), higher, &format!("average {j}")));
+        }
+    }
+    println!("E + Σ e_k − 1: largest |d|/SE = {worst:.2} (z = {z:.2})");
 }
 
 #[test]

@@ -5,8 +5,9 @@
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    AlbedoTable, AlbedoTabulated, Beckmann, Bsdf, CompensatedConductor, CompensatedDielectric, Compensation,
-    ComplexIor, Conductor, Dielectric, Ggx, Side, Transport,
+    ALBEDO_TABLE_SIZE, AlbedoTable, AlbedoTabulated, Beckmann, Bsdf, CompensatedConductor,
+    CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx, LAST_TABULATED_ORDER,
+    ORDER_TABLES, Side, Transport,
 };
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::{Domain, integrate_sphere};
@@ -71,6 +72,19 @@ fn chi2_cases() -> Vec<(String, Box<dyn Bsdf>, f64)> {
             theta,
         ));
     }
+    // the per-order lobe (its own per-channel profile, the Kulla–Conty sampler)
+    let copper = Conductor::new(ComplexIor::COPPER);
+    let aluminium = Conductor::new(ComplexIor::ALUMINIUM);
+    v.push((
+        "PerOrder GGX copper α = 0.8 θo = 0.7".into(),
+        Box::new(CompensatedConductor::new(ggx(0.8), copper, Compensation::PerOrder).unwrap()),
+        0.7,
+    ));
+    v.push((
+        "PerOrder Beckmann aluminium α = 0.4 θo = 1.2".into(),
+        Box::new(CompensatedConductor::new(beckmann(0.4), aluminium, Compensation::PerOrder).unwrap()),
+        1.2,
+    ));
     // anisotropic slopes (the tables at √(αx αy)): the sampler is still exact
     v.push((
         "KullaConty GGX gold αx = 0.2, αy = 0.8".into(),
@@ -169,7 +183,8 @@ fn white_furnace_within_table_error() {
             }
             let e_table = f64::from(table.directional(mu, alpha).unwrap());
             let tol = match scheme {
-                Compensation::KullaConty => eps,
+                // (the per-order lobe is Kulla–Conty's for F = 1: `per_order_is_kulla_conty_for_f1`)
+                Compensation::KullaConty | Compensation::PerOrder => eps,
                 Compensation::Turquin => eps / e_table,
             };
             let label = format!("white furnace {} {scheme:?} α = {alpha} μo = {mu}", table.name());
@@ -224,6 +239,102 @@ fn kulla_conty_lobe_is_normalized() {
     }
 }
 
+/// The per-order lobe's albedo at a node (μ at x = i/31, α at r = j/31, where the
+/// constructor's interpolation is exact) is the documented model
+/// g = (1 − E) Σ_k e_k F̄^k/Σ_k e_k (tail: e_6 F̄⁶ ρF̄/(1 − ρF̄), ρ = e_tail/(e_6 + e_tail)),
+/// computed here from the raw nodes of the tables (relative 1e-4: the f32 round trip of μ), and
+/// the lobe f_ms = f − f_ss integrates to it (adaptive quadrature of the channels weighted
+/// 1, 2, 4; 2e-5 relative + 1e-6),
+/// for gold and aluminium, GGX and Beckmann.
+#[test]
+fn per_order_lobe_has_the_model_albedo() {
+    fn run<S: AlbedoTabulated>(
+        slope_of: impl Fn(f32) -> S,
+        table: AlbedoTable,
+        orders: microsurface::ScatteringOrderTable,
+    ) {
+        let n = ALBEDO_TABLE_SIZE;
+        for (name, conductor) in [("gold", gold()), ("aluminium", Conductor::new(ComplexIor::ALUMINIUM))] {
+            for (i, j) in [(8usize, 31usize), (20, 17), (29, 25), (31, 10)] {
+                let r = j as f64 / (n - 1) as f64;
+                let alpha = (r * r) as f32;
+                let x2 = (i as f64 / (n - 1) as f64).powi(2);
+                let mu = if i == n - 1 {
+                    1.0
+                } else {
+                    (x2 * f64::from(alpha) / (1.0 + f64::from(alpha) - x2)) as f32
+                };
+                let b =
+                    CompensatedConductor::new(slope_of(alpha), conductor, Compensation::PerOrder).unwrap();
+                let got = b.multiple_scattering_albedo(mu).unwrap();
+                let node = j * n + i;
+                let e: Vec<f64> =
+                    (0..ORDER_TABLES).map(|t| f64::from(orders.directional_nodes(t)[node])).collect();
+                let total: f64 = e.iter().sum();
+                let c = 1.0 - f64::from(table.directional_nodes()[node]);
+                let f_avg = b.fresnel_average();
+                for ch in 0..3 {
+                    let fb = f64::from(f_avg[ch]);
+                    let mut w: f64 = (0..ORDER_TABLES - 1).map(|t| e[t] * fb.powi(t as i32 + 2)).sum();
+                    let (last, tail) = (e[ORDER_TABLES - 2], e[ORDER_TABLES - 1]);
+                    if last + tail > 0.0 {
+                        let rho = tail / (last + tail);
+                        w += last * fb.powi(LAST_TABULATED_ORDER as i32) * rho * fb / (1.0 - rho * fb);
+                    }
+                    let expected = if total > 0.0 { c * w / total } else { c * fb * fb };
+                    let g = f64::from(got[ch]);
+                    assert!(
+                        (g - expected).abs() <= 1e-4 * expected + 1e-7,
+                        "{} {name} node ({i}, {j}) channel {ch}: lobe albedo {g:.6e}, model {expected:.6e}",
+                        table.name()
+                    );
+                }
+                // one integral of the channels weighted 1, 2, 4 (a channel's error cannot hide)
+                let weights = Vec3::new(1.0, 2.0, 4.0);
+                let ss = *b.single_scattering();
+                let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+                let lobe = integrate_sphere(
+                    &mut |w| f64::from((b.eval(wo, w).f - ss.eval(wo, w).f).dot(weights) * w.z),
+                    8,
+                    16,
+                    Domain::UpperHemisphere,
+                    1e-6,
+                    6,
+                );
+                let g = f64::from(got.dot(weights));
+                assert!(
+                    (lobe - g).abs() <= 2e-5 * g + 1e-6,
+                    "{} {name} α = {alpha} μo = {mu}: ∫ f_ms cos · (1, 2, 4) = {lobe:.7e}, g(μo) · (1, 2, 4) = {g:.7e}",
+                    table.name()
+                );
+            }
+        }
+    }
+    run(ggx, AlbedoTable::GGX, microsurface::ScatteringOrderTable::GGX);
+    run(beckmann, AlbedoTable::BECKMANN, microsurface::ScatteringOrderTable::BECKMANN);
+}
+
+/// For F = 1 (F̄ = 1) the per-order lobe is the Kulla–Conty lobe: the same f to relative 1e-5
+/// (their arithmetic differs in rounding only), on 500 random pairs per case.
+#[test]
+fn per_order_is_kulla_conty_for_f1() {
+    let mut rng = validation::rng(1850);
+    for a in [0.05f32, 0.3, 1.0] {
+        let kc = CompensatedConductor::new(ggx(a), Conductor::perfect(), Compensation::KullaConty).unwrap();
+        let po = CompensatedConductor::new(ggx(a), Conductor::perfect(), Compensation::PerOrder).unwrap();
+        for _ in 0..500 {
+            let mut d = || {
+                let z = uniform32(&mut rng);
+                dir(f64::from(z).acos(), std::f64::consts::TAU * f64::from(uniform32(&mut rng)))
+            };
+            let (wo, wi) = (d(), d());
+            let (f, g) = (kc.eval(wo, wi).f, po.eval(wo, wi).f);
+            assert!(rel_close(f, g, 1e-5), "α = {a}: Kulla–Conty {f}, per-order {g} at wo = {wo}, wi = {wi}");
+            assert_eq!(kc.pdf(wo, wi), po.pdf(wo, wi), "α = {a}: the samplers differ");
+        }
+    }
+}
+
 /// F_avg by the constructor's 4 panels of Gauss–Legendre equals a 2000-panel midpoint rule to
 /// 1e-6 for the metal presets.
 #[test]
@@ -250,13 +361,16 @@ fn fresnel_average_is_accurate() {
     }
 }
 
-/// Kulla–Conty is reciprocal: f(ωo, ωi) = f(ωi, ωo) (relative 1e-4, the single-scattering
+/// Kulla–Conty and the per-order lobe are reciprocal: f(ωo, ωi) = f(ωi, ωo) (relative 1e-4, the single-scattering
 /// lobe's f32 rounding), on 2000 random pairs of upper-hemisphere directions per case.
 #[test]
 fn kulla_conty_is_reciprocal() {
     let mut rng = validation::rng(1800);
-    for a in [0.05f32, 0.3, 1.0] {
-        let b = CompensatedConductor::new(beckmann(a), gold(), Compensation::KullaConty).unwrap();
+    for (a, scheme) in [0.05f32, 0.3, 1.0]
+        .into_iter()
+        .flat_map(|a| [(a, Compensation::KullaConty), (a, Compensation::PerOrder)])
+    {
+        let b = CompensatedConductor::new(beckmann(a), gold(), scheme).unwrap();
         for _ in 0..2000 {
             let mut d = || {
                 let z = uniform32(&mut rng);
@@ -270,7 +384,7 @@ fn kulla_conty_is_reciprocal() {
             let (f, g) = (b.eval(wo, wi).f, b.eval(wi, wo).f);
             assert!(
                 rel_close(f, g, 1e-4),
-                "α = {a}: f(wo, wi) = {f}, f(wi, wo) = {g} at wo = {wo}, wi = {wi}"
+                "{scheme:?} α = {a}: f(wo, wi) = {f}, f(wi, wo) = {g} at wo = {wo}, wi = {wi}"
             );
         }
     }
@@ -325,7 +439,7 @@ fn backfacing_views_are_single_scattering() {
 fn invalid_input_gives_nothing() {
     let ok = dir(0.5, 0.2);
     let bad = [Vec3::NAN, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0)];
-    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
+    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
         let b = CompensatedConductor::new(ggx(0.4), gold(), scheme).unwrap();
         let check = |label: &str, call: &dyn Fn() -> bool| {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(call));

@@ -15,6 +15,7 @@
 //! 7th node is recomputed at 3; the run fails if they differ by more than 1e-5.
 
 mod dielectric;
+mod orders;
 mod quadrature;
 
 use dielectric::dielectric_albedo;
@@ -486,6 +487,7 @@ fn quick() {
         "tables --quick: {} nodes recomputed (and {dielectric_nodes} dielectric R, T pairs), {failures} differ",
         2 * (QUICK_CELLS + 1)
     );
+    let failures = failures + orders::quick();
     assert_eq!(failures, 0, "the shipped tables are not reproduced bit for bit");
 }
 
@@ -493,16 +495,18 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {
         println!(
-            "usage: cargo run --release --example tables [-- --quick | --interpolation] [--only conductor|dielectric]\n\n  \
+            "usage: cargo run --release --example tables [-- --quick | --interpolation] [--only conductor|dielectric|orders]\n\n  \
              (no flag)        rebuild src/albedo/data.rs, src/albedo/dielectric_data.rs and target/tables/*.f32,\n                   \
              print the quadrature error estimates\n  --interpolation  measure the lookups' interpolation error against \
              quadrature\n  --quick          recompute a subset of nodes and check them against the shipped tables bit for \
-             bit\n  --only X         rebuild (or measure) only the conductor (E, E_avg) or only the dielectric tables"
+             bit\n  --only X         rebuild (or measure) only the conductor (E, E_avg) or only the dielectric tables,\n                   or only the walk's per-order energies"
         );
         return;
     }
     let only = args.iter().position(|a| a == "--only").and_then(|k| args.get(k + 1)).map(String::as_str);
-    let (conductor, dielectric) = (only != Some("dielectric"), only != Some("conductor"));
+    let (conductor, dielectric) =
+        (only.is_none() || only == Some("conductor"), only.is_none() || only == Some("dielectric"));
+    let per_order = only.is_none() || only == Some("orders"); // the walk's per-order energies (orders.rs)
     if args.iter().any(|a| a == "--quick") {
         quick();
         return;
@@ -538,6 +542,12 @@ fn main() {
             [Family::Ggx, Family::Beckmann].into_iter().map(|f| (f, build(f))).collect();
         changed |= write_if_changed(&root.join("src/albedo/data.rs"), &source(&tables));
         export(&tables, &root.join("target/tables")).expect("write target/tables");
+    }
+    if per_order {
+        let tables: Vec<_> =
+            [Family::Ggx, Family::Beckmann].into_iter().map(|f| (f, orders::build(f))).collect();
+        changed |= write_if_changed(&root.join("src/albedo/orders_data.rs"), &orders::source(&tables));
+        orders::export(&tables, &root.join("target/tables")).expect("write target/tables");
     }
     if dielectric {
         let mut tables = Vec::new();

@@ -5,8 +5,8 @@
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, MAX_TABULATED_ALPHA, node_cell,
-    scale_invariant_direction,
+    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
+    ORDER_TABLES, ScatteringOrderTable, node_cell,
 };
 use crate::error::Error;
 use crate::material::Conductor;
@@ -45,6 +45,8 @@ pub trait AlbedoTabulated: MicrosurfaceSlope {
     const ALBEDO: AlbedoTable;
     /// The family's dielectric tables (reflected and transmitted, both sides).
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable;
+    /// The family's per-order energies of the F = 1 walk.
+    const ORDERS: ScatteringOrderTable;
 
     /// The isotropic roughness the tables are read at: √(αx αy), the geometric mean of the
     /// principal radii (for an [`Elliptical`](crate::Elliptical) slope √(α₁ α₂), which is
@@ -58,11 +60,13 @@ pub trait AlbedoTabulated: MicrosurfaceSlope {
 impl AlbedoTabulated for Ggx {
     const ALBEDO: AlbedoTable = AlbedoTable::GGX;
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::GGX;
+    const ORDERS: ScatteringOrderTable = ScatteringOrderTable::GGX;
 }
 
 impl AlbedoTabulated for Beckmann {
     const ALBEDO: AlbedoTable = AlbedoTable::BECKMANN;
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::BECKMANN;
+    const ORDERS: ScatteringOrderTable = ScatteringOrderTable::BECKMANN;
 }
 
 /// How a [`CompensatedConductor`] restores the energy single scattering loses.
@@ -88,6 +92,19 @@ pub enum Compensation {
     /// the **view direction** ωo (as the report prescribes): for F = 1 the albedo is exactly 1,
     /// the lobe keeps the single-scattering shape, and it is not reciprocal.
     Turquin,
+    /// A reciprocal additive lobe whose energy per RGB channel is the walk's per-order model
+    /// of the energy single scattering leaves out ([`ScatteringOrderTable`]):
+    ///
+    /// f_ms(ωo, ωi) = g(μo) g(μi) / (π ḡ),   ḡ = 2∫₀¹ g(μ) μ dμ,
+    /// g(μ) = (1 − E(μ)) Σ_k e_k(μ) F̄^k / Σ_k e_k(μ),   F̄ = F_avg,
+    ///
+    /// per channel, with e_k the F = 1 walk's energy of order k = 2 … 6 and the tail (weighted
+    /// as the geometric continuation of orders 6 and above: e_6 F̄⁶ ρF̄/(1 − ρF̄),
+    /// ρ = e_tail/(e_6 + e_tail), which is e_tail at F̄ = 1). Its albedo is exactly g(μo): the
+    /// energy of each order k weighted by F̄ᵏ (each bounce reflects F_avg), the split of
+    /// 1 − E(μ) between the orders taken from the walk instead of Kulla and Conty's
+    /// geometric series in E_avg. For F = 1 it is [`Compensation::KullaConty`].
+    PerOrder,
 }
 
 /// A conductor microfacet BRDF with energy compensation: the exact single-scattering lobe of
@@ -110,8 +127,10 @@ pub enum Compensation {
 /// E_exact(μo) − E_table(μo) (at most 1.2e-3 for GGX and 3.7e-3 for Beckmann; Turquin's scaled
 /// lobe by that error divided by E(μo)).
 ///
-/// **Sampling** (Kulla–Conty): with probability p = E(μo) (the energies of the two lobes for
-/// F = 1) the caller's uniforms drive the exact visible-normal sample of the single-scattering
+/// **Sampling** (Kulla–Conty and per-order): with probability p = E(μo) (the energies of the
+/// two lobes for F = 1; E here interpolated linearly between the uniform nodes μ = i/31, so
+/// that the lookup needs no division or root, any p ∈ (0, 1] giving an exact mixture) the
+/// caller's uniforms drive the exact visible-normal sample of the single-scattering
 /// lobe (uc rescaled to uc/p), otherwise u samples the added lobe's profile (1 − E(μi)) μi
 /// tabulated per cell of the direction axis (a cell by its mass, μi² uniform in it, φ uniform:
 /// density d_cell μi/π); the density is the mixture pdf = p pdf_ss + (1 − p) d_cell μi/π, exact
@@ -125,9 +144,19 @@ pub enum Compensation {
 /// normal, which single scattering supports) have no tabulated albedo: the lobe is then the
 /// single-scattering lobe alone; so is it for light directions below the horizon.
 ///
-/// **Cost.** Construction integrates F_avg (64 Fresnel evaluations) and the average (31 cells):
-/// about a microsecond; build the BSDF once per material, it is `Copy`. Eval adds one (Turquin)
-/// or two (Kulla–Conty) 1D table lookups to the single-scattering eval.
+/// **Cost.** Construction integrates F_avg (64 Fresnel evaluations) and the average (31 cells;
+/// the per-order scheme three more and the blend of six order tables): a few microseconds;
+/// build the BSDF once per material, it is `Copy`. Eval adds one (Turquin) or two (Kulla–Conty,
+/// per-order) branch-free 1D table lookups to the single-scattering eval, pdf one
+/// direction-axis lookup and one uniform-μ lookup (measured in `README.md`).
+///
+/// **Per-order** ([`Compensation::PerOrder`]) restores each channel's energy from the walk's
+/// per-order energies ([`ScatteringOrderTable`], standard error ≤ 1.95e-3 per node) instead of
+/// Kulla and Conty's series in E_avg: for F = 1 it is the Kulla–Conty lobe; for coloured metals
+/// it follows the walk where the series does not (GGX gold, copper, aluminium at α = 1: albedo
+/// within 0.5 % of the walk against 3–4 % for Kulla–Conty, `examples/compensation`), but its
+/// F̄ = F_avg per bounce misses the grazing-facet Fresnel of the higher orders for grazing views
+/// at small α (gold at α = 0.1, μo = 0.1: 3 % low, as Kulla–Conty).
 ///
 /// # Examples
 /// ```
@@ -152,12 +181,26 @@ pub struct CompensatedConductor<S> {
     scheme: Compensation,
     /// The tables' roughness √(αx αy).
     alpha: f32,
+    /// Whether the scheme has an additive lobe with energy (Kulla–Conty or per-order, not
+    /// a mirror, 1 − E_avg > 0): its sampler is a mixture.
+    mixing: bool,
+    /// 31² (1 + α): the direction node coordinate is 31 x = √(min(μ · this/(μ + α), 31²)).
+    node_scale: f32,
+    /// The probability of the single-scattering lobe in the sampling mixture, at the uniform
+    /// nodes μ = i/31 (E(μ) there; linear in μ between them): a table without a division or a
+    /// square root per lookup.
+    single_probability: [f32; ALBEDO_TABLE_SIZE],
     /// 1 − E at the direction nodes x = i/31, for this α.
     complement: [f32; ALBEDO_TABLE_SIZE],
     /// 1 − E_avg of the interpolated E.
     complement_average: f64,
     /// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi.
     profile: Profile,
+    /// The additive lobe as a product h(μo) h(μi) per channel: h at the direction nodes
+    /// (Kulla–Conty: √(F_ms/(π (1 − E_avg))) (1 − E); per order: g/√(π ḡ)).
+    lobe: [Vec3; ALBEDO_TABLE_SIZE],
+    /// ∫ h(μi) μi dωi per channel: the additive lobe's albedo at μo is h(μo) times this.
+    lobe_norm: Vec3,
     /// F_avg per channel.
     fresnel_average: Vec3,
     /// F0 per channel.
@@ -201,19 +244,56 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
         let fresnel_ms = (f_avg * f_avg * e_avg / (DVec3::ONE - f_avg * complement_average)).as_vec3();
         let scale = match scheme {
             // no energy lost (every node of the row is 1): nothing to restore
-            Compensation::KullaConty if complement_average <= 0.0 => Vec3::ZERO,
-            Compensation::KullaConty => {
+            Compensation::KullaConty | Compensation::PerOrder if complement_average <= 0.0 => Vec3::ZERO,
+            Compensation::KullaConty | Compensation::PerOrder => {
                 (fresnel_ms.as_dvec3() / (core::f64::consts::PI * complement_average)).as_vec3()
             }
             Compensation::Turquin => fresnel_normal,
         };
+        let lobe = match scheme {
+            Compensation::Turquin => [Vec3::ZERO; ALBEDO_TABLE_SIZE],
+            Compensation::KullaConty => {
+                let root = scale.as_dvec3().map(f64::sqrt);
+                core::array::from_fn(|i| (root * f64::from(complement[i])).as_vec3())
+            }
+            Compensation::PerOrder if single.is_specular() || complement_average <= 0.0 => {
+                [Vec3::ZERO; ALBEDO_TABLE_SIZE]
+            }
+            Compensation::PerOrder => per_order_lobe(&S::ORDERS, alpha, &complement, f_avg),
+        };
+        let lobe_norm = match scheme {
+            Compensation::Turquin => Vec3::ZERO,
+            _ => {
+                let mut norm = DVec3::ZERO;
+                for c in 0..3 {
+                    let h: [f32; ALBEDO_TABLE_SIZE] = core::array::from_fn(|i| lobe[i][c]);
+                    norm[c] = core::f64::consts::PI * average_of_complement(&h, f64::from(alpha)).0;
+                }
+                norm.as_vec3()
+            }
+        };
+        let node_scale = LAST * LAST * (1.0 + alpha);
+        let mut single_probability = [1.0; ALBEDO_TABLE_SIZE];
+        if !single.is_specular() {
+            for (i, p) in single_probability.iter_mut().enumerate() {
+                let mu = i as f32 / LAST;
+                let (k, f) = node_cell(direction_node(mu, alpha, node_scale), ALBEDO_TABLE_SIZE);
+                *p = 1.0 - (complement[k] + f * (complement[k + 1] - complement[k]));
+            }
+        }
+        let mixing = scheme != Compensation::Turquin && !single.is_specular() && complement_average > 0.0;
         Ok(Self {
             single,
             scheme,
+            mixing,
             alpha,
+            node_scale,
+            single_probability,
             complement,
             complement_average,
             profile,
+            lobe,
+            lobe_norm,
             fresnel_average,
             fresnel_normal,
             fresnel_ms,
@@ -249,6 +329,18 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         (1.0 - self.complement_average) as f32
     }
 
+    /// The albedo ∫ f_ms cos θi dωi of the additive lobe for a view at cos θo = μ, per RGB
+    /// channel: F_ms (1 − E(μ)) for [`Compensation::KullaConty`], the per-order model g(μ)
+    /// (interpolated linearly in x between the nodes) for [`Compensation::PerOrder`]. `None`
+    /// for [`Compensation::Turquin`] (no additive lobe) and unless μ ∈ [0, 1].
+    pub fn multiple_scattering_albedo(&self, mu: f32) -> Option<Vec3> {
+        if self.scheme == Compensation::Turquin || !(0.0..=1.0).contains(&mu) {
+            return None;
+        }
+        let (i, f) = self.cell(mu);
+        Some(self.lobe[i].lerp(self.lobe[i + 1], f) * self.lobe_norm)
+    }
+
     /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel (Gauss–Legendre, error below 1e-7).
     pub fn fresnel_average(&self) -> Vec3 {
         self.fresnel_average
@@ -277,7 +369,25 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// The cell i ∈ [0, 30] of the direction axis that holds μ, and the fraction within it.
     #[inline(always)]
     fn cell(&self, mu: f32) -> (usize, f32) {
-        node_cell(scale_invariant_direction(mu, self.alpha) * LAST, ALBEDO_TABLE_SIZE)
+        table_cell(direction_node(mu, self.alpha, self.node_scale))
+    }
+
+    /// Whether the sampler mixes in the additive lobe's profile for the view `wo`: a view
+    /// above the horizon of an additive lobe with energy.
+    #[inline(always)]
+    fn mixes(&self, wo: Vec3) -> bool {
+        self.mixing && wo.z > 0.0
+    }
+
+    /// The probability p of the single-scattering lobe in the sampling mixture for a view
+    /// above the horizon at cos θo = μ: E(μ) at the nodes μ = i/31, linear between them
+    /// (within the conductor table's uniform-μ interpolation error of E, ≤ 7.4e-2; any p in
+    /// (0, 1] gives an exact mixture, this one keeps the weights near the lobes' energies).
+    #[inline(always)]
+    fn mixture_probability(&self, mu: f32) -> f32 {
+        let (i, f) = table_cell(mu * LAST);
+        let (a, b) = (self.single_probability[i], self.single_probability[i + 1]);
+        a + f * (b - a)
     }
 
     /// The density of the Kulla–Conty lobe's sampler at wi (upper hemisphere):
@@ -310,23 +420,37 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         if wo.z > 0.0 { self.complement_at(wo.z) } else { 0.0 }
     }
 
-    /// The compensation added to f_ss (Kulla–Conty) for a view complement `c_o`.
+    /// The additive lobe's factor h(μo) of a view direction above the horizon, 0 otherwise
+    /// (no compensation).
     #[inline(always)]
-    fn kc_lobe(&self, c_o: f32, wi: Vec3) -> Vec3 {
-        if wi.z > 0.0 && c_o > 0.0 { self.scale * (c_o * self.complement_at(wi.z)) } else { Vec3::ZERO }
+    fn view_lobe(&self, wo: Vec3) -> Vec3 {
+        if wo.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let (i, f) = self.cell(wo.z);
+        self.lobe[i].lerp(self.lobe[i + 1], f)
     }
 
-    /// The Kulla–Conty lobe f_ms and the mixture density at wi from one table lookup (the same
+    /// The additive lobe h(μo) h(μi) for the view factor `h_o`.
+    #[inline(always)]
+    fn kc_lobe(&self, h_o: Vec3, wi: Vec3) -> Vec3 {
+        if wi.z > 0.0 {
+            let (i, f) = self.cell(wi.z);
+            h_o * self.lobe[i].lerp(self.lobe[i + 1], f)
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// The additive lobe f_ms and the mixture density at wi from one table lookup (the same
     /// arithmetic as [`Self::kc_lobe`] and [`Self::mixture_pdf`], bit for bit).
     #[inline(always)]
-    fn kc_lobe_and_pdf(&self, c_o: f32, p: f32, pdf_ss: f32, wi: Vec3) -> (Vec3, f32) {
+    fn kc_lobe_and_pdf(&self, h_o: Vec3, p: f32, pdf_ss: f32, wi: Vec3) -> (Vec3, f32) {
         if wi.z <= 0.0 {
             return (Vec3::ZERO, p * pdf_ss + (1.0 - p) * 0.0);
         }
         let (i, f) = self.cell(wi.z);
-        let (a, b) = (self.complement[i], self.complement[i + 1]);
-        let c_i = a + f * (b - a);
-        let lobe = if c_o > 0.0 { self.scale * (c_o * c_i) } else { Vec3::ZERO };
+        let lobe = h_o * self.lobe[i].lerp(self.lobe[i + 1], f);
         (lobe, p * pdf_ss + (1.0 - p) * (self.profile.density[i] * wi.z * FRAC_1_PI))
     }
 
@@ -370,10 +494,9 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
             return v;
         }
-        let c_o = self.view_complement(wo);
         let f = match self.scheme {
-            Compensation::KullaConty => v.f + self.kc_lobe(c_o, wi),
-            Compensation::Turquin => v.f * self.turquin_factor(c_o),
+            Compensation::KullaConty | Compensation::PerOrder => v.f + self.kc_lobe(self.view_lobe(wo), wi),
+            Compensation::Turquin => v.f * self.turquin_factor(self.view_complement(wo)),
         };
         BsdfValue { f, exact: true }
     }
@@ -383,24 +506,25 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) {
             return self.single.sample_keyed(wo, uc, u, key);
         }
-        let c_o = self.view_complement(wo);
         match self.scheme {
             Compensation::Turquin => {
                 let s = self.single.sample_keyed(wo, uc, u, key)?;
-                let weight = s.weight * self.turquin_factor(c_o);
+                let weight = s.weight * self.turquin_factor(self.view_complement(wo));
                 weight.is_finite().then_some(BsdfSample { weight, ..s })
             }
-            Compensation::KullaConty if c_o == 0.0 => self.single.sample_keyed(wo, uc, u, key),
-            Compensation::KullaConty => {
-                let p = 1.0 - c_o;
+            Compensation::KullaConty | Compensation::PerOrder if !self.mixes(wo) => {
+                self.single.sample_keyed(wo, uc, u, key)
+            }
+            Compensation::KullaConty | Compensation::PerOrder => {
+                let (p, h_o) = (self.mixture_probability(wo.z), self.view_lobe(wo));
                 if uc < p {
                     let s = self.single.sample_keyed(wo, (uc / p).min(ONE_MINUS_ULP), u, key)?;
-                    let (lobe, pdf) = self.kc_lobe_and_pdf(c_o, p, s.pdf, s.wi);
+                    let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, s.pdf, s.wi);
                     Self::finish(wo, s.wi, s.weight * s.pdf + lobe * s.wi.z.abs(), pdf)
                 } else {
                     let wi = self.sample_profile(u)?;
                     let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-                    let (lobe, pdf) = self.kc_lobe_and_pdf(c_o, p, pdf_ss, wi);
+                    let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, pdf_ss, wi);
                     Self::finish(wo, wi, (v.f + lobe) * wi.z, pdf)
                 }
             }
@@ -410,15 +534,12 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let pdf_ss = self.single.pdf(wo, wi);
-        // Turquin samples the single-scattering lobe (which validates the directions)
-        if self.scheme == Compensation::Turquin {
+        // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe,
+        // whose pdf validates the directions
+        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) {
             return pdf_ss;
         }
-        if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
-            return pdf_ss;
-        }
-        let c_o = self.view_complement(wo);
-        if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) }
+        self.mixture_pdf(self.mixture_probability(wo.z), pdf_ss, wi)
     }
 
     #[inline]
@@ -427,16 +548,37 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
             return (v, pdf_ss);
         }
-        let c_o = self.view_complement(wo);
         match self.scheme {
-            Compensation::KullaConty => {
-                let f = v.f + self.kc_lobe(c_o, wi);
-                let pdf = if c_o == 0.0 { pdf_ss } else { self.mixture_pdf(1.0 - c_o, pdf_ss, wi) };
+            Compensation::KullaConty | Compensation::PerOrder => {
+                let f = v.f + self.kc_lobe(self.view_lobe(wo), wi);
+                let pdf = if self.mixes(wo) {
+                    self.mixture_pdf(self.mixture_probability(wo.z), pdf_ss, wi)
+                } else {
+                    pdf_ss
+                };
                 (BsdfValue { f, exact: true }, pdf)
             }
-            Compensation::Turquin => (BsdfValue { f: v.f * self.turquin_factor(c_o), exact: true }, pdf_ss),
+            Compensation::Turquin => {
+                (BsdfValue { f: v.f * self.turquin_factor(self.view_complement(wo)), exact: true }, pdf_ss)
+            }
         }
     }
+}
+
+/// The cell i ∈ [0, 30] of a fractional node coordinate t ∈ [0, 31] and the fraction within
+/// it (t = 31 extrapolates cell 30 to its end). Through u32: a cheaper conversion than to usize
+/// (the callers' t is never negative or NaN).
+#[inline(always)]
+fn table_cell(t: f32) -> (usize, f32) {
+    let i = (t as u32).min(ALBEDO_TABLE_SIZE as u32 - 2);
+    (i as usize, t - i as f32)
+}
+
+/// The fractional direction node 31 x = 31 √(μ (1 + α)/(μ + α)) ∈ [0, 31] of μ ∈ [0, 1]
+/// (`node_scale` = 31² (1 + α)), with the square of the node scale folded into the root.
+#[inline(always)]
+fn direction_node(mu: f32, alpha: f32, node_scale: f32) -> f32 {
+    (mu * node_scale / (mu + alpha)).min(LAST * LAST).sqrt()
 }
 
 /// 1 − E at the direction nodes for roughness α: the table's two roughness rows around
@@ -531,6 +673,64 @@ fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f64) -> (f64, Prof
         }
     }
     (total, profile)
+}
+
+/// The factor h = g/√(π ḡ) of the per-order lobe g(μo) g(μi)/(π ḡ) at the direction nodes
+/// ([`Compensation::PerOrder`]): the order tables' two roughness rows around r = √α blended
+/// as [`blended_complement`] blends E's, g = (1 − E) Σ_k e_k F̄^k/Σ_k e_k per channel (pure
+/// order 2 where the walk recorded no higher order), ḡ in closed form for g linear in x per
+/// cell ([`average_of_complement`]). In f64.
+fn per_order_lobe(
+    orders: &ScatteringOrderTable,
+    alpha: f32,
+    complement: &[f32; ALBEDO_TABLE_SIZE],
+    f_avg: DVec3,
+) -> [Vec3; ALBEDO_TABLE_SIZE] {
+    let t = alpha.sqrt() * LAST;
+    let (j, f) = node_cell(t, ALBEDO_TABLE_SIZE);
+    let f = f64::from(f);
+    let mut g = [[0.0f32; ALBEDO_TABLE_SIZE]; 3];
+    for i in 0..ALBEDO_TABLE_SIZE {
+        let e: [f64; ORDER_TABLES] = core::array::from_fn(|k| {
+            let nodes = orders.directional_nodes(k);
+            let (lo, hi) = (
+                f64::from(nodes[j * ALBEDO_TABLE_SIZE + i]),
+                f64::from(nodes[(j + 1) * ALBEDO_TABLE_SIZE + i]),
+            );
+            lo + f * (hi - lo)
+        });
+        let total: f64 = e.iter().sum();
+        for (c, g) in g.iter_mut().enumerate() {
+            let fbar = f_avg[c];
+            let ratio = if total > 0.0 {
+                let (last, tail) = (e[ORDER_TABLES - 2], e[ORDER_TABLES - 1]);
+                let mut weighted: f64 = e[..ORDER_TABLES - 1]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &ek)| ek * fbar.powi(k as i32 + 2))
+                    .sum();
+                if last + tail > 0.0 {
+                    // the tail as the geometric continuation e_K ρ^m of order K = 6
+                    let rho = tail / (last + tail);
+                    weighted +=
+                        last * fbar.powi(LAST_TABULATED_ORDER as i32) * rho * fbar / (1.0 - rho * fbar);
+                }
+                weighted / total
+            } else {
+                fbar * fbar
+            };
+            g[i] = (f64::from(complement[i]) * ratio) as f32;
+        }
+    }
+    let mut h = [Vec3::ZERO; ALBEDO_TABLE_SIZE];
+    for (c, g) in g.iter().enumerate() {
+        let (average, _) = average_of_complement(g, f64::from(alpha));
+        let norm = if average > 0.0 { 1.0 / (core::f64::consts::PI * average).sqrt() } else { 0.0 };
+        for (h, &gi) in h.iter_mut().zip(g) {
+            h[c] = (f64::from(gi) * norm) as f32;
+        }
+    }
+    h
 }
 
 /// F_avg = 2∫₀¹ F(μ) μ dμ per channel, by composite Gauss–Legendre.

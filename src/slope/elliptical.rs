@@ -237,6 +237,7 @@ impl<S> Elliptical<S> {
 impl<S: AxisAlignedSlope + AlbedoTabulated> AlbedoTabulated for Elliptical<S> {
     const ALBEDO: AlbedoTable = S::ALBEDO;
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable = S::DIELECTRIC_ALBEDO;
+    const ORDERS: crate::ScatteringOrderTable = S::ORDERS;
 
     /// √(α₁ α₂): the compensated lobe of the rotated ellipse is that of the axis-aligned one.
     #[inline]

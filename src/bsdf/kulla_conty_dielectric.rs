@@ -1,0 +1,425 @@
+//! Energy-compensated dielectrics with the random walk's split between reflection and
+//! transmission: the single-scattering microfacet BSDF plus separable (rank-1) lobes of the
+//! higher orders' reflected and transmitted energy, from the walk's tables
+//! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
+
+use super::compensated::AlbedoTabulated;
+use super::lobe_profile::{LobeProfile, PROFILE_NODES, profile_cell, row_at};
+use super::microfacet::{MicrofacetBsdf, Technique};
+use super::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
+};
+use crate::albedo::{DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
+use crate::error::Error;
+use crate::material::{Dielectric, Side};
+use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+use core::f64::consts::PI;
+use glam::{Vec2, Vec3};
+
+/// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
+const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A slope family with the random walk's dielectric tables: the families a
+/// [`KullaContyDielectric`] can be built on.
+pub trait WalkTabulated: AlbedoTabulated {
+    /// The family's higher-order dielectric tables.
+    const DIELECTRIC_WALK: DielectricWalkTable;
+}
+
+impl WalkTabulated for Ggx {
+    const DIELECTRIC_WALK: DielectricWalkTable = DielectricWalkTable::GGX;
+}
+
+impl WalkTabulated for Beckmann {
+    const DIELECTRIC_WALK: DielectricWalkTable = DielectricWalkTable::BECKMANN;
+}
+
+/// The rows and samplers of one side of the interface (the side of the view).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SideLobes {
+    /// E_ss = R_ss + T_ss at the direction nodes (the single-scattering lobe's share of the
+    /// sampling mixture).
+    single: [f32; PROFILE_NODES],
+    /// ΔR at the direction nodes.
+    reflected: [f32; PROFILE_NODES],
+    /// ΔT at the direction nodes, times this side's reciprocity factor c.
+    transmitted: [f32; PROFILE_NODES],
+    /// 1/(π ΔR̄) (0 without a lobe).
+    reflected_scale: f32,
+    /// 1/(π ΔT̄′) of the *other* side's scaled ΔT′ (0 without a lobe): the normalization of
+    /// the transmission from this side.
+    transmitted_scale: f32,
+    /// The radiance factor (η_wo/η_wi)² of a transmission from this side, or 1 (importance).
+    transmitted_transport: f32,
+    /// The sampler of ΔR(μ) μ on this side.
+    reflected_profile: LobeProfile,
+    /// The sampler of ΔT(μ) μ on this side (used for light arriving from the other side).
+    transmitted_profile: LobeProfile,
+}
+
+/// A dielectric microfacet BSDF compensated with the random walk's higher orders, reflection
+/// and transmission apart: the exact single-scattering BSDF of [`MicrofacetBsdf`]
+/// (height-correlated Smith, dielectric Fresnel, [`Technique::SingleScattering`]) plus two
+/// separable lobes,
+///
+/// f = f_ss + f_R + f_T,
+/// f_R(ωo, ωi) = ΔR_a(μo) ΔR_a(μi) / (π ΔR̄_a)                (ωi on the view's side a),
+/// f_T(ωo, ωi) = c_a ΔT_a(μo) · c_b ΔT_b(μi) / (π c_b ΔT̄_b)   (ωi on the other side b),
+///
+/// with ΔR_s, ΔT_s the walk's reflected and transmitted energy of orders ≥ 2 for light from
+/// side s ([`DielectricWalkTable`]: the walk of Heitz et al. 2016, supplement §3.4),
+/// ḡ = 2∫₀¹ g(μ) μ dμ, and μ = |cos θ|. The additive separable form is Kulla and Conty's
+/// (2017, *Revisiting Physically Based Shading at Imageworks*, the multiple-scattering lobe
+/// (1 − E(μo))(1 − E(μi))/(π(1 − E_avg))), applied to each side's reflected and transmitted
+/// higher orders instead of the conductor's 1 − E.
+///
+/// **Energy** (importance transport, the flux): ∫ f_R cos dωi = ΔR_a(μo) and
+/// ∫ f_T |cos| dωi = c_a ΔT_a(μo) for every view, so the albedo is
+/// R_ss + T_ss + ΔR + c_a ΔT = 1 up to the tables' errors and the factor c_a, with the walk's
+/// split between reflection and transmission.
+///
+/// **Reciprocity.** Detailed balance in a medium of index n (equilibrium radiance ∝ n²) makes
+/// the flux BSDF of a transmission satisfy n_a² f(ωa, ωb) = n_b² f(ωb, ωa) (Veach 1997, §5.2,
+/// in importance form). The rank-1 f_T satisfies it if and only if n_a² c_a ΔT̄_a =
+/// n_b² c_b ΔT̄_b, which the walk's own higher orders satisfy (they are the difference of two
+/// reciprocal BSDFs) up to the tables' noise and interpolation. The factors
+/// c_out = √(η² ΔT̄_in/ΔT̄_out) and c_in = 1/c_out (η = n_in/n_out) enforce it exactly and
+/// split the residual evenly between the sides: [`Self::transmission_mismatch`] reports
+/// ΔT̄_out/(η² ΔT̄_in) − 1, and the albedo from side a errs by (c_a − 1) ΔT_a(μo) for it.
+/// f_R is symmetric.
+///
+/// **Sampling.** A mixture chosen by the view's energies: the single-scattering sample with
+/// probability ∝ E_ss(μo) = R_ss + T_ss (single-scattering tables, [`crate::DielectricAlbedoTable`]),
+/// the reflection lobe ∝ ΔR_a(μo) and the transmission lobe ∝ c_a ΔT_a(μo); each lobe samples
+/// its profile g(μi) μi per cell of the direction axis (a cell by its mass, μi² uniform in it,
+/// φ uniform) on its hemisphere. `pdf` is the exact mixture density, and a sample's weight is
+/// f·|cos θi|/pdf at its direction.
+///
+/// **Tables.** Both families' tables at α = √(αx αy), blended in (α, η) once at
+/// construction (both sides read the same (r, u) coordinate), the direction axis
+/// x = √(μ (1 + α)/(μ + α)) interpolated linearly at run time; ΔR̄ and ΔT̄ are the exact
+/// averages of the interpolated rows (closed form per cell).
+///
+/// **Transport.** [`Transport::Radiance`] (the default) multiplies transmissions by
+/// (η_wo/η_wi)², as the single-scattering BSDF does; [`Transport::Importance`] is the flux
+/// BSDF above.
+///
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness below
+/// [`super::SMOOTH_ALPHA`]) and η = 1 are the Dirac lobes of the single-scattering BSDF,
+/// uncompensated. A view or light on the horizon has no added lobe.
+///
+/// # Examples
+/// ```
+/// use microsurface::glam::{Vec2, Vec3};
+/// use microsurface::{Bsdf, Dielectric, Ggx, KullaContyDielectric, Transport};
+///
+/// let glass = KullaContyDielectric::new(Ggx::isotropic(0.5)?, Dielectric::new(1.5)?)?
+///     .with_transport(Transport::Importance);
+/// let wo = Vec3::new(0.6, 0.0, 0.8);
+/// let s = glass.sample(wo, 0.7, Vec2::new(0.4, 0.2)).expect("glass scatters");
+/// let (f, pdf) = glass.eval_with_pdf(wo, s.wi);
+/// assert!((pdf - s.pdf).abs() <= 1e-5 * pdf);
+/// assert!((s.weight - f.f * s.wi.z.abs() / pdf).abs().max_element() <= 1e-4 * s.weight.max_element());
+/// // reciprocal across the interface: f(out → in) = η² f(in → out) for the flux
+/// let wi = Vec3::new(-0.3, 0.0, -(1.0f32 - 0.09).sqrt());
+/// let (a, b) = (glass.eval(wo, wi).f.x, glass.eval(wi, wo).f.x);
+/// assert!((a - 1.5 * 1.5 * b).abs() <= 1e-4 * a);
+/// // beyond the tables
+/// assert!(KullaContyDielectric::new(Ggx::isotropic(0.5)?, Dielectric::new(4.0)?).is_err());
+/// # Ok::<(), microsurface::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KullaContyDielectric<S> {
+    single: MicrofacetBsdf<S, Dielectric>,
+    transport: Transport,
+    /// The tables' roughness √(αx αy).
+    alpha: f32,
+    /// η_wi/η_wo of a transmission from outside (η) and from inside (1/η).
+    transmitted_eta: [f32; 2],
+    /// The view's side: outside (0), inside (1).
+    sides: [SideLobes; 2],
+    /// ΔT̄_out/(η² ΔT̄_in) − 1 of the interpolated tables (0 without transmission lobes).
+    mismatch: f32,
+}
+
+impl<S: WalkTabulated> KullaContyDielectric<S> {
+    /// The compensated BSDF of a dielectric interface on the given slopes (radiance
+    /// transport).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`] (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`], [`MAX_TABULATED_ETA`]] = [1/3, 3]
+    /// (`"eta"`): the tables' range.
+    pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
+        let alpha = slope.albedo_alpha();
+        if alpha > MAX_TABULATED_ALPHA {
+            return Err(Error::InvalidParameter {
+                name: "alpha",
+                value: alpha,
+                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the walk tables' range",
+            });
+        }
+        let eta = dielectric.eta();
+        let eta_error = |value| Error::InvalidParameter {
+            name: "eta",
+            value,
+            expected: "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric walk tables' range",
+        };
+        if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) {
+            return Err(eta_error(eta));
+        }
+        let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
+        let empty = SideLobes {
+            single: [1.0; PROFILE_NODES],
+            reflected: [0.0; PROFILE_NODES],
+            transmitted: [0.0; PROFILE_NODES],
+            reflected_scale: 0.0,
+            transmitted_scale: 0.0,
+            transmitted_transport: 1.0,
+            reflected_profile: LobeProfile::EMPTY,
+            transmitted_profile: LobeProfile::EMPTY,
+        };
+        let mut b = Self {
+            single,
+            transport: Transport::Radiance,
+            alpha,
+            transmitted_eta: [eta, 1.0 / eta],
+            sides: [empty; 2],
+            mismatch: 0.0,
+        };
+        // a Dirac lobe is not compensated (and √(αx αy) may underflow to 0 there)
+        if single.is_specular() {
+            return Ok(b);
+        }
+        let mut averages = [0.0f64; 2];
+        for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
+            let (r, t) = S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(eta_error(seen))?;
+            let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
+            let side = &mut b.sides[s];
+            for ((e, r), t) in side.single.iter_mut().zip(r).zip(t) {
+                *e = r + t;
+            }
+            side.reflected = dr;
+            side.transmitted = dt;
+            let (r_avg, r_profile) = LobeProfile::new(&dr, alpha);
+            let (t_avg, t_profile) = LobeProfile::new(&dt, alpha);
+            side.reflected_scale = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
+            side.reflected_profile = r_profile;
+            side.transmitted_profile = t_profile;
+            averages[s] = t_avg;
+        }
+        // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in with c_in = 1/c_out
+        let eta_sq = f64::from(eta) * f64::from(eta);
+        let (m_out, m_in) = (averages[0], eta_sq * averages[1]);
+        let c_out = if m_out > 0.0 && m_in > 0.0 { (m_in / m_out).sqrt() } else { 0.0 };
+        b.mismatch = if c_out > 0.0 { (m_out / m_in - 1.0) as f32 } else { 0.0 };
+        let c = [c_out, if c_out > 0.0 { 1.0 / c_out } else { 0.0 }];
+        for s in 0..2 {
+            for v in &mut b.sides[s].transmitted {
+                *v = (f64::from(*v) * c[s]) as f32;
+            }
+            // the transmission from side s is normalized by the other side's scaled average
+            let other = c[1 - s] * averages[1 - s];
+            b.sides[s].transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
+        }
+        Ok(b.with_transport(Transport::Radiance))
+    }
+}
+
+impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
+    /// The same BSDF with the given transport mode.
+    #[must_use]
+    pub fn with_transport(self, transport: Transport) -> Self {
+        let mut b = Self { single: self.single.with_transport(transport), transport, ..self };
+        let eta = b.transmitted_eta[0];
+        // (η_wo/η_wi)² of a transmission: from outside 1/η², from inside η²
+        let radiance = [1.0 / (eta * eta), eta * eta];
+        for (side, r) in b.sides.iter_mut().zip(radiance) {
+            side.transmitted_transport = match transport {
+                Transport::Radiance => r,
+                Transport::Importance => 1.0,
+            };
+        }
+        b
+    }
+
+    /// The uncompensated single-scattering BSDF of the same material.
+    pub fn single_scattering(&self) -> &MicrofacetBsdf<S, Dielectric> {
+        &self.single
+    }
+
+    /// The roughness the tables are read at, √(αx αy).
+    pub fn table_alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// ΔT̄_out/(η² ΔT̄_in) − 1: how far the interpolated tables are from the reciprocity of the
+    /// walk's higher orders (0 when there is no transmission lobe). The lobes are made
+    /// reciprocal by splitting it evenly between the sides (see the type's documentation).
+    pub fn transmission_mismatch(&self) -> f32 {
+        self.mismatch
+    }
+
+    /// The added albedo (ΔR, c ΔT) of a view with |cos θo| = μ ∈ [0, 1] on `side`, as this
+    /// BSDF interpolates it (importance transport); `None` outside [0, 1] (NaN included).
+    pub fn higher_orders(&self, mu: f32, side: Side) -> Option<(f32, f32)> {
+        if !(0.0..=1.0).contains(&mu) {
+            return None;
+        }
+        let s = &self.sides[side_index(side)];
+        let cell = profile_cell(mu, self.alpha);
+        Some((row_at(&s.reflected, cell), row_at(&s.transmitted, cell)))
+    }
+
+    /// The added lobe f_R or f_T at (wo, wi), both off the horizon, from the view's cell.
+    #[inline(always)]
+    fn added(&self, a: &SideLobes, cell_o: (usize, f32), wo: Vec3, wi: Vec3) -> Vec3 {
+        let cell_i = profile_cell(wi.z.abs(), self.alpha);
+        let f = if (wi.z > 0.0) == (wo.z > 0.0) {
+            row_at(&a.reflected, cell_o) * row_at(&a.reflected, cell_i) * a.reflected_scale
+        } else {
+            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
+            row_at(&a.transmitted, cell_o)
+                * row_at(&b.transmitted, cell_i)
+                * (a.transmitted_scale * a.transmitted_transport)
+        };
+        Vec3::splat(f)
+    }
+
+    /// The mixture's lobe probabilities (single, reflection, transmission) for the view's
+    /// cell, unnormalized, and their sum.
+    #[inline(always)]
+    fn weights(a: &SideLobes, cell_o: (usize, f32)) -> ([f32; 3], f32) {
+        let w = [row_at(&a.single, cell_o), row_at(&a.reflected, cell_o), row_at(&a.transmitted, cell_o)];
+        (w, w[0] + w[1] + w[2])
+    }
+
+    /// The mixture density at wi (off the horizon) for the view's weights.
+    #[inline(always)]
+    fn mixture_pdf(
+        &self,
+        a: &SideLobes,
+        (w, total): ([f32; 3], f32),
+        wo: Vec3,
+        wi: Vec3,
+        pdf_ss: f32,
+    ) -> f32 {
+        let mu_i = wi.z.abs();
+        let (cell_i, _) = profile_cell(mu_i, self.alpha);
+        let lobe = if (wi.z > 0.0) == (wo.z > 0.0) {
+            w[1] * a.reflected_profile.pdf(cell_i, mu_i)
+        } else {
+            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
+            w[2] * b.transmitted_profile.pdf(cell_i, mu_i)
+        };
+        (w[0] * pdf_ss + lobe) / total
+    }
+
+    /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
+    /// horizon.
+    #[inline(always)]
+    fn compensates(&self, wo: Vec3, wi: Vec3) -> bool {
+        !self.single.is_specular() && valid_direction(wo) && valid_direction(wi) && wo.z != 0.0 && wi.z != 0.0
+    }
+
+    /// A sample from f·|cos θi| and the density at wi, `None` unless both are usable (the
+    /// filter of the single-scattering sampler).
+    #[inline(always)]
+    fn finish(&self, wo: Vec3, wi: Vec3, f_cos: Vec3, pdf: f32) -> Option<BsdfSample> {
+        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite()) || wi.z == 0.0 {
+            return None;
+        }
+        let weight = f_cos / pdf;
+        if !weight.is_finite() || f_cos.max_element() < f32::MIN_POSITIVE * wi.z.abs() {
+            return None;
+        }
+        let reflection = (wi.z > 0.0) == (wo.z > 0.0);
+        let eta =
+            if reflection { 1.0 } else { self.transmitted_eta[side_index(Side::above_or_inside(wo.z))] };
+        let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf: true };
+        Some(BsdfSample { wi, weight, pdf, eta, flags })
+    }
+}
+
+/// The index of a side in [`KullaContyDielectric::sides`].
+#[inline(always)]
+fn side_index(side: Side) -> usize {
+    match side {
+        Side::Outside => 0,
+        Side::Inside => 1,
+    }
+}
+
+impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
+    #[inline]
+    fn flags(&self) -> BsdfFlags {
+        self.single.flags()
+    }
+
+    #[inline]
+    fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
+        let v = self.single.eval_keyed(wo, wi, key);
+        if !self.compensates(wo, wi) {
+            return v;
+        }
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        let cell_o = profile_cell(wo.z.abs(), self.alpha);
+        BsdfValue { f: v.f + self.added(a, cell_o, wo, wi), exact: true }
+    }
+
+    #[inline]
+    fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z == 0.0 {
+            return self.single.sample_keyed(wo, uc, u, key);
+        }
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        let cell_o = profile_cell(wo.z.abs(), self.alpha);
+        let (w, total) = Self::weights(a, cell_o);
+        if !(total > 0.0) {
+            return self.single.sample_keyed(wo, uc, u, key);
+        }
+        let pick = uc * total;
+        let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
+        let wi = if pick < w[0] {
+            let s = self.single.sample_keyed(wo, (pick / w[0]).min(ONE_MINUS_ULP), u, key)?;
+            let pdf = self.mixture_pdf(a, (w, total), wo, s.wi, s.pdf);
+            let f_cos = s.weight * s.pdf + self.added(a, cell_o, wo, s.wi) * s.wi.z.abs();
+            return self.finish(wo, s.wi, f_cos, pdf);
+        } else if pick < w[0] + w[1] {
+            flip(a.reflected_profile.sample(u)?)
+        } else {
+            let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
+            -flip(b.transmitted_profile.sample(u)?)
+        };
+        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
+        let pdf = self.mixture_pdf(a, (w, total), wo, wi, pdf_ss);
+        self.finish(wo, wi, (v.f + self.added(a, cell_o, wo, wi)) * wi.z.abs(), pdf)
+    }
+
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let pdf_ss = self.single.pdf(wo, wi);
+        if !self.compensates(wo, wi) {
+            return pdf_ss;
+        }
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        let weights = Self::weights(a, profile_cell(wo.z.abs(), self.alpha));
+        if !(weights.1 > 0.0) {
+            return pdf_ss;
+        }
+        self.mixture_pdf(a, weights, wo, wi, pdf_ss)
+    }
+
+    #[inline]
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
+        if !self.compensates(wo, wi) {
+            return (v, pdf_ss);
+        }
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        let cell_o = profile_cell(wo.z.abs(), self.alpha);
+        let weights = Self::weights(a, cell_o);
+        let pdf = if weights.1 > 0.0 { self.mixture_pdf(a, weights, wo, wi, pdf_ss) } else { pdf_ss };
+        (BsdfValue { f: v.f + self.added(a, cell_o, wo, wi), exact: true }, pdf)
+    }
+}

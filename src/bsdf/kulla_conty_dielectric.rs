@@ -4,7 +4,7 @@
 //! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
 
 use super::compensated::AlbedoTabulated;
-use super::lobe_profile::{LobeProfile, PROFILE_NODES, profile_cell, row_at};
+use super::lobe_profile::{LobeProfile, PROFILE_NODES, profile_cell, profile_cells, row_at};
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
@@ -15,6 +15,9 @@ use crate::material::{Dielectric, Side};
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
 use core::f64::consts::PI;
 use glam::{Vec2, Vec3};
+
+/// The cells (index, fraction) of the view's and the light's cosine on the direction axis.
+type Cells = ((usize, f32), (usize, f32));
 
 /// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
 const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -37,9 +40,10 @@ impl WalkTabulated for Beckmann {
 /// The rows and samplers of one side of the interface (the side of the view).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct SideLobes {
-    /// E_ss = R_ss + T_ss at the direction nodes (the single-scattering lobe's share of the
-    /// sampling mixture).
-    single: [f32; PROFILE_NODES],
+    /// The sampling mixture's probabilities of the single-scattering lobe and of the reflection
+    /// lobe at the direction nodes: E_ss, ΔR over E_ss + ΔR + c ΔT (E_ss = R_ss + T_ss); the
+    /// transmission lobe has the rest.
+    mixture: [[f32; 2]; PROFILE_NODES],
     /// ΔR at the direction nodes.
     reflected: [f32; PROFILE_NODES],
     /// ΔT at the direction nodes, times this side's reciprocity factor c.
@@ -88,12 +92,16 @@ struct SideLobes {
 /// ΔT̄_out/(η² ΔT̄_in) − 1, and the albedo from side a errs by (c_a − 1) ΔT_a(μo) for it.
 /// f_R is symmetric.
 ///
-/// **Sampling.** A mixture chosen by the view's energies: the single-scattering sample with
-/// probability ∝ E_ss(μo) = R_ss + T_ss (single-scattering tables, [`crate::DielectricAlbedoTable`]),
-/// the reflection lobe ∝ ΔR_a(μo) and the transmission lobe ∝ c_a ΔT_a(μo); each lobe samples
-/// its profile g(μi) μi per cell of the direction axis (a cell by its mass, μi² uniform in it,
-/// φ uniform) on its hemisphere. `pdf` is the exact mixture density, and a sample's weight is
-/// f·|cos θi|/pdf at its direction.
+/// **Sampling.** A mixture chosen by the view's energies: at every direction node the
+/// probabilities of the single-scattering sample, the reflection lobe and the transmission
+/// lobe are E_ss : ΔR_a : c_a ΔT_a (E_ss = R_ss + T_ss from [`crate::DielectricAlbedoTable`]),
+/// normalized at construction and interpolated linearly in x at μo (no division at run time);
+/// each lobe samples its profile g(μi) μi per cell of the direction axis (a cell by its mass,
+/// μi² uniform in it, φ uniform) on its hemisphere. `pdf` is the exact mixture density, and a
+/// sample's weight is f·|cos θi|/pdf at its direction, with f and pdf computed as `eval` and
+/// `pdf` compute them (both cosines located on the axis with one shared division; the lobe is
+/// chosen with μo located alone, a few ulps of a cell fraction apart, which changes a lobe
+/// probability by a relative ~1e-7).
 ///
 /// **Tables.** Both families' tables at α = √(αx αy), blended in (α, η) once at
 /// construction (both sides read the same (r, u) coordinate), the direction axis
@@ -170,7 +178,7 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         }
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let empty = SideLobes {
-            single: [1.0; PROFILE_NODES],
+            mixture: [[1.0, 0.0]; PROFILE_NODES],
             reflected: [0.0; PROFILE_NODES],
             transmitted: [0.0; PROFILE_NODES],
             reflected_scale: 0.0,
@@ -192,11 +200,12 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             return Ok(b);
         }
         let mut averages = [0.0f64; 2];
+        let mut single = [[0.0f32; PROFILE_NODES]; 2];
         for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
             let (r, t) = S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(eta_error(seen))?;
             let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
             let side = &mut b.sides[s];
-            for ((e, r), t) in side.single.iter_mut().zip(r).zip(t) {
+            for (e, (r, t)) in single[s].iter_mut().zip(r.into_iter().zip(t)) {
                 *e = r + t;
             }
             side.reflected = dr;
@@ -221,6 +230,13 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             // the transmission from side s is normalized by the other side's scaled average
             let other = c[1 - s] * averages[1 - s];
             b.sides[s].transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
+            let side = &mut b.sides[s];
+            for (i, m) in side.mixture.iter_mut().enumerate() {
+                let w =
+                    [f64::from(single[s][i]), f64::from(side.reflected[i]), f64::from(side.transmitted[i])];
+                let total = w[0] + w[1] + w[2];
+                *m = if total > 0.0 { [(w[0] / total) as f32, (w[1] / total) as f32] } else { [1.0, 0.0] };
+            }
         }
         Ok(b.with_transport(Transport::Radiance))
     }
@@ -271,10 +287,10 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
         Some((row_at(&s.reflected, cell), row_at(&s.transmitted, cell)))
     }
 
-    /// The added lobe f_R or f_T at (wo, wi), both off the horizon, from the view's cell.
+    /// The added lobe f_R or f_T at (wo, wi), both off the horizon, from their cells.
     #[inline(always)]
-    fn added(&self, a: &SideLobes, cell_o: (usize, f32), wo: Vec3, wi: Vec3) -> Vec3 {
-        let cell_i = profile_cell(wi.z.abs(), self.alpha);
+    fn added(&self, a: &SideLobes, cells: Cells, wo: Vec3, wi: Vec3) -> Vec3 {
+        let (cell_o, cell_i) = cells;
         let f = if (wi.z > 0.0) == (wo.z > 0.0) {
             row_at(&a.reflected, cell_o) * row_at(&a.reflected, cell_i) * a.reflected_scale
         } else {
@@ -286,33 +302,36 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
         Vec3::splat(f)
     }
 
-    /// The mixture's lobe probabilities (single, reflection, transmission) for the view's
-    /// cell, unnormalized, and their sum.
+    /// The mixture's lobe probabilities (single, reflection, transmission) for the view's cell:
+    /// the normalized node probabilities interpolated (no division at run time), the third
+    /// the complement of the first two.
     #[inline(always)]
-    fn weights(a: &SideLobes, cell_o: (usize, f32)) -> ([f32; 3], f32) {
-        let w = [row_at(&a.single, cell_o), row_at(&a.reflected, cell_o), row_at(&a.transmitted, cell_o)];
-        (w, w[0] + w[1] + w[2])
+    fn probabilities(a: &SideLobes, (i, f): (usize, f32)) -> [f32; 3] {
+        let (lo, hi) = (a.mixture[i], a.mixture[i + 1]);
+        let p0 = lo[0] + f * (hi[0] - lo[0]);
+        let p1 = lo[1] + f * (hi[1] - lo[1]);
+        [p0, p1, (1.0 - p0 - p1).max(0.0)]
     }
 
-    /// The mixture density at wi (off the horizon) for the view's weights.
+    /// The mixture density at wi (off the horizon, in cell `cell_i`) for the view's
+    /// probabilities.
     #[inline(always)]
-    fn mixture_pdf(
-        &self,
-        a: &SideLobes,
-        (w, total): ([f32; 3], f32),
-        wo: Vec3,
-        wi: Vec3,
-        pdf_ss: f32,
-    ) -> f32 {
+    fn mixture_pdf(&self, a: &SideLobes, p: [f32; 3], cell_i: usize, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         let mu_i = wi.z.abs();
-        let (cell_i, _) = profile_cell(mu_i, self.alpha);
         let lobe = if (wi.z > 0.0) == (wo.z > 0.0) {
-            w[1] * a.reflected_profile.pdf(cell_i, mu_i)
+            p[1] * a.reflected_profile.pdf(cell_i, mu_i)
         } else {
             let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
-            w[2] * b.transmitted_profile.pdf(cell_i, mu_i)
+            p[2] * b.transmitted_profile.pdf(cell_i, mu_i)
         };
-        (w[0] * pdf_ss + lobe) / total
+        p[0] * pdf_ss + lobe
+    }
+
+    /// The view's side and the cells of both directions.
+    #[inline(always)]
+    fn side_and_cells(&self, wo: Vec3, wi: Vec3) -> (&SideLobes, Cells) {
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        (a, profile_cells(wo.z.abs(), wi.z.abs(), self.alpha))
     }
 
     /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
@@ -362,9 +381,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return v;
         }
-        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        let cell_o = profile_cell(wo.z.abs(), self.alpha);
-        BsdfValue { f: v.f + self.added(a, cell_o, wo, wi), exact: true }
+        let (a, cells) = self.side_and_cells(wo, wi);
+        BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }
     }
 
     #[inline]
@@ -374,26 +392,23 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         }
         let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
         let cell_o = profile_cell(wo.z.abs(), self.alpha);
-        let (w, total) = Self::weights(a, cell_o);
-        if !(total > 0.0) {
-            return self.single.sample_keyed(wo, uc, u, key);
-        }
-        let pick = uc * total;
+        let p = Self::probabilities(a, cell_o);
         let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
-        let wi = if pick < w[0] {
-            let s = self.single.sample_keyed(wo, (pick / w[0]).min(ONE_MINUS_ULP), u, key)?;
-            let pdf = self.mixture_pdf(a, (w, total), wo, s.wi, s.pdf);
-            let f_cos = s.weight * s.pdf + self.added(a, cell_o, wo, s.wi) * s.wi.z.abs();
+        let wi = if uc < p[0] {
+            let s = self.single.sample_keyed(wo, (uc / p[0]).min(ONE_MINUS_ULP), u, key)?;
+            // f and the density as eval and pdf compute them (the cells located together)
+            let (_, cells) = self.side_and_cells(wo, s.wi);
+            let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, s.wi, s.pdf);
+            let f_cos = s.weight * s.pdf + self.added(a, cells, wo, s.wi) * s.wi.z.abs();
             return self.finish(wo, s.wi, f_cos, pdf);
-        } else if pick < w[0] + w[1] {
+        } else if uc < p[0] + p[1] {
             flip(a.reflected_profile.sample(u)?)
         } else {
             let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
             -flip(b.transmitted_profile.sample(u)?)
         };
-        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-        let pdf = self.mixture_pdf(a, (w, total), wo, wi, pdf_ss);
-        self.finish(wo, wi, (v.f + self.added(a, cell_o, wo, wi)) * wi.z.abs(), pdf)
+        let (v, pdf) = self.eval_with_pdf_keyed(wo, wi, key);
+        self.finish(wo, wi, v.f * wi.z.abs(), pdf)
     }
 
     #[inline]
@@ -402,12 +417,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return pdf_ss;
         }
-        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        let weights = Self::weights(a, profile_cell(wo.z.abs(), self.alpha));
-        if !(weights.1 > 0.0) {
-            return pdf_ss;
-        }
-        self.mixture_pdf(a, weights, wo, wi, pdf_ss)
+        let (a, (cell_o, cell_i)) = self.side_and_cells(wo, wi);
+        self.mixture_pdf(a, Self::probabilities(a, cell_o), cell_i.0, wo, wi, pdf_ss)
     }
 
     #[inline]
@@ -416,10 +427,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return (v, pdf_ss);
         }
-        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        let cell_o = profile_cell(wo.z.abs(), self.alpha);
-        let weights = Self::weights(a, cell_o);
-        let pdf = if weights.1 > 0.0 { self.mixture_pdf(a, weights, wo, wi, pdf_ss) } else { pdf_ss };
-        (BsdfValue { f: v.f + self.added(a, cell_o, wo, wi), exact: true }, pdf)
+        let (a, cells) = self.side_and_cells(wo, wi);
+        let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, wi, pdf_ss);
+        (BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }, pdf)
     }
 }

@@ -19,6 +19,19 @@ pub(crate) fn profile_cell(mu: f32, alpha: f32) -> (usize, f32) {
     node_cell(scale_invariant_direction(mu, alpha) * LAST, PROFILE_NODES)
 }
 
+/// The cells of two cosines at once ([`profile_cell`] of each), sharing one division:
+/// x² = μo k (μi + α)/((μo + α)(μi + α)) and likewise for μi (k = 1 + α; a few ulps from the
+/// separate computation).
+#[inline(always)]
+pub(crate) fn profile_cells(mu_o: f32, mu_i: f32, alpha: f32) -> ((usize, f32), (usize, f32)) {
+    let k = 1.0 + alpha;
+    let (so, si) = (mu_o + alpha, mu_i + alpha);
+    let inv = 1.0 / (so * si);
+    let xo = (mu_o * k * si * inv).min(1.0).sqrt();
+    let xi = (mu_i * k * so * inv).min(1.0).sqrt();
+    (node_cell(xo * LAST, PROFILE_NODES), node_cell(xi * LAST, PROFILE_NODES))
+}
+
 /// The value at (cell, fraction) of a row of node values, linear in x.
 #[inline(always)]
 pub(crate) fn row_at(row: &[f32; PROFILE_NODES], (i, f): (usize, f32)) -> f32 {

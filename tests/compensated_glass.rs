@@ -192,7 +192,7 @@ fn added_lobes_are_normalized() {
             for above in [true, false] {
                 let wo = view(mu, above);
                 let (dr, dt) = b.higher_orders(mu, side_of(above)).unwrap();
-                let mut part = |same: bool| {
+                let part = |same: bool| {
                     integrate_sphere(
                         &mut |w| {
                             if w.z == 0.0 || ((w.z > 0.0) == (wo.z > 0.0)) != same {

@@ -173,6 +173,34 @@ impl DielectricWalkTable {
     }
 }
 
+impl DielectricWalkTable {
+    /// The variance of ΔT at the 16 direction nodes as [`Self::direction_row`] blends it: the
+    /// squared bilinear weights times the nodes' squared standard errors (independent
+    /// walks). `None` outside the tables' range.
+    pub(crate) fn transmitted_row_variance(
+        &self,
+        alpha: f32,
+        eta: f32,
+    ) -> Option<[f32; DIELECTRIC_TABLE_SIZE]> {
+        if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA && in_eta_range(eta)) {
+            return None;
+        }
+        let range = EtaRange::of(eta);
+        let eta_ge_1 = if eta >= 1.0 { eta } else { 1.0 / eta };
+        let (j, fj) = node_cell(alpha.sqrt() * LAST, DIELECTRIC_TABLE_SIZE);
+        let (l, fl) = node_cell(eta_coordinate(eta_ge_1) * LAST, DIELECTRIC_TABLE_SIZE);
+        let var = |k: usize| self.standard_errors(range, k).map_or(0.0, |(_, t)| t * t);
+        let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
+        for (i, o) in out.iter_mut().enumerate() {
+            let at = |jj: usize, ll: usize| var(ll * ROW + jj * DIELECTRIC_TABLE_SIZE + i);
+            let (a, b) = ((1.0 - fj) * (1.0 - fl), fj * (1.0 - fl));
+            let (c, d) = ((1.0 - fj) * fl, fj * fl);
+            *o = a * a * at(j, l) + b * b * at(j + 1, l) + c * c * at(j, l + 1) + d * d * at(j + 1, l + 1);
+        }
+        Some(out)
+    }
+}
+
 /// Whether η lies in [1/3, 3].
 #[inline(always)]
 fn in_eta_range(eta: f32) -> bool {

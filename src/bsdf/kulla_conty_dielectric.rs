@@ -86,10 +86,15 @@ struct SideLobes {
 /// the flux BSDF of a transmission satisfy n_a² f(ωa, ωb) = n_b² f(ωb, ωa) (Veach 1997, §5.2,
 /// in importance form). The rank-1 f_T satisfies it if and only if n_a² c_a ΔT̄_a =
 /// n_b² c_b ΔT̄_b, which the walk's own higher orders satisfy (they are the difference of two
-/// reciprocal BSDFs) up to the tables' noise and interpolation. The factors
-/// c_out = √(η² ΔT̄_in/ΔT̄_out) and c_in = 1/c_out (η = n_in/n_out) enforce it exactly and
-/// split the residual evenly between the sides: [`Self::transmission_mismatch`] reports
-/// ΔT̄_out/(η² ΔT̄_in) − 1, and the albedo from side a errs by (c_a − 1) ΔT_a(μo) for it.
+/// reciprocal BSDFs) up to the tables' noise and interpolation. The factors c enforce it
+/// exactly: with L = ln(η² ΔT̄_in/ΔT̄_out) (η = n_in/n_out), ln c_out = w L and
+/// ln c_in = −(1 − w) L, where w = v_out/(v_out + v_in) is the share of the relative variance
+/// v = Var(ΔT̄)/ΔT̄² of the outside average (from the nodes' standard errors through the
+/// blend and the linear average): the noisier side absorbs more of the residual, and equal
+/// noise splits it evenly (c_out = 1/c_in = √(η² ΔT̄_in/ΔT̄_out)).
+/// [`Self::transmission_mismatch`] reports ΔT̄_out/(η² ΔT̄_in) − 1, and the albedo from side a
+/// errs by (c_a − 1) ΔT_a(μo) for it. Without transmitted higher orders on either side
+/// (an average of 0) there is no transmission lobe.
 /// f_R is symmetric.
 ///
 /// **Sampling.** A mixture chosen by the view's energies: at every direction node the
@@ -200,7 +205,14 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             return Ok(b);
         }
         let mut averages = [0.0f64; 2];
+        let mut variances = [0.0f64; 2];
         let mut single = [[0.0f32; PROFILE_NODES]; 2];
+        // the averages are linear in the nodes: their weights, from the unit rows
+        let node_weights: [f64; PROFILE_NODES] = core::array::from_fn(|i| {
+            let mut unit = [0.0; PROFILE_NODES];
+            unit[i] = 1.0;
+            LobeProfile::new(&unit, alpha).0
+        });
         for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
             let (r, t) = S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(eta_error(seen))?;
             let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
@@ -216,13 +228,23 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             side.reflected_profile = r_profile;
             side.transmitted_profile = t_profile;
             averages[s] = t_avg;
+            let var = S::DIELECTRIC_WALK.transmitted_row_variance(alpha, seen).ok_or(eta_error(seen))?;
+            variances[s] = node_weights.iter().zip(var).map(|(w, v)| w * w * f64::from(v)).sum();
         }
-        // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in with c_in = 1/c_out
+        // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in; the log-ratio L = ln(η² ΔT̄_in/ΔT̄_out) is
+        // split by the averages' relative variances (ln c_out = w L, ln c_in = −(1 − w) L)
         let eta_sq = f64::from(eta) * f64::from(eta);
         let (m_out, m_in) = (averages[0], eta_sq * averages[1]);
-        let c_out = if m_out > 0.0 && m_in > 0.0 { (m_in / m_out).sqrt() } else { 0.0 };
-        b.mismatch = if c_out > 0.0 { (m_out / m_in - 1.0) as f32 } else { 0.0 };
-        let c = [c_out, if c_out > 0.0 { 1.0 / c_out } else { 0.0 }];
+        let c = if m_out > 0.0 && m_in > 0.0 {
+            let log_ratio = (m_in / m_out).ln();
+            let (v_out, v_in) =
+                (variances[0] / (averages[0] * averages[0]), variances[1] / (averages[1] * averages[1]));
+            let w = if v_out + v_in > 0.0 { v_out / (v_out + v_in) } else { 0.5 };
+            b.mismatch = (m_out / m_in - 1.0) as f32;
+            [(w * log_ratio).exp(), (-(1.0 - w) * log_ratio).exp()]
+        } else {
+            [0.0, 0.0]
+        };
         for s in 0..2 {
             for v in &mut b.sides[s].transmitted {
                 *v = (f64::from(*v) * c[s]) as f32;

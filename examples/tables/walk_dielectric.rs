@@ -235,6 +235,19 @@ pub fn export(tables: &[(Family, Side, Vec<Cell>)], dir: &std::path::Path) -> st
             )?;
         }
     }
+    std::fs::write(
+        dir.join("README_walk_dielectric.txt"),
+        "Little-endian f32 arrays, no header.\n\n\
+         <family>_walk_dielectric_<side>_<reflected|transmitted>.f32: 16 x 16 x 16 values V[l][j][i],\n\
+         l (eta) slowest, i (direction) fastest: the random walk's reflected / transmitted (flux)\n\
+         energy of scattering orders >= 2 (Delta R, Delta T) of a dielectric with light from <side>\n\
+         (outside: relative index eta; inside: 1/eta); the _se files hold each value's standard\n\
+         error. Axes as the single-scattering dielectric exports: u = l/15, eta = 1 + 2 u^2 in\n\
+         [1, 3]; r = j/15, alpha = r^2; x = i/15, mu = X alpha/(1 + alpha - X) with X = x^2 (node\n\
+         x = 0 estimated at mu = 1e-7). Lookup of (mu, alpha, eta): x = sqrt(mu (1 + alpha)/(mu +\n\
+         alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2), trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n\
+         See microsurface::DielectricWalkTable and microsurface::KullaContyDielectric.\n",
+    )?;
     Ok(())
 }
 

@@ -20,9 +20,9 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use microsurface::{
-    Bsdf, CompensatedConductor, Compensation, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material,
-    MicrofacetBsdf, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing,
-    SingleScattering, SpecularLimit, Technique, UniformHeight,
+    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
+    Estimator, Ggx, KullaContyDielectric, Material, MicrofacetBsdf, Microsurface, MicrosurfaceSlope,
+    PositionFree, ScatteringOrder, Shadowing, SingleScattering, SpecularLimit, Technique, UniformHeight,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -308,8 +308,53 @@ fn compensated(c: &mut Criterion<Clock>) {
     g.finish();
 }
 
+/// The energy-compensated glass (η = 1.5: `KullaContyDielectric`, the walk's higher orders as
+/// reflection and transmission lobes, and Turquin's `CompensatedDielectric`) against the
+/// single-scattering glass, static dispatch, views above the surface and light directions on
+/// the whole sphere. Ids `glass/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin}`.
+fn compensated_glass(c: &mut Criterion<Clock>) {
+    let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
+    let glass = Dielectric::new(1.5).expect("valid index");
+    let single = MicrofacetBsdf::new(slope, glass)
+        .expect("α ≤ MAX_WALK_ALPHA")
+        .with_technique(Technique::SingleScattering);
+    let kc = KullaContyDielectric::new(slope, glass).expect("in the tables' range");
+    let turquin = CompensatedDielectric::new(slope, glass).expect("in the tables' range");
+    let x = inputs(true, 310);
+    macro_rules! bench {
+        ($g:expr, $name:expr, $model:expr, $call:ident) => {
+            $g.bench_function($name, |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    bench!(@call black_box($model), $call, k)
+                })
+            });
+        };
+        (@call $m:expr, eval, $k:expr) => { $m.eval(black_box(x.wo[$k]), black_box(x.wi[$k])) };
+        (@call $m:expr, pdf, $k:expr) => { $m.pdf(black_box(x.wo[$k]), black_box(x.wi[$k])) };
+        (@call $m:expr, sample, $k:expr) => { $m.sample(black_box(x.wo[$k]), black_box(x.uc[$k]), black_box(x.u[$k])) };
+    }
+    let mut g = c.benchmark_group("glass/compensated/eval");
+    bench!(g, "single", &single, eval);
+    bench!(g, "kulla-conty", &kc, eval);
+    bench!(g, "turquin", &turquin, eval);
+    g.finish();
+    let mut g = c.benchmark_group("glass/compensated/pdf");
+    bench!(g, "single", &single, pdf);
+    bench!(g, "kulla-conty", &kc, pdf);
+    bench!(g, "turquin", &turquin, pdf);
+    g.finish();
+    let mut g = c.benchmark_group("glass/compensated/sample");
+    bench!(g, "single", &single, sample);
+    bench!(g, "kulla-conty", &kc, sample);
+    bench!(g, "turquin", &turquin, sample);
+    g.finish();
+}
+
 fn bsdfs(c: &mut Criterion<Clock>) {
     compensated(c);
+    compensated_glass(c);
     sample_vs_vndf(c);
     bench_material(c, "gold", Conductor::new(ComplexIor::GOLD), 100);
     bench_material(c, "glass", Dielectric::new(1.5).expect("valid index"), 200);

@@ -8,9 +8,11 @@
 //!   Σ|h − h_walk| / Σ h_walk (F = 1), per α ∈ {0.1, 0.3, 0.6, 1} and θo ∈ {0, 1, 1.4}, with
 //!   the noise floor of the estimate (the same distance between two independent walk runs);
 //! * the albedo error of anisotropic GGX (F = 1) compensated at α = √(αx αy);
-//! * glass (`CompensatedDielectric`, Turquin scaling, and single scattering): the reflected,
-//!   transmitted and total albedo against the walk's (importance transport: flux), max and RMS
-//!   over μ, α and η ∈ {1.33, 1.5, 2} seen from outside and from inside (1/η);
+//! * glass (`CompensatedDielectric`, Turquin scaling; `KullaContyDielectric`, the walk's
+//!   higher orders as separable reflection and transmission lobes; and single scattering): the
+//!   reflected, transmitted and total albedo against the walk's (importance transport: flux),
+//!   max and RMS over μ, α and η ∈ {1.33, 1.5, 2} seen from outside and from inside (1/η), and
+//!   the lobe-shape error over the whole sphere (η = 1.5, both sides);
 //! * the technique-choice table: per material and α, the albedo error (max over μo and RGB) and
 //!   the time per sample of single scattering, the compensated lobes, the walk and the
 //!   position-free PT and BDPT estimators (timed one technique at a time after the error runs,
@@ -28,8 +30,8 @@ use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::{RngExt, SeedableRng};
 use microsurface::{
     Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
-    Estimator, Ggx, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Shadowing, Technique, Transport,
-    UniformHeight,
+    Estimator, Ggx, KullaContyDielectric, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Shadowing,
+    Technique, Transport, UniformHeight,
 };
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -144,8 +146,61 @@ struct GlassCell {
     inside: bool,
     alpha: f32,
     mu: f32,
-    /// [walk, single, turquin], channels [R, T, R + T].
-    albedo: [Estimate; 3],
+    /// [walk, single, turquin, kulla-conty], channels [R, T, R + T].
+    albedo: [Estimate; 4],
+}
+
+/// The glass models: [walk, single, Turquin, Kulla–Conty with the walk's split], importance
+/// transport.
+fn glass_models(slope: Ggx, material: Dielectric) -> [Box<dyn Bsdf>; 4] {
+    let mf = MicrofacetBsdf::new(slope, material).unwrap().with_transport(Transport::Importance);
+    [
+        Box::new(mf.with_technique(Technique::RandomWalk)),
+        Box::new(mf.with_technique(Technique::SingleScattering)),
+        Box::new(CompensatedDielectric::new(slope, material).unwrap().with_transport(Transport::Importance)),
+        Box::new(KullaContyDielectric::new(slope, material).unwrap().with_transport(Transport::Importance)),
+    ]
+}
+
+/// The binned f·|cos θi| of glass over the whole sphere (2·LOBE_NZ × LOBE_NPHI equal-area
+/// cells, z ∈ [−1, 1]) of `n` samples, normalized by n.
+fn sphere_lobe(n: usize, mut draw: impl FnMut() -> Option<(Vec3, f32)>) -> Vec<f64> {
+    let nz = 2 * LOBE_NZ;
+    let mut h = vec![0.0; nz * LOBE_NPHI];
+    for _ in 0..n {
+        if let Some((w, weight)) = draw() {
+            let iz = (((w.z + 1.0) * 0.5 * nz as f32) as usize).min(nz - 1);
+            let phi = w.y.atan2(w.x).rem_euclid(core::f32::consts::TAU);
+            let ip = ((phi / core::f32::consts::TAU * LOBE_NPHI as f32) as usize).min(LOBE_NPHI - 1);
+            h[iz * LOBE_NPHI + ip] += f64::from(weight) / n as f64;
+        }
+    }
+    h
+}
+
+/// One glass lobe case (η = 1.5): L1 of [single, Turquin, Kulla–Conty] against the walk, and
+/// the walk-vs-walk floor.
+struct GlassLobeCell {
+    inside: bool,
+    alpha: f32,
+    theta: f32,
+    floor: f64,
+    errors: [f64; 3],
+}
+
+fn glass_lobe_cell(inside: bool, alpha: f32, theta: f32, n: usize, seed: u64) -> GlassLobeCell {
+    let models = glass_models(Ggx::isotropic(alpha).unwrap(), Dielectric::new(1.5).unwrap());
+    let wo = Vec3::new(theta.sin(), 0.0, if inside { -theta.cos() } else { theta.cos() });
+    let run = |m: usize, seed: u64| {
+        let mut rng = Pcg::seed_from_u64(seed);
+        sphere_lobe(n, || {
+            let (uc, u) = uniforms(&mut rng);
+            models[m].sample(wo, uc, u).map(|s| (s.wi, s.weight.x))
+        })
+    };
+    let (walk, walk_b) = (run(0, seed), run(0, seed + 1));
+    let errors = core::array::from_fn(|k| l1(&run(k + 1, seed + 2 + k as u64), &walk));
+    GlassLobeCell { inside, alpha, theta, floor: l1(&walk_b, &walk), errors }
 }
 
 fn glass_cell(eta: f32, inside: bool, alpha: f32, mu: f32, n: usize, seed: u64) -> GlassCell {
@@ -153,12 +208,7 @@ fn glass_cell(eta: f32, inside: bool, alpha: f32, mu: f32, n: usize, seed: u64) 
     let material = Dielectric::new(eta).unwrap();
     let s = (1.0 - mu * mu).max(0.0).sqrt();
     let wo = Vec3::new(s, 0.0, if inside { -mu } else { mu });
-    let mf = MicrofacetBsdf::new(slope, material).unwrap().with_transport(Transport::Importance);
-    let models: [Box<dyn Bsdf>; 3] = [
-        Box::new(mf.with_technique(Technique::RandomWalk)),
-        Box::new(mf.with_technique(Technique::SingleScattering)),
-        Box::new(CompensatedDielectric::new(slope, material).unwrap().with_transport(Transport::Importance)),
-    ];
+    let models = glass_models(slope, material);
     // one sample stream per model: channel 0 the reflected weight, 1 the transmitted, 2 both
     let albedo = core::array::from_fn(|m| {
         let mut rng = Pcg::seed_from_u64(seed + m as u64);
@@ -345,7 +395,7 @@ fn conductor_cost(c: Conductor, alpha: f32, mus: &[f32], n: usize) -> [f64; 7] {
 }
 
 /// ns per sample of [single, Turquin, walk] for glass η = 1.5 seen from outside.
-fn glass_cost(alpha: f32, mus: &[f32], n: usize) -> [f64; 3] {
+fn glass_cost(alpha: f32, mus: &[f32], n: usize) -> [f64; 4] {
     let slope = Ggx::isotropic(alpha).unwrap();
     let material = Dielectric::new(1.5).unwrap();
     let wos = views(mus, false);
@@ -359,6 +409,12 @@ fn glass_cost(alpha: f32, mus: &[f32], n: usize) -> [f64; 3] {
             30_021,
         ),
         time_samples(&mf.with_technique(Technique::RandomWalk), &wos, n / 10, 30_022),
+        time_samples(
+            &KullaContyDielectric::new(slope, material).unwrap().with_transport(Transport::Importance),
+            &wos,
+            n,
+            30_023,
+        ),
     ]
 }
 
@@ -427,10 +483,22 @@ fn main() -> std::io::Result<()> {
             }
         }
     }
-    eprintln!("glass albedo: {} cells × {} samples × 3 models", glass_jobs.len(), s.albedo_samples);
+    eprintln!("glass albedo: {} cells × {} samples × 4 models", glass_jobs.len(), s.albedo_samples);
     let glass = par_map(glass_jobs.len(), |i| {
         let (eta, inside, a, mu) = glass_jobs[i];
         glass_cell(eta, inside, a, mu, s.albedo_samples, 19_000 + 8 * i as u64)
+    });
+
+    let glass_lobe_jobs: Vec<(bool, f32, f32)> = [false, true]
+        .iter()
+        .flat_map(|&inside| {
+            [0.1f32, 0.3, 0.6, 1.0].iter().flat_map(move |&a| [0.0f32, 1.0, 1.4].map(|t| (inside, a, t)))
+        })
+        .collect();
+    eprintln!("glass lobes: {} cases × {} samples × 5 runs", glass_lobe_jobs.len(), s.lobe_samples);
+    let glass_lobes = par_map(glass_lobe_jobs.len(), |i| {
+        let (inside, a, t) = glass_lobe_jobs[i];
+        glass_lobe_cell(inside, a, t, s.lobe_samples, 21_000 + 8 * i as u64)
     });
 
     let dir = std::path::Path::new("target/compensation");
@@ -549,7 +617,7 @@ fn main() -> std::io::Result<()> {
     .unwrap();
     writeln!(md, "| technique | side | R: max | RMS | T: max | RMS | R + T: max | RMS |").unwrap();
     writeln!(md, "|---|---|---|---|---|---|---|---|").unwrap();
-    for (m, name) in [(1usize, "single"), (2, "turquin")] {
+    for (m, name) in [(1usize, "single"), (2, "Turquin"), (3, "Kulla–Conty (walk split)")] {
         for inside in [false, true] {
             write!(md, "| {name} | {} |", if inside { "inside" } else { "outside" }).unwrap();
             for part in 0..3 {
@@ -565,7 +633,33 @@ fn main() -> std::io::Result<()> {
             md.push('\n');
         }
     }
-    let mut csv = String::from("eta,side,alpha,mu,part,walk,walk_se,single,single_se,turquin,turquin_se\n");
+    writeln!(
+        md,
+        "\nGlass lobe shape against the walk (GGX, η = 1.5, importance transport; relative L1 of f·|cos θi| \
+         binned in {} × {LOBE_NPHI} equal-area cells of the sphere, {} samples per run; floor: two walk runs):\n",
+        2 * LOBE_NZ,
+        s.lobe_samples
+    )
+    .unwrap();
+    writeln!(md, "| side | α | θo | floor | single | Turquin | Kulla–Conty (walk split) |").unwrap();
+    writeln!(md, "|---|---|---|---|---|---|---|").unwrap();
+    for l in &glass_lobes {
+        writeln!(
+            md,
+            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} |",
+            if l.inside { "inside" } else { "outside" },
+            l.alpha,
+            l.theta,
+            l.floor,
+            l.errors[0],
+            l.errors[1],
+            l.errors[2]
+        )
+        .unwrap();
+    }
+    let mut csv = String::from(
+        "eta,side,alpha,mu,part,walk,walk_se,single,single_se,turquin,turquin_se,kulla_conty,kulla_conty_se\n",
+    );
     for c in &glass {
         for (part, pname) in ["R", "T", "total"].iter().enumerate() {
             write!(
@@ -577,7 +671,7 @@ fn main() -> std::io::Result<()> {
                 c.mu
             )
             .unwrap();
-            for m in 0..3 {
+            for m in 0..4 {
                 write!(csv, ",{:.6},{:.2e}", c.albedo[m].mean[part], c.albedo[m].se[part]).unwrap();
             }
             csv.push('\n');
@@ -596,7 +690,7 @@ fn main() -> std::io::Result<()> {
         .flat_map(|&(_, c)| s.alphas.iter().map(move |&a| (c, a)))
         .map(|(c, a)| conductor_cost(c, a, &s.mus, cost_samples))
         .collect();
-    let glass_costs: Vec<[f64; 3]> = s.alphas.iter().map(|&a| glass_cost(a, &s.mus, cost_samples)).collect();
+    let glass_costs: Vec<[f64; 4]> = s.alphas.iter().map(|&a| glass_cost(a, &s.mus, cost_samples)).collect();
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
 
     // the technique-choice table: per material and α, max over μo (and RGB) of |A − A_walk|,
@@ -608,7 +702,8 @@ fn main() -> std::io::Result<()> {
          (a tenth for walk, PT and BDPT) cycling over the μo, each technique timed alone after the error \
          runs; load average {}). The walk is the reference (error 0, its standard error is in the headers above); \
          PT and BDPT are the position-free model's estimators (Wang et al. 2022), a different model whose albedo \
-         differs from the walk's by the entry. Glass: total albedo, importance transport, η = 1.5 from outside.\n",
+         differs from the walk's by the entry. Glass: total albedo, importance transport, η = 1.5 from outside \
+         (Kulla–Conty: the walk-split KullaContyDielectric); then the larger error of R and T, views from both sides.\n",
         s.mus,
         load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
     )
@@ -652,12 +747,31 @@ fn main() -> std::io::Result<()> {
         };
         writeln!(
             md,
-            "| glass 1.5 | {a} | {:.4} | — | {:.4} | — | — | — | {:.0} | — | {:.0} | — | {:.0} | — | — |",
+            "| glass 1.5 | {a} | {:.4} | {:.4} | {:.4} | — | — | — | {:.0} | {:.0} | {:.0} | — | {:.0} | — | — |",
             err(1),
+            err(3),
             err(2),
             ns[0],
+            ns[3],
             ns[1],
             ns[2]
+        )
+        .unwrap();
+    }
+    // where the energy goes: the larger of the R and T errors, views from both sides
+    for &a in &s.alphas {
+        let row: Vec<&GlassCell> = glass.iter().filter(|c| c.eta == 1.5 && c.alpha == a).collect();
+        let err = |m: usize| {
+            row.iter()
+                .flat_map(|c| (0..2).map(move |p| (c.albedo[m].mean[p] - c.albedo[0].mean[p]).abs()))
+                .fold(0.0f64, f64::max)
+        };
+        writeln!(
+            md,
+            "| glass 1.5, R and T, both sides | {a} | {:.4} | {:.4} | {:.4} | — | — | — | | | | | | | |",
+            err(1),
+            err(3),
+            err(2)
         )
         .unwrap();
     }

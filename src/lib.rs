@@ -137,16 +137,17 @@ mod vector;
 mod vndf;
 
 pub use albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable, EtaRange,
-    LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, ORDER_TABLE_MAX_STANDARD_ERROR,
-    ORDER_TABLES, ScatteringOrderTable, TabulatedOrder,
+    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
+    DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
+    MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable,
+    TabulatedOrder, WALK_BATCH,
 };
 pub use basis::orthonormal_basis;
 pub use bsdf::{
     AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf,
-    NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SMOOTH_ALPHA, SampleFlags, ShadingFrame,
-    SpecularEvent, SpecularLimit, Technique, Transport,
+    CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, KullaContyDielectric,
+    MAX_WALK_ALPHA, MicrofacetBsdf, NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SMOOTH_ALPHA,
+    SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport, WalkTabulated,
 };
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;

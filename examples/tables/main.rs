@@ -1,10 +1,12 @@
-//! Generates the crate's single-scattering albedo tables (`src/albedo/data.rs`: conductor E and
-//! E_avg; `src/albedo/dielectric_data.rs`: dielectric R and T) by deterministic quadrature, on
-//! all cores, and exports them for shaders.
+//! Generates the crate's albedo tables, on all cores, and exports them for shaders: the
+//! single-scattering tables by deterministic quadrature (`src/albedo/data.rs`: conductor E and
+//! E_avg; `src/albedo/dielectric_data.rs`: dielectric R and T) and the random walk's tables by
+//! seeded Monte Carlo (`src/albedo/orders_data.rs`: the conductor's energy per order;
+//! `src/albedo/dielectric_walk_data.rs`: the dielectric's higher orders ΔR, ΔT).
 //!
 //! ```sh
 //! cargo run --release --example tables            # rebuild both and target/tables/
-//! cargo run --release --example tables -- --only dielectric   # or conductor
+//! cargo run --release --example tables -- --only dielectric   # or conductor, orders, walk-dielectric
 //! cargo run --release --example tables -- --quick # recompute a subset, check it against the shipped tables
 //! ```
 //!
@@ -17,6 +19,7 @@
 mod dielectric;
 mod orders;
 mod quadrature;
+mod walk_dielectric;
 
 use dielectric::dielectric_albedo;
 use quadrature::{Family, gauss_legendre, single_scattering_albedo};
@@ -483,8 +486,36 @@ fn quick() {
         failures += 1;
         println!("{} is not the generator's text for its own nodes", path.display());
     }
+    // the walk tables: a few cells recomputed with another seed, within the combined SE
+    let walk_table = |family: Family| match family {
+        Family::Ggx => microsurface::DielectricWalkTable::GGX,
+        Family::Beckmann => microsurface::DielectricWalkTable::BECKMANN,
+    };
+    let shipped_cell = |family: Family, side: Side, k: usize| {
+        let t = walk_table(family);
+        let (r, tr) = t.nodes(range_of(side));
+        walk_dielectric::Cell {
+            reflected: f64::from(r[k]),
+            transmitted: f64::from(tr[k]),
+            walks: t.walks(range_of(side), k).expect("node index"),
+        }
+    };
+    failures += walk_dielectric::quick(&shipped_cell);
+    let mut shipped = Vec::new();
+    for family in [Family::Ggx, Family::Beckmann] {
+        for side in [Side::Outside, Side::Inside] {
+            let cells = (0..walk_dielectric::NODES).map(|k| shipped_cell(family, side, k)).collect();
+            shipped.push((family, side, cells));
+        }
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/albedo/dielectric_walk_data.rs");
+    if std::fs::read_to_string(&path).ok().as_deref() != Some(walk_dielectric::source(&shipped).as_str()) {
+        failures += 1;
+        println!("{} is not the generator's text for its own nodes", path.display());
+    }
     println!(
-        "tables --quick: {} nodes recomputed (and {dielectric_nodes} dielectric R, T pairs), {failures} differ",
+        "tables --quick: {} nodes recomputed (and {dielectric_nodes} dielectric R, T pairs, walk cells within \
+         their combined SE), {failures} differ",
         2 * (QUICK_CELLS + 1)
     );
     let failures = failures + orders::quick();
@@ -495,11 +526,13 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {
         println!(
-            "usage: cargo run --release --example tables [-- --quick | --interpolation] [--only conductor|dielectric|orders]\n\n  \
+            "usage: cargo run --release --example tables [-- --quick | --interpolation] [--only conductor|dielectric|orders|walk-dielectric]\n\n  \
              (no flag)        rebuild src/albedo/data.rs, src/albedo/dielectric_data.rs and target/tables/*.f32,\n                   \
              print the quadrature error estimates\n  --interpolation  measure the lookups' interpolation error against \
              quadrature\n  --quick          recompute a subset of nodes and check them against the shipped tables bit for \
-             bit\n  --only X         rebuild (or measure) only the conductor (E, E_avg) or only the dielectric tables,\n                   or only the walk's per-order energies"
+             bit\n  --only X         rebuild (or measure) only the conductor (E, E_avg) or only the dielectric tables,\n                   \
+             or only the walk's per-order energies (orders: src/albedo/orders_data.rs), or only the walk's higher orders\n                   \
+             of dielectrics, ΔR and ΔT (walk-dielectric: src/albedo/dielectric_walk_data.rs)"
         );
         return;
     }
@@ -507,6 +540,11 @@ fn main() {
     let (conductor, dielectric) =
         (only.is_none() || only == Some("conductor"), only.is_none() || only == Some("dielectric"));
     let per_order = only.is_none() || only == Some("orders"); // the walk's per-order energies (orders.rs)
+    let walk = only.is_none() || only == Some("walk-dielectric");
+    if std::env::var_os("TABLES_WALK_PROBE").is_some() {
+        walk_dielectric::probe();
+        return;
+    }
     if args.iter().any(|a| a == "--quick") {
         quick();
         return;
@@ -558,6 +596,21 @@ fn main() {
         }
         changed |= write_if_changed(&root.join("src/albedo/dielectric_data.rs"), &dielectric_source(&tables));
         dielectric_export(&tables, &root.join("target/tables")).expect("write target/tables");
+    }
+    if walk {
+        let mut tables = Vec::new();
+        for family in [Family::Ggx, Family::Beckmann] {
+            for side in [Side::Outside, Side::Inside] {
+                let t0 = std::time::Instant::now();
+                tables.push((family, side, walk_dielectric::build(family, side)));
+                println!("  {:.1} s", t0.elapsed().as_secs_f64());
+            }
+        }
+        changed |= write_if_changed(
+            &root.join("src/albedo/dielectric_walk_data.rs"),
+            &walk_dielectric::source(&tables),
+        );
+        walk_dielectric::export(&tables, &root.join("target/tables")).expect("write target/tables");
     }
     println!(
         "done in {:.1} s ({} CPU threads)",

@@ -1,0 +1,456 @@
+//! Energy-compensated dielectrics with the random walk's split between reflection and
+//! transmission: the single-scattering microfacet BSDF plus separable (rank-1) lobes of the
+//! higher orders' reflected and transmitted energy, from the walk's tables
+//! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
+
+use super::compensated::AlbedoTabulated;
+use super::lobe_profile::{LobeProfile, PROFILE_NODES, profile_cell, profile_cells, row_at};
+use super::microfacet::{MicrofacetBsdf, Technique};
+use super::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
+};
+use crate::albedo::{DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
+use crate::error::Error;
+use crate::material::{Dielectric, Side};
+use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+use core::f64::consts::PI;
+use glam::{Vec2, Vec3};
+
+/// The cells (index, fraction) of the view's and the light's cosine on the direction axis.
+type Cells = ((usize, f32), (usize, f32));
+
+/// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
+const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A slope family with the random walk's dielectric tables: the families a
+/// [`KullaContyDielectric`] can be built on.
+pub trait WalkTabulated: AlbedoTabulated {
+    /// The family's higher-order dielectric tables.
+    const DIELECTRIC_WALK: DielectricWalkTable;
+}
+
+impl WalkTabulated for Ggx {
+    const DIELECTRIC_WALK: DielectricWalkTable = DielectricWalkTable::GGX;
+}
+
+impl WalkTabulated for Beckmann {
+    const DIELECTRIC_WALK: DielectricWalkTable = DielectricWalkTable::BECKMANN;
+}
+
+/// The rows and samplers of one side of the interface (the side of the view).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SideLobes {
+    /// The sampling mixture's probabilities of the single-scattering lobe and of the reflection
+    /// lobe at the direction nodes: E_ss, ΔR over E_ss + ΔR + c ΔT (E_ss = R_ss + T_ss); the
+    /// transmission lobe has the rest.
+    mixture: [[f32; 2]; PROFILE_NODES],
+    /// ΔR at the direction nodes.
+    reflected: [f32; PROFILE_NODES],
+    /// ΔT at the direction nodes, times this side's reciprocity factor c.
+    transmitted: [f32; PROFILE_NODES],
+    /// 1/(π ΔR̄) (0 without a lobe).
+    reflected_scale: f32,
+    /// 1/(π ΔT̄′) of the *other* side's scaled ΔT′ (0 without a lobe): the normalization of
+    /// the transmission from this side.
+    transmitted_scale: f32,
+    /// The radiance factor (η_wo/η_wi)² of a transmission from this side, or 1 (importance).
+    transmitted_transport: f32,
+    /// The sampler of ΔR(μ) μ on this side.
+    reflected_profile: LobeProfile,
+    /// The sampler of ΔT(μ) μ on this side (used for light arriving from the other side).
+    transmitted_profile: LobeProfile,
+}
+
+/// A dielectric microfacet BSDF compensated with the random walk's higher orders, reflection
+/// and transmission apart: the exact single-scattering BSDF of [`MicrofacetBsdf`]
+/// (height-correlated Smith, dielectric Fresnel, [`Technique::SingleScattering`]) plus two
+/// separable lobes,
+///
+/// f = f_ss + f_R + f_T,
+/// f_R(ωo, ωi) = ΔR_a(μo) ΔR_a(μi) / (π ΔR̄_a)                (ωi on the view's side a),
+/// f_T(ωo, ωi) = c_a ΔT_a(μo) · c_b ΔT_b(μi) / (π c_b ΔT̄_b)   (ωi on the other side b),
+///
+/// with ΔR_s, ΔT_s the walk's reflected and transmitted energy of orders ≥ 2 for light from
+/// side s ([`DielectricWalkTable`]: the walk of Heitz et al. 2016, supplement §3.4),
+/// ḡ = 2∫₀¹ g(μ) μ dμ, and μ = |cos θ|. The additive separable form is Kulla and Conty's
+/// (2017, *Revisiting Physically Based Shading at Imageworks*, the multiple-scattering lobe
+/// (1 − E(μo))(1 − E(μi))/(π(1 − E_avg))), applied to each side's reflected and transmitted
+/// higher orders instead of the conductor's 1 − E.
+///
+/// **Energy** (importance transport, the flux): ∫ f_R cos dωi = ΔR_a(μo) and
+/// ∫ f_T |cos| dωi = c_a ΔT_a(μo) for every view, so the albedo is
+/// R_ss + T_ss + ΔR + c_a ΔT = 1 up to the tables' errors and the factor c_a, with the walk's
+/// split between reflection and transmission.
+///
+/// **Reciprocity.** Detailed balance in a medium of index n (equilibrium radiance ∝ n²) makes
+/// the flux BSDF of a transmission satisfy n_a² f(ωa, ωb) = n_b² f(ωb, ωa) (Veach 1997, §5.2,
+/// in importance form). The rank-1 f_T satisfies it if and only if n_a² c_a ΔT̄_a =
+/// n_b² c_b ΔT̄_b, which the walk's own higher orders satisfy (they are the difference of two
+/// reciprocal BSDFs) up to the tables' noise and interpolation. The factors c enforce it
+/// exactly: with L = ln(η² ΔT̄_in/ΔT̄_out) (η = n_in/n_out), ln c_out = w L and
+/// ln c_in = −(1 − w) L, where w = v_out/(v_out + v_in) is the share of the relative variance
+/// v = Var(ΔT̄)/ΔT̄² of the outside average (from the nodes' standard errors through the
+/// blend and the linear average): the noisier side absorbs more of the residual, and equal
+/// noise splits it evenly (c_out = 1/c_in = √(η² ΔT̄_in/ΔT̄_out)).
+/// [`Self::transmission_mismatch`] reports ΔT̄_out/(η² ΔT̄_in) − 1, and the albedo from side a
+/// errs by (c_a − 1) ΔT_a(μo) for it. Without transmitted higher orders on either side
+/// (an average of 0) there is no transmission lobe.
+/// f_R is symmetric.
+///
+/// **Sampling.** A mixture chosen by the view's energies: at every direction node the
+/// probabilities of the single-scattering sample, the reflection lobe and the transmission
+/// lobe are E_ss : ΔR_a : c_a ΔT_a (E_ss = R_ss + T_ss from [`crate::DielectricAlbedoTable`]),
+/// normalized at construction and interpolated linearly in x at μo (no division at run time);
+/// each lobe samples its profile g(μi) μi per cell of the direction axis (a cell by its mass,
+/// μi² uniform in it, φ uniform) on its hemisphere. `pdf` is the exact mixture density, and a
+/// sample's weight is f·|cos θi|/pdf at its direction, with f and pdf computed as `eval` and
+/// `pdf` compute them (both cosines located on the axis with one shared division; the lobe is
+/// chosen with μo located alone, a few ulps of a cell fraction apart, which changes a lobe
+/// probability by a relative ~1e-7).
+///
+/// **Tables.** Both families' tables at α = √(αx αy), blended in (α, η) once at
+/// construction (both sides read the same (r, u) coordinate), the direction axis
+/// x = √(μ (1 + α)/(μ + α)) interpolated linearly at run time; ΔR̄ and ΔT̄ are the exact
+/// averages of the interpolated rows (closed form per cell).
+///
+/// **Transport.** [`Transport::Radiance`] (the default) multiplies transmissions by
+/// (η_wo/η_wi)², as the single-scattering BSDF does; [`Transport::Importance`] is the flux
+/// BSDF above.
+///
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness below
+/// [`super::SMOOTH_ALPHA`]) and η = 1 are the Dirac lobes of the single-scattering BSDF,
+/// uncompensated. A view or light on the horizon has no added lobe.
+///
+/// # Examples
+/// ```
+/// use microsurface::glam::{Vec2, Vec3};
+/// use microsurface::{Bsdf, Dielectric, Ggx, KullaContyDielectric, Transport};
+///
+/// let glass = KullaContyDielectric::new(Ggx::isotropic(0.5)?, Dielectric::new(1.5)?)?
+///     .with_transport(Transport::Importance);
+/// let wo = Vec3::new(0.6, 0.0, 0.8);
+/// let s = glass.sample(wo, 0.7, Vec2::new(0.4, 0.2)).expect("glass scatters");
+/// let (f, pdf) = glass.eval_with_pdf(wo, s.wi);
+/// assert!((pdf - s.pdf).abs() <= 1e-5 * pdf);
+/// assert!((s.weight - f.f * s.wi.z.abs() / pdf).abs().max_element() <= 1e-4 * s.weight.max_element());
+/// // reciprocal across the interface: f(out → in) = η² f(in → out) for the flux
+/// let wi = Vec3::new(-0.3, 0.0, -(1.0f32 - 0.09).sqrt());
+/// let (a, b) = (glass.eval(wo, wi).f.x, glass.eval(wi, wo).f.x);
+/// assert!((a - 1.5 * 1.5 * b).abs() <= 1e-4 * a);
+/// // beyond the tables
+/// assert!(KullaContyDielectric::new(Ggx::isotropic(0.5)?, Dielectric::new(4.0)?).is_err());
+/// # Ok::<(), microsurface::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KullaContyDielectric<S> {
+    single: MicrofacetBsdf<S, Dielectric>,
+    transport: Transport,
+    /// The tables' roughness √(αx αy).
+    alpha: f32,
+    /// η_wi/η_wo of a transmission from outside (η) and from inside (1/η).
+    transmitted_eta: [f32; 2],
+    /// The view's side: outside (0), inside (1).
+    sides: [SideLobes; 2],
+    /// ΔT̄_out/(η² ΔT̄_in) − 1 of the interpolated tables (0 without transmission lobes).
+    mismatch: f32,
+}
+
+impl<S: WalkTabulated> KullaContyDielectric<S> {
+    /// The compensated BSDF of a dielectric interface on the given slopes (radiance
+    /// transport).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`] (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`], [`MAX_TABULATED_ETA`]] = [1/3, 3]
+    /// (`"eta"`): the tables' range.
+    pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
+        let alpha = slope.albedo_alpha();
+        if alpha > MAX_TABULATED_ALPHA {
+            return Err(Error::InvalidParameter {
+                name: "alpha",
+                value: alpha,
+                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the walk tables' range",
+            });
+        }
+        let eta = dielectric.eta();
+        let eta_error = |value| Error::InvalidParameter {
+            name: "eta",
+            value,
+            expected: "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric walk tables' range",
+        };
+        if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) {
+            return Err(eta_error(eta));
+        }
+        let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
+        let empty = SideLobes {
+            mixture: [[1.0, 0.0]; PROFILE_NODES],
+            reflected: [0.0; PROFILE_NODES],
+            transmitted: [0.0; PROFILE_NODES],
+            reflected_scale: 0.0,
+            transmitted_scale: 0.0,
+            transmitted_transport: 1.0,
+            reflected_profile: LobeProfile::EMPTY,
+            transmitted_profile: LobeProfile::EMPTY,
+        };
+        let mut b = Self {
+            single,
+            transport: Transport::Radiance,
+            alpha,
+            transmitted_eta: [eta, 1.0 / eta],
+            sides: [empty; 2],
+            mismatch: 0.0,
+        };
+        // a Dirac lobe is not compensated (and √(αx αy) may underflow to 0 there)
+        if single.is_specular() {
+            return Ok(b);
+        }
+        let mut averages = [0.0f64; 2];
+        let mut variances = [0.0f64; 2];
+        let mut single = [[0.0f32; PROFILE_NODES]; 2];
+        // the averages are linear in the nodes: their weights, from the unit rows
+        let node_weights: [f64; PROFILE_NODES] = core::array::from_fn(|i| {
+            let mut unit = [0.0; PROFILE_NODES];
+            unit[i] = 1.0;
+            LobeProfile::new(&unit, alpha).0
+        });
+        for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
+            let (r, t) = S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(eta_error(seen))?;
+            let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
+            let side = &mut b.sides[s];
+            for (e, (r, t)) in single[s].iter_mut().zip(r.into_iter().zip(t)) {
+                *e = r + t;
+            }
+            side.reflected = dr;
+            side.transmitted = dt;
+            let (r_avg, r_profile) = LobeProfile::new(&dr, alpha);
+            let (t_avg, t_profile) = LobeProfile::new(&dt, alpha);
+            side.reflected_scale = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
+            side.reflected_profile = r_profile;
+            side.transmitted_profile = t_profile;
+            averages[s] = t_avg;
+            let var = S::DIELECTRIC_WALK.transmitted_row_variance(alpha, seen).ok_or(eta_error(seen))?;
+            variances[s] = node_weights.iter().zip(var).map(|(w, v)| w * w * f64::from(v)).sum();
+        }
+        // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in; the log-ratio L = ln(η² ΔT̄_in/ΔT̄_out) is
+        // split by the averages' relative variances (ln c_out = w L, ln c_in = −(1 − w) L)
+        let eta_sq = f64::from(eta) * f64::from(eta);
+        let (m_out, m_in) = (averages[0], eta_sq * averages[1]);
+        let c = if m_out > 0.0 && m_in > 0.0 {
+            let log_ratio = (m_in / m_out).ln();
+            let (v_out, v_in) =
+                (variances[0] / (averages[0] * averages[0]), variances[1] / (averages[1] * averages[1]));
+            let w = if v_out + v_in > 0.0 { v_out / (v_out + v_in) } else { 0.5 };
+            b.mismatch = (m_out / m_in - 1.0) as f32;
+            [(w * log_ratio).exp(), (-(1.0 - w) * log_ratio).exp()]
+        } else {
+            [0.0, 0.0]
+        };
+        for s in 0..2 {
+            for v in &mut b.sides[s].transmitted {
+                *v = (f64::from(*v) * c[s]) as f32;
+            }
+            // the transmission from side s is normalized by the other side's scaled average
+            let other = c[1 - s] * averages[1 - s];
+            b.sides[s].transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
+            let side = &mut b.sides[s];
+            for (i, m) in side.mixture.iter_mut().enumerate() {
+                let w =
+                    [f64::from(single[s][i]), f64::from(side.reflected[i]), f64::from(side.transmitted[i])];
+                let total = w[0] + w[1] + w[2];
+                *m = if total > 0.0 { [(w[0] / total) as f32, (w[1] / total) as f32] } else { [1.0, 0.0] };
+            }
+        }
+        Ok(b.with_transport(Transport::Radiance))
+    }
+}
+
+impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
+    /// The same BSDF with the given transport mode.
+    #[must_use]
+    pub fn with_transport(self, transport: Transport) -> Self {
+        let mut b = Self { single: self.single.with_transport(transport), transport, ..self };
+        let eta = b.transmitted_eta[0];
+        // (η_wo/η_wi)² of a transmission: from outside 1/η², from inside η²
+        let radiance = [1.0 / (eta * eta), eta * eta];
+        for (side, r) in b.sides.iter_mut().zip(radiance) {
+            side.transmitted_transport = match transport {
+                Transport::Radiance => r,
+                Transport::Importance => 1.0,
+            };
+        }
+        b
+    }
+
+    /// The uncompensated single-scattering BSDF of the same material.
+    pub fn single_scattering(&self) -> &MicrofacetBsdf<S, Dielectric> {
+        &self.single
+    }
+
+    /// The roughness the tables are read at, √(αx αy).
+    pub fn table_alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// ΔT̄_out/(η² ΔT̄_in) − 1: how far the interpolated tables are from the reciprocity of the
+    /// walk's higher orders (0 when there is no transmission lobe). The lobes are made
+    /// reciprocal by splitting it evenly between the sides (see the type's documentation).
+    pub fn transmission_mismatch(&self) -> f32 {
+        self.mismatch
+    }
+
+    /// The added albedo (ΔR, c ΔT) of a view with |cos θo| = μ ∈ [0, 1] on `side`, as this
+    /// BSDF interpolates it (importance transport); `None` outside [0, 1] (NaN included).
+    pub fn higher_orders(&self, mu: f32, side: Side) -> Option<(f32, f32)> {
+        if !(0.0..=1.0).contains(&mu) {
+            return None;
+        }
+        let s = &self.sides[side_index(side)];
+        let cell = profile_cell(mu, self.alpha);
+        Some((row_at(&s.reflected, cell), row_at(&s.transmitted, cell)))
+    }
+
+    /// The added lobe f_R or f_T at (wo, wi), both off the horizon, from their cells.
+    #[inline(always)]
+    fn added(&self, a: &SideLobes, cells: Cells, wo: Vec3, wi: Vec3) -> Vec3 {
+        let (cell_o, cell_i) = cells;
+        let f = if (wi.z > 0.0) == (wo.z > 0.0) {
+            row_at(&a.reflected, cell_o) * row_at(&a.reflected, cell_i) * a.reflected_scale
+        } else {
+            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
+            row_at(&a.transmitted, cell_o)
+                * row_at(&b.transmitted, cell_i)
+                * (a.transmitted_scale * a.transmitted_transport)
+        };
+        Vec3::splat(f)
+    }
+
+    /// The mixture's lobe probabilities (single, reflection, transmission) for the view's cell:
+    /// the normalized node probabilities interpolated (no division at run time), the third
+    /// the complement of the first two.
+    #[inline(always)]
+    fn probabilities(a: &SideLobes, (i, f): (usize, f32)) -> [f32; 3] {
+        let (lo, hi) = (a.mixture[i], a.mixture[i + 1]);
+        let p0 = lo[0] + f * (hi[0] - lo[0]);
+        let p1 = lo[1] + f * (hi[1] - lo[1]);
+        [p0, p1, (1.0 - p0 - p1).max(0.0)]
+    }
+
+    /// The mixture density at wi (off the horizon, in cell `cell_i`) for the view's
+    /// probabilities.
+    #[inline(always)]
+    fn mixture_pdf(&self, a: &SideLobes, p: [f32; 3], cell_i: usize, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        let mu_i = wi.z.abs();
+        let lobe = if (wi.z > 0.0) == (wo.z > 0.0) {
+            p[1] * a.reflected_profile.pdf(cell_i, mu_i)
+        } else {
+            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
+            p[2] * b.transmitted_profile.pdf(cell_i, mu_i)
+        };
+        p[0] * pdf_ss + lobe
+    }
+
+    /// The view's side and the cells of both directions.
+    #[inline(always)]
+    fn side_and_cells(&self, wo: Vec3, wi: Vec3) -> (&SideLobes, Cells) {
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        (a, profile_cells(wo.z.abs(), wi.z.abs(), self.alpha))
+    }
+
+    /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
+    /// horizon.
+    #[inline(always)]
+    fn compensates(&self, wo: Vec3, wi: Vec3) -> bool {
+        !self.single.is_specular() && valid_direction(wo) && valid_direction(wi) && wo.z != 0.0 && wi.z != 0.0
+    }
+
+    /// A sample from f·|cos θi| and the density at wi, `None` unless both are usable (the
+    /// filter of the single-scattering sampler).
+    #[inline(always)]
+    fn finish(&self, wo: Vec3, wi: Vec3, f_cos: Vec3, pdf: f32) -> Option<BsdfSample> {
+        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite()) || wi.z == 0.0 {
+            return None;
+        }
+        let weight = f_cos / pdf;
+        if !weight.is_finite() || f_cos.max_element() < f32::MIN_POSITIVE * wi.z.abs() {
+            return None;
+        }
+        let reflection = (wi.z > 0.0) == (wo.z > 0.0);
+        let eta =
+            if reflection { 1.0 } else { self.transmitted_eta[side_index(Side::above_or_inside(wo.z))] };
+        let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf: true };
+        Some(BsdfSample { wi, weight, pdf, eta, flags })
+    }
+}
+
+/// The index of a side in [`KullaContyDielectric::sides`].
+#[inline(always)]
+fn side_index(side: Side) -> usize {
+    match side {
+        Side::Outside => 0,
+        Side::Inside => 1,
+    }
+}
+
+impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
+    #[inline]
+    fn flags(&self) -> BsdfFlags {
+        self.single.flags()
+    }
+
+    #[inline]
+    fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
+        let v = self.single.eval_keyed(wo, wi, key);
+        if !self.compensates(wo, wi) {
+            return v;
+        }
+        let (a, cells) = self.side_and_cells(wo, wi);
+        BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }
+    }
+
+    #[inline]
+    fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z == 0.0 {
+            return self.single.sample_keyed(wo, uc, u, key);
+        }
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        let cell_o = profile_cell(wo.z.abs(), self.alpha);
+        let p = Self::probabilities(a, cell_o);
+        let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
+        let wi = if uc < p[0] {
+            let s = self.single.sample_keyed(wo, (uc / p[0]).min(ONE_MINUS_ULP), u, key)?;
+            // f and the density as eval and pdf compute them (the cells located together)
+            let (_, cells) = self.side_and_cells(wo, s.wi);
+            let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, s.wi, s.pdf);
+            let f_cos = s.weight * s.pdf + self.added(a, cells, wo, s.wi) * s.wi.z.abs();
+            return self.finish(wo, s.wi, f_cos, pdf);
+        } else if uc < p[0] + p[1] {
+            flip(a.reflected_profile.sample(u)?)
+        } else {
+            let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
+            -flip(b.transmitted_profile.sample(u)?)
+        };
+        let (v, pdf) = self.eval_with_pdf_keyed(wo, wi, key);
+        self.finish(wo, wi, v.f * wi.z.abs(), pdf)
+    }
+
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let pdf_ss = self.single.pdf(wo, wi);
+        if !self.compensates(wo, wi) {
+            return pdf_ss;
+        }
+        let (a, (cell_o, cell_i)) = self.side_and_cells(wo, wi);
+        self.mixture_pdf(a, Self::probabilities(a, cell_o), cell_i.0, wo, wi, pdf_ss)
+    }
+
+    #[inline]
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
+        if !self.compensates(wo, wi) {
+            return (v, pdf_ss);
+        }
+        let (a, cells) = self.side_and_cells(wo, wi);
+        let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, wi, pdf_ss);
+        (BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }, pdf)
+    }
+}

@@ -615,11 +615,14 @@ fn measurement_point(k: usize, side: Side, uniform: bool) -> (f64, f64, f64) {
     (mu, alpha, if side == Side::Outside { eta } else { 1.0 / eta })
 }
 
+/// A measurement point (μ, α, η seen) and its cell (index, fraction) on each axis.
+type Located = ((f64, f64, f64), [(usize, f64); 3]);
+
 /// `--design`: the interpolation error of a table design (axes) at `points` measurement points,
 /// computing only the nodes at the corners of the points' cells: (max, RMS) of R, T, R + T.
 fn design_error(family: Family, side: Side, axes: Axes, points: usize, uniform: bool) -> [(f64, f64); 3] {
     let last = axes.nodes - 1;
-    let located: Vec<((f64, f64, f64), [(usize, f64); 3])> = (0..points)
+    let located: Vec<Located> = (0..points)
         .map(|k| {
             let p = measurement_point(k, side, uniform);
             let at = axes.coordinates(p.0, p.1, p.2);

@@ -348,30 +348,72 @@ fn out_of_range_gives_none() {
 // ---------------------------------------------------------------------------------------------
 
 /// The measured interpolation errors of R + T of the dielectric lookups (max over 256 random
-/// points against quadrature, `examples/tables --interpolation`; large: `DESIGN.md`), per
-/// family (GGX, Beckmann) and side (outside, inside).
+/// points against quadrature, `examples/tables --interpolation`; `DESIGN.md`), per family
+/// (GGX, Beckmann) and side (outside, inside).
 const STATED_DIELECTRIC_ERROR: [[f64; 2]; 2] = [
     [DIELECTRIC_ERROR_GGX_OUT, DIELECTRIC_ERROR_GGX_IN],
     [DIELECTRIC_ERROR_BECKMANN_OUT, DIELECTRIC_ERROR_BECKMANN_IN],
 ];
-const DIELECTRIC_ERROR_GGX_OUT: f64 = 3.26e-1;
-const DIELECTRIC_ERROR_GGX_IN: f64 = 7.63e-2;
-const DIELECTRIC_ERROR_BECKMANN_OUT: f64 = 5.46e-1;
-const DIELECTRIC_ERROR_BECKMANN_IN: f64 = 1.04e-1;
+const DIELECTRIC_ERROR_GGX_OUT: f64 = 4.80e-2;
+const DIELECTRIC_ERROR_GGX_IN: f64 = 6.17e-2;
+const DIELECTRIC_ERROR_BECKMANN_OUT: f64 = 7.50e-2;
+const DIELECTRIC_ERROR_BECKMANN_IN: f64 = 1.30e-1;
 
 fn dielectric_table(family: usize) -> DielectricAlbedoTable {
     [DielectricAlbedoTable::GGX, DielectricAlbedoTable::BECKMANN][family]
 }
 
-/// (μ, α, η ≥ 1) of dielectric node (i, j, l), as the table's documentation defines the axes.
-fn dielectric_node_coordinates(i: usize, j: usize, l: usize) -> (f32, f32, f32) {
+/// The floor of the dielectric tables' log/√ blend axis.
+const BLEND_FLOOR: f64 = 1e-6;
+
+/// The dielectric tables' blend B(v) = ½ ln(v/vf)/ln(1/vf) + ½ (√v − √vf)/(1 − √vf).
+fn blend(v: f64) -> f64 {
+    let v = v.max(BLEND_FLOOR);
+    0.5 * (v / BLEND_FLOOR).ln() / (1.0 / BLEND_FLOOR).ln()
+        + 0.5 * (v.sqrt() - BLEND_FLOOR.sqrt()) / (1.0 - BLEND_FLOOR.sqrt())
+}
+
+/// The lower part of the inside direction axis, ½ B(t) + ½ (1 − √(1 − t)).
+fn knee_blend(t: f64) -> f64 {
+    0.5 * blend(t) + 0.5 * (1.0 - (1.0 - t).max(0.0).sqrt())
+}
+
+/// The v ∈ [vf, 1] at which the increasing `f` reaches b ∈ [0, 1] (bisection in ln v).
+fn inverse(f: fn(f64) -> f64, b: f64) -> f64 {
+    let (mut lo, mut hi) = (BLEND_FLOOR.ln(), 0.0f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid.exp()) < b {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (0.5 * (lo + hi)).exp()
+}
+
+/// (μ, α, η ≥ 1) of dielectric node (i, j, l) of the table of light from outside or `inside`,
+/// as the table's documentation defines the axes: x = i/15, r = j/15, u = l/15; α = B⁻¹(r),
+/// η = 1 + 2u³; μ = B⁻¹(x) from outside, and from inside (critical cosine μc = √(1 − 1/η²))
+/// μ = μc K⁻¹(x/k) below the knee k = 7/15, μ = μc + (1 − μc) ((x − k)/(1 − k))² above it.
+fn dielectric_node_coordinates(i: usize, j: usize, l: usize, inside: bool) -> (f32, f32, f32) {
     let last = (DIELECTRIC_TABLE_SIZE - 1) as f64;
-    let r = j as f64 / last;
-    let alpha = (r * r).max(f64::from(ALPHA_LIMIT));
-    let big_x = (i as f64 / last).powi(2);
-    let mu = if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
-    let u = l as f64 / last;
-    (mu as f32, alpha as f32, (1.0 + 2.0 * u * u) as f32)
+    let (x, r, u) = (i as f64 / last, j as f64 / last, l as f64 / last);
+    let alpha = inverse(blend, r);
+    let eta = 1.0 + 2.0 * u.powi(3);
+    let mu = if inside {
+        let mu_c = (1.0 - 1.0 / (eta * eta)).max(0.0).sqrt();
+        let knee = 7.0 / last;
+        if x <= knee {
+            mu_c * inverse(knee_blend, x / knee)
+        } else {
+            let s = (x - knee) / (1.0 - knee);
+            mu_c + (1.0 - mu_c) * s * s
+        }
+    } else {
+        inverse(blend, x)
+    };
+    (mu.min(1.0) as f32, alpha as f32, eta as f32)
 }
 
 /// Monte Carlo R and T of the crate's single-scattering dielectric BSDF (importance transport:
@@ -421,9 +463,10 @@ fn dielectric_albedo_mc(family: usize, mu: f32, alpha: f32, eta_seen: f32, seed:
 
 #[test]
 fn dielectric_nodes_match_the_single_scattering_bsdf() {
-    // nodes with μ > 0 (the BSDF has no lobe on the horizon), α ≥ 1e-3 (below, the BSDF's
-    // f32 directions cannot resolve the lobe) and η > 1 (the row η = 1 holds the limit η → 1
-    // of the rough lobe, while the BSDF at η = 1 exactly is the transparent Dirac), both sides
+    // nodes with μ > 0 (the BSDF has no lobe on the horizon), α ≥ 1e-3 (j ≥ 4; below, the
+    // BSDF's f32 directions cannot resolve the lobe) and η > 1 (the row η = 1 holds the limit
+    // η → 1 of the rough lobe, while the BSDF at η = 1 exactly is the transparent Dirac), both
+    // sides
     let mut pick = rng(21);
     let cells: Vec<(usize, bool, usize, usize, usize)> = (0..24)
         .map(|k| {
@@ -431,19 +474,19 @@ fn dielectric_nodes_match_the_single_scattering_bsdf() {
                 k % 2,
                 (k / 2) % 2 == 1,
                 pick.random_range(1..DIELECTRIC_TABLE_SIZE),
-                pick.random_range(1..DIELECTRIC_TABLE_SIZE),
+                pick.random_range(4..DIELECTRIC_TABLE_SIZE),
                 pick.random_range(1..DIELECTRIC_TABLE_SIZE),
             )
         })
         .collect();
     let z = family_z(FAMILY_ALPHA, 2 * cells.len());
     let results = par_map(&cells, |k, &(family, inside, i, j, l)| {
-        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l);
+        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l, inside);
         let eta_seen = if inside { 1.0 / eta } else { eta };
         dielectric_albedo_mc(family, mu, alpha, eta_seen, 500 + k as u64)
     });
     for (&(family, inside, i, j, l), [refl, trans, _]) in cells.iter().zip(&results) {
-        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l);
+        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l, inside);
         let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
         let (r_nodes, t_nodes) = dielectric_table(family).nodes(side);
         let k = (l * DIELECTRIC_TABLE_SIZE + j) * DIELECTRIC_TABLE_SIZE + i;
@@ -488,7 +531,8 @@ fn dielectric_interpolation_is_within_the_stated_bound() {
 #[test]
 fn dielectric_nodes_are_physical() {
     // every node: 0 ≤ R, T and R + T ≤ 1 (single scattering loses energy, never gains); at
-    // μ = 0 nothing is transmitted; at η = 1 nothing is reflected
+    // μ = 0 (the nodes i ≤ 7 of the inside table's row η = 1, where the critical cosine sits
+    // at μ = 0) nothing is transmitted; at η = 1 nothing is reflected
     for family in 0..2 {
         for side in [EtaRange::AtLeastOne, EtaRange::AtMostOne] {
             let (r, t) = dielectric_table(family).nodes(side);
@@ -501,7 +545,7 @@ fn dielectric_nodes_are_physical() {
                     r[k],
                     t[k]
                 );
-                if i == 0 {
+                if side == EtaRange::AtMostOne && l == 0 && i <= 7 {
                     assert_eq!(t[k], 0.0, "node {k}: T(μ = 0)");
                 }
                 if l == 0 {
@@ -540,10 +584,12 @@ fn dielectric_lookup_reproduces_the_nodes() {
         for inside in [false, true] {
             let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
             let (r_nodes, t_nodes) = dielectric_table(family).nodes(side);
-            for l in [0, 1, 7, 15] {
+            // the inside table's row η = 1 is read only by lookups with η < 1 (η = 1 itself
+            // reads the outside table)
+            for l in [usize::from(inside), 1, 7, 15] {
                 for j in [1, 7, 15] {
                     for i in [0, 5, 11, 15] {
-                        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l);
+                        let (mu, alpha, eta) = dielectric_node_coordinates(i, j, l, inside);
                         let k = (l * DIELECTRIC_TABLE_SIZE + j) * DIELECTRIC_TABLE_SIZE + i;
                         let v = dielectric_table(family)
                             .albedo(mu, alpha, if inside { 1.0 / eta } else { eta })

@@ -17,11 +17,13 @@
 //! 7th node is recomputed at 3; the run fails if they differ by more than 1e-5.
 
 mod dielectric;
+mod dielectric_axes;
 mod orders;
 mod quadrature;
 mod walk_dielectric;
 
 use dielectric::dielectric_albedo;
+use dielectric_axes::{Axes, BelowKnee, Roughness};
 use quadrature::{Family, gauss_legendre, single_scattering_albedo};
 use std::fmt::Write as _;
 use std::io::IsTerminal;
@@ -221,9 +223,14 @@ fn write_readme(dir: &std::path::Path) -> std::io::Result<()> {
          <family>_dielectric_<side>_<reflected|transmitted>.f32: 16 x 16 x 16 values V[l][j][i],\n\
          l (eta) slowest, i (direction) fastest: the single-scattering reflected / transmitted\n\
          (flux) albedo of a dielectric with light from <side> (outside: relative index eta;\n\
-         inside: 1/eta). u = l/15, eta = 1 + 2 u^2 in [1, 3]; r = j/15, alpha = r^2 (row 0:\n\
-         alpha = 1e-6); x = i/15 with mu as above. Lookup of (mu, alpha, eta):\n\
-         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2),\n\
+         inside: 1/eta). With B(v) = 0.5 ln(v/1e-6)/ln(1e6) + 0.5 (sqrt(v) - 1e-3)/(1 - 1e-3)\n\
+         for v >= 1e-6 (0 below): u = l/15, eta = 1 + 2 u^3 in [1, 3]; r = j/15 = B(alpha)\n\
+         (row 0: alpha = 1e-6); x = i/15 = B(mu) for light from outside, and from inside, with\n\
+         e = 1/eta and the critical cosine mc = sqrt(1 - e^2), k = 7/15:\n\
+         x = k (0.5 B(mu/mc) + 0.5 (1 - sqrt(1 - mu/mc))) for mu <= mc,\n\
+         x = k + (1 - k) sqrt((mu - mc)/(1 - mc)) above (row l = 0: mc = 0).\n\
+         Lookup of (mu, alpha, eta seen): the table of the side (eta >= 1: outside, else inside\n\
+         at 1/eta), x as above with the eta seen, r = B(alpha), u = cbrt((eta - 1)/2),\n\
          trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n",
     );
     readme.push_str(
@@ -268,24 +275,12 @@ impl Side {
     }
 }
 
-/// η ≥ 1 of η-node coordinate u ∈ [0, 1]: η = 1 + 2u².
-fn eta_of(u: f64) -> f64 {
-    1.0 + 2.0 * u * u
-}
-
-/// The α of dielectric roughness node j.
-fn dielectric_alpha_of_node(j: usize) -> f64 {
-    let r = j as f64 / (ND - 1) as f64;
-    (r * r).max(ALPHA_LIMIT)
-}
-
-/// (R, T) at dielectric node k = (l·ND + j)·ND + i (η slowest, direction fastest).
+/// (R, T) at dielectric node k = (l·ND + j)·ND + i (η slowest, direction fastest) of the
+/// shipped axes.
 fn dielectric_node(family: Family, side: Side, k: usize, panels: usize) -> (f64, f64) {
     let (i, j, l) = (k % ND, (k / ND) % ND, k / (ND * ND));
-    let alpha = dielectric_alpha_of_node(j);
-    let eta = eta_of(l as f64 / (ND - 1) as f64);
-    let eta = if side == Side::Outside { eta } else { 1.0 / eta };
-    dielectric_albedo(family, mu_of(i as f64 / (ND - 1) as f64, alpha), alpha, eta, panels)
+    let (mu, alpha, eta) = dielectric_axes::SHIPPED.node(i, j, l, side);
+    dielectric_albedo(family, mu, alpha, eta, panels)
 }
 
 /// The dielectric tables of one family and side: R and T nodes.
@@ -339,22 +334,13 @@ fn range_of(side: Side) -> microsurface::EtaRange {
     }
 }
 
-/// The interpolation error of the dielectric lookups at pseudo-random points inside the cells
-/// against direct quadrature: (max, RMS) of R, of T and of R + T.
-fn dielectric_interpolation_error(family: Family, side: Side) -> [(f64, f64); 3] {
+/// The interpolation error of the shipped dielectric lookups at the measurement points
+/// ([`measurement_point`]) against direct quadrature: (max, RMS) of R, of T and of R + T.
+fn dielectric_interpolation_error(family: Family, side: Side, uniform: bool) -> [(f64, f64); 3] {
     let table = dielectric_table_of(family);
     let label = format!("{} {} interpolation", family.name(), side.name());
     let errors = par_map(INTERPOLATION_POINTS, &label, |k| {
-        let mut state = (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-        let mut next = || {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let (x, r, u) = (next(), next(), next());
-        let alpha = (r * r).max(1e-4);
-        let mu = mu_of(x, alpha);
-        let eta = eta_of(u);
-        let eta_side = if side == Side::Outside { eta } else { 1.0 / eta };
+        let (mu, alpha, eta_side) = measurement_point(k, side, uniform);
         let (er, et) = dielectric_albedo(family, mu, alpha, eta_side, DIELECTRIC_PANELS);
         let v = table.albedo(mu as f32, alpha as f32, eta_side as f32).expect("in range");
         let e = ((f64::from(v.reflected) - er).abs(), (f64::from(v.transmitted) - et).abs());
@@ -529,7 +515,9 @@ fn main() {
             "usage: cargo run --release --example tables [-- --quick | --interpolation] [--only conductor|dielectric|orders|walk-dielectric]\n\n  \
              (no flag)        rebuild src/albedo/data.rs, src/albedo/dielectric_data.rs and target/tables/*.f32,\n                   \
              print the quadrature error estimates\n  --interpolation  measure the lookups' interpolation error against \
-             quadrature\n  --quick          recompute a subset of nodes and check them against the shipped tables bit for \
+             quadrature (dielectric: --uniform for mu uniform)\n  --design K P N M R S [family] [side]  measure a dielectric \
+             axis design (knee node K, eta = 1 + 2u^P, N nodes, M points, log roughness R, symmetric knee S: 0/1) \
+             from the nodes around the points only\n  --quick          recompute a subset of nodes and check them against the shipped tables bit for \
              bit\n  --only X         rebuild (or measure) only the conductor (E, E_avg) or only the dielectric tables,\n                   \
              or only the walk's per-order energies (orders: src/albedo/orders_data.rs), or only the walk's higher orders\n                   \
              of dielectrics, ΔR and ΔT (walk-dielectric: src/albedo/dielectric_walk_data.rs)"
@@ -549,6 +537,44 @@ fn main() {
         quick();
         return;
     }
+    if let Some(k) = args.iter().position(|a| a == "--design") {
+        // --design KNEE POWER NODES POINTS LOG_ROUGHNESS SYMMETRIC_KNEE [ggx|beckmann] [outside|inside] [--uniform]
+        let num = |d: usize| args.get(k + d).and_then(|v| v.parse::<f64>().ok());
+        let axes = Axes {
+            knee: num(1).map_or(dielectric_axes::SHIPPED.knee, |v| v as usize),
+            eta_power: num(2).unwrap_or(dielectric_axes::SHIPPED.eta_power),
+            nodes: num(3).map_or(dielectric_axes::SHIPPED.nodes, |v| v as usize),
+            roughness: num(5).map_or(dielectric_axes::SHIPPED.roughness, |v| {
+                if v == 0.0 { Roughness::Sqrt } else { Roughness::Blend }
+            }),
+            below_knee: num(6).map_or(dielectric_axes::SHIPPED.below_knee, |v| {
+                if v == 0.0 { BelowKnee::Blend } else { BelowKnee::Symmetric }
+            }),
+        };
+        let points = num(4).map_or(INTERPOLATION_POINTS, |v| v as usize);
+        let uniform = args.iter().any(|a| a == "--uniform");
+        for family in [Family::Ggx, Family::Beckmann] {
+            if args.iter().any(|a| a == "ggx" || a == "beckmann") && !args.iter().any(|a| a == family.name())
+            {
+                continue;
+            }
+            for side in [Side::Outside, Side::Inside] {
+                if args.iter().any(|a| a == "outside" || a == "inside")
+                    && !args.iter().any(|a| a == side.name())
+                {
+                    continue;
+                }
+                let [(rm, rr), (tm, tr), (em, er)] = design_error(family, side, axes, points, uniform);
+                println!(
+                    "{} from {} {axes:?}: R max {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}; R + T max \
+                     {em:.2e}, RMS {er:.2e}",
+                    family.name(),
+                    side.name()
+                );
+            }
+        }
+        return;
+    }
     if args.iter().any(|a| a == "--interpolation") {
         for family in [Family::Ggx, Family::Beckmann] {
             if conductor {
@@ -560,7 +586,9 @@ fn main() {
             }
             if dielectric {
                 for side in [Side::Outside, Side::Inside] {
-                    let [(rm, rr), (tm, tr), (em, er)] = dielectric_interpolation_error(family, side);
+                    let uniform = args.iter().any(|a| a == "--uniform");
+                    let [(rm, rr), (tm, tr), (em, er)] =
+                        dielectric_interpolation_error(family, side, uniform);
                     println!(
                         "{} dielectric from {}: interpolation error at {INTERPOLATION_POINTS} random points: R max \
                          {rm:.2e}, RMS {rr:.2e}; T max {tm:.2e}, RMS {tr:.2e}; R + T max {em:.2e}, RMS {er:.2e}",
@@ -630,4 +658,93 @@ fn write_if_changed(path: &std::path::Path, text: &str) -> bool {
     std::fs::write(path, text).unwrap_or_else(|e| panic!("write {}: {e}", path.display()));
     println!("wrote {} ({})", path.display(), if changed { "changed" } else { "unchanged" });
     changed
+}
+
+/// The pseudo-random measurement points of `--interpolation` and `--design`: (μ, α, η seen)
+/// for point k of `side`, with (x, r, u) uniform and α = max(r², 1e-4), μ = x²α/(1 + α − x²)
+/// (the conductor's scale-invariant axis) and η = 1 + 2u² (the sampling of the first
+/// measurement, kept fixed so that every design is measured at the same points), or, with
+/// `uniform`, μ uniform in [0, 1].
+fn measurement_point(k: usize, side: Side, uniform: bool) -> (f64, f64, f64) {
+    let mut state = (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    let mut next = || {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (x, r, u) = (next(), next(), next());
+    let alpha = (r * r).max(1e-4);
+    let mu = if uniform { x } else { mu_of(x, alpha) };
+    let eta = 1.0 + 2.0 * u * u;
+    (mu, alpha, if side == Side::Outside { eta } else { 1.0 / eta })
+}
+
+/// A measurement point (μ, α, η seen) and its cell (index, fraction) on each axis.
+type Located = ((f64, f64, f64), [(usize, f64); 3]);
+
+/// `--design`: the interpolation error of a table design (axes) at `points` measurement points,
+/// computing only the nodes at the corners of the points' cells: (max, RMS) of R, T, R + T.
+fn design_error(family: Family, side: Side, axes: Axes, points: usize, uniform: bool) -> [(f64, f64); 3] {
+    let last = axes.nodes - 1;
+    let located: Vec<Located> = (0..points)
+        .map(|k| {
+            let p = measurement_point(k, side, uniform);
+            let at = axes.coordinates(p.0, p.1, p.2);
+            (
+                p,
+                at.map(|t| {
+                    let i = (t as usize).min(last - 1);
+                    (i, t - i as f64)
+                }),
+            )
+        })
+        .collect();
+    let mut keys: Vec<(usize, usize, usize)> = Vec::new();
+    for (_, c) in &located {
+        for d in 0..8 {
+            keys.push((c[0].0 + (d & 1), c[1].0 + ((d >> 1) & 1), c[2].0 + (d >> 2)));
+        }
+    }
+    keys.sort_unstable();
+    keys.dedup();
+    let label = format!("{} {} design nodes", family.name(), side.name());
+    let values = par_map(keys.len() + points, &label, |k| {
+        if k < keys.len() {
+            let (i, j, l) = keys[k];
+            let (mu, alpha, eta) = axes.node(i, j, l, side);
+            dielectric_albedo(family, mu, alpha, eta, DIELECTRIC_PANELS)
+        } else {
+            let (mu, alpha, eta) = located[k - keys.len()].0;
+            dielectric_albedo(family, mu, alpha, eta, DIELECTRIC_PANELS)
+        }
+    });
+    let node = |key: (usize, usize, usize)| values[keys.binary_search(&key).expect("computed")];
+    let errors: Vec<(f64, f64, f64)> = located
+        .iter()
+        .enumerate()
+        .map(|(k, (p, c))| {
+            let mut v = [0.0; 2];
+            for d in 0..8 {
+                let w: f64 = (0..3).map(|a| if (d >> a) & 1 == 1 { c[a].1 } else { 1.0 - c[a].1 }).product();
+                let n = node((c[0].0 + (d & 1), c[1].0 + ((d >> 1) & 1), c[2].0 + (d >> 2)));
+                v[0] += w * n.0;
+                v[1] += w * n.1;
+            }
+            let exact = values[keys.len() + k];
+            let e = ((v[0] - exact.0).abs(), (v[1] - exact.1).abs(), (v[0] + v[1] - exact.0 - exact.1).abs());
+            if std::env::var_os("TABLES_DEBUG").is_some() && e.0.max(e.1).max(e.2) > 0.02 {
+                println!(
+                    "  μ {:.3e} α {:.3e} η {:.4}: quadrature R {:.4} T {:.4}, interpolated R {:.4} T {:.4} at {:?}",
+                    p.0, p.1, p.2, exact.0, exact.1, v[0], v[1], c
+                );
+            }
+            e
+        })
+        .collect();
+    println!("{label}: {} nodes, {points} points", keys.len());
+    let stats = |e: &dyn Fn(&(f64, f64, f64)) -> f64| {
+        let max = errors.iter().map(e).fold(0.0, f64::max);
+        let rms = (errors.iter().map(|v| e(v) * e(v)).sum::<f64>() / errors.len() as f64).sqrt();
+        (max, rms)
+    };
+    [stats(&|v| v.0), stats(&|v| v.1), stats(&|v| v.2)]
 }

@@ -18,3 +18,71 @@ pub(crate) fn node_cell(t: f32, nodes: usize) -> (usize, f32) {
     let i = (t as usize).min(nodes - 2);
     (i, t - i as f32)
 }
+
+/// Below this value the log/√ blend axis [`log_sqrt_blend`] is 0 (its lookups read the first
+/// node).
+pub(crate) const BLEND_FLOOR: f32 = 1e-6;
+/// ln(1/[`BLEND_FLOOR`]).
+const LN_INV_BLEND_FLOOR: f32 = 13.815_511;
+/// √[`BLEND_FLOOR`].
+const SQRT_BLEND_FLOOR: f32 = 1e-3;
+
+/// The dielectric tables' log/√ blend B(v) = ½ ln(v/vf)/ln(1/vf) + ½ (√v − √vf)/(1 − √vf)
+/// ∈ [0, 1] for v ∈ [vf, 1], vf = [`BLEND_FLOOR`] (0 below vf): the logarithmic half resolves
+/// features at a scale set by v itself (the masking at μ ≈ α, the slow decay of the
+/// transmission as μ → 0, small α), the square-root half the Fresnel term's dependence on μ
+/// (see `DESIGN.md`, "Dielectric albedo tables").
+#[inline(always)]
+pub(crate) fn log_sqrt_blend(v: f32) -> f32 {
+    let v = v.max(BLEND_FLOOR);
+    (0.5 / LN_INV_BLEND_FLOOR) * (v * (1.0 / BLEND_FLOOR)).ln()
+        + (0.5 / (1.0 - SQRT_BLEND_FLOOR)) * (v.sqrt() - SQRT_BLEND_FLOOR)
+}
+
+/// The direction node the critical cosine sits on in the dielectric tables of internal
+/// incidence (η < 1), as a fraction of the axis: 7/15.
+pub(crate) const KNEE: f32 = 7.0 / 15.0;
+
+/// The direction axis of a dielectric table row: from outside (η ≥ 1) x = B(μ); from inside
+/// (η < 1) the critical cosine μc = √(1 − η²) is pinned to the node [`KNEE`]:
+/// x = KNEE · (½ B(t) + ½ (1 − √(1 − t))) with t = μ/μc for μ ≤ μc, and
+/// x = KNEE + (1 − KNEE) √((μ − μc)/(1 − μc)) above (so the onset of total internal
+/// reflection sits on the same node in every η row, 1 − F ∝ √(μ − μc) is linear in x above it,
+/// and the rough lobe's fall from total reflection just below it is resolved as well).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum DielectricDirection {
+    /// x = B(μ).
+    Outside,
+    /// The knee axis of the critical cosine `mu_c` > 0, with 1/μc and 1/(1 − μc).
+    Inside { mu_c: f32, inv_mu_c: f32, inv_above: f32 },
+}
+
+impl DielectricDirection {
+    /// The axis of light seeing the relative index η ∈ [1/3, 3].
+    #[inline(always)]
+    pub(crate) fn of(eta: f32) -> Self {
+        if eta >= 1.0 {
+            return Self::Outside;
+        }
+        // η < 1 in f32 is at most 1 − 2⁻²⁴: μc ≥ 3.4e-4
+        let mu_c = ((1.0 - eta) * (1.0 + eta)).sqrt();
+        Self::Inside { mu_c, inv_mu_c: 1.0 / mu_c, inv_above: 1.0 / (1.0 - mu_c) }
+    }
+
+    /// x ∈ [0, 1] of μ ∈ [0, 1].
+    #[inline(always)]
+    pub(crate) fn coordinate(&self, mu: f32) -> f32 {
+        match *self {
+            Self::Outside => log_sqrt_blend(mu),
+            Self::Inside { mu_c, inv_mu_c, inv_above } => {
+                if mu <= mu_c {
+                    let t = mu * inv_mu_c;
+                    KNEE * (0.5 * log_sqrt_blend(t) + 0.5 * (1.0 - (1.0 - t).max(0.0).sqrt()))
+                } else {
+                    KNEE + (1.0 - KNEE) * ((mu - mu_c) * inv_above).min(1.0).sqrt()
+                }
+            }
+        }
+        .min(1.0)
+    }
+}

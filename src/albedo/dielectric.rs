@@ -1,7 +1,7 @@
 //! The reflected and transmitted single-scattering albedo tables of dielectric microsurfaces
 //! and their interpolation.
 
-use super::axis::{node_cell, scale_invariant_direction};
+use super::axis::{DielectricDirection, log_sqrt_blend, node_cell};
 use super::dielectric_data as data;
 use super::table::MAX_TABULATED_ALPHA;
 
@@ -18,10 +18,28 @@ const NODES: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE * DIELECTRIC_
 /// A row of the η axis: 16 × 16 nodes.
 const ROW: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;
 
-/// The η-axis coordinate u = √((η − 1)/2) ∈ [0, 1] of a relative index η ∈ [1, 3] (η = 1 + 2u²).
+/// The η-axis coordinate u = ∛((η − 1)/2) ∈ [0, 1] of a relative index η ∈ [1, 3] (η = 1 + 2u³).
 #[inline(always)]
 fn eta_coordinate(eta_at_least_one: f32) -> f32 {
-    ((eta_at_least_one - 1.0) * 0.5).max(0.0).sqrt().min(1.0)
+    ((eta_at_least_one - 1.0) * 0.5).max(0.0).cbrt().min(1.0)
+}
+
+/// The roughness-axis coordinate r = B(α) ∈ [0, 1] of α ∈ (0, 1] (the log/√ blend of the
+/// direction axis: rows log-spaced at small α, so that the masking feature at μ ≈ α moves by
+/// about one direction cell per row).
+#[inline(always)]
+fn roughness_coordinate(alpha: f32) -> f32 {
+    log_sqrt_blend(alpha).min(1.0)
+}
+
+/// The fractional node coordinates of a lookup: (x, r, u)·15 on the table of the side of η.
+#[inline(always)]
+fn node_coordinates(mu: f32, alpha: f32, eta: f32, eta_at_least_one: f32) -> [f32; 3] {
+    [
+        DielectricDirection::of(eta).coordinate(mu) * LAST,
+        roughness_coordinate(alpha) * LAST,
+        eta_coordinate(eta_at_least_one) * LAST,
+    ]
 }
 
 /// Which of a family's two dielectric tables: the one of relative indices η ≥ 1 (light
@@ -75,23 +93,37 @@ pub struct DielectricAlbedo {
 /// every refraction from there) and R(0) is the Fresnel reflectance averaged over the visible
 /// normals.
 ///
-/// **Axes.** The relative index seen by the light is η ∈ [1, 3] from outside and 1/η from
-/// inside (so η ∈ [1/3, 3] is covered), on the axis u = √((η − 1)/2) ∈ [0, 1] with 16 equal
-/// steps: the critical cosine √(1 − 1/η²) seen from inside is ≈ 2u near η = 1, so the axis
-/// resolves the fast onset of total internal reflection. Roughness r = √α ∈ [0, 1] and the
-/// direction axis x = √(μ (1 + α)/(μ + α)) as in [`crate::AlbedoTable`], 16 steps each (row
-/// r = 0 at α = 1e-6). Trilinear in (x, r, u).
+/// **Axes** (16 nodes each, trilinear in (x, r, u); `DESIGN.md`, "Dielectric albedo tables",
+/// has the measurements behind them). With the log/√ blend
+/// B(v) = ½ ln(v/vf)/ln(1/vf) + ½ (√v − √vf)/(1 − √vf), vf = 1e-6 (B = 0 below vf):
+/// - index: the relative index seen by the light is η ∈ [1, 3] from outside and 1/η from
+///   inside (so η ∈ [1/3, 3] is covered), on u = ∛((η − 1)/2) (η = 1 + 2u³: the first node
+///   at η − 1 = 5.9e-4, where R and the critical cosine change fastest);
+/// - roughness: r = B(α) (rows log-spaced at small α, from α = 1e-6 at r = 0; lookups below
+///   1e-6 read that row);
+/// - direction, from outside: x = B(μ) (the logarithmic half resolves the masking at μ ≈ α
+///   and the slow decay of T as μ → 0, the square-root half the Fresnel term in μ; lookups
+///   below μ = 1e-6 read the first node);
+/// - direction, from inside: the critical cosine μc = √(1 − η²) sits on node 7 in every η
+///   row, x = (7/15)(½ B(t) + ½ (1 − √(1 − t))) with t = μ/μc below it and
+///   x = 7/15 + (8/15) √((μ − μc)/(1 − μc)) above it, so the onset of total internal
+///   reflection is not blended across η rows and 1 − F ∝ √(μ − μc) is linear in x; the row
+///   η = 1 of this table holds the limit μc → 0 of the axis (its nodes 0–7 at μ = 0).
 ///
 /// **Accuracy** (measured by the generator, see `DESIGN.md`): nodes within 1e-5 of the exact
-/// integral (2 and 3 quadrature panels agree to 3.9e-6 at every 7th node). **Between the nodes
-/// the interpolation is poor**: the direction axis, shared with [`crate::AlbedoTable`], is
-/// scale-invariant in μ/α, but the Fresnel term depends on μ itself, T falls to its limit 0
-/// only slowly as μ → 0, R changes fast in η near 1, and from inside the onset of total
-/// internal reflection at μ = √(1 − η²) moves across the direction axis with η. Measured at random points against
-/// quadrature, R + T errs by up to 0.33 (GGX) and 0.55 (Beckmann) from outside, 0.08 and 0.10
-/// from inside (RMS 0.039 / 0.058 and 0.008 / 0.013); R and T alone by up to 0.9. Use the
-/// nodes, or treat lookups between them with that error.
+/// integral (2 and 3 quadrature panels agree to 7.4e-6 at every 7th node). Between the
+/// nodes, measured at 256 pseudo-random points per table and side against quadrature
+/// (α ≥ 1e-4, μ concentrated near μ ≈ α as on the conductor's scale-invariant axis):
 ///
+/// | table | R max / RMS | T max / RMS | R + T max / RMS |
+/// |---|---|---|---|
+/// | GGX, outside | 2.3e-2 / 4.3e-3 | 5.8e-2 / 8.8e-3 | 4.8e-2 / 7.9e-3 |
+/// | GGX, inside | 6.2e-2 / 1.4e-2 | 5.6e-2 / 7.9e-3 | 6.2e-2 / 1.5e-2 |
+/// | Beckmann, outside | 2.8e-2 / 4.5e-3 | 9.0e-2 / 1.0e-2 | 7.5e-2 / 9.0e-3 |
+/// | Beckmann, inside | 1.3e-1 / 1.6e-2 | 7.6e-2 / 1.1e-2 | 1.3e-1 / 1.8e-2 |
+///
+/// The largest errors sit near η = 1 (where T at large α depends on μ/α alone) and at small
+/// μ with α ≈ μ; treat a lookup as uncertain by these maxima, the nodes by 1e-5.
 /// # Examples
 /// ```
 /// use microsurface::DielectricAlbedoTable;
@@ -147,14 +179,13 @@ impl DielectricAlbedoTable {
             return None;
         }
         let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let x = scale_invariant_direction(mu, alpha);
-        let at = [x * LAST, alpha.sqrt() * LAST, eta_coordinate(eta_ge_1) * LAST];
+        let at = node_coordinates(mu, alpha, eta, eta_ge_1);
         Some(DielectricAlbedo { reflected: trilinear(tables[0], at), transmitted: trilinear(tables[1], at) })
     }
 
     /// The raw node values (R, T) of one side, `values[(l * 16 + j) * 16 + i]` at x = i/15,
-    /// r = j/15, u = l/15 (η = 1 + 2u² from outside, its inverse from inside), for export to
-    /// shaders.
+    /// r = j/15, u = l/15 on the axes of the type's documentation (η = 1 + 2u³ from outside,
+    /// its inverse from inside; the direction axis of the side), for export to shaders.
     #[must_use]
     pub fn nodes(&self, range: EtaRange) -> (&'static [f32], &'static [f32]) {
         let t = match range {
@@ -193,14 +224,14 @@ fn trilinear(grid: &[f32; NODES], at: [f32; 3]) -> f32 {
 
 impl DielectricAlbedoTable {
     /// R and T at the 16 direction nodes x = i/15 for roughness α and the relative index η
-    /// seen by the light, blended bilinearly in (r, u) as [`Self::albedo`] interpolates (the
-    /// run-time lookup of a compensated lobe then interpolates linearly in x only). `None`
-    /// outside the tables' range.
+    /// seen by the light, blended bilinearly in (r, u) as [`Self::albedo`] interpolates, and
+    /// the direction axis of η (the run-time lookup of a compensated lobe then interpolates
+    /// linearly in x only). `None` outside the tables' range.
     pub(crate) fn direction_row(
         &self,
         alpha: f32,
         eta: f32,
-    ) -> Option<([f32; DIELECTRIC_TABLE_SIZE], [f32; DIELECTRIC_TABLE_SIZE])> {
+    ) -> Option<([f32; DIELECTRIC_TABLE_SIZE], [f32; DIELECTRIC_TABLE_SIZE], DielectricDirection)> {
         if !(alpha > 0.0
             && alpha <= MAX_TABULATED_ALPHA
             && (1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta))
@@ -208,7 +239,7 @@ impl DielectricAlbedoTable {
             return None;
         }
         let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let (j, fj) = cell(alpha.sqrt() * LAST);
+        let (j, fj) = cell(roughness_coordinate(alpha) * LAST);
         let (l, fl) = cell(eta_coordinate(eta_ge_1) * LAST);
         let blend = |grid: &[f32; NODES]| {
             let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
@@ -220,6 +251,6 @@ impl DielectricAlbedoTable {
             }
             out
         };
-        Some((blend(tables[0]), blend(tables[1])))
+        Some((blend(tables[0]), blend(tables[1]), DielectricDirection::of(eta)))
     }
 }

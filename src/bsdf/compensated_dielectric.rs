@@ -7,7 +7,7 @@ use super::compensated::AlbedoTabulated;
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction};
 use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, node_cell, scale_invariant_direction,
+    DIELECTRIC_TABLE_SIZE, DielectricDirection, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, node_cell,
 };
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
@@ -74,6 +74,8 @@ pub struct CompensatedDielectric<S> {
     alpha: f32,
     /// E = R + T at the direction nodes x = i/15, for views above (0) and below (1) the surface.
     albedo: [[f32; DIELECTRIC_TABLE_SIZE]; 2],
+    /// The tables' direction axis of each side's relative index.
+    axis: [DielectricDirection; 2],
 }
 
 impl<S: AlbedoTabulated> CompensatedDielectric<S> {
@@ -102,21 +104,23 @@ impl<S: AlbedoTabulated> CompensatedDielectric<S> {
         }
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let mut albedo = [[1.0; DIELECTRIC_TABLE_SIZE]; 2];
+        let mut axis = [DielectricDirection::of(eta), DielectricDirection::of(1.0 / eta)];
         // a Dirac lobe is not compensated (and √(αx αy) may underflow to 0 there)
         if !single.is_specular() {
-            for (side, seen) in albedo.iter_mut().zip([eta, 1.0 / eta]) {
-                let (r, t) =
+            for ((side, side_axis), seen) in albedo.iter_mut().zip(&mut axis).zip([eta, 1.0 / eta]) {
+                let (r, t, row_axis) =
                     S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(Error::InvalidParameter {
                         name: "eta",
                         value: seen,
                         expected: "a relative index in [1/3, 3] seen from either side",
                     })?;
+                *side_axis = row_axis;
                 for ((e, r), t) in side.iter_mut().zip(r).zip(t) {
                     *e = r + t;
                 }
             }
         }
-        Ok(Self { single, alpha, albedo })
+        Ok(Self { single, alpha, albedo, axis })
     }
 }
 
@@ -146,14 +150,14 @@ impl<S: MicrosurfaceSlope> CompensatedDielectric<S> {
     }
 
     /// E at |cos θo| = μ for a view on `side`: linear interpolation on the tables' direction
-    /// axis x = √(μ (1 + α)/(μ + α)). Branch-free.
+    /// axis of the side's relative index (see [`crate::DielectricAlbedoTable`]).
     #[inline(always)]
     fn albedo_at(&self, mu: f32, side: Side) -> f32 {
         let side = match side {
             Side::Outside => 0,
             Side::Inside => 1,
         };
-        let x = scale_invariant_direction(mu, self.alpha);
+        let x = self.axis[side].coordinate(mu);
         let (i, f) = node_cell(x * LAST, DIELECTRIC_TABLE_SIZE);
         let row = &self.albedo[side];
         row[i] + f * (row[i + 1] - row[i])

@@ -214,12 +214,17 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             LobeProfile::new(&unit, alpha).0
         });
         for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
-            let (r, t) = S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(eta_error(seen))?;
             let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
-            let side = &mut b.sides[s];
-            for (e, (r, t)) in single[s].iter_mut().zip(r.into_iter().zip(t)) {
-                *e = r + t;
+            // E_ss = R + T at the walk table's direction nodes μ = α X/(1 + α − X), X = (i/15)²
+            // (the single-scattering table has its own direction axis; E_ss only sets the
+            // sampling mixture, for which any positive weights give an exact density)
+            for (i, e) in single[s].iter_mut().enumerate() {
+                let x_sq = (i as f32 / (PROFILE_NODES - 1) as f32).powi(2);
+                let mu = (alpha * x_sq / (1.0 + alpha - x_sq)).min(1.0);
+                let v = S::DIELECTRIC_ALBEDO.albedo(mu, alpha, seen).ok_or(eta_error(seen))?;
+                *e = v.reflected + v.transmitted;
             }
+            let side = &mut b.sides[s];
             side.reflected = dr;
             side.transmitted = dt;
             let (r_avg, r_profile) = LobeProfile::new(&dr, alpha);

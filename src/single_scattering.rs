@@ -9,6 +9,10 @@ use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
 
+/// An f32 value of ωi·(ωi + ωo) above this is positive in exact arithmetic (its rounding error
+/// is below 3 ulps of 2, 4e-7).
+const VISIBLE_SUM_MARGIN: f32 = 1e-6;
+
 /// An outgoing direction sampled from the single-scattering BSDF, with its weight and density.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SingleSample {
@@ -159,6 +163,9 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::pdf`] for directions the caller has validated.
     #[inline(always)]
     pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if M::MIRROR_FACETS && wi.z > 0.0 && wo.z > 0.0 {
+            return self.mirror_density(wi, wo);
+        }
         let (Some(start), Some(wo_side)) =
             (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
         else {
@@ -186,7 +193,14 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
             return (f_cos, self.density(at, wo, wo_side));
         }
         let m = self.model.material();
-        let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+        let (vertex, pdf) = if M::MIRROR_FACETS {
+            // the density `pdf` and `sample` give (wo is above the horizon: `exit_side`)
+            let vertex = m.vertex_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+            (vertex, self.mirror_density(wi, wo))
+        } else {
+            let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+            (vertex, pdf)
+        };
         let factor = self.model.shadowing_factor(at, k_in, self.model.exit(wo, wo_side), VertexRole::Last);
         ((vertex.as_dvec3() * factor).as_vec3(), pdf)
     }
@@ -197,6 +211,23 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         let at = PositionFree::<S, M>::incident(wi)?;
         let (slope, m) = (self.model.slope(), self.model.material());
         let s = m.sample_phase_unchecked(slope, at.w, at.side, rng);
+        if M::MIRROR_FACETS && wi.z > 0.0 {
+            // a front-facing view of mirror facets (conductors): G2/G1 = (1 + Λi)/(1 + Λi + Λo)
+            // from the f32 Λ (above the horizon Λ has no cancellation and saturates only at
+            // cos θ = 0: a few f32 ulps), written 1/(1 + Λo/(1 + Λi)) so that it cannot
+            // overflow, and the density `pdf` gives at the returned direction
+            if !(s.wo.z > 0.0) {
+                return None;
+            }
+            let last = 1.0 / (1.0 + slope.lambda_unchecked(s.wo) / (1.0 + slope.lambda_unchecked(wi)));
+            let weight = s.weight * last;
+            if !(last > 0.0 && weight.is_finite()) {
+                return None;
+            }
+            // 0 only for ωo within rounding of −ωi (no visible half vector: eval is 0 there)
+            let pdf = self.mirror_density(wi, s.wo);
+            return (pdf > 0.0).then_some(SingleSample { wo: s.wo, weight, pdf });
+        }
         let k_in = self.model.incident_k(at);
         let out = self.model.exit(s.wo, s.side);
         let last = if let (true, Some(lambda_o), true) = (k_in >= 1.0, out.lambda, at.side == out.side) {
@@ -213,6 +244,27 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         // the density at the returned f32 direction, as `pdf` computes it
         let pdf = m.pdf_phase_unchecked(slope, &at.to(s.wo, s.side));
         Some(SingleSample { wo: s.wo, weight, pdf })
+    }
+
+    /// The density of a reflection of mirror facets ([`Material::MIRROR_FACETS`]) between ωi
+    /// and ωo strictly above the horizon: D(ωh)/(4 A(ωi)) from the slope
+    /// ([`MicrosurfaceSlope::reflection_density_unchecked`]; for GGX in f32, relative error
+    /// below 4e-6), the one function `pdf`, `eval_with_pdf` and `sample` share, so that their
+    /// densities agree bit for bit.
+    /// 0 where the half vector is not a facet normal ωi can see (ωi·(ωi + ωo) ≤ 0, in f64 as
+    /// the reflection half vector is tested for `eval`: only for ωo within
+    /// rounding of −ωi, where the f32 directions' lengths decide the sign).
+    #[inline(always)]
+    fn mirror_density(&self, wi: Vec3, wo: Vec3) -> f32 {
+        // the f32 dot product of ωi with ωi + ωo (|ωi + ωo| ≤ 2) is within 4e-7 of the exact one
+        let visible = wi.dot(wi + wo) > VISIBLE_SUM_MARGIN || {
+            let w = wi.as_dvec3();
+            w.dot(w + wo.as_dvec3()) > 0.0
+        };
+        if !visible {
+            return 0.0;
+        }
+        self.model.slope().reflection_density_unchecked(wi, wo)
     }
 
     /// The phase-function density of ωo from the incident state `at`.

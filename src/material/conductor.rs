@@ -105,6 +105,7 @@ impl Conductor {
 impl Material for Conductor {
     const TRANSMITS: bool = false;
     const EXACT_PHASE_PDF: bool = true;
+    const MIRROR_FACETS: bool = true;
 
     #[inline]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(

@@ -71,6 +71,13 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
     const EXACT_PHASE_PDF: bool;
 
+    /// Whether the facets are mirrors with a per-channel weight w(ωi·ωh) (conductors): the
+    /// phase function of an outside reflection is w·D(ωh)/(4 A(ωi)), the sampler reflects ωi
+    /// about ωm ~ D_ωi with weight w, and nothing crosses the surface. Single scattering then
+    /// forms its density and masking ratio from the slope directly (`SingleScattering`).
+    #[doc(hidden)]
+    const MIRROR_FACETS: bool = false;
+
     /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
     /// interaction's sides. Stochastic (unbiased) for the diffuse material, exact otherwise
     /// (the formulas are on each material's type).

@@ -5,6 +5,7 @@
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::position_free::{Incident, PositionFree, Shadowing, VertexRole};
+use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
@@ -164,7 +165,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     #[inline(always)]
     pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
         if M::MIRROR_FACETS && wi.z > 0.0 && wo.z > 0.0 {
-            return self.mirror_density(wi, wo);
+            return Self::mirror_density(self.model.slope(), wi, wo);
         }
         let (Some(start), Some(wo_side)) =
             (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
@@ -196,7 +197,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         let (vertex, pdf) = if M::MIRROR_FACETS {
             // the density `pdf` and `sample` give (wo is above the horizon: `exit_side`)
             let vertex = m.vertex_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
-            (vertex, self.mirror_density(wi, wo))
+            (vertex, Self::mirror_density(self.model.slope(), wi, wo))
         } else {
             let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
             (vertex, pdf)
@@ -208,26 +209,14 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::sample`] for a direction the caller has validated.
     #[inline(always)]
     pub(crate) fn sample_unchecked(&self, wi: Vec3, rng: &mut impl Rng) -> Option<SingleSample> {
+        if M::MIRROR_FACETS && wi.z > 0.0 {
+            // the uniforms in the order the material's own sampler draws them
+            let (u1, u2) = (uniform(rng), uniform(rng));
+            return Self::sample_mirror_front(self.model.slope(), self.model.material(), wi, u1, u2);
+        }
         let at = PositionFree::<S, M>::incident(wi)?;
         let (slope, m) = (self.model.slope(), self.model.material());
         let s = m.sample_phase_unchecked(slope, at.w, at.side, rng);
-        if M::MIRROR_FACETS && wi.z > 0.0 {
-            // a front-facing view of mirror facets (conductors): G2/G1 = (1 + Λi)/(1 + Λi + Λo)
-            // from the f32 Λ (above the horizon Λ has no cancellation and saturates only at
-            // cos θ = 0: a few f32 ulps), written 1/(1 + Λo/(1 + Λi)) so that it cannot
-            // overflow, and the density `pdf` gives at the returned direction
-            if !(s.wo.z > 0.0) {
-                return None;
-            }
-            let last = 1.0 / (1.0 + slope.lambda_unchecked(s.wo) / (1.0 + slope.lambda_unchecked(wi)));
-            let weight = s.weight * last;
-            if !(last > 0.0 && weight.is_finite()) {
-                return None;
-            }
-            // 0 only for ωo within rounding of −ωi (no visible half vector: eval is 0 there)
-            let pdf = self.mirror_density(wi, s.wo);
-            return (pdf > 0.0).then_some(SingleSample { wo: s.wo, weight, pdf });
-        }
         let k_in = self.model.incident_k(at);
         let out = self.model.exit(s.wo, s.side);
         let last = if let (true, Some(lambda_o), true) = (k_in >= 1.0, out.lambda, at.side == out.side) {
@@ -246,6 +235,33 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         Some(SingleSample { wo: s.wo, weight, pdf })
     }
 
+    /// [`SingleScattering::sample`] of mirror facets ([`Material::MIRROR_FACETS`]: conductors)
+    /// seen from above the horizon (ωi.z > 0, unit), from the two uniforms of the visible
+    /// normal: ωm ~ D_ωi, ωo = reflect(ωi, ωm), the weight F·G2/G1 with G2/G1 = (1 + Λi)/(1 +
+    /// Λi + Λo) from the f32 Λ (above the horizon Λ has no cancellation and saturates only at
+    /// cos θ = 0: a few f32 ulps), written 1/(1 + Λo/(1 + Λi)) so that it cannot overflow, and
+    /// the density `pdf` gives at the returned direction. The weight is finite (F ∈ [0, 1],
+    /// G2/G1 ∈ (0, 1]) and ωo unit (renormalized). `None` if ωo points into the surface or
+    /// lies within rounding of −ωi (no visible half vector: eval is 0 there).
+    /// Takes the slope and the material by reference (the renderer layer holds them, and
+    /// copying them into a `SingleScattering` costs as much as a Λ).
+    #[inline(always)]
+    pub(crate) fn sample_mirror_front(
+        slope: &S,
+        material: &M,
+        wi: Vec3,
+        u1: f32,
+        u2: f32,
+    ) -> Option<SingleSample> {
+        let s = material.sample_mirror_unchecked(slope, wi, u1, u2);
+        if !(s.wo.z > 0.0) {
+            return None;
+        }
+        let last = 1.0 / (1.0 + slope.lambda_unchecked(s.wo) / (1.0 + slope.lambda_unchecked(wi)));
+        let pdf = Self::mirror_density(slope, wi, s.wo);
+        (last > 0.0 && pdf > 0.0).then(|| SingleSample { wo: s.wo, weight: s.weight * last, pdf })
+    }
+
     /// The density of a reflection of mirror facets ([`Material::MIRROR_FACETS`]) between ωi
     /// and ωo strictly above the horizon: D(ωh)/(4 A(ωi)) from the slope
     /// ([`MicrosurfaceSlope::reflection_density_unchecked`]; for GGX in f32, relative error
@@ -255,7 +271,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// the reflection half vector is tested for `eval`: only for ωo within
     /// rounding of −ωi, where the f32 directions' lengths decide the sign).
     #[inline(always)]
-    fn mirror_density(&self, wi: Vec3, wo: Vec3) -> f32 {
+    pub(crate) fn mirror_density(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
         // the f32 dot product of ωi with ωi + ωo (|ωi + ωo| ≤ 2) is within 4e-7 of the exact one
         let visible = wi.dot(wi + wo) > VISIBLE_SUM_MARGIN || {
             let w = wi.as_dvec3();
@@ -264,7 +280,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         if !visible {
             return 0.0;
         }
-        self.model.slope().reflection_density_unchecked(wi, wo)
+        slope.reflection_density_unchecked(wi, wo)
     }
 
     /// The phase-function density of ωo from the incident state `at`.

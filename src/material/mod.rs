@@ -201,6 +201,25 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         rng: &mut impl Rng,
     ) -> PhaseSample;
 
+    /// [`Material::sample_phase`] of mirror facets ([`Material::MIRROR_FACETS`]) from the two
+    /// uniforms of the visible normal (the ones `sample_phase` draws, in that order), without
+    /// the argument check, for callers that hold the uniforms themselves (the renderer
+    /// layer's single scattering). Other materials never have it called and return a NaN
+    /// direction with a zero weight.
+    #[doc(hidden)]
+    #[inline]
+    #[must_use]
+    fn sample_mirror_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        u1: f32,
+        u2: f32,
+    ) -> PhaseSample {
+        let _ = (slope, wi, u1, u2);
+        PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: Side::Outside }
+    }
+
     /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[must_use]

@@ -111,7 +111,9 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
     #[inline(always)]
     fn sample(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
         match self.technique {
-            Technique::SingleScattering => self.single().sample(walk_in, rng).map(|s| (s.wo, s.weight, s.pdf)),
+            Technique::SingleScattering => {
+                self.single().sample(walk_in, rng).map(|s| (s.wo, s.weight, s.pdf))
+            }
             Technique::RandomWalk => self.surface.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
             Technique::PositionFree { shadowing, .. } => {
                 self.pf(shadowing).sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0))

@@ -52,7 +52,8 @@ pub enum Technique {
     /// energy of higher orders. Valid for backfacing view directions (normal mapping): the
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
-    /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term) for every
+    /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term or GGX's f32
+    /// conductor density, see [`crate::SingleScattering::pdf`]) for every
     /// roughness; samples whose pdf or f would be subnormal are not returned (at most
     /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::SingleScattering::sample`] for the f32
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
@@ -382,10 +383,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         let weight = weight * self.transport_scale(wo, wi);
         let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z.abs());
         // NaN fails every comparison; wi.z = 0 gives f_max = ∞ or NaN
-        if !(pdf >= f32::MIN_POSITIVE
-            && pdf <= f32::MAX
-            && f_max >= f64::from(f32::MIN_POSITIVE)
-            && f_max <= f64::MAX
+        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf)
+            && (f64::from(f32::MIN_POSITIVE)..=f64::MAX).contains(&f_max)
             && weight.max_element() <= f32::MAX)
         {
             return None;
@@ -403,7 +402,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     #[inline(always)]
     fn exact_reflection(&self, wo: Vec3, wi: Vec3, weight: Vec3, pdf: f32) -> Option<BsdfSample> {
         let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z);
-        if !(pdf >= f32::MIN_POSITIVE && pdf <= f32::MAX && f_max >= f64::from(f32::MIN_POSITIVE)) {
+        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf) && f_max >= f64::from(f32::MIN_POSITIVE)) {
             return None;
         }
         let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };

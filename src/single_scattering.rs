@@ -5,9 +5,14 @@
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::position_free::{Incident, PositionFree, Shadowing, VertexRole};
+use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
+
+/// An f32 value of ωi·(ωi + ωo) above this is positive in exact arithmetic (its rounding error
+/// is below 3 ulps of 2, 4e-7).
+const VISIBLE_SUM_MARGIN: f32 = 1e-6;
 
 /// An outgoing direction sampled from the single-scattering BSDF, with its weight and density.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -105,7 +110,10 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     }
 
     /// The density with which [`SingleScattering::sample`] draws ωo: the material's phase-function
-    /// density (exact for conductors and dielectrics).
+    /// density (exact for conductors and dielectrics). For a conductor with ωi and ωo above
+    /// the horizon, D(ωh)/(4 A(ωi)): GGX evaluates it in f32 from the unnormalized half
+    /// vector (relative error below 4e-6 for every α and pair of directions), other slopes in
+    /// f64 (a few f32 ulps); `sample` and `eval_with_pdf` return the same bits.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
@@ -132,7 +140,11 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// the albedo of a diffuse facet, 1 for a dielectric), with the density of ωo
     /// ([`SingleScattering::pdf`] at the returned direction, bit for bit). The masking ratio
     /// is formed in f64 (from logarithms where Λ underflows, backfacing Beckmann views), so
-    /// that the weight equals f·|cos θo|/pdf at the returned f32 direction to a few f32 ulps.
+    /// that the weight equals f·|cos θo|/pdf at the returned f32 direction to a few f32 ulps;
+    /// for a conductor seen from above the horizon it is formed from the f32 Λ (no
+    /// cancellation there) and the density is GGX's f32 form (relative error below 4e-6, see
+    /// [`SingleScattering::pdf`]), so the weight equals f·|cos θo|/pdf to within 1e-5 (with
+    /// the Fresnel term taken at the sampled normal, see [`Conductor`](crate::Conductor)).
     /// `None` if ωi cannot light the material (on the horizon, or at the nadir of an opaque
     /// material) or the sampled direction cannot leave the surface. Resolution limit of
     /// backfacing Beckmann views below α ≈ 1e-3: see [`PositionFree::sample_single`].
@@ -159,6 +171,9 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::pdf`] for directions the caller has validated.
     #[inline(always)]
     pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if M::MIRROR_FACETS && wi.z > 0.0 && wo.z > 0.0 {
+            return Self::mirror_density(self.model.slope(), wi, wo);
+        }
         let (Some(start), Some(wo_side)) =
             (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
         else {
@@ -186,7 +201,14 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
             return (f_cos, self.density(at, wo, wo_side));
         }
         let m = self.model.material();
-        let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+        let (vertex, pdf) = if M::MIRROR_FACETS {
+            // the density `pdf` and `sample` give (wo is above the horizon: `exit_side`)
+            let vertex = m.vertex_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+            (vertex, Self::mirror_density(self.model.slope(), wi, wo))
+        } else {
+            let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+            (vertex, pdf)
+        };
         let factor = self.model.shadowing_factor(at, k_in, self.model.exit(wo, wo_side), VertexRole::Last);
         ((vertex.as_dvec3() * factor).as_vec3(), pdf)
     }
@@ -194,6 +216,11 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::sample`] for a direction the caller has validated.
     #[inline(always)]
     pub(crate) fn sample_unchecked(&self, wi: Vec3, rng: &mut impl Rng) -> Option<SingleSample> {
+        if M::MIRROR_FACETS && wi.z > 0.0 {
+            // the uniforms in the order the material's own sampler draws them
+            let (u1, u2) = (uniform(rng), uniform(rng));
+            return Self::sample_mirror_front(self.model.slope(), self.model.material(), wi, u1, u2);
+        }
         let at = PositionFree::<S, M>::incident(wi)?;
         let (slope, m) = (self.model.slope(), self.model.material());
         let s = m.sample_phase_unchecked(slope, at.w, at.side, rng);
@@ -213,6 +240,55 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         // the density at the returned f32 direction, as `pdf` computes it
         let pdf = m.pdf_phase_unchecked(slope, &at.to(s.wo, s.side));
         Some(SingleSample { wo: s.wo, weight, pdf })
+    }
+
+    /// [`SingleScattering::sample`] of mirror facets ([`Material::MIRROR_FACETS`]: conductors)
+    /// seen from above the horizon (ωi.z > 0, unit), from the two uniforms of the visible
+    /// normal: ωm ~ D_ωi, ωo = reflect(ωi, ωm), the weight F·G2/G1 with G2/G1 = (1 + Λi)/(1 +
+    /// Λi + Λo) from the f32 Λ (above the horizon Λ has no cancellation and saturates only at
+    /// cos θ = 0: a few f32 ulps), written 1/(1 + Λo/(1 + Λi)) so that it cannot overflow, and
+    /// the density `pdf` gives at the returned direction. The weight is finite (F ∈ [0, 1],
+    /// G2/G1 ∈ (0, 1]) and ωo unit (renormalized). `None` if ωo points into the surface or
+    /// lies within rounding of −ωi (no visible half vector: eval is 0 there).
+    /// Takes the slope and the material by reference (the renderer layer holds them, and
+    /// copying them into a `SingleScattering` costs as much as a Λ).
+    #[inline(always)]
+    pub(crate) fn sample_mirror_front(
+        slope: &S,
+        material: &M,
+        wi: Vec3,
+        u1: f32,
+        u2: f32,
+    ) -> Option<SingleSample> {
+        let s = material.sample_mirror_unchecked(slope, wi, u1, u2);
+        let exits = s.wo.z > 0.0;
+        if !exits {
+            return None;
+        }
+        let last = 1.0 / (1.0 + slope.lambda_unchecked(s.wo) / (1.0 + slope.lambda_unchecked(wi)));
+        let pdf = Self::mirror_density(slope, wi, s.wo);
+        (last > 0.0 && pdf > 0.0).then(|| SingleSample { wo: s.wo, weight: s.weight * last, pdf })
+    }
+
+    /// The density of a reflection of mirror facets ([`Material::MIRROR_FACETS`]) between ωi
+    /// and ωo strictly above the horizon: D(ωh)/(4 A(ωi)) from the slope
+    /// ([`MicrosurfaceSlope::reflection_density_unchecked`]; for GGX in f32, relative error
+    /// below 4e-6), the one function `pdf`, `eval_with_pdf` and `sample` share, so that their
+    /// densities agree bit for bit.
+    /// 0 where the half vector is not a facet normal ωi can see (ωi·(ωi + ωo) ≤ 0, in f64 as
+    /// the reflection half vector is tested for `eval`: only for ωo within
+    /// rounding of −ωi, where the f32 directions' lengths decide the sign).
+    #[inline(always)]
+    pub(crate) fn mirror_density(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
+        // the f32 dot product of ωi with ωi + ωo (|ωi + ωo| ≤ 2) is within 4e-7 of the exact one
+        let visible = wi.dot(wi + wo) > VISIBLE_SUM_MARGIN || {
+            let w = wi.as_dvec3();
+            w.dot(w + wo.as_dvec3()) > 0.0
+        };
+        if !visible {
+            return 0.0;
+        }
+        slope.reflection_density_unchecked(wi, wo)
     }
 
     /// The phase-function density of ωo from the incident state `at`.

@@ -1,6 +1,6 @@
 //! The renderer-facing BSDF of a microsurface, with a choice of technique.
 
-use super::seed::{Hasher, PrimedRng};
+use super::seed::{Hasher, PrimedPcg, PrimedRng};
 use super::specular::SpecularLimit;
 use super::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
@@ -52,7 +52,8 @@ pub enum Technique {
     /// energy of higher orders. Valid for backfacing view directions (normal mapping): the
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
-    /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term) for every
+    /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term or GGX's f32
+    /// conductor density, see [`crate::SingleScattering::pdf`]) for every
     /// roughness; samples whose pdf or f would be subnormal are not returned (at most
     /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::SingleScattering::sample`] for the f32
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
@@ -363,6 +364,52 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         if f.is_finite() { f } else { Vec3::ZERO }
     }
 
+    /// The sample of direction `wi` with the research layer's finite weight and density `pdf`
+    /// (exact or not: `exact_pdf`): the transport factor applied, and `None` unless the density
+    /// and the BSDF value f = weight·pdf/|cos θi| the sample implies are normal f32 numbers: a
+    /// subnormal one has lost its precision, and eval could not reproduce
+    /// weight = f·|cos θi|/pdf (deep tails: Beckmann dielectric α = 1 at cos θo = 1e-3 gave
+    /// f = 2e-45, 33 % off). Dropping such samples loses at most 4π·f32::MIN_POSITIVE of
+    /// probability and π·f32::MIN_POSITIVE of energy.
+    #[inline(always)]
+    fn finish_sample(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        weight: Vec3,
+        pdf: f32,
+        exact_pdf: bool,
+    ) -> Option<BsdfSample> {
+        let weight = weight * self.transport_scale(wo, wi);
+        let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z.abs());
+        // NaN fails every comparison; wi.z = 0 gives f_max = ∞ or NaN
+        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf)
+            && (f64::from(f32::MIN_POSITIVE)..=f64::MAX).contains(&f_max)
+            && weight.max_element() <= f32::MAX)
+        {
+            return None;
+        }
+        // light never crosses an opaque surface: under a normal map wo and wi may lie on
+        // opposite sides of the shading plane, and that is still a reflection
+        let reflection = !M::TRANSMITS || (wi.z > 0.0) == (wo.z > 0.0);
+        let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf };
+        Some(BsdfSample { wi, weight, pdf, eta: self.relative_eta(wo, wi), flags })
+    }
+
+    /// The sample of an exact single-scattering reflection above the horizon (`wi.z > 0`, a
+    /// finite weight) if its density and the BSDF value it implies are normal f32 numbers (see
+    /// `sample_keyed`).
+    #[inline(always)]
+    fn exact_reflection(&self, wo: Vec3, wi: Vec3, weight: Vec3, pdf: f32) -> Option<BsdfSample> {
+        let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z);
+        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf) && f_max >= f64::from(f32::MIN_POSITIVE)) {
+            return None;
+        }
+        let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
+        let weight = weight * self.transport_scale(wo, wi);
+        Some(BsdfSample { wi, weight, pdf, eta: 1.0, flags })
+    }
+
     /// The Dirac lobe's sample.
     #[inline]
     fn sample_specular(&self, wo: Vec3, uc: f32) -> Option<BsdfSample> {
@@ -411,56 +458,45 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         if self.dirac(wo) {
             return self.sample_specular(wo, uc);
         }
+        if M::MIRROR_FACETS && self.technique == Technique::SingleScattering && wo.z > 0.0 {
+            // a conductor seen from above: the caller's (u.x, u.y) are the visible normal's
+            // uniforms, taken as they are (no generator, no hash); the research sample's
+            // weight is finite and its direction unit and above the horizon by construction
+            let (slope, material) = (self.surface.slope(), self.surface.material());
+            let s = SingleScattering::sample_mirror_front(slope, material, wo, u.x, u.y)?;
+            return self.exact_reflection(wo, s.wo, s.weight, s.pdf);
+        }
         let seed = self.seed;
         let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
         let uniforms = [u.x, u.y, uc];
         let walk_in = wo;
-        let (walk_out, weight, pdf, exact_pdf) = match self.technique {
+        let s = match self.technique {
             Technique::SingleScattering => {
                 // at most the phase function's uniforms: the private generator (and its hash)
-                // is built only if a material draws more than the caller gave
+                // is built only if a material draws more than the caller gave. The research
+                // sample's weight is finite and its direction unit (`SingleScattering::sample`)
                 let mut rng = PrimedRng::new(&uniforms, hash);
                 let s = self.single().sample_unchecked(walk_in, &mut rng)?;
-                (s.wo, s.weight, Some(s.pdf), M::EXACT_PHASE_PDF)
+                return self.finish_sample(wo, s.wo, s.weight, s.pdf, M::EXACT_PHASE_PDF);
             }
             Technique::RandomWalk => {
                 // the walk draws the height of its first intersection first: from the private
                 // generator, so that the caller's uniforms drive the first visible normal
-                let mut rng = PrimedRng::after_one_private(&uniforms, hash);
-                let s = self.surface.sample(walk_in, &mut rng).filter(|s| self.order.includes(s.bounces))?;
-                (s.wo, s.weight, None, false)
+                let mut rng = PrimedPcg::after_one_private(&uniforms, hash());
+                self.surface.sample(walk_in, &mut rng)
             }
             Technique::PositionFree { shadowing, .. } => {
-                let mut rng = PrimedRng::new(&uniforms, hash);
-                let s = self
-                    .position_free(shadowing)
-                    .sample(walk_in, &mut rng)
-                    .filter(|s| self.order.includes(s.bounces))?;
-                (s.wo, s.weight, None, false)
+                // the estimators draw beyond the caller's uniforms from the first bounce on
+                let mut rng = PrimedPcg::new(&uniforms, hash());
+                self.position_free(shadowing).sample(walk_in, &mut rng)
             }
         };
-        let wi = walk_out;
-        let pdf = pdf.unwrap_or_else(|| self.research_pdf_out(walk_in, walk_out));
-        let weight = weight * self.transport_scale(wo, wi);
-        // the density and the BSDF value f = weight·pdf/|cos θi| the sample implies must be
-        // normal f32 numbers: a subnormal one has lost its precision, and eval could not
-        // reproduce weight = f·|cos θi|/pdf (deep tails: Beckmann dielectric α = 1 at
-        // cos θo = 1e-3 gave f = 2e-45, 33 % off). Dropping such samples loses at most
-        // 4π·f32::MIN_POSITIVE of probability and π·f32::MIN_POSITIVE of energy.
-        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite() && weight.is_finite() && super::is_direction(wi))
-            || wi.z == 0.0
-        {
+        let s = s.filter(|s| self.order.includes(s.bounces))?;
+        let walk_out = s.wo;
+        if !(s.weight.is_finite() && super::is_direction(walk_out)) {
             return None;
         }
-        let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z.abs());
-        if f_max < f64::from(f32::MIN_POSITIVE) {
-            return None;
-        }
-        // light never crosses an opaque surface: under a normal map wo and wi may lie on
-        // opposite sides of the shading plane, and that is still a reflection
-        let reflection = !M::TRANSMITS || (wi.z > 0.0) == (wo.z > 0.0);
-        let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf };
-        Some(BsdfSample { wi, weight, pdf, eta: self.relative_eta(wo, wi), flags })
+        self.finish_sample(wo, walk_out, s.weight, self.research_pdf_out(walk_in, walk_out), false)
     }
 
     /// One validation of the directions for both; single scattering also shares the half

@@ -105,6 +105,7 @@ impl Conductor {
 impl Material for Conductor {
     const TRANSMITS: bool = false;
     const EXACT_PHASE_PDF: bool = true;
+    const MIRROR_FACETS: bool = true;
 
     #[inline]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(
@@ -159,7 +160,20 @@ impl Material for Conductor {
         _side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        // the uniforms in the order drawn: the visible normal's u1, then u2
+        let (u1, u2) = (uniform(rng), uniform(rng));
+        self.sample_mirror_unchecked(slope, wi, u1, u2)
+    }
+
+    #[inline(always)]
+    fn sample_mirror_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        u1: f32,
+        u2: f32,
+    ) -> PhaseSample {
+        let wm = slope.sample_d_wi_unchecked(wi, u1, u2);
         let c = wi.dot(wm);
         let wo = renormalize(reflect(wi, wm), wm);
         // near-perpendicular facets: ωo is within (ulp of ωo)/c of −ωi... the half vector that

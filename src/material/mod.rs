@@ -71,6 +71,13 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// Whether [`Material::pdf_phase`] is the exact density of [`Material::sample_phase`].
     const EXACT_PHASE_PDF: bool;
 
+    /// Whether the facets are mirrors with a per-channel weight w(ωi·ωh) (conductors): the
+    /// phase function of an outside reflection is w·D(ωh)/(4 A(ωi)), the sampler reflects ωi
+    /// about ωm ~ D_ωi with weight w, and nothing crosses the surface. Single scattering then
+    /// forms its density and masking ratio from the slope directly (`SingleScattering`).
+    #[doc(hidden)]
+    const MIRROR_FACETS: bool = false;
+
     /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
     /// interaction's sides. Stochastic (unbiased) for the diffuse material, exact otherwise
     /// (the formulas are on each material's type).
@@ -193,6 +200,25 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample;
+
+    /// [`Material::sample_phase`] of mirror facets ([`Material::MIRROR_FACETS`]) from the two
+    /// uniforms of the visible normal (the ones `sample_phase` draws, in that order), without
+    /// the argument check, for callers that hold the uniforms themselves (the renderer
+    /// layer's single scattering). Other materials never have it called and return a NaN
+    /// direction with a zero weight.
+    #[doc(hidden)]
+    #[inline]
+    #[must_use]
+    fn sample_mirror_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        u1: f32,
+        u2: f32,
+    ) -> PhaseSample {
+        let _ = (slope, wi, u1, u2);
+        PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: Side::Outside }
+    }
 
     /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]

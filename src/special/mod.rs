@@ -8,6 +8,7 @@ mod erf;
 mod erfcx;
 mod erfinv;
 mod gamma;
+mod gaussian;
 mod trig;
 
 pub use erf::{erf, erfc};
@@ -16,4 +17,5 @@ pub(crate) use erfcx::{PSI_SERIES_FROM, erfcx64, one_minus_scaled_erfcx};
 pub use erfinv::erfinv;
 pub(crate) use erfinv::{erfc_inv_f32, erfinv_from_both_ends, erfinv64};
 pub use gamma::{beta, ln_beta, ln_gamma};
+pub(crate) use gaussian::gaussian_integral_and_half;
 pub use trig::sin_cos_turns;

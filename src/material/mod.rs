@@ -213,7 +213,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// share its random facet between the two: the evaluation's expectation given everything
     /// before it is unchanged, so the walk's estimate stays unbiased (crate-internal hot path).
     #[doc(hidden)]
-    #[inline]
+    #[inline(always)]
     #[must_use]
     fn eval_and_sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,

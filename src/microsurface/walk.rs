@@ -137,25 +137,28 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         for bounce in 1..=last {
             let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else { break };
             ln_c1 = hit.ln_c1;
-            let continues = bounce != last;
-            let sampled = if order.includes(bounce) {
-                let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
-                // next-event estimation and the next direction in one material call
-                let (phase, sampled) = if continues {
-                    let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
-                    (phase, Some(s))
-                } else {
-                    (self.material.eval_phase_unchecked(slope, &it, rng), None)
-                };
-                if phase != Vec3::ZERO {
-                    let ln_c1_o = if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) };
-                    sum += throughput * phase * (lambda_o * ln_c1_o).exp();
+            let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
+            let escape = || (lambda_o * if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) }).exp();
+            let includes = order.includes(bounce);
+            if bounce == last {
+                if includes {
+                    let phase = self.material.eval_phase_unchecked(slope, &it, rng);
+                    if phase != Vec3::ZERO {
+                        sum += throughput * phase * escape();
+                    }
                 }
-                sampled
+                break;
+            }
+            let s = if includes {
+                // next-event estimation and the next direction in one material call
+                let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
+                if phase != Vec3::ZERO {
+                    sum += throughput * phase * escape();
+                }
+                s
             } else {
-                continues.then(|| self.material.sample_phase_unchecked(slope, -wr, side, rng))
+                self.material.sample_phase_unchecked(slope, -wr, side, rng)
             };
-            let Some(s) = sampled else { break };
             let next_side = Self::side_after(s.side);
             if next_side != side {
                 ln_c1 = flip_ln_c1(ln_c1);

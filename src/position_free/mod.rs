@@ -499,16 +499,21 @@ mod tests {
         }
     }
 
-    /// The same for bidirectional path tracing, with N = 50 000 so that σ̂/√N ≤ 0.0025 (σ̂ ≈ 0.56),
-    /// z = 3.29 (Šidák, family-wise 1e-3 over the two shadowing models). It fails today: the
-    /// correlated model gives 0.9912 ± 0.0009 (N = 400 000). Ignored until the cause is fixed
-    /// (DESIGN.md, “BDPT from below at a = 28.9: what is known”).
+    /// The same for bidirectional path tracing with correlated shadowing, N = 80 000 so that
+    /// σ̂/√N ≤ 0.0025 (σ̂ ≈ 0.57: 0.002), z = 3.29 (two-sided 1e-3). Before, the balance weight of
+    /// a camera path whose own f32 density rounded to 0 was 0/0 = NaN and the path was dropped:
+    /// 0.9912 ± 0.0009 (N = 400 000), 4.4 σ̂/√N below 1 at this N.
     #[test]
-    #[ignore = "open defect (issue 14): BDPT's albedo from below at a = 28.9 is 0.991, not 1"]
     fn bdpt_from_below_conserves_energy_for_smooth_beckmann() {
-        for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
-            assert_albedo_from_below_is_one(shadowing, Estimator::Bdpt, 50_000, 0.0025, 3.29);
-        }
+        assert_albedo_from_below_is_one(Shadowing::Correlated, Estimator::Bdpt, 80_000, 0.0025, 3.29);
+    }
+
+    /// The uncorrelated model in the same test fails today: 0.9903 ± 0.0018. Ignored until the
+    /// cause is found (DESIGN.md, “BDPT from below at a = 28.9”).
+    #[test]
+    #[ignore = "open defect (issue 14): uncorrelated BDPT's albedo from below at a = 28.9 is 0.990, not 1"]
+    fn bdpt_uncorrelated_from_below_conserves_energy_for_smooth_beckmann() {
+        assert_albedo_from_below_is_one(Shadowing::Uncorrelated, Estimator::Bdpt, 80_000, 0.0025, 3.29);
     }
 
     /// The albedo ∫ f·cos dωo of the perfect mirror of `smooth_mirror` seen from

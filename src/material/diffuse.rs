@@ -66,6 +66,18 @@ impl Diffuse {
     }
 }
 
+impl Diffuse {
+    /// A direction from the Lambertian lobe of the facet with normal `wm` (cosine-weighted
+    /// about ωm), weighted by the albedo.
+    #[inline(always)]
+    fn sample_at_facet(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
+        let local = cosine_hemisphere(uniform(rng), uniform(rng));
+        let (t, b) = basis(wm);
+        let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
+        PhaseSample { wo, weight: self.albedo, side: Side::Outside }
+    }
+}
+
 impl Material for Diffuse {
     const TRANSMITS: bool = false;
     const EXACT_PHASE_PDF: bool = false;
@@ -116,10 +128,27 @@ impl Material for Diffuse {
         rng: &mut impl Rng,
     ) -> PhaseSample {
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
-        let local = cosine_hemisphere(uniform(rng), uniform(rng));
-        let (t, b) = basis(wm);
-        let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
-        PhaseSample { wo, weight: self.albedo, side: Side::Outside }
+        self.sample_at_facet(wm, rng)
+    }
+
+    /// One visible facet ωm ~ D_ωi for both: the estimate (a/π)⟨ωo, ωm⟩⁺ of the phase function
+    /// (unbiased given the walk so far, as in `eval_phase`) and the direction sampled from the
+    /// same facet. Saves one visible-normal sample per bounce of the walk's `eval`; the walk's
+    /// random stream differs from that of the separate calls.
+    #[inline]
+    fn eval_and_sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        it: &Interaction,
+        rng: &mut impl Rng,
+    ) -> (Vec3, PhaseSample) {
+        let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
+        let phase = if it.is_outside_reflection() {
+            self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
+        } else {
+            Vec3::ZERO
+        };
+        (phase, self.sample_at_facet(wm, rng))
     }
 
     /// (a/π) ⟨ωo, ωm⟩ (1 + Λ(ωi))/(1 + Λ(ωi) + Λ(ωo)) with ωm drawn from D_ωi: the

@@ -231,6 +231,26 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     fn vertex_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction, rng: &mut impl Rng)
     -> Vec3;
 
+    /// The phase function at the interaction `it` (as [`Material::eval_phase`]) and a sample
+    /// of p(ωi, ·) from the same incident direction and side (as [`Material::sample_phase`]):
+    /// the two calls of a bounce of the walk's next-event estimation (supplement §3.1,
+    /// Algorithm 2). By default the two separate unchecked calls, in that order (the random
+    /// stream of the separate calls). A material whose evaluation is itself stochastic may
+    /// share its random facet between the two: the evaluation's expectation given everything
+    /// before it is unchanged, so the walk's estimate stays unbiased (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    #[must_use]
+    fn eval_and_sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        it: &Interaction,
+        rng: &mut impl Rng,
+    ) -> (Vec3, PhaseSample) {
+        let phase = self.eval_phase_unchecked(slope, it, rng);
+        (phase, self.sample_phase_unchecked(slope, it.wi(), it.wi_side(), rng))
+    }
+
     /// [`Material::connection`] without the argument check (crate-internal hot path): by
     /// default the three separate unchecked calls.
     #[doc(hidden)]

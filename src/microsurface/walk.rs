@@ -89,6 +89,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         Side::of(wi.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
     }
 
+    /// The side a phase sample leaves on, known at compile time for an opaque material
+    /// ([`Side::Outside`]), so that the walk's side bookkeeping (frames, flips of ln C¹)
+    /// folds away for conductors and diffuse facets, whose sampler is not inlined.
+    #[inline(always)]
+    fn side_after(sampled: Side) -> Side {
+        if M::TRANSMITS { sampled } else { Side::Outside }
+    }
+
     /// Evaluates the multiple-scattering BSDF times |cos θo| by a random walk with next-event
     /// estimation (supplement §3.1 Algorithm 2; §3.4 for the dielectric). Stochastic and
     /// unbiased: average several calls.
@@ -116,7 +124,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             return Vec3::ZERO;
         }
         let slope = self.geometry.slope();
-        let wo_side = Side::above_or_inside(wo.z);
+        let wo_side = if M::TRANSMITS { Side::above_or_inside(wo.z) } else { Side::Outside };
         // Λ of ωo seen from its own side, constant along the walk
         let lambda_o = slope.lambda_unchecked(wo_side.frame(wo));
         let last = order.last();
@@ -129,23 +137,34 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         for bounce in 1..=last {
             let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else { break };
             ln_c1 = hit.ln_c1;
-            if order.includes(bounce) {
-                let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
-                let phase = self.material.eval_phase_unchecked(slope, &it, rng);
-                if phase != Vec3::ZERO {
-                    let ln_c1_o = if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) };
-                    sum += throughput * phase * (lambda_o * ln_c1_o).exp();
-                }
-            }
+            let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
+            let escape = || (lambda_o * if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) }).exp();
+            let includes = order.includes(bounce);
             if bounce == last {
+                if includes {
+                    let phase = self.material.eval_phase_unchecked(slope, &it, rng);
+                    if phase != Vec3::ZERO {
+                        sum += throughput * phase * escape();
+                    }
+                }
                 break;
             }
-            let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
-            if s.side != side {
+            let s = if includes {
+                // next-event estimation and the next direction in one material call
+                let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
+                if phase != Vec3::ZERO {
+                    sum += throughput * phase * escape();
+                }
+                s
+            } else {
+                self.material.sample_phase_unchecked(slope, -wr, side, rng)
+            };
+            let next_side = Self::side_after(s.side);
+            if next_side != side {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
             wr = s.wo;
-            side = s.side;
+            side = next_side;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {
                 break;
@@ -187,11 +206,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             };
             ln_c1 = hit.ln_c1;
             let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
-            if s.side != side {
+            let next_side = Self::side_after(s.side);
+            if next_side != side {
                 ln_c1 = flip_ln_c1(ln_c1);
             }
             wr = s.wo;
-            side = s.side;
+            side = next_side;
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
@@ -234,16 +254,23 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut sum = Vec3::ZERO;
         let mut bounce = 1;
         loop {
-            if order.includes(bounce) {
-                let phase = self.material.eval_phase_unchecked(slope, &Interaction::reflection(-wr, wo), rng);
+            let continues = bounce != last;
+            let sampled = if order.includes(bounce) {
+                let it = Interaction::reflection(-wr, wo);
+                let (phase, sampled) = if continues {
+                    let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
+                    (phase, Some(s))
+                } else {
+                    (self.material.eval_phase_unchecked(slope, &it, rng), None)
+                };
                 if phase != Vec3::ZERO {
                     sum += throughput * phase * depth.escape_probability(ln_lambda_o) as f32;
                 }
-            }
-            if bounce == last {
-                break;
-            }
-            let s = self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng);
+                sampled
+            } else {
+                continues.then(|| self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng))
+            };
+            let Some(s) = sampled else { break };
             wr = s.wo;
             throughput *= s.weight;
             if throughput == Vec3::ZERO {

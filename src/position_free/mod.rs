@@ -494,30 +494,63 @@ mod tests {
     /// multiple scattering was lost (mean 0.915, 25 σ̂/√N below 1).
     #[test]
     fn pt_from_below_conserves_energy_for_smooth_beckmann() {
-        const N: usize = 20_000;
-        const Z: f64 = 3.29;
-        let wi = from_below();
         for shadowing in [Shadowing::Correlated, Shadowing::Uncorrelated] {
-            let pf = smooth_mirror(shadowing);
-            let mut rng = Pcg64Mcg::seed_from_u64(43);
-            let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
-            for _ in 0..N {
-                let wo = if uniform(&mut rng) < 1.0 - PDF_COSINE_SHARE {
-                    pf.material.sample_phase(&pf.slope, wi, Side::Outside, &mut rng).wo
-                } else {
-                    cosine_hemisphere(uniform(&mut rng), uniform(&mut rng))
-                };
-                let pdf = f64::from(pf.pdf(wi, wo));
-                let f = f64::from(pf.eval_pt(wi, wo, ScatteringOrder::All, &mut rng).x);
-                let x = if pdf > 0.0 { f / pdf } else { 0.0 };
-                (sum, sum_sq) = (sum + x, sum_sq + x * x);
-            }
-            let mean = sum / N as f64;
-            let sd = (sum_sq / N as f64 - mean * mean).max(0.0).sqrt();
-            let se = sd / (N as f64).sqrt();
-            let report = format!("{shadowing:?}: N = {N}, mean {mean}, σ̂ {sd}, z = {Z}");
-            assert!(se <= 0.01, "not resolved: {report}");
-            assert!((mean - 1.0).abs() <= Z * se, "{report}");
+            assert_albedo_from_below_is_one(shadowing, Estimator::Pt, 20_000, 0.01, 3.29);
         }
+    }
+
+    /// The same for bidirectional path tracing with correlated shadowing, N = 80 000 so that
+    /// σ̂/√N ≤ 0.0025 (σ̂ ≈ 0.57: 0.002), z = 3.29 (two-sided 1e-3). Before, the balance weight of
+    /// a camera path whose own f32 density rounded to 0 was 0/0 = NaN and the path was dropped:
+    /// 0.9912 ± 0.0009 (N = 400 000), 4.4 σ̂/√N below 1 at this N.
+    #[test]
+    fn bdpt_from_below_conserves_energy_for_smooth_beckmann() {
+        assert_albedo_from_below_is_one(Shadowing::Correlated, Estimator::Bdpt, 80_000, 0.0025, 3.29);
+    }
+
+    /// The uncorrelated model in the same test fails today: 0.9903 ± 0.0018. Ignored until the
+    /// cause is found (DESIGN.md, “BDPT from below at a = 28.9”).
+    #[test]
+    #[ignore = "open defect (issue 14): uncorrelated BDPT's albedo from below at a = 28.9 is 0.990, not 1"]
+    fn bdpt_uncorrelated_from_below_conserves_energy_for_smooth_beckmann() {
+        assert_albedo_from_below_is_one(Shadowing::Uncorrelated, Estimator::Bdpt, 80_000, 0.0025, 3.29);
+    }
+
+    /// The albedo ∫ f·cos dωo of the perfect mirror of `smooth_mirror` seen from
+    /// `from_below()` by `estimator` is 1: the mean of f·cos/pdf over N directions drawn from
+    /// the mixture whose density is [`PositionFree::pdf`] (0.8 phase sampling, 0.2 cosine)
+    /// agrees within z σ̂/√N, and σ̂/√N ≤ `max_se`.
+    fn assert_albedo_from_below_is_one(
+        shadowing: Shadowing,
+        estimator: Estimator,
+        n: usize,
+        max_se: f64,
+        z: f64,
+    ) {
+        let wi = from_below();
+        let pf = smooth_mirror(shadowing);
+        let mut rng = Pcg64Mcg::seed_from_u64(43);
+        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let wo = if uniform(&mut rng) < 1.0 - PDF_COSINE_SHARE {
+                pf.material.sample_phase(&pf.slope, wi, Side::Outside, &mut rng).wo
+            } else {
+                cosine_hemisphere(uniform(&mut rng), uniform(&mut rng))
+            };
+            let pdf = f64::from(pf.pdf(wi, wo));
+            let f = match estimator {
+                Estimator::Pt => pf.eval_pt(wi, wo, ScatteringOrder::All, &mut rng),
+                Estimator::Bdpt => pf.eval_bdpt(wi, wo, ScatteringOrder::All, &mut rng),
+            };
+            let x = if pdf > 0.0 { f64::from(f.x) / pdf } else { 0.0 };
+            (sum, sum_sq) = (sum + x, sum_sq + x * x);
+        }
+        let mean = sum / n as f64;
+        let sd = (sum_sq / n as f64 - mean * mean).max(0.0).sqrt();
+        let se = sd / (n as f64).sqrt();
+        let report =
+            format!("{estimator:?}, {shadowing:?}: N = {n}, mean {mean}, σ̂ {sd}, σ̂/√N {se}, z = {z}");
+        assert!(se <= max_se, "not resolved: {report}");
+        assert!((mean - 1.0).abs() <= z * se, "{report}");
     }
 }

@@ -7,9 +7,9 @@
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::SeedableRng;
 use microsurface::{
-    Beckmann, Bsdf, Dielectric, DielectricAlbedoTable, DielectricWalkTable, EtaRange, Ggx,
-    KullaContyDielectric, MAX_WALK_TABLE_SE, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Side,
-    Technique, Transport, UniformHeight, WalkTabulated,
+    Beckmann, Bsdf, Dielectric, DielectricWalkTable, EtaRange, Ggx, KullaContyDielectric, MAX_WALK_TABLE_SE,
+    MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Side, Technique, Transport, UniformHeight,
+    WalkTabulated,
 };
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::{Domain, integrate_sphere};

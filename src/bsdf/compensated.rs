@@ -2,6 +2,7 @@
 //! higher orders restored from the single-scattering albedo tables ([`AlbedoTable`]), with a
 //! deterministic eval, an exact pdf and a sampler (Kulla and Conty 2017; Turquin 2019).
 
+use super::lobe_profile::LobeProfile;
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::albedo::{
@@ -11,8 +12,6 @@ use crate::albedo::{
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
-use crate::special::sin_cos_turns;
-use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
 
 /// The last node index of the tables, as a float.
@@ -233,7 +232,7 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
             ([0.0; ALBEDO_TABLE_SIZE], 0.0, Profile::EMPTY)
         } else {
             let c = blended_complement(&S::ALBEDO, alpha);
-            let (average, profile) = average_of_complement(&c, f64::from(alpha));
+            let (average, profile) = average_of_complement(&c, alpha);
             (c, average, profile)
         };
         let fresnel_average = fresnel_average(&conductor);
@@ -267,7 +266,7 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
                 let mut norm = DVec3::ZERO;
                 for c in 0..3 {
                     let h: [f32; ALBEDO_TABLE_SIZE] = core::array::from_fn(|i| lobe[i][c]);
-                    norm[c] = core::f64::consts::PI * average_of_complement(&h, f64::from(alpha)).0;
+                    norm[c] = core::f64::consts::PI * average_of_complement(&h, alpha).0;
                 }
                 norm.as_vec3()
             }
@@ -394,24 +393,14 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// d_i μi/π with d_i the cell's probability over its Δμ² (see [`Profile`]).
     #[inline(always)]
     fn profile_pdf(&self, wi: Vec3) -> f32 {
-        if wi.z > 0.0 { self.profile.density[self.cell(wi.z).0] * wi.z * FRAC_1_PI } else { 0.0 }
+        if wi.z > 0.0 { self.profile.pdf(self.cell(wi.z).0, wi.z) } else { 0.0 }
     }
 
     /// Samples the Kulla–Conty lobe's sampler from u ∈ [0, 1)²: a cell by its probability,
     /// μ² uniform in the cell, φ uniform. `None` on the horizon.
     #[inline(always)]
     fn sample_profile(&self, u: Vec2) -> Option<Vec3> {
-        let cdf = &self.profile.cdf;
-        // the first cell whose cumulative probability exceeds u.x
-        let i = cdf[1..].partition_point(|&c| c <= u.x).min(ALBEDO_TABLE_SIZE - 2);
-        let width = cdf[i + 1] - cdf[i];
-        let v = if width > 0.0 { ((u.x - cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
-        let (m0, m1) = (self.profile.mu_sq[i], self.profile.mu_sq[i + 1]);
-        let mu_sq = m0 + v * (m1 - m0);
-        let mu = mu_sq.sqrt();
-        let sin_theta = (1.0 - mu_sq).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = sin_cos_turns(u.y);
-        (mu > 0.0).then(|| Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, mu))
+        self.profile.sample(u)
     }
 
     /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
@@ -451,7 +440,7 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         }
         let (i, f) = self.cell(wi.z);
         let lobe = h_o * self.lobe[i].lerp(self.lobe[i + 1], f);
-        (lobe, p * pdf_ss + (1.0 - p) * (self.profile.density[i] * wi.z * FRAC_1_PI))
+        (lobe, p * pdf_ss + (1.0 - p) * self.profile.pdf(i, wi.z))
     }
 
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
@@ -598,81 +587,16 @@ fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZ
     out
 }
 
-/// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi: cell i of the direction
-/// axis is chosen with probability M_i/c̄ (M_i = ∫_cell (1 − E) d(μ²), c̄ = Σ M_i = 1 − E_avg),
-/// and μ² is uniform within it, so its density in solid angle is d_i μ/π with
-/// d_i = P_i/Δμ²_i: the lobe's profile with 1 − E replaced by its mean over the cell, and the
-/// sample weight of the lobe is F_ms (1 − E(μo)) times (1 − E(μi)) over that mean (between 0
-/// and 2 for a linear 1 − E).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Profile {
-    /// Cumulative probabilities of the cells (0 first, 1 last).
-    cdf: [f32; ALBEDO_TABLE_SIZE],
-    /// μ² at the direction nodes.
-    mu_sq: [f32; ALBEDO_TABLE_SIZE],
-    /// d_i per cell.
-    density: [f32; ALBEDO_TABLE_SIZE - 1],
-}
-
-impl Profile {
-    /// No lobe (a Dirac mirror).
-    const EMPTY: Profile = Profile {
-        cdf: [0.0; ALBEDO_TABLE_SIZE],
-        mu_sq: [0.0; ALBEDO_TABLE_SIZE],
-        density: [0.0; ALBEDO_TABLE_SIZE - 1],
-    };
-}
+/// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi on the tables' 32-node
+/// direction axis: the sample weight of the lobe is F_ms (1 − E(μo)) times (1 − E(μi)) over its
+/// mean in the cell (between 0 and 2 for a linear 1 − E).
+type Profile = LobeProfile<ALBEDO_TABLE_SIZE>;
 
 /// c̄ = ∫₀¹ c(μ) 2μ dμ for c linear in x on each cell [i/31, (i+1)/31] of the direction axis
-/// x = √(μ (1 + α)/(μ + α)), i.e. μ = α x²/(1 + α − x²), in closed form, and the sampler of
-/// c(μ) μ built from the cells' masses:
-///
-/// ∫ (a + b x) d(μ²) = a Δμ² + b Δ(x μ²) − b α² ΔP,   P(x) = ∫ x⁴/(k − x²)² dx
-///                   = x + k x / (2 (k − x²)) − (3√k/2) atanh(x/√k),   k = 1 + α.
-///
-/// In f64; the differences of P across a cell lose at most log₂(1/α) bits (1e-13 at
-/// α = 1e-3).
-fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f64) -> (f64, Profile) {
-    let k = 1.0 + alpha;
-    let sk = k.sqrt();
-    let mu_sq = |x: f64| {
-        if x >= 1.0 {
-            return 1.0;
-        }
-        let m = alpha * x * x / (k - x * x);
-        m * m
-    };
-    let p = |x: f64| x + k * x / (2.0 * (k - x * x)) - 1.5 * sk * (x / sk).atanh();
-    let h = 1.0 / f64::from(LAST);
-    let mut masses = [0.0f64; ALBEDO_TABLE_SIZE - 1];
-    for (i, mass) in masses.iter_mut().enumerate() {
-        let (x0, x1) = (i as f64 * h, if i == ALBEDO_TABLE_SIZE - 2 { 1.0 } else { (i + 1) as f64 * h });
-        let (c0, c1) = (f64::from(c[i]), f64::from(c[i + 1]));
-        let b = (c1 - c0) / h;
-        let a = c0 - b * x0;
-        let (m0, m1) = (mu_sq(x0), mu_sq(x1));
-        // ≥ 0 for c ≥ 0; rounding can leave −1e-20 in a cell of c = 0
-        *mass = (a * (m1 - m0) + b * (x1 * m1 - x0 * m0) - b * alpha * alpha * (p(x1) - p(x0))).max(0.0);
-    }
-    let total: f64 = masses.iter().sum();
-    let mut profile = Profile::EMPTY;
-    if total > 0.0 {
-        let mut acc = 0.0;
-        for i in 0..ALBEDO_TABLE_SIZE {
-            profile.mu_sq[i] = mu_sq(if i == ALBEDO_TABLE_SIZE - 1 { 1.0 } else { i as f64 * h }) as f32;
-            profile.cdf[i] = (acc / total) as f32;
-            if let Some(m) = masses.get(i) {
-                acc += m;
-            }
-        }
-        profile.cdf[ALBEDO_TABLE_SIZE - 1] = 1.0;
-        for i in 0..ALBEDO_TABLE_SIZE - 1 {
-            let prob = f64::from(profile.cdf[i + 1]) - f64::from(profile.cdf[i]);
-            let width = f64::from(profile.mu_sq[i + 1]) - f64::from(profile.mu_sq[i]);
-            profile.density[i] = if width > 0.0 { (prob / width) as f32 } else { 0.0 };
-        }
-    }
-    (total, profile)
+/// x = √(μ (1 + α)/(μ + α)), in closed form, and the sampler of c(μ) μ
+/// ([`LobeProfile::new`]).
+fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f32) -> (f64, Profile) {
+    LobeProfile::new(c, alpha)
 }
 
 /// The factor h = g/√(π ḡ) of the per-order lobe g(μo) g(μi)/(π ḡ) at the direction nodes
@@ -724,7 +648,7 @@ fn per_order_lobe(
     }
     let mut h = [Vec3::ZERO; ALBEDO_TABLE_SIZE];
     for (c, g) in g.iter().enumerate() {
-        let (average, _) = average_of_complement(g, f64::from(alpha));
+        let (average, _) = average_of_complement(g, alpha);
         let norm = if average > 0.0 { 1.0 / (core::f64::consts::PI * average).sqrt() } else { 0.0 };
         for (h, &gi) in h.iter_mut().zip(g) {
             h[c] = (f64::from(gi) * norm) as f32;
@@ -781,7 +705,7 @@ mod tests {
                 })
                 .sum();
             let exact = b.complement_average;
-            let cdf = b.profile.cdf;
+            let cdf = *b.profile.cdf();
             assert!(
                 cdf[0] == 0.0 && cdf[ALBEDO_TABLE_SIZE - 1] == 1.0 && cdf.windows(2).all(|w| w[0] <= w[1])
             );

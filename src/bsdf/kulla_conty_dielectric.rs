@@ -56,9 +56,9 @@ struct SideLobes {
     /// The radiance factor (η_wo/η_wi)² of a transmission from this side, or 1 (importance).
     transmitted_transport: f32,
     /// The sampler of ΔR(μ) μ on this side.
-    reflected_profile: LobeProfile,
+    reflected_profile: LobeProfile<PROFILE_NODES>,
     /// The sampler of ΔT(μ) μ on this side (used for light arriving from the other side).
-    transmitted_profile: LobeProfile,
+    transmitted_profile: LobeProfile<PROFILE_NODES>,
 }
 
 /// A dielectric microfacet BSDF compensated with the random walk's higher orders, reflection

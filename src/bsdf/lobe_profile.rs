@@ -38,39 +38,36 @@ pub(crate) fn row_at(row: &[f32; PROFILE_NODES], (i, f): (usize, f32)) -> f32 {
     row[i] + f * (row[i + 1] - row[i])
 }
 
-/// The sampler of g(μ) μ for g ≥ 0 linear in x on each cell of the direction axis: cell i is
-/// chosen with probability M_i/ḡ (M_i = ∫_cell g d(μ²), ḡ = Σ M_i = 2∫₀¹ g μ dμ), μ² uniform
-/// within it, φ uniform, so its density in solid angle is d_i μ/π with d_i = P_i/Δμ²_i: the
-/// profile with g replaced by its mean over the cell (the weight g/mean lies in [0, 2] for a
-/// linear g).
+/// The sampler of g(μ) μ for g ≥ 0 linear in x on each cell of an `N`-node direction axis
+/// x = √(μ (1 + α)/(μ + α)) (node i at x = i/(N − 1)): cell i is chosen with probability
+/// M_i/ḡ (M_i = ∫_cell g d(μ²), ḡ = Σ M_i = 2∫₀¹ g μ dμ), μ² uniform within it, φ uniform, so
+/// its density in solid angle is d_i μ/π with d_i = P_i/Δμ²_i: the profile with g replaced by
+/// its mean over the cell (the weight g/mean lies in [0, 2] for a linear g). The conductor's
+/// lobes use the 32 nodes of its tables, the dielectric's the 16 of theirs.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct LobeProfile {
+pub(crate) struct LobeProfile<const N: usize> {
     /// Cumulative probabilities of the cells (0 first, 1 last).
-    cdf: [f32; PROFILE_NODES],
+    cdf: [f32; N],
     /// μ² at the direction nodes.
-    mu_sq: [f32; PROFILE_NODES],
-    /// d_i per cell.
-    density: [f32; PROFILE_NODES - 1],
+    mu_sq: [f32; N],
+    /// d_i per cell (the last entry unused, 0).
+    density: [f32; N],
 }
 
-impl LobeProfile {
+impl<const N: usize> LobeProfile<N> {
     /// No lobe.
-    pub(crate) const EMPTY: LobeProfile = LobeProfile {
-        cdf: [0.0; PROFILE_NODES],
-        mu_sq: [0.0; PROFILE_NODES],
-        density: [0.0; PROFILE_NODES - 1],
-    };
+    pub(crate) const EMPTY: Self = Self { cdf: [0.0; N], mu_sq: [0.0; N], density: [0.0; N] };
 
-    /// ḡ = 2∫₀¹ g(μ) μ dμ of the row g (node values at x = i/15, linear in x between them) at
-    /// roughness α, in closed form, and the sampler of g μ. With μ = α X/(k − X), X = x²,
-    /// k = 1 + α, on a cell where g = a + b x:
+    /// ḡ = 2∫₀¹ g(μ) μ dμ of the row g (node values at x = i/(N − 1), linear in x between
+    /// them) at roughness α, in closed form, and the sampler of g μ. With μ = α X/(k − X),
+    /// X = x², k = 1 + α, on a cell where g = a + b x:
     ///
     /// ∫ (a + b x) d(μ²) = a Δμ² + b Δ(x μ²) − b α² ΔP,   P(x) = ∫ x⁴/(k − x²)² dx
     ///                   = x + k x/(2 (k − x²)) − (3√k/2) atanh(x/√k).
     ///
-    /// In f64 (the differences of P lose at most log₂(1/α) bits). The empty sampler for
-    /// ḡ = 0.
-    pub(crate) fn new(g: &[f32; PROFILE_NODES], alpha: f32) -> (f64, LobeProfile) {
+    /// In f64 (the differences of P across a cell lose at most log₂(1/α) bits, 1e-13 at
+    /// α = 1e-3). The empty sampler for ḡ = 0.
+    pub(crate) fn new(g: &[f32; N], alpha: f32) -> (f64, Self) {
         let alpha = f64::from(alpha);
         let k = 1.0 + alpha;
         let sk = k.sqrt();
@@ -82,10 +79,11 @@ impl LobeProfile {
             m * m
         };
         let p = |x: f64| x + k * x / (2.0 * (k - x * x)) - 1.5 * sk * (x / sk).atanh();
-        let h = 1.0 / f64::from(LAST);
-        let x_of = |i: usize| if i == PROFILE_NODES - 1 { 1.0 } else { i as f64 * h };
-        let mut masses = [0.0f64; PROFILE_NODES - 1];
-        for (i, mass) in masses.iter_mut().enumerate() {
+        let h = 1.0 / (N - 1) as f64;
+        let x_of = |i: usize| if i == N - 1 { 1.0 } else { i as f64 * h };
+        // cell masses; the last entry stays 0
+        let mut masses = [0.0f64; N];
+        for (i, mass) in masses.iter_mut().enumerate().take(N - 1) {
             let (x0, x1) = (x_of(i), x_of(i + 1));
             let (g0, g1) = (f64::from(g[i]), f64::from(g[i + 1]));
             let b = (g1 - g0) / h;
@@ -94,25 +92,29 @@ impl LobeProfile {
             // ≥ 0 for g ≥ 0; rounding can leave −1e-20 in a cell of g = 0
             *mass = (a * (m1 - m0) + b * (x1 * m1 - x0 * m0) - b * alpha * alpha * (p(x1) - p(x0))).max(0.0);
         }
-        let total: f64 = masses.iter().sum();
+        let total: f64 = masses[..N - 1].iter().sum();
         let mut profile = Self::EMPTY;
         if total > 0.0 {
             let mut acc = 0.0;
-            for i in 0..PROFILE_NODES {
+            for i in 0..N {
                 profile.mu_sq[i] = mu_sq(x_of(i)) as f32;
                 profile.cdf[i] = (acc / total) as f32;
-                if let Some(m) = masses.get(i) {
-                    acc += m;
-                }
+                acc += masses[i];
             }
-            profile.cdf[PROFILE_NODES - 1] = 1.0;
-            for i in 0..PROFILE_NODES - 1 {
+            profile.cdf[N - 1] = 1.0;
+            for i in 0..N - 1 {
                 let prob = f64::from(profile.cdf[i + 1]) - f64::from(profile.cdf[i]);
                 let width = f64::from(profile.mu_sq[i + 1]) - f64::from(profile.mu_sq[i]);
                 profile.density[i] = if width > 0.0 { (prob / width) as f32 } else { 0.0 };
             }
         }
         (total, profile)
+    }
+
+    /// The cumulative probabilities of the cells (0 first, 1 last; all 0 for no lobe).
+    #[cfg(test)]
+    pub(crate) fn cdf(&self) -> &[f32; N] {
+        &self.cdf
     }
 
     /// The density d_i μ/π of a direction with |cos θ| = μ in cell i (the hemisphere it was
@@ -128,7 +130,7 @@ impl LobeProfile {
     pub(crate) fn sample(&self, u: Vec2) -> Option<Vec3> {
         let cdf = &self.cdf;
         // the first cell whose cumulative probability exceeds u.x
-        let i = cdf[1..].partition_point(|&c| c <= u.x).min(PROFILE_NODES - 2);
+        let i = cdf[1..].partition_point(|&c| c <= u.x).min(N - 2);
         let width = cdf[i + 1] - cdf[i];
         let v = if width > 0.0 { ((u.x - cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
         let (m0, m1) = (self.mu_sq[i], self.mu_sq[i + 1]);

@@ -96,10 +96,10 @@ impl<const N: usize> LobeProfile<N> {
         let mut profile = Self::EMPTY;
         if total > 0.0 {
             let mut acc = 0.0;
-            for i in 0..N {
+            for (i, mass) in masses.iter().enumerate() {
                 profile.mu_sq[i] = mu_sq(x_of(i)) as f32;
                 profile.cdf[i] = (acc / total) as f32;
-                acc += masses[i];
+                acc += mass;
             }
             profile.cdf[N - 1] = 1.0;
             for i in 0..N - 1 {

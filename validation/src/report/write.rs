@@ -401,6 +401,16 @@ const RENDERS: [(&str, &str); 2] = [
     ),
 ];
 
+/// A figure of the HTML page: the SVG, its title as the alternative text and `caption`.
+fn figure_html(f: &Figure, caption: &str) -> String {
+    format!(
+        "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>\n",
+        escape(&f.file),
+        escape(&f.title),
+        escape(caption)
+    )
+}
+
 /// Copies the sweep images from `docs/` into `out_dir`; returns the (file, caption) of those
 /// that exist.
 fn copy_renders(out_dir: &std::path::Path, files: &mut Vec<PathBuf>) -> Vec<(&'static str, &'static str)> {
@@ -537,24 +547,12 @@ pub fn write(
         Single scattering is a different model: its curve is that model's error against the walk's converged reference (a bias that \
         no number of samples removes), not a Monte Carlo error.</p>\n");
     for f in figures.iter().filter(|f| f.file.starts_with("error_vs_time")) {
-        let _ = writeln!(
-            html,
-            "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>",
-            escape(&f.file),
-            escape(&f.title),
-            escape(&f.title)
-        );
+        html.push_str(&figure_html(f, &f.title));
     }
     html.push_str(&efficiency.html());
     html.push_str("<h2 id=\"lobes\">Lobes per scattering order</h2>\n<p>The analogue of Wang et al. 2022, Fig. 6: the walk and both position-free models side by side.</p>\n");
     for f in figures.iter().filter(|f| f.file.starts_with("lobes")) {
-        let _ = writeln!(
-            html,
-            "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>",
-            escape(&f.file),
-            escape(&f.title),
-            escape(&lobe_caption(results, budget, &f.file, &f.title))
-        );
+        html.push_str(&figure_html(f, &lobe_caption(results, budget, &f.file, &f.title)));
     }
     html.push_str(&lobe.html());
     html.push_str(
@@ -563,13 +561,7 @@ pub fn write(
         <a href=\"albedo_tables.csv\">albedo_tables.csv</a>.</p>\n",
     );
     for f in figures.iter().filter(|f| f.file == "albedo_tables.svg") {
-        let _ = writeln!(
-            html,
-            "<figure><img src=\"{}\" alt=\"{}\"/><figcaption>{}</figcaption></figure>",
-            escape(&f.file),
-            escape(&f.title),
-            escape(&f.title)
-        );
+        html.push_str(&figure_html(f, &f.title));
     }
     html.push_str(&renders_html(&renders));
     html.push_str(&energy.html());

@@ -28,6 +28,15 @@ fn eta_coordinate(eta_at_least_one: f32) -> f32 {
 
 /// The energy a dielectric microsurface scatters after two or more bounces, split by where it
 /// leaves.
+///
+/// # Examples
+/// ```
+/// use microsurface::DielectricWalkTable;
+///
+/// // rough glass (α = 1, η = 1.5) seen from outside at normal incidence
+/// let h = DielectricWalkTable::GGX.energy(1.0, 1.0, 1.5).expect("in range");
+/// assert!(h.reflected >= 0.0 && h.transmitted > 0.0 && h.reflected + h.transmitted < 1.0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HigherOrders {
     /// ΔR: the flux fraction leaving on the incident side after ≥ 2 bounces.

@@ -18,6 +18,18 @@ pub const ORDER_TABLE_MAX_STANDARD_ERROR: f32 = 1.96e-3;
 const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
 
 /// Which scattering orders a per-order table holds.
+///
+/// # Examples
+/// ```
+/// use microsurface::{ScatteringOrderTable, TabulatedOrder};
+///
+/// assert_eq!(TabulatedOrder::Exactly(2).index(), Some(0));
+/// assert_eq!(TabulatedOrder::Exactly(1).index(), None); // single scattering: `AlbedoTable`
+/// // a rough F = 1 conductor seen at normal incidence: the second order carries most of the rest
+/// let t = ScatteringOrderTable::GGX;
+/// let (e2, tail) = (t.directional(TabulatedOrder::Exactly(2), 1.0, 1.0), t.directional(TabulatedOrder::Tail, 1.0, 1.0));
+/// assert!(e2.unwrap() > tail.unwrap());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TabulatedOrder {
     /// Exactly k bounces, 2 ≤ k ≤ [`LAST_TABULATED_ORDER`].

@@ -1,7 +1,42 @@
 //! Assertions and helpers shared by the deterministic tests: rejected parameters, caught
-//! panics, f32 spacings.
+//! panics, f32 spacings, finite answers at a BSDF's edges.
 
-use microsurface::Error;
+use glam::{Vec2, Vec3};
+use microsurface::{Bsdf, Error};
+
+/// The largest f32 below 1: the top uniform a renderer's sampler can hand over.
+pub const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The view cosines of [`assert_finite_at_edges`]: near, on and just below the horizon, and ±0.5.
+pub const EDGE_VIEW_COSINES: [f32; 8] = [1e-7, 1e-4, 0.01, 0.0, -1e-7, -1e-4, 0.5, -0.5];
+
+/// The unit view of cosine `z` in the xz plane.
+#[must_use]
+pub fn edge_view(z: f32) -> Vec3 {
+    Vec3::new((1.0 - z * z).sqrt(), 0.0, z)
+}
+
+/// No NaN or infinity at a BSDF's edges: for every view of [`EDGE_VIEW_COSINES`], `sample`
+/// at the extreme uniforms (0 and [`ONE_MINUS`]) and at an interior pair returns a finite
+/// weight with a positive finite pdf and a finite `eval_with_pdf` at its direction, and
+/// `eval_with_pdf` is finite at every direction of `wis`. `label` names the BSDF on failure.
+#[track_caller]
+pub fn assert_finite_at_edges(b: &dyn Bsdf, wis: &[Vec3], label: &str) {
+    for z in EDGE_VIEW_COSINES {
+        let wo = edge_view(z);
+        for (uc, u) in [(0.0, Vec2::ZERO), (ONE_MINUS, Vec2::splat(ONE_MINUS)), (0.5, Vec2::new(0.3, 0.9))] {
+            if let Some(s) = b.sample(wo, uc, u) {
+                assert!(s.weight.is_finite() && s.pdf.is_finite() && s.pdf > 0.0, "{label} wo = {wo}: {s:?}");
+                let (v, pdf) = b.eval_with_pdf(wo, s.wi);
+                assert!(v.f.is_finite() && pdf.is_finite(), "{label} wo = {wo} wi = {}", s.wi);
+            }
+        }
+        for &wi in wis {
+            let (v, pdf) = b.eval_with_pdf(wo, wi);
+            assert!(v.f.is_finite() && pdf.is_finite(), "{label} wo = {wo} wi = {wi}");
+        }
+    }
+}
 
 /// Asserts that `result` is `Error::InvalidParameter` for `name` with the rejected `value`
 /// (the same bits, or both NaN), a non-empty `expected`, and a Display that names `name`.

@@ -274,19 +274,22 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 /// ω̂ = ω/|ω| the directions the f32 vectors represent (normalized in f64), if it is a valid
 /// microfacet normal for the pair (ωh.z > 0 and ωi·ωh > 0).
 ///
-/// Exact to a few f64 ulps for every pair but ωo = −ωi, whatever the inputs' lengths
-/// (within [`crate::DIRECTION_TOLERANCE`]). The sum of the unnormalized vectors is not: its
-/// ωi·ωh is (|ωi|² + ωi·ωo)/|ωi + ωo|, and for a near-forward reflection (ωo close to −ωi,
-/// |ω̂i + ω̂o| = 2 ω̂i·ωh small) the lengths' deviations from 1 (an f32 ulp, 6e-8, for
-/// directions the crate produced) are as large as 2(ω̂i·ωh)², so that ωi·ωh lost its sign in
-/// ~1 % of the reflections a smooth Beckmann surface (α = 0.02) sampled from θi = 120°
-/// (ω̂i·ωh ≈ 1e-4): eval and pdf were 0 where the sampler put mass (DESIGN.md, “BDPT from
-/// below at a = 28.9”).
+/// Whatever the inputs' lengths (within [`crate::DIRECTION_TOLERANCE`]), its direction is
+/// exact to a few f64 ulps divided by |ω̂i + ω̂o| = 2ω̂i·ωh (1e-16/|ω̂i + ω̂o| rad; only
+/// ωo = −ωi has none). The half vector of the unnormalized sum ωi + ωo is not: its ωi·ωh is
+/// (|ωi|² + ωi·ωo)/|ωi + ωo|, and the lengths' deviations from 1 (about an f32 ulp, 6e-8,
+/// for directions the crate produced) enter the numerator 1 + ω̂i·ω̂o = 2(ω̂i·ωh)² directly.
+/// For the near-forward reflections of a smooth surface seen from below (ωo within 2ω̂i·ωh
+/// of −ωi; Beckmann α = 0.02 at θi = 120°, ω̂i·ωh ≈ 1e-4) that sum lost the sign of ωi·ωh
+/// for about 1 % of the sampled directions (eval and pdf 0 where the sampler put mass) and
+/// was off by a median 5 % elsewhere; and with αy = 5e-4 a length error of 1.6e-8 changed D
+/// by 0.4 % for an ordinary pair (DESIGN.md, “BDPT from below at a = 28.9”).
 #[inline(always)]
 pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<DVec3> {
     // in f64: D in its tails and at small α amplifies the half vector's rounding
-    let (wi, wo) = (wi.as_dvec3().normalize(), wo.as_dvec3().normalize());
-    let wh = (wi + wo).normalize_or_zero();
+    let (wi, wo) = (wi.as_dvec3(), wo.as_dvec3());
+    // ω̂i + ω̂o ∝ ωi + (|ωi|/|ωo|) ωo: one square root and one division
+    let wh = (wi + wo * (wi.length_squared() / wo.length_squared()).sqrt()).normalize_or_zero();
     (wh.z > 0.0 && wi.dot(wh) > 0.0).then_some(wh)
 }
 

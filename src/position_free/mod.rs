@@ -256,11 +256,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// (`relative_shadowing`), so that it equals f·|cos θo|/pdf at the returned f32 direction
     /// to a few f32 ulps (16 ulps tested, `tests/bsdf/backfacing_masking.rs`) for every roughness.
     /// Resolution: for a backfacing ωi the reflection ωo = −ωi + 2(ωi·ωm)ωm leaves within
-    /// 2ωi·ωm of −ωi, and where ωi·ωm ≲ 1e-4 (Beckmann α ≲ 1e-3 below θ ≈ 1.8, α = 0.02 at
-    /// θ = 2.9; not GGX, whose visible lobe is wide) the f32 rounding of ωo moves the half
-    /// vector that eval and pdf recompute by more than the lobe's width: the density at the
-    /// returned direction is then not resolved (it may be subnormal or 0, and the renderer
-    /// interface drops such samples).
+    /// 2ωi·ωm of −ωi; eval and pdf recompute the half vector from the directions the f32
+    /// vectors represent, and it moves by about 2⁻²⁴/(2ωi·ωm) rad along the facets ωi grazes.
+    /// Where the visible normals' ωi·ωm is ≲ 1e-6 (Beckmann α = 1e-4 below θ ≈ 1.6, α = 1e-3
+    /// below θ ≈ 2.3; not GGX, whose visible lobe is wide) the sampled f32 normal itself no
+    /// longer resolves ωi·ωm: the density at the returned direction is then not resolved (it
+    /// may be subnormal or 0, and the renderer interface drops such samples).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
@@ -500,18 +501,23 @@ mod tests {
     }
 
     /// The same for bidirectional path tracing with correlated shadowing, N = 80 000 so that
-    /// σ̂/√N ≤ 0.0025 (σ̂ ≈ 0.57: 0.002), z = 3.29 (two-sided 1e-3). Before, the balance weight of
-    /// a camera path whose own f32 density rounded to 0 was 0/0 = NaN and the path was dropped:
-    /// 0.9912 ± 0.0009 (N = 400 000), 4.4 σ̂/√N below 1 at this N.
+    /// σ̂/√N ≤ 0.0025 (σ̂ ≈ 0.55: 0.002), z = 3.29 (two-sided 1e-3). Before, the balance weight of
+    /// a camera path whose own density evaluated to 0 was 0/0 = NaN and the path was dropped:
+    /// 0.9912 ± 0.0009 (N = 400 000), 4.4 σ̂/√N below 1 at this N; those zero densities, and the
+    /// remaining deficit (0.9966 ± 0.0020 here), came from the reflection half vector of the
+    /// unnormalized f32 directions (see the uncorrelated test below).
     #[test]
     fn bdpt_from_below_conserves_energy_for_smooth_beckmann() {
         assert_albedo_from_below_is_one(Shadowing::Correlated, Estimator::Bdpt, 80_000, 0.0025, 3.29);
     }
 
-    /// The uncorrelated model in the same test fails today: 0.9903 ± 0.0018. Ignored until the
-    /// cause is found (DESIGN.md, “BDPT from below at a = 28.9”).
+    /// The same for the uncorrelated model (σ̂ ≈ 0.50). Before, eval and pdf formed the half
+    /// vector of these near-forward reflections (ωo within 2ωi·ωm ≈ 2e-4 of −ωi) from the
+    /// unnormalized f32 vectors, and their lengths' rounding lost the sign of ωi·ωh for 0.8 %
+    /// of the phase-sampled directions: eval 0 where the sampler put mass, 0.9903 ± 0.0018, 5.4
+    /// σ̂/√N below 1 (all of it at order 1, which is the whole albedo of this model here: the
+    /// order-2 share Λ(ωo)/(1 + Λ(ωo)) underflows).
     #[test]
-    #[ignore = "open defect (issue 14): uncorrelated BDPT's albedo from below at a = 28.9 is 0.990, not 1"]
     fn bdpt_uncorrelated_from_below_conserves_energy_for_smooth_beckmann() {
         assert_albedo_from_below_is_one(Shadowing::Uncorrelated, Estimator::Bdpt, 80_000, 0.0025, 3.29);
     }

@@ -270,44 +270,39 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     }
 }
 
-/// Below this |ωi + ωo|² = 4(ωi·ωh)² a reflection pair with a direction below the horizon
-/// takes its half vector from the normalized directions ([`reflection_half_vector`]).
-const NORMALIZED_SUM_BELOW: f64 = 0.25;
-
 /// The normalized half vector of a reflection ωi → ωo, if it is a valid microfacet normal
 /// for the pair (ωh.z > 0 and ωi·ωh > 0).
 ///
 /// The f32 vectors' lengths differ from 1 by Δ (an f32 ulp, 6e-8, for directions the crate
 /// produced; up to [`crate::DIRECTION_TOLERANCE`] for callers'). In the half vector of their
 /// plain sum ωi + ωo, Δ = |ωi| − |ωo| turns ωh towards the longer one by Δ√(1 − c²)/(2c) rad,
-/// c = ω̂i·ωh, and so changes c itself by about Δ/(2c): relative to c, Δ/(2c²), which is 1/c
-/// times the change of c that a rounding of either direction by Δ causes. For near-forward
-/// reflections (ωo close to −ωi, c small) this dominates: from below a smooth surface
-/// (Beckmann α = 0.02 at θi = 120°, c ≈ 1e-4) the plain sum lost the sign of ωi·ωh for about
-/// 1 % of the sampled directions (eval and pdf 0 where the sampler put mass) and was off by a
-/// median 5 % elsewhere (DESIGN.md, “BDPT from below at a = 28.9”).
+/// c = ω̂i·ωh, which changes c itself by about Δ/(2c): relative to c, Δ/(2c²), 1/c times the
+/// change of c that a rounding of either direction by Δ causes. For near-forward reflections
+/// (ωo close to −ωi, c small) this dominates: from below a smooth surface (Beckmann α = 0.02
+/// at θi = 120°, c ≈ 1e-4) the plain sum lost the sign of ωi·ωh for about 1 % of the sampled
+/// directions (eval and pdf 0 where the sampler put mass) and was off by a median 5 %
+/// elsewhere (DESIGN.md, “BDPT from below at a = 28.9”).
 ///
-/// So where c < 1/4 (|ωi + ωo|² < 1/4) and a direction is below the horizon, ωh is formed
-/// from the directions the vectors represent, ωh ∝ ω̂i + ω̂o ∝ ωi + (|ωi|/|ωo|)ωo in f64: its
-/// direction is then exact to 1e-16/c rad whatever the lengths (only ωo = −ωi has none).
-/// Elsewhere the plain sum's error is at most 4 times the effect of the inputs' own rounding.
-/// Both directions above the horizon keep the plain sum, which the slopes' reflection
-/// densities of the renderer's front-facing single scattering
-/// ([`MicrosurfaceSlope::reflection_density_unchecked`]) also form, so that eval, pdf and
-/// sample weights agree bit for bit there; a near-forward pair above the horizon needs both
-/// directions grazing (at α = 1e-4 and cos θ = 1e-2 the two forms' D differ by 1 %). The rule
-/// is symmetric in ωi and ωo, so that forward and reverse densities of one pair agree.
+/// So where either direction is below the horizon, ωh is that of the directions the vectors
+/// represent, ωh ∝ ω̂i + ω̂o ∝ ωi + (|ωi|/|ωo|)ωo in f64: its direction is exact to 1e-16/c rad
+/// whatever the lengths (only ωo = −ωi has none). Where both are above, ωh is that of the
+/// plain sum, the convention of the slopes' reflection densities in the renderer's
+/// front-facing single scattering ([`MicrosurfaceSlope::reflection_density_unchecked`]), so
+/// that eval, pdf and sample weights agree bit for bit there; a near-forward pair above the
+/// horizon needs both directions grazing (at α = 1e-4 and cos θ = 1e-2 the two forms' D differ
+/// by 1 %). The rule is symmetric in ωi and ωo, so that the forward and reverse densities of a
+/// pair agree. The f64 reference of `validation::reference::phase_reflection_ref` follows it.
 #[inline(always)]
 pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<DVec3> {
     // in f64: D in its tails and at small α amplifies the half vector's rounding
     let (wi, wo) = (wi.as_dvec3(), wo.as_dvec3());
-    let mut sum = wi + wo;
-    let mut len_sq = sum.length_squared();
-    if len_sq < NORMALIZED_SUM_BELOW && (wi.z < 0.0 || wo.z < 0.0) {
+    let sum = if wi.z < 0.0 || wo.z < 0.0 {
         // ω̂i + ω̂o ∝ ωi + (|ωi|/|ωo|) ωo: one square root and one division
-        sum = wi + wo * (wi.length_squared() / wo.length_squared()).sqrt();
-        len_sq = sum.length_squared();
-    }
+        wi + wo * (wi.length_squared() / wo.length_squared()).sqrt()
+    } else {
+        wi + wo
+    };
+    let len_sq = sum.length_squared();
     // as `normalize_or_zero` rounds it; a zero sum (ωo = −ωi) gives NaN components, which
     // fail both tests
     let wh = sum * (1.0 / len_sq.sqrt());

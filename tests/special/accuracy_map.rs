@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | Λ, G1, D, projected area, αᵢ | 1e-6 | 4.4e-7 (GGX D) |
 //! | D_ωi | 5e-6 | 2.5e-6 (GGX, ωi below the horizon) |
-//! | phase functions, single-scattering BSDFs | 1e-5 | 9.7e-6 (GGX dielectric reflection) |
+//! | phase functions, single-scattering BSDFs | 1e-5 | 3.9e-6 (GGX dielectric reflection) |
 //! | Fresnel terms | 1e-5 | 3.4e-6 (conductor) |
 //!
 //! Tests marked `#[ignore = "library bug: …"]` exceed their bound because of a defect found

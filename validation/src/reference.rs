@@ -249,8 +249,17 @@ impl RefFresnel {
     }
 }
 
-/// Reflection phase function F D_ωi(ωh)/(4 ωi·ωh).
+/// Reflection phase function F D_ωi(ωh)/(4 ωi·ωh), with the crate's half vector: where a
+/// direction is below the horizon, that of the directions ωi/|ωi| and ωo/|ωo| the vectors
+/// represent (the half vector of the plain sum ωi + ωo depends on their lengths, and for the
+/// near-forward pairs of a view from below by as much as ωi·ωh itself); where both are above,
+/// that of the plain sum, the convention of the crate's front-facing kernels.
 pub fn phase_reflection_ref(s: &RefSlope, f: RefFresnel, wi: DVec3, wo: DVec3) -> f64 {
+    let (wi, wo) = match (wi.z < 0.0 || wo.z < 0.0, normalize(wi), normalize(wo)) {
+        (true, Some(wi), Some(wo)) => (wi, wo),
+        (true, _, _) => return 0.0,
+        (false, _, _) => (wi, wo),
+    };
     let Some(h) = normalize(wi + wo) else { return 0.0 };
     let c = wi.dot(h);
     if h.z <= 0.0 || c <= 0.0 {

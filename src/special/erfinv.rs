@@ -153,7 +153,7 @@ fn horner(coefficients: &[f32], x: f32) -> f32 {
 /// domain (measured 2.9e-7), against the f64 [`erfinv_from_both_ends`] by the unit test. t is clamped
 /// to [1e-30, ½].
 #[must_use]
-#[inline]
+#[inline(always)]
 pub(crate) fn erfc_inv_f32(tail: f32) -> f32 {
     let t = tail.clamp(1e-30, 0.5);
     let y = 1.0 - 2.0 * t;

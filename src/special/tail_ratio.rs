@@ -353,12 +353,36 @@ const FAR: [f64; 8] = [
     -9691.867176273454,
 ];
 
-/// A degree-7 polynomial with coefficients `c` (lowest degree first) at s, by Estrin's scheme.
+/// A degree-7 polynomial's coefficients (lowest degree first) in the order of [`estrin7`]'s
+/// two-lane evaluation: c₀, c₄, c₁, c₅, c₂, c₆, c₃, c₇.
+const fn lanes(c: [f64; 8]) -> [f64; 8] {
+    [c[0], c[4], c[1], c[5], c[2], c[6], c[3], c[7]]
+}
+
+/// `PIECES` and `FAR` in the order of [`lanes`].
+const PIECES_LANES: [[f64; 8]; PIECE_COUNT as usize] = {
+    let mut out = [[0.0; 8]; PIECE_COUNT as usize];
+    let mut k = 0;
+    while k < PIECE_COUNT as usize {
+        out[k] = lanes(PIECES[k]);
+        k += 1;
+    }
+    out
+};
+const FAR_LANES: [f64; 8] = lanes(FAR);
+
+/// A degree-7 polynomial at s by Estrin's scheme, from its coefficients in the order of
+/// [`lanes`]: the low half (c₀ … c₃) and the high half (c₄ … c₇) in the two lanes of each
+/// vector operation, with no shuffles until the last one.
 #[inline(always)]
 fn estrin7(c: &[f64; 8], s: f64) -> f64 {
     let s2 = s * s;
     let s4 = s2 * s2;
-    ((c[0] + c[1] * s) + s2 * (c[2] + c[3] * s)) + s4 * ((c[4] + c[5] * s) + s2 * (c[6] + c[7] * s))
+    // (c₀ + c₁s, c₄ + c₅s) and (c₂ + c₃s, c₆ + c₇s)
+    let (p0, p4) = (c[0] + c[2] * s, c[1] + c[3] * s);
+    let (p2, p6) = (c[4] + c[6] * s, c[5] + c[7] * s);
+    let (low, high) = (p0 + s2 * p2, p4 + s2 * p6);
+    low + s4 * high
 }
 
 /// r(v) = 1 − √π v erfcx(v) for v ≥ 0, given `inv_v` = 1/v (read only from
@@ -377,10 +401,10 @@ pub(crate) fn tail_ratio(v: f64, inv_v: f64) -> f64 {
         // whose interpolant holds at their common end), in [0, PIECE_COUNT − 1]
         let k = ((v * PIECES_PER_V - 0.5 + ROUNDING_MAGIC).to_bits() as u32).min(PIECE_COUNT - 1);
         let s = v - (f64::from(k) + 0.5) * (1.0 / PIECES_PER_V);
-        return estrin7(&PIECES[k as usize], s);
+        return estrin7(&PIECES_LANES[k as usize], s);
     }
     let w = inv_v * inv_v;
-    0.5 * w * estrin7(&FAR, w)
+    0.5 * w * estrin7(&FAR_LANES, w)
 }
 
 #[cfg(test)]

@@ -59,8 +59,8 @@ pub(crate) fn sample_visible_normal(beckmann: &Beckmann, wi: Vec3, u1: f32, u2: 
     // coordinate) from its own, in parallel
     let inv_len = 1.0 / len_xy;
     let azimuth = Azimuth { cos_phi: v.x * inv_len, sin_phi: v.y * inv_len, len_xy };
-    let x = visible_slope_x(v.z * inv_len, v.z.abs() / (v.z.abs() + len_xy), f64::from(u1));
     let y = gaussian_slope(f64::from(u2));
+    let x = visible_slope_x(v.z * inv_len, v.z.abs() / (v.z.abs() + len_xy), f64::from(u1));
     ensure_visible(wi, azimuth.unstretched_normal(ax, ay, x, y))
 }
 

@@ -780,16 +780,18 @@ const PIECES: [[f64; 16]; 42] = [
 ];
 
 /// `PIECES` with A's and B's coefficients of each degree side by side (A₀, B₀, A₁, B₁, …), the
-/// layout of the two-lane evaluation.
+/// layout of the two-lane evaluation, and scaled to the variable σ = 4s = s/`PIECE_WIDTH`
+/// (the coefficient of degree i times 4⁻ⁱ, exactly).
 const PAIRED: [[f64; 16]; PIECE_COUNT] = {
     let mut paired = [[0.0; 16]; PIECE_COUNT];
     let mut k = 0;
     while k < PIECE_COUNT {
-        let mut i = 0;
+        let (mut i, mut scale) = (0, 1.0);
         while i < 8 {
-            paired[k][2 * i] = PIECES[k][i];
-            paired[k][2 * i + 1] = PIECES[k][8 + i];
+            paired[k][2 * i] = PIECES[k][i] * scale;
+            paired[k][2 * i + 1] = PIECES[k][8 + i] * scale;
             i += 1;
+            scale *= PIECE_WIDTH;
         }
         k += 1;
     }
@@ -812,11 +814,14 @@ pub(crate) fn gaussian_integral_and_half(x: f64) -> Option<(f64, f64)> {
     if !(x >= GAUSSIAN_FIT_FROM) {
         return None;
     }
-    // x ∈ [FROM, TO): the piece is the nearest integer of 4(x − FROM) − ½ (a tie picks either
-    // neighbour, whose interpolant holds at their common end), in [0, PIECE_COUNT − 1]
-    let k = (((x - GAUSSIAN_FIT_FROM) * PIECES_PER_X - 0.5 + ROUNDING_MAGIC).to_bits() as u32)
-        .min(PIECE_COUNT as u32 - 1) as usize;
-    let s = x - (GAUSSIAN_FIT_FROM + (k as f64 + 0.5) * PIECE_WIDTH);
+    // x ∈ [FROM, TO): the piece is the nearest integer k of t = 4(x − FROM) − ½ (a tie picks
+    // either neighbour, whose interpolant holds at their common end), in [0, PIECE_COUNT − 1],
+    // and σ = t − k = 4(x − c_k) ∈ [−½, ½] its variable (`PAIRED` is scaled to it), both from
+    // one rounding (no integer-to-float conversion on the way to the polynomial)
+    let t = (x - GAUSSIAN_FIT_FROM) * PIECES_PER_X - 0.5;
+    let rounded = t + ROUNDING_MAGIC;
+    let k = (rounded.to_bits() as u32).min(PIECE_COUNT as u32 - 1) as usize;
+    let s = t - (rounded - ROUNDING_MAGIC).min((PIECE_COUNT - 1) as f64);
     let c = &PAIRED[k];
     // Estrin's scheme (three levels of multiply–adds instead of seven in a chain), on the pairs
     // (A's coefficient, B's) that `PAIRED` stores side by side: the two polynomials in the two

@@ -359,12 +359,19 @@ const fn lanes(c: [f64; 8]) -> [f64; 8] {
     [c[0], c[4], c[1], c[5], c[2], c[6], c[3], c[7]]
 }
 
-/// `PIECES` and `FAR` in the order of [`lanes`].
+/// `PIECES` in the order of [`lanes`], scaled to the variable σ = 4s (the coefficient of
+/// degree i times 4⁻ⁱ, exactly), and `FAR` in that order.
 const PIECES_LANES: [[f64; 8]; PIECE_COUNT as usize] = {
     let mut out = [[0.0; 8]; PIECE_COUNT as usize];
     let mut k = 0;
     while k < PIECE_COUNT as usize {
-        out[k] = lanes(PIECES[k]);
+        let (mut scaled, mut i, mut scale) = (PIECES[k], 0, 1.0);
+        while i < 8 {
+            scaled[i] *= scale;
+            scale /= PIECES_PER_V;
+            i += 1;
+        }
+        out[k] = lanes(scaled);
         k += 1;
     }
     out
@@ -397,10 +404,13 @@ fn estrin7(c: &[f64; 8], s: f64) -> f64 {
 pub(crate) fn tail_ratio(v: f64, inv_v: f64) -> f64 {
     debug_assert!(!(v < 0.0), "tail_ratio({v}) outside its domain");
     if v < TAIL_RATIO_SPLIT {
-        // the piece holding v: the nearest integer of 4v − ½ (a tie picks either neighbour,
-        // whose interpolant holds at their common end), in [0, PIECE_COUNT − 1]
-        let k = ((v * PIECES_PER_V - 0.5 + ROUNDING_MAGIC).to_bits() as u32).min(PIECE_COUNT - 1);
-        let s = v - (f64::from(k) + 0.5) * (1.0 / PIECES_PER_V);
+        // the piece holding v: the nearest integer k of t = 4v − ½ (a tie picks either
+        // neighbour, whose interpolant holds at their common end), in [0, PIECE_COUNT − 1], and
+        // σ = t − k = 4(v − c_k) ∈ [−½, ½] (`PIECES_LANES` is scaled to it) from one rounding
+        let t = v * PIECES_PER_V - 0.5;
+        let rounded = t + ROUNDING_MAGIC;
+        let k = (rounded.to_bits() as u32).min(PIECE_COUNT - 1);
+        let s = t - (rounded - ROUNDING_MAGIC).min(f64::from(PIECE_COUNT - 1));
         return estrin7(&PIECES_LANES[k as usize], s);
     }
     let w = inv_v * inv_v;

@@ -157,56 +157,87 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64, f64) {
 #[inline]
 fn visible_slope_x(kappa: f64, s: f64, u: f64) -> f64 {
     let u = cut_tails64(u);
-    let mut x = GuessTable::get().guess(kappa, s, u);
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, kappa);
-    let fallback = |x: f64, lo: f64, hi: f64| {
-        #[cfg(test)]
-        tests::FALLBACKS.with(|n| n.set(n.get() + 1));
-        let target = ln_s(kappa, kappa).0 + u.ln();
-        refine(kappa, target, x, lo, hi).min(kappa)
-    };
+    let x = GuessTable::get().guess(kappa, s, u);
     if x.is_nan() || x >= kappa {
         #[cfg(test)]
         tests::FALLBACKS.with(|n| n.set(n.get() + 1));
         return visible_slope_x_above(kappa, f64::NEG_INFINITY, u);
     }
     let residual = Residual::new(kappa, u);
-    for _ in 0..FAST_STEPS {
-        let Some((g, derivative, second, third)) = residual.at(x) else {
-            return fallback(x, lo, hi);
+    // the first step straight-line (it is almost always accepted: its values stay in
+    // registers), the others in a loop
+    let (mut x, mut lo, mut hi) = match fast_step(residual, x, f64::NEG_INFINITY, kappa) {
+        Step::Accepted(x) => return x.min(kappa),
+        Step::Continue(x, lo, hi) => (x, lo, hi),
+        Step::Fallback(x, lo, hi) => return fallback(kappa, u, x, lo, hi),
+    };
+    for _ in 1..FAST_STEPS {
+        (x, lo, hi) = match fast_step(residual, x, lo, hi) {
+            Step::Accepted(x) => return x.min(kappa),
+            Step::Continue(x, lo, hi) => (x, lo, hi),
+            Step::Fallback(x, lo, hi) => return fallback(kappa, u, x, lo, hi),
         };
-        if g > 0.0 {
-            hi = x;
-        } else {
-            lo = x;
-        }
-        // the step of `refine`: Halley's where its correction is small, else Newton's
-        let d2 = derivative * derivative;
-        let halley = (g * second).abs() <= 2.0 * HALLEY_MAX_CORRECTION * d2;
-        let next = if halley { x - g * derivative / (d2 - 0.5 * g * second) } else { x - g / derivative };
-        if !(next > lo && next < hi) {
-            return fallback(x, lo, hi);
-        }
-        let step = (next - x).abs();
-        x = next;
-        // the error estimate of x̃ times g′ (> 0 here: the step stayed finite), without
-        // dividing by g′: ERROR_ESTIMATE_SAFETY·((g″/g′)² + |g‴/g′|/6)·|step|³·g′ for Halley's
-        // step, ½·ERROR_ESTIMATE_SAFETY·|g″/g′|·step²·g′ for Newton's
-        let accepted = if halley {
-            ERROR_ESTIMATE_SAFETY
-                * (second * second + third.abs() * derivative * (1.0 / 6.0))
-                * step
-                * step
-                * step
-                <= FAST_LN_CDF_TOLERANCE * derivative
-        } else {
-            ERROR_ESTIMATE_SAFETY * 0.5 * second.abs() * step * step <= FAST_LN_CDF_TOLERANCE
-        };
-        if accepted {
-            return x.min(kappa);
-        }
     }
-    fallback(x, lo, hi)
+    fallback(kappa, u, x, lo, hi)
+}
+
+/// The outcome of one fast step of [`visible_slope_x`].
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    /// The new x̃, within the tolerance.
+    Accepted(f64),
+    /// The new x̃ and the bracket (lo, hi) of the root, for another step.
+    Continue(f64, f64, f64),
+    /// The step left the bracket or the residual could not be evaluated: x̃ and the bracket
+    /// for the fallback iteration.
+    Fallback(f64, f64, f64),
+}
+
+/// One Halley (or Newton) step of [`visible_slope_x`] on `residual` from x̃ = `x` inside the
+/// bracket (`lo`, `hi`), with its a-posteriori acceptance test.
+#[inline(always)]
+fn fast_step(residual: Residual, x: f64, mut lo: f64, mut hi: f64) -> Step {
+    let Some((g, derivative, second, third)) = residual.at(x) else {
+        return Step::Fallback(x, lo, hi);
+    };
+    if g > 0.0 {
+        hi = x;
+    } else {
+        lo = x;
+    }
+    // the step of `refine`: Halley's where its correction is small, else Newton's
+    let d2 = derivative * derivative;
+    let halley = (g * second).abs() <= 2.0 * HALLEY_MAX_CORRECTION * d2;
+    let next = if halley { x - g * derivative / (d2 - 0.5 * g * second) } else { x - g / derivative };
+    if !(next > lo && next < hi) {
+        return Step::Fallback(x, lo, hi);
+    }
+    let step = (next - x).abs();
+    // the error estimate of x̃ times g′ (> 0 here: the step stayed finite), without dividing
+    // by g′: ERROR_ESTIMATE_SAFETY·((g″/g′)² + |g‴/g′|/6)·|step|³·g′ for Halley's step,
+    // ½·ERROR_ESTIMATE_SAFETY·|g″/g′|·step²·g′ for Newton's
+    let accepted = if halley {
+        ERROR_ESTIMATE_SAFETY
+            * (second * second + third.abs() * derivative * (1.0 / 6.0))
+            * step
+            * step
+            * step
+            <= FAST_LN_CDF_TOLERANCE * derivative
+    } else {
+        ERROR_ESTIMATE_SAFETY * 0.5 * second.abs() * step * step <= FAST_LN_CDF_TOLERANCE
+    };
+    if accepted { Step::Accepted(next) } else { Step::Continue(next, lo, hi) }
+}
+
+/// The fallback of [`visible_slope_x`]: the safeguarded f64 iteration of
+/// [`visible_slope_x_above`] from x̃ = `x` within the bracket (`lo`, `hi`).
+#[cold]
+#[inline(never)]
+fn fallback(kappa: f64, u: f64, x: f64, lo: f64, hi: f64) -> f64 {
+    #[cfg(test)]
+    tests::FALLBACKS.with(|n| n.set(n.get() + 1));
+    let target = ln_s(kappa, kappa).0 + u.ln();
+    refine(kappa, target, x, lo, hi).min(kappa)
 }
 
 /// The residual g = F(x̃)/u − 1 of the fast steps of [`visible_slope_x`] (F = S(x̃)/S(κ) the

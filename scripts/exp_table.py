@@ -41,7 +41,7 @@ def committed(path):
     found = {}
     for name in items():
         start = source.index(f"const {name}: ")
-        end = source.index(";", start)
+        end = source.index(";\n", start)
         found[name] = [float(x) for x in re.findall(number, source[start:end].split("=", 1)[1])]
     return found
 

@@ -14,6 +14,7 @@ pub(crate) const ROUNDING_MAGIC: f64 = 6_755_399_441_055_744.0;
 const INV_LN2_32: f64 = 46.16624130844683;
 const LN2_32_HI: f64 = 0.021660849392446835;
 const LN2_32_LO: f64 = 5.145609244655338e-14;
+#[allow(clippy::approx_constant)] // 2^{16/32} = √2, from the generator
 const TWO_TO_J_32: [f64; 32] = [
     1.0,
     1.0218971486541166,

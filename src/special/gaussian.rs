@@ -811,7 +811,7 @@ pub(crate) fn gaussian_integral_and_half(x: f64) -> Option<(f64, f64)> {
     if x >= GAUSSIAN_FIT_TO {
         return Some((crate::constants::SQRT_PI, 0.0));
     }
-    if !(x >= GAUSSIAN_FIT_FROM) {
+    if x.is_nan() || x < GAUSSIAN_FIT_FROM {
         return None;
     }
     // x ∈ [FROM, TO): the piece is the nearest integer k of t = 4(x − FROM) − ½ (a tie picks

@@ -402,7 +402,7 @@ fn estrin7(c: &[f64; 8], s: f64) -> f64 {
 #[must_use]
 #[inline(always)]
 pub(crate) fn tail_ratio(v: f64, inv_v: f64) -> f64 {
-    debug_assert!(!(v < 0.0), "tail_ratio({v}) outside its domain");
+    debug_assert!(v.is_nan() || v >= 0.0, "tail_ratio({v}) outside its domain");
     if v < TAIL_RATIO_SPLIT {
         // the piece holding v: the nearest integer k of t = 4v − ½ (a tie picks either
         // neighbour, whose interpolant holds at their common end), in [0, PIECE_COUNT − 1], and

@@ -48,7 +48,7 @@ pub(crate) fn sample_visible_normal(beckmann: &Beckmann, wi: Vec3, u1: f32, u2: 
     let (ax, ay) = (f64::from(beckmann.alpha_x()), f64::from(beckmann.alpha_y()));
     let v = stretch64(beckmann, wi);
     let len_xy = (v.x * v.x + v.y * v.y).sqrt();
-    if !(len_xy > 0.0) {
+    if len_xy.is_nan() || len_xy <= 0.0 {
         // vertical: any azimuth (φ = 0)
         let Some((x, y)) = visible_slopes(v.z, 0.0, u1, u2) else {
             return Vec3::Z;

@@ -88,7 +88,7 @@ pub(crate) fn visible_slopes(z: f64, len_xy: f64, u1: f32, u2: f32) -> Option<(f
 /// of [0, 1]. Both tails are cut at probability 2⁻²⁴ (the crate's tail policy, `rng`): u = 0
 /// gives x̃ = −3.744, with 2⁻²⁴ of the density below it, and u = 1 − 2⁻²⁴ gives +3.744.
 #[must_use]
-#[inline]
+#[inline(always)]
 pub(crate) fn gaussian_slope(u: f64) -> f64 {
     // in single precision: u is an f32 uniform or an f64 one that `erfc_inv_f32` reads in
     // single precision anyway

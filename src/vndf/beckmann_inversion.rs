@@ -218,18 +218,20 @@ fn fast_step(residual: Residual, x: f64, mut lo: f64, mut hi: f64) -> Step {
         return Step::Fallback(x, lo, hi);
     }
     let step = (next - x).abs();
-    // the error estimate of x̃ times g′ (> 0 here: the step stayed finite), without dividing
-    // by g′: ERROR_ESTIMATE_SAFETY·((g″/g′)² + |g‴/g′|/6)·|step|³·g′ for Halley's step,
+    // the error estimate of x̃ times g′/(u S(κ)) (g′ > 0 here: the step stayed finite), the
+    // relative error of F, without dividing by g′ or u S(κ):
+    // ERROR_ESTIMATE_SAFETY·((g″/g′)² + |g‴/g′|/6)·|step|³·g′ for Halley's step,
     // ½·ERROR_ESTIMATE_SAFETY·|g″/g′|·step²·g′ for Newton's
+    let tolerance = FAST_LN_CDF_TOLERANCE * residual.norm();
     let accepted = if halley {
         ERROR_ESTIMATE_SAFETY
             * (second * second + third.abs() * derivative * (1.0 / 6.0))
             * step
             * step
             * step
-            <= FAST_LN_CDF_TOLERANCE * derivative
+            <= tolerance * derivative
     } else {
-        ERROR_ESTIMATE_SAFETY * 0.5 * second.abs() * step * step <= FAST_LN_CDF_TOLERANCE
+        ERROR_ESTIMATE_SAFETY * 0.5 * second.abs() * step * step <= tolerance
     };
     if accepted { Step::Accepted(next) } else { Step::Continue(next, lo, hi) }
 }
@@ -245,18 +247,20 @@ fn fallback(kappa: f64, u: f64, x: f64, lo: f64, hi: f64) -> f64 {
     refine(kappa, target, x, lo, hi).min(kappa)
 }
 
-/// The residual g = F(x̃)/u − 1 of the fast steps of [`visible_slope_x`] (F = S(x̃)/S(κ) the
-/// visible-slope CDF) and its first three derivatives, on either side of the horizon.
+/// The residual of the fast steps of [`visible_slope_x`] and its first three derivatives, on
+/// either side of the horizon: g = (F(x̃) − u)·S(κ)·c for the visible-slope CDF
+/// F = S(x̃)/S(κ) and a positive constant c (g/(u S(κ) c) = F/u − 1 is the relative error of
+/// F, [`Residual::norm`] = u S(κ) c; no division by it).
 #[derive(Debug, Clone, Copy)]
 enum Residual {
-    /// κ ≥ 0: F = S(x̃)/S(κ) with S = κA + B from the fit of the Gaussian and its integral;
-    /// `scale` = 1/(u S(κ)).
-    Above { kappa: f64, scale: f64 },
+    /// κ ≥ 0: g = S(x̃) − u S(κ) with S = κA + B from the fit of the Gaussian and its integral
+    /// (c = 1); `norm` = u S(κ).
+    Above { kappa: f64, norm: f64 },
     /// κ = −m < 0: with v = −x̃ and t = κ − x̃ = v − m > 0, S(x̃) = e^{−v²} ψ(v)/2 with
     /// ψ(v) = 1 − m√π erfcx(v) = (t + m r(v))/v (both terms positive: no cancellation) and
-    /// S(κ) = e^{−m²} r(m)/2, so F = e^{−t(m + v)} ψ(v)/r(m) and F′ = 2t e^{−t(m + v)}/r(m);
-    /// `scale` = 1/(u r(m)).
-    Below { m: f64, scale: f64 },
+    /// S(κ) = e^{−m²} r(m)/2, so F = e^{−t(m + v)} ψ(v)/r(m); g = e^{−t(m + v)} ψ(v) − u r(m)
+    /// (c = 2e^{m²}), g′ = 2t e^{−t(m + v)}; `norm` = u r(m).
+    Below { m: f64, norm: f64 },
 }
 
 impl Residual {
@@ -264,7 +268,7 @@ impl Residual {
     fn new(kappa: f64, u: f64) -> Self {
         if kappa < 0.0 {
             let m = -kappa;
-            return Self::Below { m, scale: 1.0 / (u * tail_ratio(m, 1.0 / m)) };
+            return Self::Below { m, norm: u * tail_ratio(m, 1.0 / m) };
         }
         // S(κ) = κA(κ) + B(κ), κ√π to double precision from `GAUSS_NEGLIGIBLE_FROM` on (inside
         // the fit: the f64 form is the never-taken alternative)
@@ -274,7 +278,15 @@ impl Residual {
         } else {
             kappa * SQRT_PI
         };
-        Self::Above { kappa, scale: 1.0 / (u * s_kappa) }
+        Self::Above { kappa, norm: u * s_kappa }
+    }
+
+    /// u S(κ) c: the residual's scale (g/norm = F/u − 1).
+    #[inline(always)]
+    fn norm(self) -> f64 {
+        match self {
+            Self::Above { norm, .. } | Self::Below { norm, .. } => norm,
+        }
     }
 
     /// (g, g′, g″, g‴) at x̃ < κ; `None` below the fit (x̃ < −4.5 above the horizon,
@@ -284,26 +296,25 @@ impl Residual {
     #[inline(always)]
     fn at(self, x: f64) -> Option<(f64, f64, f64, f64)> {
         match self {
-            Self::Above { kappa, scale } => {
+            Self::Above { kappa, norm } => {
                 let (a, b) = gaussian_integral_and_half(x)?;
-                let derivative = 2.0 * (kappa - x) * b * scale;
+                let derivative = 2.0 * (kappa - x) * b;
                 // B′ = −2x̃B
-                let second = -2.0 * b * scale - 2.0 * x * derivative;
-                let third = 4.0 * x * b * scale - 2.0 * derivative - 2.0 * x * second;
-                Some(((kappa * a + b) * scale - 1.0, derivative, second, third))
+                let second = -2.0 * b - 2.0 * x * derivative;
+                let third = 4.0 * x * b - 2.0 * derivative - 2.0 * x * second;
+                Some(((kappa * a + b) - norm, derivative, second, third))
             }
-            Self::Below { m, scale } => {
+            Self::Below { m, norm } => {
                 let v = -x;
                 let t = v - m;
                 let inv_v = 1.0 / v;
                 let psi = (t + m * tail_ratio(v, inv_v)) * inv_v;
-                // e^{−t(m + v)}/(u r(m))
-                let gauss = exp_nonpositive(-t * (m + v)) * scale;
+                let gauss = exp_nonpositive(-t * (m + v));
                 let derivative = 2.0 * t * gauss;
                 // d/dx̃ e^{−t(m + v)} = 2v e^{−t(m + v)}, dt/dx̃ = dv/dx̃ = −1
                 let second = 2.0 * gauss * (2.0 * t * v - 1.0);
                 let third = 2.0 * gauss * (2.0 * v * (2.0 * t * v - 1.0) - 2.0 * (t + v));
-                Some((gauss * psi - 1.0, derivative, second, third))
+                Some((gauss * psi - norm, derivative, second, third))
             }
         }
     }

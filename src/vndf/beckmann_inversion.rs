@@ -339,6 +339,9 @@ const GUESS_U_CELLS: usize = 128;
 /// m + √(m² + 1) change by less than 1e-8.
 const GUESS_KAPPA_LIMIT: f64 = 1e4;
 
+/// √(−ln u) at the nodes of the guess table's first cell in u: 2⁻²⁴ (the cut tail) and 1/128.
+const FIRST_CELL_W: (f64, f64) = (4.078_667_960_675_236, 2.202_732_454_003_349_3);
+
 /// The initial guess of [`visible_slope_x`]: the exact quantile (from [`visible_slope_x_above`])
 /// at the nodes of a grid in s = |κ|/(1 + |κ|) and u, interpolated bilinearly. Above the horizon
 /// (κ ≥ 0) it holds x̃ itself (which tends to the Gaussian quantile as κ → ∞); below, the
@@ -386,9 +389,31 @@ impl GuessTable {
     }
 
     /// The interpolated guess of x̃ for u ∈ [0, 1], given s = |κ|/(1 + |κ|) (may equal or
-    /// exceed κ where the table is coarse, next to u = 1).
+    /// exceed κ where the table is coarse, next to u = 1). Bilinear, but in the first cell in
+    /// u (u < 1/128, whose node at u = 0 holds the quantile at 2⁻²⁴, where the tails are cut)
+    /// linear in w = √(−ln u) instead (`first_cell_guess`): the quantile is singular in u
+    /// there and about linear in w (exactly −w at κ = 0), and a bilinear guess sent 1/128 of
+    /// the uniforms to the fallback.
     #[inline(always)]
     fn guess(&self, kappa: f64, s: f64, u: f64) -> f64 {
+        if u < 1.0 / GUESS_U_CELLS as f64 {
+            return self.first_cell_guess(kappa, s, u);
+        }
+        self.interpolate(kappa, s, u, None)
+    }
+
+    /// [`GuessTable::guess`] in the first cell in u (out of line: 1/128 of the uniforms).
+    #[cold]
+    #[inline(never)]
+    fn first_cell_guess(&self, kappa: f64, s: f64, u: f64) -> f64 {
+        let w = (-u.ln()).sqrt();
+        let weight = ((FIRST_CELL_W.0 - w) / (FIRST_CELL_W.0 - FIRST_CELL_W.1)) as f32;
+        self.interpolate(kappa, s, u, Some(weight))
+    }
+
+    /// The table interpolated at (s, u), bilinearly or with the given weight in u.
+    #[inline(always)]
+    fn interpolate(&self, kappa: f64, s: f64, u: f64, u_weight: Option<f32>) -> f64 {
         // s ∈ [0, 1] and u ∈ [0, 1]: the cells are the nearest integers of CELLS·s − ½ and
         // CELLS·u − ½ (the floor but at a tie, where either cell interpolates the node), in
         // [0, CELLS − 1], formed by rounding with `ROUNDING_MAGIC` (cheaper than an f64 → u32
@@ -398,7 +423,7 @@ impl GuessTable {
         let a = (fs - f64::from(i)) as f32;
         let fu = u * GUESS_U_CELLS as f64;
         let j = ((fu - 0.5 + ROUNDING_MAGIC).to_bits() as u32).min(GUESS_U_CELLS as u32 - 1);
-        let b = (fu - f64::from(j)) as f32;
+        let b = u_weight.unwrap_or((fu - f64::from(j)) as f32);
         let (i, j) = (i as usize, j as usize);
         let rows = if kappa < 0.0 { &self.below } else { &self.above };
         let (r0, r1) = (&rows[i], &rows[i + 1]);
@@ -532,7 +557,7 @@ mod tests {
     /// iteration, `HALLEY_TOLERANCE`·(1 + |x̃|)) dominates: below that of the iteration alone.
     const FAST_CDF_MAX_ERROR_FAR: f64 = 1e-5;
     /// The largest fraction of the grid's samples allowed to take the fallback iteration.
-    const FAST_MAX_FALLBACK_FRACTION: f64 = 0.06;
+    const FAST_MAX_FALLBACK_FRACTION: f64 = 0.005;
 
     /// The documented bound above the horizon: |F(x̃) − u| ≤ `ABOVE_RELATIVE`·u + `ABOVE_ABSOLUTE`.
     const ABOVE_RELATIVE: f64 = 1e-7;
@@ -570,6 +595,15 @@ mod tests {
             worst <= ABOVE_ABSOLUTE,
             "|F − u| exceeds {ABOVE_RELATIVE:e}·u by {worst:e} > {ABOVE_ABSOLUTE:e} at κ = {at_k}, u = {at_u}"
         );
+    }
+
+    /// The tabulated constants of the first cell in u.
+    #[test]
+    fn first_cell_constants() {
+        let ln2 = core::f64::consts::LN_2;
+        assert!((FIRST_CELL_W.0 - (24.0 * ln2).sqrt()).abs() <= 4.0 * f64::EPSILON);
+        assert!((FIRST_CELL_W.1 - (7.0 * ln2).sqrt()).abs() <= 4.0 * f64::EPSILON);
+        assert_eq!(cut_tails64(0.0), 2f64.powi(-24));
     }
 
     #[test]

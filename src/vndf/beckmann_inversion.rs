@@ -339,8 +339,9 @@ const GUESS_U_CELLS: usize = 128;
 /// m + √(m² + 1) change by less than 1e-8.
 const GUESS_KAPPA_LIMIT: f64 = 1e4;
 
-/// √(−ln u) at the nodes of the guess table's first cell in u: 2⁻²⁴ (the cut tail) and 1/128.
-const FIRST_CELL_W: (f64, f64) = (4.078_667_960_675_236, 2.202_732_454_003_349_3);
+/// √(−ln u) at the nodes of the guess table's first cell in u, 2⁻²⁴ (the cut tail) and 1/128,
+/// and √(−ln(1 − u)) at those of its last cell, 1 − 2⁻²⁴ and 127/128.
+const TAIL_CELL_W: (f64, f64) = (4.078_667_960_675_236, 2.202_732_454_003_349_3);
 
 /// The initial guess of [`visible_slope_x`]: the exact quantile (from [`visible_slope_x_above`])
 /// at the nodes of a grid in s = |κ|/(1 + |κ|) and u, interpolated bilinearly. Above the horizon
@@ -391,13 +392,18 @@ impl GuessTable {
     /// The interpolated guess of x̃ for u ∈ [0, 1], given s = |κ|/(1 + |κ|) (may equal or
     /// exceed κ where the table is coarse, next to u = 1). Bilinear, but in the first cell in
     /// u (u < 1/128, whose node at u = 0 holds the quantile at 2⁻²⁴, where the tails are cut)
-    /// linear in w = √(−ln u) instead (`first_cell_guess`): the quantile is singular in u
-    /// there and about linear in w (exactly −w at κ = 0), and a bilinear guess sent 1/128 of
-    /// the uniforms to the fallback.
+    /// linear in w = √(−ln u) instead (`first_cell_guess`), and above the horizon in the last
+    /// one (u > 127/128, its node at u = 1 holding the quantile at 1 − 2⁻²⁴) linear in
+    /// √(−ln(1 − u)) (`last_cell_guess`): the quantile is singular in u there and about linear
+    /// in these (exactly −√(−ln u) at κ = 0; the Gaussian quantile's tails for large κ).
+    /// Bilinear guesses sent most of these uniforms to the fallback.
     #[inline(always)]
     fn guess(&self, kappa: f64, s: f64, u: f64) -> f64 {
         if u < 1.0 / GUESS_U_CELLS as f64 {
             return self.first_cell_guess(kappa, s, u);
+        }
+        if u > 1.0 - 1.0 / GUESS_U_CELLS as f64 && kappa >= 0.0 {
+            return self.last_cell_guess(kappa, s, u);
         }
         self.interpolate(kappa, s, u, None)
     }
@@ -407,7 +413,17 @@ impl GuessTable {
     #[inline(never)]
     fn first_cell_guess(&self, kappa: f64, s: f64, u: f64) -> f64 {
         let w = (-u.ln()).sqrt();
-        let weight = ((FIRST_CELL_W.0 - w) / (FIRST_CELL_W.0 - FIRST_CELL_W.1)) as f32;
+        let weight = ((TAIL_CELL_W.0 - w) / (TAIL_CELL_W.0 - TAIL_CELL_W.1)) as f32;
+        self.interpolate(kappa, s, u, Some(weight))
+    }
+
+    /// [`GuessTable::guess`] in the last cell in u above the horizon, linear in
+    /// w = √(−ln(1 − u)) (out of line: 1/128 of the uniforms).
+    #[cold]
+    #[inline(never)]
+    fn last_cell_guess(&self, kappa: f64, s: f64, u: f64) -> f64 {
+        let w = (-(1.0 - u).ln()).sqrt();
+        let weight = ((w - TAIL_CELL_W.1) / (TAIL_CELL_W.0 - TAIL_CELL_W.1)) as f32;
         self.interpolate(kappa, s, u, Some(weight))
     }
 
@@ -559,21 +575,24 @@ mod tests {
     /// The largest fraction of the grid's samples allowed to take the fallback iteration.
     const FAST_MAX_FALLBACK_FRACTION: f64 = 0.005;
 
-    /// The documented bound above the horizon: |F(x̃) − u| ≤ `ABOVE_RELATIVE`·u + `ABOVE_ABSOLUTE`.
+    /// The documented bound above the horizon (and below it for |κ| ≤ 64):
+    /// |F(x̃) − u| ≤ `ABOVE_RELATIVE`·u + `ABOVE_ABSOLUTE`.
     const ABOVE_RELATIVE: f64 = 1e-7;
     const ABOVE_ABSOLUTE: f64 = 1e-10;
 
-    /// Above the horizon, on the grid of `worst_cdf_error` plus the extreme uniforms, the
-    /// error of the sampled CDF is within 1e-7·u + 1e-10 (the step's acceptance plus the
-    /// Gaussian fit's absolute error).
-    #[test]
-    fn fast_visible_slope_meets_its_cdf_bound_above_the_horizon() {
+    /// The largest |F(x̃) − u| − 1e-7·u of the fast sampler on one side of the horizon (`sign`
+    /// of κ), over the κ of `worst_cdf_error` up to |κ| ≤ `kappa_max` and its uniforms plus
+    /// the extreme ones; with its κ and u, the number of samples and the largest |F − u|.
+    fn worst_relative_excess(sign: f64, kappa_max: f64) -> (f64, f64, f64, usize, f64) {
         let tails = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1.0 - 1e-5, 1.0 - 1e-6, 1.0];
         let (mut worst, mut at_k, mut at_u) = (f64::NEG_INFINITY, 0.0, 0.0);
         let (mut checked, mut largest) = (0usize, 0.0f64);
         for i in 0..=400 {
             let s = i as f64 / 401.0;
-            let kappa = s / (1.0 - s);
+            let kappa = sign * s / (1.0 - s);
+            if kappa.abs() > kappa_max {
+                break;
+            }
             let ln_s_kappa = ln_s(kappa, kappa).0;
             let grid = (0..=250).map(|j| (j as f64 + 0.37) / 251.0);
             for u in grid.chain(tails) {
@@ -588,6 +607,15 @@ mod tests {
                 }
             }
         }
+        (worst, at_k, at_u, checked, largest)
+    }
+
+    /// Above the horizon, on the grid of `worst_cdf_error` plus the extreme uniforms, the
+    /// error of the sampled CDF is within 1e-7·u + 1e-10 (the step's acceptance plus the
+    /// Gaussian fit's absolute error).
+    #[test]
+    fn fast_visible_slope_meets_its_cdf_bound_above_the_horizon() {
+        let (worst, at_k, at_u, checked, largest) = worst_relative_excess(1.0, f64::INFINITY);
         eprintln!(
             "fast sampler above the horizon: {checked} samples, worst |F − u| − {ABOVE_RELATIVE:e}·u = {worst:.3e} at κ = {at_k}, u = {at_u}; largest |F − u| {largest:.3e}"
         );
@@ -597,13 +625,29 @@ mod tests {
         );
     }
 
+    /// Below the horizon, for |κ| ≤ 64, the same bound 1e-7·u + 1e-10 on the grid plus the
+    /// extreme uniforms (the step's acceptance plus the relative errors of the tail-ratio fit
+    /// and the exponential, 1e-10 and 4e-15).
+    #[test]
+    fn fast_visible_slope_meets_its_cdf_bound_below_the_horizon() {
+        let (worst, at_k, at_u, checked, largest) = worst_relative_excess(-1.0, 64.0);
+        eprintln!(
+            "fast sampler below the horizon, |κ| ≤ 64: {checked} samples, worst |F − u| − {ABOVE_RELATIVE:e}·u = {worst:.3e} at κ = {at_k}, u = {at_u}; largest |F − u| {largest:.3e}"
+        );
+        assert!(
+            worst <= ABOVE_ABSOLUTE,
+            "|F − u| exceeds {ABOVE_RELATIVE:e}·u by {worst:e} > {ABOVE_ABSOLUTE:e} at κ = {at_k}, u = {at_u}"
+        );
+    }
+
     /// The tabulated constants of the first cell in u.
     #[test]
-    fn first_cell_constants() {
+    fn tail_cell_constants() {
         let ln2 = core::f64::consts::LN_2;
-        assert!((FIRST_CELL_W.0 - (24.0 * ln2).sqrt()).abs() <= 4.0 * f64::EPSILON);
-        assert!((FIRST_CELL_W.1 - (7.0 * ln2).sqrt()).abs() <= 4.0 * f64::EPSILON);
+        assert!((TAIL_CELL_W.0 - (24.0 * ln2).sqrt()).abs() <= 4.0 * f64::EPSILON);
+        assert!((TAIL_CELL_W.1 - (7.0 * ln2).sqrt()).abs() <= 4.0 * f64::EPSILON);
         assert_eq!(cut_tails64(0.0), 2f64.powi(-24));
+        assert_eq!(cut_tails64(1.0), 1.0 - 2f64.powi(-24));
     }
 
     #[test]
@@ -616,6 +660,16 @@ mod tests {
         eprintln!("fast sampler, |κ| ≤ 400: worst |F − u| {far:.3e} at κ = {k}, u = {u}");
         let (old, k, u) = worst_cdf_error(400.0, |k, u| visible_slope_x_above(k, f64::NEG_INFINITY, u));
         eprintln!("iteration alone, |κ| ≤ 400: worst |F − u| {old:.3e} at κ = {k}, u = {u}");
+        // the fallback from the table's guess (which the fast steps now rarely hand over to)
+        let (from_guess, k, u) = worst_cdf_error(400.0, |k, u| {
+            let x = GuessTable::get().guess(k, k.abs() / (1.0 + k.abs()), u);
+            fallback(k, u, x.min(k), f64::NEG_INFINITY, k)
+        });
+        eprintln!("fallback from the guess, |κ| ≤ 400: worst |F − u| {from_guess:.3e} at κ = {k}, u = {u}");
+        assert!(
+            from_guess <= FAST_CDF_MAX_ERROR_FAR,
+            "fallback: |F − u| = {from_guess:e} > {FAST_CDF_MAX_ERROR_FAR:e} for |κ| ≤ 400"
+        );
         // the grid of `worst_cdf_error(400.0, ..)`: 2 · 400 κ (s < 400/401) by 251 u
         let fraction = fallbacks as f64 / (2.0 * 400.0 * 251.0);
         eprintln!("fallback fraction {fraction:.4} ({fallbacks} calls)");

@@ -28,9 +28,10 @@ const LAMBDA32_VANISHES_FROM: f64 = 10.0;
 /// cancellation of erf(a) − 1 (they use erfc); so is Λ in `lambda64` (relative error 4e-13),
 /// while the f32 [`MicrosurfaceSlope::lambda`] of the walks is formed from a fit of the tail
 /// ratio and a table exponential, within 0.51 f32 ulp. Visible normals are sampled
-/// exactly by inverting the visible-slope CDF (Jakob 2014, extended to θ ∈ [0, π]) with a
-/// safeguarded Halley iteration on the log-CDF, without the supplement's truncation of the
-/// tail (`erf_min = −0.9999`).
+/// exactly by inverting the visible-slope CDF (Jakob 2014, extended to θ ∈ [0, π]) from a
+/// tabulated guess with Halley steps on fitted forms of the CDF (a safeguarded Halley
+/// iteration on the log-CDF where their error estimate fails), without the supplement's
+/// truncation of the tail (`erf_min = −0.9999`).
 ///
 /// # Examples
 /// ```
@@ -161,9 +162,9 @@ impl Beckmann {
     ///
     /// Exact inversion of the visible-slope CDF F (a tabulated guess, Halley steps and, where
     /// their error estimate fails, a safeguarded Halley iteration on its logarithm):
-    /// |F(x̃) − u| ≤ 1e-7·u + 1e-10 seen from above the horizon, ≤ 2e-7 for
-    /// |cot θ| ≤ 64 on either side; ỹ is Gaussian and independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
-    /// visible, returns the zero slope.
+    /// |F(x̃) − u| ≤ 1e-7·u + 1e-10 seen from above the horizon and from below it for
+    /// |cot θ| ≤ 64, ≤ 1e-5 beyond; ỹ is Gaussian and independent of x̃. Seen from straight
+    /// below (sin θ = 0, cos θ < 0), where nothing is visible, returns the zero slope.
     #[inline]
     #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {

@@ -1,7 +1,8 @@
 //! Beckmann visible normals by exact inversion of the visible-slope CDF (Jakob 2014,
 //! “An Improved Visible Normal Sampling Routine for the Beckmann Distribution”, extended to
 //! θ ∈ [0, π]): a tabulated initial guess, Halley steps on the CDF (above the horizon from a
-//! piecewise fit of the Gaussian and its integral) and, where their error estimate fails, a
+//! piecewise fit of the Gaussian and its integral, below it from a fit of the tail ratio and a
+//! table exponential) and, where their error estimate fails, a
 //! safeguarded Halley iteration on the log-CDF, without the supplement's truncation of the tail
 //! (`erf_min = −0.9999`). It is
 //! [`Beckmann`]'s `sample_d_wi` (and so [`SmithVndf`](super::SmithVndf)`<Beckmann>`).
@@ -153,12 +154,12 @@ fn ln_s(kappa: f64, x: f64) -> (f64, f64, f64) {
 ///
 /// Error bound of the sampled CDF F: |F(x̃) − u| ≤ 1e-7·u + 1e-10 above the horizon (the step's
 /// acceptance plus the fit's absolute error, below 5e-12 for A and 9e-12 for B, against
-/// S(κ) ≥ ½); below it |F(x̃) − u| ≤ 1e-7·u + 1e-10 for |κ| ≤ 64 (the step's acceptance plus the
-/// relative errors of r, 1e-10, and of the exponential, 4e-15, where the fast steps decide,
-/// and the fallback's f32 resolution of x̃ where they hand over); and the measured bounds of
-/// `fast_visible_slope_meets_its_cdf_bound`: below 2e-7 for |κ| ≤ 64 and below 1e-5 for
-/// |κ| ≤ 400, where the f32 resolution of x̃ that the fallback iteration's tolerance follows
-/// dominates. The tails are cut as in [`visible_slope_x_above`].
+/// S(κ) ≥ ½) and below it for |κ| ≤ 64 where the fast steps decide (the step's acceptance plus
+/// the relative errors of r, 1e-10, and of the exponential, 4e-15) — measured on a grid with the
+/// extreme uniforms, which none of them leaves to the fallback; in every case (the fallback
+/// included, whose f32 resolution of x̃ then dominates) below 2e-7 for |κ| ≤ 64 and below 1e-5
+/// for |κ| ≤ 400 (`fast_visible_slope_meets_its_cdf_bound*`). The tails are cut as in
+/// [`visible_slope_x_above`].
 #[inline]
 fn visible_slope_x(kappa: f64, s: f64, u: f64) -> f64 {
     let u = cut_tails64(u);

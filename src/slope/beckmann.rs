@@ -3,7 +3,9 @@
 use super::{MicrosurfaceSlope, check_roughness, is_direction, is_direction64, is_uniform};
 use crate::constants::INV_SQRT_PI;
 use crate::error::Error;
-use crate::special::{PSI_SERIES_FROM, one_minus_scaled_erfcx};
+use crate::special::{
+    EXP_NONPOSITIVE_FROM, PSI_SERIES_FROM, exp_nonpositive, one_minus_scaled_erfcx, tail_ratio,
+};
 use crate::vndf::{sample_visible_normal, visible_slopes};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -13,17 +15,23 @@ const INV_PI: f64 = core::f64::consts::FRAC_1_PI;
 const D_VANISHES_BELOW_COS: f64 = 1e-100;
 /// Below this projected area (a ≈ 26 from below) D_ωi is evaluated in log space.
 const AREA_LOG_SPACE_BELOW: f64 = 1e-280;
+/// From this a = cot θ/αᵢ on, Λ above the horizon (below 5.2e-48) rounds to 0 in f32: half the
+/// smallest subnormal is 7.0e-46.
+const LAMBDA32_VANISHES_FROM: f64 = 10.0;
 
 /// The anisotropic Beckmann slope distribution (Heitz et al. 2016, supplement §2.2):
 ///
 /// P²²(x̃, ỹ) = exp(−x̃²/αx² − ỹ²/αy²) / (π αx αy),
 /// Λ(ω) = (erf(a) − 1)/2 + exp(−a²)/(2a√π) with a = 1/(αᵢ tan θ).
 ///
-/// Λ, D, D_ωi and the projected area are evaluated in double precision with forms that
-/// avoid the cancellation of erf(a) − 1 (they use erfc). Visible normals are sampled
-/// exactly by inverting the visible-slope CDF (Jakob 2014, extended to θ ∈ [0, π]) with a
-/// safeguarded Halley iteration on the log-CDF, without the supplement's truncation of the
-/// tail (`erf_min = −0.9999`).
+/// D, D_ωi and the projected area are evaluated in double precision with forms that avoid the
+/// cancellation of erf(a) − 1 (they use erfc); so is Λ in `lambda64` (relative error 4e-13),
+/// while the f32 [`MicrosurfaceSlope::lambda`] of the walks is formed from a fit of the tail
+/// ratio and a table exponential, within 0.51 f32 ulp. Visible normals are sampled
+/// exactly by inverting the visible-slope CDF (Jakob 2014, extended to θ ∈ [0, π]) from a
+/// tabulated guess with Halley steps on fitted forms of the CDF (a safeguarded Halley
+/// iteration on the log-CDF where their error estimate fails), without the supplement's
+/// truncation of the tail (`erf_min = −0.9999`).
 ///
 /// # Examples
 /// ```
@@ -73,7 +81,10 @@ impl Beckmann {
         Self::new(alpha, alpha)
     }
 
-    /// D(ωm) in double precision (0 for ωm.z ≤ 0).
+    /// D(ωm) in double precision (0 for ωm.z ≤ 0), the exponential from the table of
+    /// [`exp_nonpositive`] (relative error 4e-15; the library's below −708, where the result
+    /// is subnormal): relative error below 5e-15 beyond that of the exponent's rounding,
+    /// E·2⁻⁵² for the exponent E (measured by the unit test).
     #[inline]
     fn d_double(&self, wm: DVec3) -> f64 {
         // also 0 where 0 < m.z < 1e-100: there the exponent exceeds 1e120 for every f32 α
@@ -83,7 +94,9 @@ impl Beckmann {
         // one division; multiplied left to right, so that a vanishing exponential gives 0
         let (x, y) = (wm.x * self.inv_alpha_x, wm.y * self.inv_alpha_y);
         let inv_z2 = 1.0 / (wm.z * wm.z);
-        (-(x * x + y * y) * inv_z2).exp() * inv_z2 * inv_z2 * self.d_scale
+        let exponent = -(x * x + y * y) * inv_z2;
+        let gauss = if exponent >= EXP_NONPOSITIVE_FROM { exp_nonpositive(exponent) } else { exponent.exp() };
+        gauss * inv_z2 * inv_z2 * self.d_scale
     }
 
     /// The projected area in double precision.
@@ -118,6 +131,28 @@ fn lambda_up64(a: f64) -> f64 {
     0.5 * INV_SQRT_PI * (-a * a).exp() * one_minus_scaled_erfcx(a) / a
 }
 
+/// Λ on the whole sphere for the f32 [`MicrosurfaceSlope::lambda`], in double precision from
+/// the fits: above the horizon Λ = e^{−a²} r(a)/(2√π a) with a = cot θ/αᵢ, e^{−a²} from
+/// [`exp_nonpositive`] (relative error 4e-15, a² formed in f64: its rounding error is
+/// amplified by a² ≤ 100) and r(a) = 1 − √π a erfcx(a) from [`tail_ratio`] (1e-10); 0 from
+/// a = 10 on (where Λ < 5.2e-48 rounds to 0 in f32); below, −1 − Λ(−ω). Relative error below
+/// 2e-10 (measured against [`MicrosurfaceSlope::lambda64`] by the unit test), so that the f32
+/// rounding of it is within 0.51 ulp of Λ. +∞ at the horizon (a = 0).
+#[inline(always)]
+fn lambda_from_fits(alpha_x: f32, alpha_y: f32, w: Vec3) -> f64 {
+    let q = projected_roughness_sq64(alpha_x, alpha_y, w);
+    let z = f64::from(w.z).abs();
+    let root_q = q.sqrt();
+    let a = z / root_q;
+    let up = if a >= LAMBDA32_VANISHES_FROM {
+        0.0
+    } else {
+        let inv_a = root_q / z;
+        exp_nonpositive(-a * a) * tail_ratio(a, inv_a) * inv_a * (0.5 * INV_SQRT_PI)
+    };
+    if w.z >= 0.0 { up } else { -1.0 - up }
+}
+
 impl Beckmann {
     /// The stretched-space primitive of [`MicrosurfaceSlope::sample_d_wi`] (supplement §2.1,
     /// `sampleP22_11`): visible slopes of the distribution stretched to α = 1, seen from
@@ -127,9 +162,9 @@ impl Beckmann {
     ///
     /// Exact inversion of the visible-slope CDF F (a tabulated guess, Halley steps and, where
     /// their error estimate fails, a safeguarded Halley iteration on its logarithm):
-    /// |F(x̃) − u| ≤ 1e-7·u + 1e-10 seen from above the horizon, ≤ 2e-7 for
-    /// |cot θ| ≤ 64 on either side; ỹ is Gaussian and independent of x̃. Seen from straight below (sin θ = 0, cos θ < 0), where nothing is
-    /// visible, returns the zero slope.
+    /// |F(x̃) − u| ≤ 1e-7·u + 1e-10 seen from above the horizon and from below it for
+    /// |cot θ| ≤ 64, ≤ 1e-5 beyond; ỹ is Gaussian and independent of x̃. Seen from straight
+    /// below (sin θ = 0, cos θ < 0), where nothing is visible, returns the zero slope.
     #[inline]
     #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
@@ -166,8 +201,9 @@ impl MicrosurfaceSlope for Beckmann {
         ((-(x * x) - y * y).exp() * INV_PI / (ax * ay)) as f32
     }
 
-    /// exp(−(m.x²/αx² + m.y²/αy²)/m.z²) / (π αx αy m.z⁴), in double precision: the error of
-    /// an f32 exponent E grows as E·2⁻²⁴, and m.z⁴ would underflow before the exponential.
+    /// exp(−(m.x²/αx² + m.y²/αy²)/m.z²) / (π αx αy m.z⁴), in double precision (relative error
+    /// below 5e-15 besides the exponent's rounding): the error of an f32 exponent E grows as
+    /// E·2⁻²⁴, and m.z⁴ would underflow before the exponential.
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
         require!(is_direction(wm), 0.0; wm);
@@ -191,9 +227,11 @@ impl MicrosurfaceSlope for Beckmann {
         self.lambda_unchecked(w)
     }
 
+    /// Formed from the fits of [`lambda_from_fits`] (within 0.51 f32 ulp of Λ, saturating at
+    /// ±`f32::MAX`); [`MicrosurfaceSlope::lambda64`] keeps the double-precision forms.
     #[inline]
     fn lambda_unchecked(&self, w: Vec3) -> f32 {
-        (self.lambda64(w) as f32).clamp(-f32::MAX, f32::MAX)
+        (lambda_from_fits(self.alpha_x, self.alpha_y, w) as f32).clamp(-f32::MAX, f32::MAX)
     }
 
     #[inline]
@@ -289,5 +327,120 @@ impl MicrosurfaceSlope for Beckmann {
     #[inline]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_visible_normal(self, wi, u1, u2)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// D in double precision against the same formula with the library's exponential, on
+    /// normals from the zenith to 1e-6 from the horizon for several roughnesses: relative
+    /// error below 5e-15, and the same 0s.
+    #[test]
+    fn d_double_meets_its_error_bound() {
+        let mut worst = 0.0f64;
+        for alpha in [0.01f32, 0.05, 0.3, 0.5, 1.0, 2.5, 40.0] {
+            let slope = Beckmann::new(alpha, 0.6 * alpha).expect("valid roughness");
+            for i in 0..=4000 {
+                let cos = 1.0 - f64::from(i) / 4000.0 * (1.0 - 1e-6);
+                for phi in [0.0f64, 0.7, 1.6] {
+                    let sin = (1.0 - cos * cos).sqrt();
+                    let wm = DVec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+                    let (x, y) = (wm.x * slope.inv_alpha_x, wm.y * slope.inv_alpha_y);
+                    let inv_z2 = 1.0 / (wm.z * wm.z);
+                    let exact = (-(x * x + y * y) * inv_z2).exp() * inv_z2 * inv_z2 * slope.d_scale;
+                    let got = slope.d_double(wm);
+                    if exact == 0.0 || exact < f64::MIN_POSITIVE {
+                        assert!((got - exact).abs() <= f64::MIN_POSITIVE, "D({wm}) = {got:e}, {exact:e}");
+                        continue;
+                    }
+                    worst = worst.max((got / exact - 1.0).abs());
+                }
+            }
+        }
+        eprintln!("Beckmann D: worst relative error against the library's exp {worst:.3e}");
+        assert!(worst <= 5e-15, "relative error {worst:e}");
+    }
+
+    /// The documented relative error of [`lambda_from_fits`] and the f32 bound that follows.
+    const FITS_MAX_RELATIVE_ERROR: f64 = 2e-10;
+    const LAMBDA32_MAX_ULPS: f64 = 0.51;
+
+    /// Directions at cot θ/αᵢ = a for a geometric sweep of a ∈ [1e-6, 12] and a linear one of
+    /// [0, 10.5], on both hemispheres and three azimuths, for several (anisotropic) roughnesses.
+    fn cases() -> impl Iterator<Item = (Beckmann, Vec3)> {
+        let alphas = [0.01f32, 0.05, 0.3, 0.5, 1.0, 2.5];
+        let geometric = (0..=2000).map(|i| 1e-6 * (12e6f64).powf(f64::from(i) / 2000.0));
+        let linear = (0..=2100).map(|i| f64::from(i) / 200.0);
+        let a_values: Vec<f64> = geometric.chain(linear).collect();
+        alphas.into_iter().flat_map(move |alpha| {
+            let slope = Beckmann::new(alpha, 0.6 * alpha).expect("valid roughness");
+            let a_values = a_values.clone();
+            [0.0f64, 0.7, 1.6].into_iter().flat_map(move |phi| {
+                // αᵢ along φ, then the polar angle with cot θ = a·αᵢ
+                let (ax, ay) = (f64::from(alpha), 0.6 * f64::from(alpha));
+                let alpha_i = (ax * ax * phi.cos().powi(2) + ay * ay * phi.sin().powi(2)).sqrt();
+                let a_values = a_values.clone();
+                a_values.into_iter().flat_map(move |a| {
+                    let theta = (a * alpha_i).recip().atan();
+                    let (s, c) = theta.sin_cos();
+                    let w = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32).normalize();
+                    [(slope, w), (slope, -w)]
+                })
+            })
+        })
+    }
+
+    /// Λ from the fits against the double-precision Λ (relative error 4e-13) over the sweep of
+    /// `cases`: relative error below 2e-10 in f64, and the f32 Λ within 0.51 ulp where Λ is
+    /// a normal f32 (within one subnormal step below); the identity Λ(−ω) = −1 − Λ(ω) holds to
+    /// an f32 rounding.
+    #[test]
+    fn lambda_from_fits_meets_its_error_bound() {
+        let (mut worst, mut worst_ulps, mut checked) = (0.0f64, 0.0f64, 0usize);
+        for (slope, w) in cases() {
+            let exact = slope.lambda64(w);
+            let fit = lambda_from_fits(slope.alpha_x, slope.alpha_y, w);
+            let lambda = slope.lambda(w);
+            if exact.is_infinite() {
+                assert_eq!(lambda, f32::MAX.copysign(w.z), "at the horizon: {w}");
+                continue;
+            }
+            checked += 1;
+            if fit == 0.0 {
+                // from a = 10 on: Λ rounds to 0 in f32
+                assert!(exact < 0.5 * f64::from(f32::from_bits(1)), "Λ({w}) = {exact:e}, fit 0");
+            } else {
+                worst = worst.max((fit / exact - 1.0).abs());
+            }
+            let ulp = f64::from(f32::EPSILON) * exact.abs();
+            if exact.abs() >= f64::from(f32::MIN_POSITIVE) && exact.abs() <= f64::from(f32::MAX) {
+                worst_ulps = worst_ulps.max((f64::from(lambda) - exact).abs() / ulp);
+            } else if exact.abs() < f64::from(f32::MIN_POSITIVE) {
+                let step = f64::from(f32::from_bits(1));
+                assert!((f64::from(lambda) - exact).abs() <= step, "Λ({w}) = {exact:e}: {lambda:e}");
+            }
+            let identity = slope.lambda(-w) + 1.0 + lambda;
+            assert!(
+                identity.abs() <= 2.0 * f32::EPSILON * (1.0 + lambda.abs()),
+                "Λ(−ω) + 1 + Λ(ω) = {identity:e} at {w}"
+            );
+        }
+        eprintln!(
+            "Beckmann Λ from fits: {checked} directions, worst relative error {worst:.3e}, worst f32 error {worst_ulps:.3} ulp"
+        );
+        assert!(worst <= FITS_MAX_RELATIVE_ERROR, "relative error {worst:e} > {FITS_MAX_RELATIVE_ERROR:e}");
+        assert!(worst_ulps <= LAMBDA32_MAX_ULPS, "f32 error {worst_ulps} ulp > {LAMBDA32_MAX_ULPS}");
+        // where the fits stop, Λ is below half the smallest f32 subnormal
+        let alpha_i = 1.0f64;
+        let theta = (LAMBDA32_VANISHES_FROM * alpha_i).recip().atan();
+        let w = Vec3::new(theta.sin() as f32, 0.0, theta.cos() as f32);
+        let slope = Beckmann::isotropic(1.0).expect("valid roughness");
+        assert!(
+            slope.lambda64(w) < 0.5 * f64::from(f32::from_bits(1)),
+            "Λ = {:e} at a = 10",
+            slope.lambda64(w)
+        );
     }
 }

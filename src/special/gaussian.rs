@@ -4,6 +4,8 @@
 //! (Jakob 2014; the Heitz et al. 2016 supplement's `sampleP22_11`, §2.1, writes the same CDF
 //! through erf).
 
+use super::exp::ROUNDING_MAGIC;
+
 /// The fit covers x ∈ [`GAUSSIAN_FIT_FROM`, `GAUSSIAN_FIT_TO`).
 pub(crate) const GAUSSIAN_FIT_FROM: f64 = -4.5;
 /// The end of the fit: from here on A(x) = √π and B(x) = 0 to within 2e-16 (absolute).
@@ -777,6 +779,25 @@ const PIECES: [[f64; 16]; 42] = [
     ],
 ];
 
+/// `PIECES` with A's and B's coefficients of each degree side by side (A₀, B₀, A₁, B₁, …), the
+/// layout of the two-lane evaluation, and scaled to the variable σ = 4s = s/`PIECE_WIDTH`
+/// (the coefficient of degree i times 4⁻ⁱ, exactly).
+const PAIRED: [[f64; 16]; PIECE_COUNT] = {
+    let mut paired = [[0.0; 16]; PIECE_COUNT];
+    let mut k = 0;
+    while k < PIECE_COUNT {
+        let (mut i, mut scale) = (0, 1.0);
+        while i < 8 {
+            paired[k][2 * i] = PIECES[k][i] * scale;
+            paired[k][2 * i + 1] = PIECES[k][8 + i] * scale;
+            i += 1;
+            scale *= PIECE_WIDTH;
+        }
+        k += 1;
+    }
+    paired
+};
+
 /// (A(x), B(x)) = (∫₋∞ˣ e^{−t²} dt, e^{−x²}/2) for x ∈ [`GAUSSIAN_FIT_FROM`, ∞); `None` below
 /// that (and for NaN). From `GAUSSIAN_FIT_TO` on, (√π, 0).
 ///
@@ -793,17 +814,29 @@ pub(crate) fn gaussian_integral_and_half(x: f64) -> Option<(f64, f64)> {
     if x.is_nan() || x < GAUSSIAN_FIT_FROM {
         return None;
     }
-    // x ∈ [FROM, TO): the index is in [0, PIECE_COUNT] (PIECE_COUNT only by rounding)
-    let k = (((x - GAUSSIAN_FIT_FROM) * PIECES_PER_X) as u32).min(PIECE_COUNT as u32 - 1) as usize;
-    let s = x - (GAUSSIAN_FIT_FROM + (k as f64 + 0.5) * PIECE_WIDTH);
-    let c = &PIECES[k];
-    // Estrin's scheme (three levels of multiply–adds instead of seven in a chain: more
-    // instructions than Horner's rule once vectorized, but 5–10 % faster, see DESIGN.md)
+    // x ∈ [FROM, TO): the piece is the nearest integer k of t = 4(x − FROM) − ½ (a tie picks
+    // either neighbour, whose interpolant holds at their common end), in [0, PIECE_COUNT − 1],
+    // and σ = t − k = 4(x − c_k) ∈ [−½, ½] its variable (`PAIRED` is scaled to it), both from
+    // one rounding (no integer-to-float conversion on the way to the polynomial)
+    let t = (x - GAUSSIAN_FIT_FROM) * PIECES_PER_X - 0.5;
+    let rounded = t + ROUNDING_MAGIC;
+    let k = (rounded.to_bits() as u32).min(PIECE_COUNT as u32 - 1) as usize;
+    let s = t - (rounded - ROUNDING_MAGIC).min((PIECE_COUNT - 1) as f64);
+    let c = &PAIRED[k];
+    // Estrin's scheme (three levels of multiply–adds instead of seven in a chain), on the pairs
+    // (A's coefficient, B's) that `PAIRED` stores side by side: the two polynomials in the two
+    // lanes of each vector operation, with no shuffles
     let s2 = s * s;
     let s4 = s2 * s2;
-    let a = ((c[0] + c[1] * s) + s2 * (c[2] + c[3] * s)) + s4 * ((c[4] + c[5] * s) + s2 * (c[6] + c[7] * s));
-    let b = ((c[8] + c[9] * s) + s2 * (c[10] + c[11] * s))
-        + s4 * ((c[12] + c[13] * s) + s2 * (c[14] + c[15] * s));
+    let pair = |i: usize| (c[2 * i], c[2 * i + 1]);
+    let level1 = |i: usize| {
+        let (low, high) = (pair(i), pair(i + 1));
+        (low.0 + high.0 * s, low.1 + high.1 * s)
+    };
+    let (p0, p2, p4, p6) = (level1(0), level1(2), level1(4), level1(6));
+    let q0 = (p0.0 + s2 * p2.0, p0.1 + s2 * p2.1);
+    let q4 = (p4.0 + s2 * p6.0, p4.1 + s2 * p6.1);
+    let (a, b) = (q0.0 + s4 * q4.0, q0.1 + s4 * q4.1);
     Some((a, b))
 }
 

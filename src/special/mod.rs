@@ -7,15 +7,19 @@
 mod erf;
 mod erfcx;
 mod erfinv;
+mod exp;
 mod gamma;
 mod gaussian;
+mod tail_ratio;
 mod trig;
 
 pub use erf::{erf, erfc};
 pub(crate) use erf::{erf64, erfc64};
 pub(crate) use erfcx::{PSI_SERIES_FROM, erfcx64, one_minus_scaled_erfcx};
 pub use erfinv::erfinv;
-pub(crate) use erfinv::{erfc_inv_f32, erfinv_from_both_ends, erfinv64};
+pub(crate) use erfinv::{NO_LOG_BELOW, erfc_inv_f32, erfinv_central, erfinv_from_both_ends, erfinv64};
+pub(crate) use exp::{EXP_NONPOSITIVE_FROM, ROUNDING_MAGIC, exp_nonpositive};
 pub use gamma::{beta, ln_beta, ln_gamma};
 pub(crate) use gaussian::gaussian_integral_and_half;
+pub(crate) use tail_ratio::tail_ratio;
 pub use trig::sin_cos_turns;

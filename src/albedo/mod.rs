@@ -20,7 +20,7 @@ mod dielectric_walk;
 mod dielectric_walk_data;
 mod table;
 
-pub(crate) use axis::{DielectricDirection, node_cell, scale_invariant_direction};
+pub(crate) use axis::{DielectricDirection, floor_index, node_cell, scale_invariant_direction};
 pub use dielectric::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable, EtaRange, MAX_TABULATED_ETA,
 };

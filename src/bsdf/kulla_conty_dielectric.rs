@@ -4,12 +4,14 @@
 //! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
 
 use super::compensated::AlbedoTabulated;
-use super::lobe_profile::{LobeProfile, PROFILE_NODES, profile_cell, profile_cells, row_at};
+use super::lobe_profile::{
+    DirectionAxis, MU_CELLS, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
+};
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
 };
-use crate::albedo::{DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
+use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
@@ -18,6 +20,14 @@ use glam::{Vec2, Vec3};
 
 /// The cells (index, fraction) of the view's and the light's cosine on the direction axis.
 type Cells = ((usize, f32), (usize, f32));
+
+/// Nodes of the walk tables' direction axis.
+const PROFILE_NODES: usize = DIELECTRIC_TABLE_SIZE;
+
+/// The smallest share of the single-scattering lobe in the sampling mixture, relative to the
+/// lobes' total: keeps its density positive wherever it scatters, should the tables give it
+/// no energy (η → 1 at grazing views).
+const MIN_SINGLE_SHARE: f64 = 1e-3;
 
 /// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
 const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -40,10 +50,10 @@ impl WalkTabulated for Beckmann {
 /// The rows and samplers of one side of the interface (the side of the view).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct SideLobes {
-    /// The sampling mixture's probabilities of the single-scattering lobe and of the reflection
-    /// lobe at the direction nodes: E_ss, ΔR over E_ss + ΔR + c ΔT (E_ss = R_ss + T_ss); the
-    /// transmission lobe has the rest.
-    mixture: [[f32; 2]; PROFILE_NODES],
+    /// The sampling mixture's probabilities of the single-scattering, the reflection and the
+    /// transmission lobe per cell of the view's uniform μ axis: E_ss : ΔR : c ΔT at the cell's
+    /// centre (E_ss = R_ss + T_ss), normalized.
+    mixture: MixtureTable<3>,
     /// ΔR at the direction nodes.
     reflected: [f32; PROFILE_NODES],
     /// ΔT at the direction nodes, times this side's reciprocity factor c.
@@ -56,9 +66,9 @@ struct SideLobes {
     /// The radiance factor (η_wo/η_wi)² of a transmission from this side, or 1 (importance).
     transmitted_transport: f32,
     /// The sampler of ΔR(μ) μ on this side.
-    reflected_profile: LobeProfile<PROFILE_NODES>,
+    reflected_profile: MuProfile,
     /// The sampler of ΔT(μ) μ on this side (used for light arriving from the other side).
-    transmitted_profile: LobeProfile<PROFILE_NODES>,
+    transmitted_profile: MuProfile,
 }
 
 /// A dielectric microfacet BSDF compensated with the random walk's higher orders, reflection
@@ -147,6 +157,8 @@ pub struct KullaContyDielectric<S> {
     transport: Transport,
     /// The tables' roughness √(αx αy).
     alpha: f32,
+    /// The walk tables' direction axis at this α.
+    axis: DirectionAxis<PROFILE_NODES>,
     /// η_wi/η_wo of a transmission from outside (η) and from inside (1/η).
     transmitted_eta: [f32; 2],
     /// The view's side: outside (0), inside (1).
@@ -183,19 +195,20 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         }
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let empty = SideLobes {
-            mixture: [[1.0, 0.0]; PROFILE_NODES],
+            mixture: MixtureTable::new(|_| [1.0, 0.0, 0.0]),
             reflected: [0.0; PROFILE_NODES],
             transmitted: [0.0; PROFILE_NODES],
             reflected_scale: 0.0,
             transmitted_scale: 0.0,
             transmitted_transport: 1.0,
-            reflected_profile: LobeProfile::EMPTY,
-            transmitted_profile: LobeProfile::EMPTY,
+            reflected_profile: MuProfile::EMPTY,
+            transmitted_profile: MuProfile::EMPTY,
         };
         let mut b = Self {
             single,
             transport: Transport::Radiance,
             alpha,
+            axis: DirectionAxis::new(if single.is_specular() { 1.0 } else { alpha }),
             transmitted_eta: [eta, 1.0 / eta],
             sides: [empty; 2],
             mismatch: 0.0,
@@ -206,33 +219,30 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         }
         let mut averages = [0.0f64; 2];
         let mut variances = [0.0f64; 2];
-        let mut single = [[0.0f32; PROFILE_NODES]; 2];
+        let mut single = [[0.0f32; MU_CELLS]; 2];
         // the averages are linear in the nodes: their weights, from the unit rows
         let node_weights: [f64; PROFILE_NODES] = core::array::from_fn(|i| {
             let mut unit = [0.0; PROFILE_NODES];
             unit[i] = 1.0;
-            LobeProfile::new(&unit, alpha).0
+            profile_average(&unit, alpha)
         });
         for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
             let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
-            // E_ss = R + T at the walk table's direction nodes μ = α X/(1 + α − X), X = (i/15)²
-            // (the single-scattering table has its own direction axis; E_ss only sets the
-            // sampling mixture, for which any positive weights give an exact density)
-            for (i, e) in single[s].iter_mut().enumerate() {
-                let x_sq = (i as f32 / (PROFILE_NODES - 1) as f32).powi(2);
-                let mu = (alpha * x_sq / (1.0 + alpha - x_sq)).min(1.0);
-                let v = S::DIELECTRIC_ALBEDO.albedo(mu, alpha, seen).ok_or(eta_error(seen))?;
+            // E_ss = R + T at the centres of the uniform μ cells (it only sets the sampling
+            // mixture, for which any positive weights give an exact density)
+            for (k, e) in single[s].iter_mut().enumerate() {
+                let v = S::DIELECTRIC_ALBEDO.albedo(mu_cell_centre(k), alpha, seen).ok_or(eta_error(seen))?;
                 *e = v.reflected + v.transmitted;
             }
             let side = &mut b.sides[s];
             side.reflected = dr;
             side.transmitted = dt;
-            let (r_avg, r_profile) = LobeProfile::new(&dr, alpha);
-            let (t_avg, t_profile) = LobeProfile::new(&dt, alpha);
+            let r_avg = profile_average(&dr, alpha);
             side.reflected_scale = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
-            side.reflected_profile = r_profile;
-            side.transmitted_profile = t_profile;
-            averages[s] = t_avg;
+            side.reflected_profile = MuProfile::new(&mu_cell_masses(&dr, alpha));
+            // the sampler of ΔT μ: the same for c ΔT (a constant factor)
+            side.transmitted_profile = MuProfile::new(&mu_cell_masses(&dt, alpha));
+            averages[s] = profile_average(&dt, alpha);
             let var = S::DIELECTRIC_WALK.transmitted_row_variance(alpha, seen).ok_or(eta_error(seen))?;
             variances[s] = node_weights.iter().zip(var).map(|(w, v)| w * w * f64::from(v)).sum();
         }
@@ -257,13 +267,20 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             // the transmission from side s is normalized by the other side's scaled average
             let other = c[1 - s] * averages[1 - s];
             b.sides[s].transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
-            let side = &mut b.sides[s];
-            for (i, m) in side.mixture.iter_mut().enumerate() {
-                let w =
-                    [f64::from(single[s][i]), f64::from(side.reflected[i]), f64::from(side.transmitted[i])];
-                let total = w[0] + w[1] + w[2];
-                *m = if total > 0.0 { [(w[0] / total) as f32, (w[1] / total) as f32] } else { [1.0, 0.0] };
-            }
+            let (axis, side) = (b.axis, &mut b.sides[s]);
+            side.mixture = MixtureTable::new(|k| {
+                let cell = axis.cell(mu_cell_centre(k));
+                let (dr, dt) = (row_at(&side.reflected, cell), row_at(&side.transmitted, cell));
+                let (dr, dt) = (f64::from(dr.max(0.0)), f64::from(dt.max(0.0)));
+                let single = f64::from(single[s][k]).max(MIN_SINGLE_SHARE * (dr + dt));
+                let total = single + dr + dt;
+                if total > 0.0 {
+                    let (p0, p1) = ((single / total) as f32, (dr / total) as f32);
+                    [p0, p1, (1.0 - p0 - p1).max(0.0)]
+                } else {
+                    [1.0, 0.0, 0.0]
+                }
+            });
         }
         Ok(b.with_transport(Transport::Radiance))
     }
@@ -310,7 +327,7 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
             return None;
         }
         let s = &self.sides[side_index(side)];
-        let cell = profile_cell(mu, self.alpha);
+        let cell = self.axis.cell(mu);
         Some((row_at(&s.reflected, cell), row_at(&s.transmitted, cell)))
     }
 
@@ -329,36 +346,31 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
         Vec3::splat(f)
     }
 
-    /// The mixture's lobe probabilities (single, reflection, transmission) for the view's cell:
-    /// the normalized node probabilities interpolated (no division at run time), the third
-    /// the complement of the first two.
+    /// The view's side and its mixture probabilities (single, reflection, transmission).
     #[inline(always)]
-    fn probabilities(a: &SideLobes, (i, f): (usize, f32)) -> [f32; 3] {
-        let (lo, hi) = (a.mixture[i], a.mixture[i + 1]);
-        let p0 = lo[0] + f * (hi[0] - lo[0]);
-        let p1 = lo[1] + f * (hi[1] - lo[1]);
-        [p0, p1, (1.0 - p0 - p1).max(0.0)]
+    fn view(&self, wo: Vec3) -> (&SideLobes, [f32; 3]) {
+        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
+        (a, *a.mixture.at(wo.z.abs()))
     }
 
-    /// The mixture density at wi (off the horizon, in cell `cell_i`) for the view's
-    /// probabilities.
+    /// The mixture density at wi (off the horizon) for the view's side `a` and probabilities
+    /// `p`: no table of the direction axis, one lookup of the uniform μ axis.
     #[inline(always)]
-    fn mixture_pdf(&self, a: &SideLobes, p: [f32; 3], cell_i: usize, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+    fn mixture_pdf(&self, a: &SideLobes, p: [f32; 3], wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         let mu_i = wi.z.abs();
         let lobe = if (wi.z > 0.0) == (wo.z > 0.0) {
-            p[1] * a.reflected_profile.pdf(cell_i, mu_i)
+            p[1] * a.reflected_profile.pdf(mu_i)
         } else {
             let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
-            p[2] * b.transmitted_profile.pdf(cell_i, mu_i)
+            p[2] * b.transmitted_profile.pdf(mu_i)
         };
         p[0] * pdf_ss + lobe
     }
 
-    /// The view's side and the cells of both directions.
+    /// The cells of both directions on the direction axis (one division).
     #[inline(always)]
-    fn side_and_cells(&self, wo: Vec3, wi: Vec3) -> (&SideLobes, Cells) {
-        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        (a, profile_cells(wo.z.abs(), wi.z.abs(), self.alpha))
+    fn cells(&self, wo: Vec3, wi: Vec3) -> Cells {
+        self.axis.cells(wo.z.abs(), wi.z.abs())
     }
 
     /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
@@ -408,8 +420,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return v;
         }
-        let (a, cells) = self.side_and_cells(wo, wi);
-        BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }
+        let (a, _) = self.view(wo);
+        BsdfValue { f: v.f + self.added(a, self.cells(wo, wi), wo, wi), exact: true }
     }
 
     #[inline]
@@ -417,25 +429,28 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z == 0.0 {
             return self.single.sample_keyed(wo, uc, u, key);
         }
-        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        let cell_o = profile_cell(wo.z.abs(), self.alpha);
-        let p = Self::probabilities(a, cell_o);
-        let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
-        let wi = if uc < p[0] {
+        let (a, p) = self.view(wo);
+        let (wi, f_cos_ss, pdf_ss) = if uc < p[0] {
+            // the single-scattering lobe: its sample carries f·|cos θi| (weight × pdf) and its
+            // density
             let s = self.single.sample_keyed(wo, (uc / p[0]).min(ONE_MINUS_ULP), u, key)?;
-            // f and the density as eval and pdf compute them (the cells located together)
-            let (_, cells) = self.side_and_cells(wo, s.wi);
-            let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, s.wi, s.pdf);
-            let f_cos = s.weight * s.pdf + self.added(a, cells, wo, s.wi) * s.wi.z.abs();
-            return self.finish(wo, s.wi, f_cos, pdf);
-        } else if uc < p[0] + p[1] {
-            flip(a.reflected_profile.sample(u)?)
+            (s.wi, s.weight * s.pdf, s.pdf)
         } else {
-            let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
-            -flip(b.transmitted_profile.sample(u)?)
+            let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
+            let wi = if uc < p[0] + p[1] {
+                flip(a.reflected_profile.sample(u)?)
+            } else {
+                let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
+                -flip(b.transmitted_profile.sample(u)?)
+            };
+            // f and the density as eval and pdf compute them
+            (wi, self.single.eval_keyed(wo, wi, key).f * wi.z.abs(), self.single.pdf(wo, wi))
         };
-        let (v, pdf) = self.eval_with_pdf_keyed(wo, wi, key);
-        self.finish(wo, wi, v.f * wi.z.abs(), pdf)
+        if wi.z == 0.0 {
+            return None;
+        }
+        let f_cos = f_cos_ss + self.added(a, self.cells(wo, wi), wo, wi) * wi.z.abs();
+        self.finish(wo, wi, f_cos, self.mixture_pdf(a, p, wo, wi, pdf_ss))
     }
 
     #[inline]
@@ -444,8 +459,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return pdf_ss;
         }
-        let (a, (cell_o, cell_i)) = self.side_and_cells(wo, wi);
-        self.mixture_pdf(a, Self::probabilities(a, cell_o), cell_i.0, wo, wi, pdf_ss)
+        let (a, p) = self.view(wo);
+        self.mixture_pdf(a, p, wo, wi, pdf_ss)
     }
 
     #[inline]
@@ -454,8 +469,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return (v, pdf_ss);
         }
-        let (a, cells) = self.side_and_cells(wo, wi);
-        let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, wi, pdf_ss);
-        (BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }, pdf)
+        let (a, p) = self.view(wo);
+        let pdf = self.mixture_pdf(a, p, wo, wi, pdf_ss);
+        (BsdfValue { f: v.f + self.added(a, self.cells(wo, wi), wo, wi), exact: true }, pdf)
     }
 }

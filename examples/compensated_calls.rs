@@ -1,0 +1,168 @@
+//! A profiling driver for the energy-compensated lobes against the single-scattering lobe they
+//! are built on (`benches/bsdf.rs`'s `gold/compensated/` and `glass/compensated/` groups: GGX
+//! α = 0.5, gold or glass η = 1.5, the bench's 1024 pre-generated inputs from the same seeds):
+//! runs `calls` calls of one method of one model, static dispatch, for instruction counts under
+//! `valgrind --tool=callgrind`. Run it with two call counts (multiples of 1024) and take the
+//! difference per call, which removes the start-up cost; the technique `none` runs the same
+//! loop around a trivial call, whose count per call is the loop's own, to subtract.
+//!
+//! Usage: `compensated_calls {gold|glass} {none|single|kulla-conty|turquin|per-order}
+//! {eval|pdf|sample|eval_with_pdf} calls`
+
+use core::f32::consts::TAU;
+use microsurface::glam::{Vec2, Vec3};
+use microsurface::rand::{RngExt, SeedableRng};
+use microsurface::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, CompensatedConductor, CompensatedDielectric, Compensation,
+    ComplexIor, Conductor, Dielectric, Ggx, KullaContyDielectric, MicrofacetBsdf, Technique,
+};
+use rand_pcg::Pcg64Mcg;
+use std::hint::black_box;
+
+/// The number of pre-generated inputs (the bench's).
+const N: usize = 1024;
+/// The roughness of every configuration (the bench's).
+const ALPHA: f32 = 0.5;
+
+/// A uniform direction on the upper hemisphere (or the whole sphere), never horizontal: the
+/// bench's generator, draw for draw.
+fn direction(rng: &mut Pcg64Mcg, sphere: bool) -> Vec3 {
+    let u = 1.0 - rng.random::<f32>();
+    let z = if sphere && rng.random::<bool>() { -u } else { u };
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = TAU * rng.random::<f32>();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// The bench's inputs: views, light directions, uniforms.
+struct Inputs {
+    wo: Vec<Vec3>,
+    wi: Vec<Vec3>,
+    uc: Vec<f32>,
+    u: Vec<Vec2>,
+}
+
+fn inputs(transmits: bool, seed: u64) -> Inputs {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let wo = (0..N).map(|_| direction(&mut rng, false)).collect();
+    let wi = (0..N).map(|_| direction(&mut rng, transmits)).collect();
+    let uc = (0..N).map(|_| rng.random::<f32>()).collect();
+    let u = (0..N).map(|_| Vec2::new(rng.random(), rng.random())).collect();
+    Inputs { wo, wi, uc, u }
+}
+
+/// A model whose every call is trivial: the driver loop's own cost.
+struct Nothing;
+
+impl Bsdf for Nothing {
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags { reflection: true, transmission: false, glossy: true, diffuse: false, specular: false }
+    }
+    #[inline(always)]
+    fn eval_keyed(&self, wo: Vec3, _wi: Vec3, _key: u64) -> BsdfValue {
+        BsdfValue { f: black_box(wo), exact: true }
+    }
+    #[inline(always)]
+    fn sample_keyed(&self, _wo: Vec3, _uc: f32, _u: Vec2, _key: u64) -> Option<BsdfSample> {
+        black_box(None)
+    }
+    #[inline(always)]
+    fn pdf(&self, wo: Vec3, _wi: Vec3) -> f32 {
+        black_box(wo.x)
+    }
+    #[inline(always)]
+    fn eval_with_pdf_keyed(&self, wo: Vec3, _wi: Vec3, _key: u64) -> (BsdfValue, f32) {
+        (BsdfValue { f: black_box(wo), exact: true }, black_box(wo.x))
+    }
+}
+
+/// `calls` calls of `what` on `b`, rotating through the inputs; returns a checksum.
+#[inline(never)]
+fn run<B: Bsdf>(b: &B, x: &Inputs, what: &str, calls: usize) -> f64 {
+    let mut sum = 0.0f64;
+    match what {
+        "eval" => {
+            for k in 0..calls {
+                let k = k & (N - 1);
+                sum += f64::from(black_box(b).eval(black_box(x.wo[k]), black_box(x.wi[k])).f.x);
+            }
+        }
+        "pdf" => {
+            for k in 0..calls {
+                let k = k & (N - 1);
+                sum += f64::from(black_box(b).pdf(black_box(x.wo[k]), black_box(x.wi[k])));
+            }
+        }
+        "eval_with_pdf" => {
+            for k in 0..calls {
+                let k = k & (N - 1);
+                sum += f64::from(black_box(b).eval_with_pdf(black_box(x.wo[k]), black_box(x.wi[k])).1);
+            }
+        }
+        "sample" => {
+            for k in 0..calls {
+                let k = k & (N - 1);
+                let s = black_box(b).sample(black_box(x.wo[k]), black_box(x.uc[k]), black_box(x.u[k]));
+                sum += s.map_or(0.0, |s| f64::from(s.pdf));
+            }
+        }
+        _ => panic!("eval, pdf, eval_with_pdf or sample, not {what}"),
+    }
+    sum
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let [_, material, technique, what, calls] = &args[..] else {
+        panic!(
+            "usage: compensated_calls {{gold|glass}} {{none|single|kulla-conty|turquin|per-order}} {{eval|pdf|sample|eval_with_pdf}} calls"
+        )
+    };
+    let calls: usize = calls.parse().expect("a call count");
+    let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
+    let sum = match material.as_str() {
+        "gold" => {
+            let gold = Conductor::new(ComplexIor::GOLD);
+            let x = inputs(false, 300);
+            let scheme = match technique.as_str() {
+                "kulla-conty" => Some(Compensation::KullaConty),
+                "turquin" => Some(Compensation::Turquin),
+                "per-order" => Some(Compensation::PerOrder),
+                _ => None,
+            };
+            match (technique.as_str(), scheme) {
+                ("none", _) => run(&Nothing, &x, what, calls),
+                ("single", _) => {
+                    let b = MicrofacetBsdf::new(slope, gold)
+                        .expect("valid material")
+                        .with_technique(Technique::SingleScattering);
+                    run(&b, &x, what, calls)
+                }
+                (_, Some(scheme)) => {
+                    run(&CompensatedConductor::new(slope, gold, scheme).expect("α ≤ 1"), &x, what, calls)
+                }
+                _ => panic!("unknown technique {technique}"),
+            }
+        }
+        "glass" => {
+            let glass = Dielectric::new(1.5).expect("valid index");
+            let x = inputs(true, 310);
+            match technique.as_str() {
+                "none" => run(&Nothing, &x, what, calls),
+                "single" => {
+                    let b = MicrofacetBsdf::new(slope, glass)
+                        .expect("valid material")
+                        .with_technique(Technique::SingleScattering);
+                    run(&b, &x, what, calls)
+                }
+                "kulla-conty" => {
+                    run(&KullaContyDielectric::new(slope, glass).expect("in range"), &x, what, calls)
+                }
+                "turquin" => run(&CompensatedDielectric::new(slope, glass).expect("in range"), &x, what, calls),
+                _ => panic!("unknown technique {technique}"),
+            }
+        }
+        _ => panic!("gold or glass, not {material}"),
+    };
+    println!("{material}/{technique}/{what}: {calls} calls, checksum {sum}");
+}

@@ -14,6 +14,7 @@ use super::{
 use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
+use crate::single_scattering::SingleScattering;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
 use core::f64::consts::PI;
 use glam::{Vec2, Vec3};
@@ -54,21 +55,19 @@ struct SideLobes {
     /// transmission lobe per cell of the view's uniform μ axis: E_ss : ΔR : c ΔT at the cell's
     /// centre (E_ss = R_ss + T_ss), normalized.
     mixture: MixtureTable<3>,
-    /// ΔR at the direction nodes.
-    reflected: [f32; PROFILE_NODES],
-    /// ΔT at the direction nodes, times this side's reciprocity factor c.
-    transmitted: [f32; PROFILE_NODES],
-    /// 1/(π ΔR̄) (0 without a lobe).
-    reflected_scale: f32,
-    /// 1/(π ΔT̄′) of the *other* side's scaled ΔT′ (0 without a lobe): the normalization of
-    /// the transmission from this side.
+    /// The added lobes' factors of the view at the direction nodes, by whether the light
+    /// crosses the interface: ΔR of this side, and ΔT of this side times its reciprocity
+    /// factor c.
+    view_rows: [[f32; PROFILE_NODES]; 2],
+    /// Their factors of the light: ΔR of this side, c ΔT of the other side.
+    light_rows: [[f32; PROFILE_NODES]; 2],
+    /// Their normalizations: 1/(π ΔR̄), and 1/(π c ΔT̄) of the other side times the transport
+    /// factor of a transmission from this side (0 without a lobe).
+    scales: [f32; 2],
+    /// 1/(π c ΔT̄) of the other side (0 without a lobe).
     transmitted_scale: f32,
-    /// The radiance factor (η_wo/η_wi)² of a transmission from this side, or 1 (importance).
-    transmitted_transport: f32,
-    /// The sampler of ΔR(μ) μ on this side.
-    reflected_profile: MuProfile,
-    /// The sampler of ΔT(μ) μ on this side (used for light arriving from the other side).
-    transmitted_profile: MuProfile,
+    /// The samplers of the light's factor times μ: ΔR(μ) μ of this side, ΔT(μ) μ of the other.
+    profiles: [MuProfile; 2],
 }
 
 /// A dielectric microfacet BSDF compensated with the random walk's higher orders, reflection
@@ -196,13 +195,11 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let empty = SideLobes {
             mixture: MixtureTable::new(|_| [1.0, 0.0, 0.0]),
-            reflected: [0.0; PROFILE_NODES],
-            transmitted: [0.0; PROFILE_NODES],
-            reflected_scale: 0.0,
+            view_rows: [[0.0; PROFILE_NODES]; 2],
+            light_rows: [[0.0; PROFILE_NODES]; 2],
+            scales: [0.0; 2],
             transmitted_scale: 0.0,
-            transmitted_transport: 1.0,
-            reflected_profile: MuProfile::EMPTY,
-            transmitted_profile: MuProfile::EMPTY,
+            profiles: [MuProfile::EMPTY; 2],
         };
         let mut b = Self {
             single,
@@ -220,6 +217,7 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         let mut averages = [0.0f64; 2];
         let mut variances = [0.0f64; 2];
         let mut single = [[0.0f32; MU_CELLS]; 2];
+        let mut transmitted_profiles = [MuProfile::EMPTY; 2];
         // the averages are linear in the nodes: their weights, from the unit rows
         let node_weights: [f64; PROFILE_NODES] = core::array::from_fn(|i| {
             let mut unit = [0.0; PROFILE_NODES];
@@ -235,13 +233,13 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
                 *e = v.reflected + v.transmitted;
             }
             let side = &mut b.sides[s];
-            side.reflected = dr;
-            side.transmitted = dt;
+            side.view_rows = [dr, dt];
             let r_avg = profile_average(&dr, alpha);
-            side.reflected_scale = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
-            side.reflected_profile = MuProfile::new(&mu_cell_masses(&dr, alpha));
-            // the sampler of ΔT μ: the same for c ΔT (a constant factor)
-            side.transmitted_profile = MuProfile::new(&mu_cell_masses(&dt, alpha));
+            side.scales[0] = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
+            side.profiles[0] = MuProfile::new(&mu_cell_masses(&dr, alpha));
+            // the sampler of ΔT μ (the same for c ΔT, a constant factor), for light crossing
+            // from the other side
+            transmitted_profiles[s] = MuProfile::new(&mu_cell_masses(&dt, alpha));
             averages[s] = profile_average(&dt, alpha);
             let var = S::DIELECTRIC_WALK.transmitted_row_variance(alpha, seen).ok_or(eta_error(seen))?;
             variances[s] = node_weights.iter().zip(var).map(|(w, v)| w * w * f64::from(v)).sum();
@@ -261,16 +259,21 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
             [0.0, 0.0]
         };
         for s in 0..2 {
-            for v in &mut b.sides[s].transmitted {
+            for v in &mut b.sides[s].view_rows[1] {
                 *v = (f64::from(*v) * c[s]) as f32;
             }
+        }
+        for s in 0..2 {
             // the transmission from side s is normalized by the other side's scaled average
             let other = c[1 - s] * averages[1 - s];
-            b.sides[s].transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
+            let other_row = b.sides[1 - s].view_rows[1];
             let (axis, side) = (b.axis, &mut b.sides[s]);
+            side.transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
+            side.light_rows = [side.view_rows[0], other_row];
+            side.profiles[1] = transmitted_profiles[1 - s];
             side.mixture = MixtureTable::new(|k| {
                 let cell = axis.cell(mu_cell_centre(k));
-                let (dr, dt) = (row_at(&side.reflected, cell), row_at(&side.transmitted, cell));
+                let (dr, dt) = (row_at(&side.view_rows[0], cell), row_at(&side.view_rows[1], cell));
                 let (dr, dt) = (f64::from(dr.max(0.0)), f64::from(dt.max(0.0)));
                 let single = f64::from(single[s][k]).max(MIN_SINGLE_SHARE * (dr + dt));
                 let total = single + dr + dt;
@@ -295,10 +298,11 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
         // (η_wo/η_wi)² of a transmission: from outside 1/η², from inside η²
         let radiance = [1.0 / (eta * eta), eta * eta];
         for (side, r) in b.sides.iter_mut().zip(radiance) {
-            side.transmitted_transport = match transport {
+            let transport = match transport {
                 Transport::Radiance => r,
                 Transport::Importance => 1.0,
             };
+            side.scales[1] = side.transmitted_scale * transport;
         }
         b
     }
@@ -328,22 +332,14 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
         }
         let s = &self.sides[side_index(side)];
         let cell = self.axis.cell(mu);
-        Some((row_at(&s.reflected, cell), row_at(&s.transmitted, cell)))
+        Some((row_at(&s.view_rows[0], cell), row_at(&s.view_rows[1], cell)))
     }
 
     /// The added lobe f_R or f_T at (wo, wi), both off the horizon, from their cells.
     #[inline(always)]
-    fn added(&self, a: &SideLobes, cells: Cells, wo: Vec3, wi: Vec3) -> Vec3 {
-        let (cell_o, cell_i) = cells;
-        let f = if (wi.z > 0.0) == (wo.z > 0.0) {
-            row_at(&a.reflected, cell_o) * row_at(&a.reflected, cell_i) * a.reflected_scale
-        } else {
-            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
-            row_at(&a.transmitted, cell_o)
-                * row_at(&b.transmitted, cell_i)
-                * (a.transmitted_scale * a.transmitted_transport)
-        };
-        Vec3::splat(f)
+    fn added(a: &SideLobes, (cell_o, cell_i): Cells, wo: Vec3, wi: Vec3) -> Vec3 {
+        let c = crossing(wo, wi);
+        Vec3::splat(row_at(&a.view_rows[c], cell_o) * row_at(&a.light_rows[c], cell_i) * a.scales[c])
     }
 
     /// The view's side and its mixture probabilities (single, reflection, transmission).
@@ -356,15 +352,19 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
     /// The mixture density at wi (off the horizon) for the view's side `a` and probabilities
     /// `p`: no table of the direction axis, one lookup of the uniform μ axis.
     #[inline(always)]
-    fn mixture_pdf(&self, a: &SideLobes, p: [f32; 3], wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        let mu_i = wi.z.abs();
-        let lobe = if (wi.z > 0.0) == (wo.z > 0.0) {
-            p[1] * a.reflected_profile.pdf(mu_i)
-        } else {
-            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
-            p[2] * b.transmitted_profile.pdf(mu_i)
-        };
-        p[0] * pdf_ss + lobe
+    fn mixture_pdf(a: &SideLobes, p: [f32; 3], wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        let c = crossing(wo, wi);
+        p[0] * pdf_ss + p[1 + c] * a.profiles[c].pdf(wi.z.abs())
+    }
+
+    /// Single scattering's density at valid directions off the horizon of a rough surface:
+    /// its research-layer density without the trait's repeated checks (the same bits as
+    /// `self.single.pdf(wo, wi)`).
+    #[inline(always)]
+    fn single_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let surface = self.single.surface();
+        let pdf = SingleScattering::new(*surface.slope(), *surface.material()).pdf_unchecked(wo, wi);
+        if pdf.is_finite() { pdf } else { 0.0 }
     }
 
     /// The cells of both directions on the direction axis (one division).
@@ -399,6 +399,12 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
     }
 }
 
+/// Whether the light crosses the interface (1) or stays on the view's side (0).
+#[inline(always)]
+fn crossing(wo: Vec3, wi: Vec3) -> usize {
+    usize::from((wi.z > 0.0) != (wo.z > 0.0))
+}
+
 /// The index of a side in [`KullaContyDielectric::sides`].
 #[inline(always)]
 fn side_index(side: Side) -> usize {
@@ -421,7 +427,7 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
             return v;
         }
         let (a, _) = self.view(wo);
-        BsdfValue { f: v.f + self.added(a, self.cells(wo, wi), wo, wi), exact: true }
+        BsdfValue { f: v.f + Self::added(a, self.cells(wo, wi), wo, wi), exact: true }
     }
 
     #[inline]
@@ -436,31 +442,28 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
             let s = self.single.sample_keyed(wo, (uc / p[0]).min(ONE_MINUS_ULP), u, key)?;
             (s.wi, s.weight * s.pdf, s.pdf)
         } else {
-            let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
-            let wi = if uc < p[0] + p[1] {
-                flip(a.reflected_profile.sample(u)?)
-            } else {
-                let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
-                -flip(b.transmitted_profile.sample(u)?)
-            };
+            // the added lobe of the light's side: its profile's direction on the view's side,
+            // mirrored through the interface for a transmission
+            let c = usize::from(uc >= p[0] + p[1]);
+            let w = a.profiles[c].sample(u)?;
+            let wi = if (wo.z > 0.0) == (c == 0) { w } else { -w };
             // f and the density as eval and pdf compute them
-            (wi, self.single.eval_keyed(wo, wi, key).f * wi.z.abs(), self.single.pdf(wo, wi))
+            (wi, self.single.eval_keyed(wo, wi, key).f * wi.z.abs(), self.single_pdf(wo, wi))
         };
         if wi.z == 0.0 {
             return None;
         }
-        let f_cos = f_cos_ss + self.added(a, self.cells(wo, wi), wo, wi) * wi.z.abs();
-        self.finish(wo, wi, f_cos, self.mixture_pdf(a, p, wo, wi, pdf_ss))
+        let f_cos = f_cos_ss + Self::added(a, self.cells(wo, wi), wo, wi) * wi.z.abs();
+        self.finish(wo, wi, f_cos, Self::mixture_pdf(a, p, wo, wi, pdf_ss))
     }
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let pdf_ss = self.single.pdf(wo, wi);
         if !self.compensates(wo, wi) {
-            return pdf_ss;
+            return self.single.pdf(wo, wi);
         }
         let (a, p) = self.view(wo);
-        self.mixture_pdf(a, p, wo, wi, pdf_ss)
+        Self::mixture_pdf(a, p, wo, wi, self.single_pdf(wo, wi))
     }
 
     #[inline]
@@ -470,7 +473,7 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
             return (v, pdf_ss);
         }
         let (a, p) = self.view(wo);
-        let pdf = self.mixture_pdf(a, p, wo, wi, pdf_ss);
-        (BsdfValue { f: v.f + self.added(a, self.cells(wo, wi), wo, wi), exact: true }, pdf)
+        let pdf = Self::mixture_pdf(a, p, wo, wi, pdf_ss);
+        (BsdfValue { f: v.f + Self::added(a, self.cells(wo, wi), wo, wi), exact: true }, pdf)
     }
 }

@@ -6,8 +6,11 @@
 //! difference per call, which removes the start-up cost; the technique `none` runs the same
 //! loop around a trivial call, whose count per call is the loop's own, to subtract.
 //!
+//! `sample-first` and `sample-last` run the sampler with the lobe-choice uniform fixed at 0 or
+//! 1⁻ (a mixture's single-scattering lobe, or its added lobe), to time the branches apart.
+//!
 //! Usage: `compensated_calls {gold|glass} {none|single|kulla-conty|turquin|per-order}
-//! {eval|pdf|sample|eval_with_pdf} calls`
+//! {eval|pdf|sample|eval_with_pdf|sample-first|sample-last} calls`
 
 use core::f32::consts::TAU;
 use microsurface::glam::{Vec2, Vec3};
@@ -106,7 +109,17 @@ fn run<B: Bsdf>(b: &B, x: &Inputs, what: &str, calls: usize) -> f64 {
                 sum += s.map_or(0.0, |s| f64::from(s.pdf));
             }
         }
-        _ => panic!("eval, pdf, eval_with_pdf or sample, not {what}"),
+        // the sampler with the lobe-choice uniform fixed at 0 (the single-scattering lobe of a
+        // mixture) or at 1⁻ (its added lobe)
+        "sample-first" | "sample-last" => {
+            let uc = if what == "sample-first" { 0.0 } else { 1.0 - f32::EPSILON / 2.0 };
+            for k in 0..calls {
+                let k = k & (N - 1);
+                let s = black_box(b).sample(black_box(x.wo[k]), black_box(uc), black_box(x.u[k]));
+                sum += s.map_or(0.0, |s| f64::from(s.pdf));
+            }
+        }
+        _ => panic!("eval, pdf, eval_with_pdf, sample, sample-first or sample-last, not {what}"),
     }
     sum
 }
@@ -115,7 +128,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let [_, material, technique, what, calls] = &args[..] else {
         panic!(
-            "usage: compensated_calls {{gold|glass}} {{none|single|kulla-conty|turquin|per-order}} {{eval|pdf|sample|eval_with_pdf}} calls"
+            "usage: compensated_calls {{gold|glass}} {{none|single|kulla-conty|turquin|per-order}} {{eval|pdf|sample|eval_with_pdf|sample-first|sample-last}} calls"
         )
     };
     let calls: usize = calls.parse().expect("a call count");
@@ -158,7 +171,9 @@ fn main() {
                 "kulla-conty" => {
                     run(&KullaContyDielectric::new(slope, glass).expect("in range"), &x, what, calls)
                 }
-                "turquin" => run(&CompensatedDielectric::new(slope, glass).expect("in range"), &x, what, calls),
+                "turquin" => {
+                    run(&CompensatedDielectric::new(slope, glass).expect("in range"), &x, what, calls)
+                }
                 _ => panic!("unknown technique {technique}"),
             }
         }

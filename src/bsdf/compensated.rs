@@ -2,14 +2,18 @@
 //! higher orders restored from the single-scattering albedo tables ([`AlbedoTable`]), with a
 //! deterministic eval, an exact pdf and a sampler (Kulla and Conty 2017; Turquin 2019).
 
+mod shared;
+
+pub(crate) use shared::{ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
+
 use super::lobe_profile::{
     DirectionAxis, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
 use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, valid_direction, valid_uniforms};
 use crate::albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
-    ORDER_TABLES, ScatteringOrderTable, node_cell,
+    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, ORDER_TABLES,
+    ScatteringOrderTable, node_cell,
 };
 use crate::error::Error;
 use crate::material::Conductor;
@@ -216,18 +220,12 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
     /// The compensated BRDF of a conductor on the given slopes.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`] (= 1), the
+    /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (= 1), the
     /// tables' range: there is no albedo to compensate with beyond it.
     pub fn new(slope: S, conductor: Conductor, scheme: Compensation) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
         // the slope's roughnesses are finite and > 0; their product may overflow to ∞ (rejected)
-        if alpha > MAX_TABULATED_ALPHA {
-            return Err(Error::InvalidParameter {
-                name: "alpha",
-                value: alpha,
-                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the albedo tables' range",
-            });
-        }
+        check_tabulated(alpha, None, Tables::Albedo)?;
         let single = MicrofacetBsdf::new(slope, conductor)?.with_technique(Technique::SingleScattering);
         // a Dirac mirror is not compensated (and √(αx αy) may underflow to 0 there)
         let (complement, complement_average, profile) = if single.is_specular() {
@@ -434,21 +432,6 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     fn view_complement(&self, wo: Vec3) -> f32 {
         if wo.z > 0.0 { self.complement_at(wo.z) } else { 0.0 }
     }
-
-    /// A sample of a direction above the horizon from f·cos θi (`f_cos`) and the density `pdf`
-    /// there, `None` unless both are usable (the filter of the single-scattering sampler).
-    #[inline(always)]
-    fn finish(wi: Vec3, f_cos: Vec3, pdf: f32) -> Option<BsdfSample> {
-        if !(pdf >= f32::MIN_POSITIVE && pdf <= f32::MAX) {
-            return None;
-        }
-        let weight = f_cos * (1.0 / pdf);
-        if !weight.is_finite() || f_cos.max_element() < f32::MIN_POSITIVE * wi.z {
-            return None;
-        }
-        let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
-        Some(BsdfSample { wi, weight, pdf, eta: 1.0, flags })
-    }
 }
 
 impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
@@ -497,7 +480,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             (wi, f_cos, pdf)
         };
         let f_cos = f_cos_ss + self.added(wo.z, wi.z) * wi.z;
-        Self::finish(wi, f_cos, self.mixture_pdf(wo.z, pdf_ss, wi.z))
+        mixture_sample(wo, wi, f_cos, self.mixture_pdf(wo.z, pdf_ss, wi.z), 1.0)
     }
 
     #[inline(always)]

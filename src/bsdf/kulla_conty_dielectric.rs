@@ -3,15 +3,13 @@
 //! higher orders' reflected and transmitted energy, from the walk's tables
 //! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
 
-use super::compensated::AlbedoTabulated;
+use super::compensated::{AlbedoTabulated, ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
 use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
-};
-use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
+use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::single_scattering::SingleScattering;
@@ -29,9 +27,6 @@ const PROFILE_NODES: usize = DIELECTRIC_TABLE_SIZE;
 /// lobes' total: keeps its density positive wherever it scatters, should the tables give it
 /// no energy (η → 1 at grazing views).
 const MIN_SINGLE_SHARE: f64 = 1e-3;
-
-/// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
-const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// A slope family with the random walk's dielectric tables: the families a
 /// [`KullaContyDielectric`] can be built on.
@@ -171,27 +166,14 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
     /// transport).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`] (`"alpha"`) or the
-    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`], [`MAX_TABULATED_ETA`]] = [1/3, 3]
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA)] = [1/3, 3]
     /// (`"eta"`): the tables' range.
     pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
-        if alpha > MAX_TABULATED_ALPHA {
-            return Err(Error::InvalidParameter {
-                name: "alpha",
-                value: alpha,
-                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the walk tables' range",
-            });
-        }
         let eta = dielectric.eta();
-        let eta_error = |value| Error::InvalidParameter {
-            name: "eta",
-            value,
-            expected: "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric walk tables' range",
-        };
-        if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) {
-            return Err(eta_error(eta));
-        }
+        check_tabulated(alpha, Some(eta), Tables::Walk)?;
+        let eta_error = |value| Tables::Walk.eta_error(value);
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let empty = SideLobes {
             mixture: MixtureTable::new(|_| [1.0, 0.0, 0.0]),
@@ -379,24 +361,6 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
     fn compensates(&self, wo: Vec3, wi: Vec3) -> bool {
         !self.single.is_specular() && valid_direction(wo) && valid_direction(wi) && wo.z != 0.0 && wi.z != 0.0
     }
-
-    /// A sample from f·|cos θi| and the density at wi, `None` unless both are usable (the
-    /// filter of the single-scattering sampler).
-    #[inline(always)]
-    fn finish(&self, wo: Vec3, wi: Vec3, f_cos: Vec3, pdf: f32) -> Option<BsdfSample> {
-        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite()) || wi.z == 0.0 {
-            return None;
-        }
-        let weight = f_cos / pdf;
-        if !weight.is_finite() || f_cos.max_element() < f32::MIN_POSITIVE * wi.z.abs() {
-            return None;
-        }
-        let reflection = (wi.z > 0.0) == (wo.z > 0.0);
-        let eta =
-            if reflection { 1.0 } else { self.transmitted_eta[side_index(Side::above_or_inside(wo.z))] };
-        let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf: true };
-        Some(BsdfSample { wi, weight, pdf, eta, flags })
-    }
 }
 
 /// Whether the light crosses the interface (1) or stays on the view's side (0).
@@ -454,7 +418,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
             return None;
         }
         let f_cos = f_cos_ss + Self::added(a, self.cells(wo, wi), wo, wi) * wi.z.abs();
-        self.finish(wo, wi, f_cos, Self::mixture_pdf(a, p, wo, wi, pdf_ss))
+        let eta = self.transmitted_eta[side_index(Side::above_or_inside(wo.z))];
+        mixture_sample(wo, wi, f_cos, Self::mixture_pdf(a, p, wo, wi, pdf_ss), eta)
     }
 
     #[inline]

@@ -383,17 +383,35 @@ mod tests {
                     let mut mass = 0.0;
                     for k in 0..MU_CELLS {
                         let (a, b) = (k as f64 / m, (k + 1) as f64 / m);
-                        let cell: f64 = [-0.861_136_311_594_053, -0.339_981_043_584_856, 0.339_981_043_584_856, 0.861_136_311_594_053]
-                            .iter()
-                            .zip([0.347_854_845_137_454, 0.652_145_154_862_546, 0.652_145_154_862_546, 0.347_854_845_137_454])
-                            .map(|(&x, w)| {
-                                let mu = 0.5 * (a + b) + 0.5 * (b - a) * x;
-                                w * 0.5 * (b - a) * 2.0 * PI * f64::from(profile.pdf(mu as f32))
-                            })
-                            .sum();
+                        let cell: f64 = [
+                            -0.861_136_311_594_053,
+                            -0.339_981_043_584_856,
+                            0.339_981_043_584_856,
+                            0.861_136_311_594_053,
+                        ]
+                        .iter()
+                        .zip([
+                            0.347_854_845_137_454,
+                            0.652_145_154_862_546,
+                            0.652_145_154_862_546,
+                            0.347_854_845_137_454,
+                        ])
+                        .map(|(&x, w)| {
+                            let mu = 0.5 * (a + b) + 0.5 * (b - a) * x;
+                            w * 0.5 * (b - a) * 2.0 * PI * f64::from(profile.pdf(mu as f32))
+                        })
+                        .sum();
                         // each cell carries about its share of the profile (the node values
                         // average neighbouring cells)
-                        assert!(cell <= 3.0 * (masses[k.saturating_sub(1)] + masses[k] + masses[(k + 1).min(MU_CELLS - 1)]) / total + 1e-6, "cell {k}: {cell}");
+                        assert!(
+                            cell <= 3.0
+                                * (masses[k.saturating_sub(1)]
+                                    + masses[k]
+                                    + masses[(k + 1).min(MU_CELLS - 1)])
+                                / total
+                                + 1e-6,
+                            "cell {k}: {cell}"
+                        );
                         mass += cell;
                     }
                     assert!((mass - 1.0).abs() <= 1e-5, "N = {N} α = {alpha}: ∫ pdf dω = {mass}");
@@ -418,7 +436,8 @@ mod tests {
     /// has density 0 everywhere.
     #[test]
     fn sampler_matches_its_density() {
-        let row: [f32; 32] = core::array::from_fn(|i| (i as f32 * 0.37).sin().abs() + if i == 3 { 2.0 } else { 0.0 });
+        let row: [f32; 32] =
+            core::array::from_fn(|i| (i as f32 * 0.37).sin().abs() + if i == 3 { 2.0 } else { 0.0 });
         let profile = MuProfile::new(&mu_cell_masses(&row, 0.2));
         let (n, bins) = (400_000usize, 4 * MU_CELLS);
         let z = validation::family_z(0.01, bins);

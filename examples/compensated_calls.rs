@@ -79,47 +79,60 @@ impl Bsdf for Nothing {
     }
 }
 
-/// `calls` calls of `what` on `b`, rotating through the inputs; returns a checksum.
-#[inline(never)]
+/// `calls` calls of `what` on `b`, rotating through the inputs; returns a checksum. Each method
+/// has its own loop, not inlined, so that the code around a call does not depend on the others.
 fn run<B: Bsdf>(b: &B, x: &Inputs, what: &str, calls: usize) -> f64 {
-    let mut sum = 0.0f64;
     match what {
-        "eval" => {
-            for k in 0..calls {
-                let k = k & (N - 1);
-                sum += f64::from(black_box(b).eval(black_box(x.wo[k]), black_box(x.wi[k])).f.x);
-            }
-        }
-        "pdf" => {
-            for k in 0..calls {
-                let k = k & (N - 1);
-                sum += f64::from(black_box(b).pdf(black_box(x.wo[k]), black_box(x.wi[k])));
-            }
-        }
-        "eval_with_pdf" => {
-            for k in 0..calls {
-                let k = k & (N - 1);
-                sum += f64::from(black_box(b).eval_with_pdf(black_box(x.wo[k]), black_box(x.wi[k])).1);
-            }
-        }
-        "sample" => {
-            for k in 0..calls {
-                let k = k & (N - 1);
-                let s = black_box(b).sample(black_box(x.wo[k]), black_box(x.uc[k]), black_box(x.u[k]));
-                sum += s.map_or(0.0, |s| f64::from(s.pdf));
-            }
-        }
+        "eval" => run_eval(b, x, calls),
+        "pdf" => run_pdf(b, x, calls),
+        "eval_with_pdf" => run_eval_with_pdf(b, x, calls),
+        "sample" => run_sample(b, x, calls, None),
         // the sampler with the lobe-choice uniform fixed at 0 (the single-scattering lobe of a
         // mixture) or at 1⁻ (its added lobe)
-        "sample-first" | "sample-last" => {
-            let uc = if what == "sample-first" { 0.0 } else { 1.0 - f32::EPSILON / 2.0 };
-            for k in 0..calls {
-                let k = k & (N - 1);
-                let s = black_box(b).sample(black_box(x.wo[k]), black_box(uc), black_box(x.u[k]));
-                sum += s.map_or(0.0, |s| f64::from(s.pdf));
-            }
-        }
+        "sample-first" => run_sample(b, x, calls, Some(0.0)),
+        "sample-last" => run_sample(b, x, calls, Some(1.0 - f32::EPSILON / 2.0)),
         _ => panic!("eval, pdf, eval_with_pdf, sample, sample-first or sample-last, not {what}"),
+    }
+}
+
+#[inline(never)]
+fn run_eval<B: Bsdf>(b: &B, x: &Inputs, calls: usize) -> f64 {
+    let mut sum = 0.0f64;
+    for k in 0..calls {
+        let k = k & (N - 1);
+        sum += f64::from(black_box(b).eval(black_box(x.wo[k]), black_box(x.wi[k])).f.x);
+    }
+    sum
+}
+
+#[inline(never)]
+fn run_pdf<B: Bsdf>(b: &B, x: &Inputs, calls: usize) -> f64 {
+    let mut sum = 0.0f64;
+    for k in 0..calls {
+        let k = k & (N - 1);
+        sum += f64::from(black_box(b).pdf(black_box(x.wo[k]), black_box(x.wi[k])));
+    }
+    sum
+}
+
+#[inline(never)]
+fn run_eval_with_pdf<B: Bsdf>(b: &B, x: &Inputs, calls: usize) -> f64 {
+    let mut sum = 0.0f64;
+    for k in 0..calls {
+        let k = k & (N - 1);
+        sum += f64::from(black_box(b).eval_with_pdf(black_box(x.wo[k]), black_box(x.wi[k])).1);
+    }
+    sum
+}
+
+#[inline(never)]
+fn run_sample<B: Bsdf>(b: &B, x: &Inputs, calls: usize, uc: Option<f32>) -> f64 {
+    let mut sum = 0.0f64;
+    for k in 0..calls {
+        let k = k & (N - 1);
+        let uc = uc.unwrap_or(x.uc[k]);
+        let s = black_box(b).sample(black_box(x.wo[k]), black_box(uc), black_box(x.u[k]));
+        sum += s.map_or(0.0, |s| f64::from(s.pdf));
     }
     sum
 }

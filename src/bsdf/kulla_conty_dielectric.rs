@@ -240,9 +240,9 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         } else {
             [0.0, 0.0]
         };
-        for s in 0..2 {
-            for v in &mut b.sides[s].view_rows[1] {
-                *v = (f64::from(*v) * c[s]) as f32;
+        for (side, c) in b.sides.iter_mut().zip(c) {
+            for v in &mut side.view_rows[1] {
+                *v = (f64::from(*v) * c) as f32;
             }
         }
         for s in 0..2 {

@@ -233,7 +233,8 @@ impl MuProfile {
         });
         let cell_mass: [f64; MU_CELLS] = core::array::from_fn(|k| 0.5 * (nodes[k] + nodes[k + 1]) * width(k));
         let total: f64 = cell_mass.iter().sum();
-        if !(total > 0.0) {
+        // (NaN fails too)
+        if total.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return Self::EMPTY;
         }
         // Vose's alias method, in f64

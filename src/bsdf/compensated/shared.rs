@@ -66,7 +66,7 @@ impl Tables {
 /// doubled the time of the conductor's compensated sample).
 #[inline(always)]
 pub(crate) fn mixture_sample(wo: Vec3, wi: Vec3, f_cos: Vec3, pdf: f32, eta: f32) -> Option<BsdfSample> {
-    if !(pdf >= f32::MIN_POSITIVE && pdf <= f32::MAX) || wi.z == 0.0 {
+    if !(f32::MIN_POSITIVE..=f32::MAX).contains(&pdf) || wi.z == 0.0 {
         return None;
     }
     let weight = f_cos * (1.0 / pdf);

@@ -134,15 +134,16 @@ pub enum Compensation {
 /// lobe by that error divided by E(μo)).
 ///
 /// **Sampling** (Kulla–Conty and per-order): with probability p = E(μo) (the energies of the
-/// two lobes for F = 1; E here interpolated linearly between the uniform nodes μ = i/31, so
-/// that the lookup needs no division or root, any p ∈ (0, 1] giving an exact mixture) the
-/// caller's uniforms drive the exact visible-normal sample of the single-scattering
-/// lobe (uc rescaled to uc/p), otherwise u samples the added lobe's profile (1 − E(μi)) μi
-/// tabulated per cell of the direction axis (a cell by its mass, μi² uniform in it, φ uniform:
-/// density d_cell μi/π); the density is the mixture pdf = p pdf_ss + (1 − p) d_cell μi/π, exact
-/// (the cell of a returned direction is recomputed from its f32 cosine, which moves at most a
-/// few ulps of μ² of probability between neighbouring cells). Turquin samples and has the density of
-/// the single-scattering lobe.
+/// two lobes for F = 1; E here taken at the centre of μo's cell on a uniform μ axis of 32
+/// cells, so that the lookup is one multiply and one truncation, any p ∈ (0, 1] giving an exact
+/// mixture) the caller's u drives the exact visible-normal sample of the single-scattering
+/// lobe, otherwise u samples the added lobe's profile (1 − E(μi)) μi by cells of the uniform μ
+/// axis: a density ρ(μi²) μi/π continuous and linear in μi² on each cell, a cell chosen by its
+/// mass with the alias method (no search), μi² within it by inverting the line, φ uniform. The
+/// density is the mixture pdf = p pdf_ss + (1 − p) ρ(μi²) μi/π, exact, the same bits in `pdf`,
+/// `eval_with_pdf` and the sample. In the added lobe's branch single scattering's f·cos θi is
+/// taken in its sampler's form F G2/G1 · pdf_ss (within 1e-5 of eval's, as its sampler's
+/// weight is). Turquin samples and has the density of the single-scattering lobe.
 ///
 /// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
 /// the Dirac mirror of the single-scattering BSDF, uncompensated (the energy the single
@@ -152,9 +153,10 @@ pub enum Compensation {
 ///
 /// **Cost.** Construction integrates F_avg (64 Fresnel evaluations) and the average (31 cells;
 /// the per-order scheme three more and the blend of six order tables): a few microseconds;
-/// build the BSDF once per material, it is `Copy`. Eval adds one (Turquin) or two (Kulla–Conty,
-/// per-order) branch-free 1D table lookups to the single-scattering eval, pdf one
-/// direction-axis lookup and one uniform-μ lookup (measured in `README.md`).
+/// build the BSDF once per material, it is `Copy`. Eval adds to the single-scattering eval one
+/// (Turquin) or two (Kulla–Conty, per-order, sharing one division) branch-free lookups of the
+/// direction axis; pdf two lookups of the uniform μ axis (no division, no root); sample the
+/// direction-axis lookups of eval and the uniform-μ lookups of pdf (measured in `README.md`).
 ///
 /// **Per-order** ([`Compensation::PerOrder`]) restores each channel's energy from the walk's
 /// per-order energies ([`ScatteringOrderTable`], standard error ≤ 1.95e-3 per node) instead of

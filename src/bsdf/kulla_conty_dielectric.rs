@@ -101,17 +101,18 @@ struct SideLobes {
 /// (an average of 0) there is no transmission lobe.
 /// f_R is symmetric.
 ///
-/// **Sampling.** A mixture chosen by the view's energies: at every direction node the
-/// probabilities of the single-scattering sample, the reflection lobe and the transmission
-/// lobe are E_ss : ΔR_a : c_a ΔT_a (E_ss = R_ss + T_ss from [`crate::DielectricAlbedoTable`]),
-/// normalized at construction and interpolated linearly in x at μo (no division at run time);
-/// each lobe samples its profile g(μi) μi per cell of the direction axis (a cell by its mass,
-/// μi² uniform in it, φ uniform) on its hemisphere. `pdf` is the exact mixture density, and a
-/// sample's weight is f·|cos θi|/pdf at its direction, with f and pdf computed as `eval` and
-/// `pdf` compute them (both cosines located on the axis with one shared division; the lobe is
-/// chosen with μo located alone, a few ulps of a cell fraction apart, which changes a lobe
-/// probability by a relative ~1e-7).
-///
+/// **Sampling.** A mixture chosen by the view's energies: per cell of a uniform μ axis of the
+/// view (32 cells, one multiply and one truncation to find one) the probabilities of the
+/// single-scattering sample, the reflection lobe and the transmission lobe are
+/// E_ss : ΔR_a : c_a ΔT_a at the cell's centre (E_ss = R_ss + T_ss from
+/// [`crate::DielectricAlbedoTable`], at least 1e-3 of the total), normalized at construction;
+/// each lobe samples the profile g(μi) μi of its light factor on its hemisphere by cells of the
+/// uniform μ axis (a density continuous and linear in μi² on each cell, a cell by its mass with
+/// the alias method, φ uniform: no division, root or search to find a cell or its density).
+/// `pdf` is the exact mixture density, and a sample's weight is f·|cos θi|/pdf at its
+/// direction, with f and pdf computed as `eval` and `pdf` compute them (the density the same
+/// bits; the single-scattering branch reuses its sampler's density, within 1e-5 of `pdf`'s).
+
 /// **Tables.** Both families' tables at α = √(αx αy), blended in (α, η) once at
 /// construction (both sides read the same (r, u) coordinate), the direction axis
 /// x = √(μ (1 + α)/(μ + α)) interpolated linearly at run time; ΔR̄ and ΔT̄ are the exact

@@ -458,17 +458,18 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
         if self.scheme == Compensation::Turquin {
-            let s = self.single.sample_keyed(wo, uc, u, key)?;
-            if self.single.is_specular() {
-                return Some(s);
+            let mut s = self.single.sample_keyed(wo, uc, u, key)?;
+            if !self.single.is_specular() {
+                s.weight *= self.turquin_factor(self.view_complement(wo));
             }
-            let weight = s.weight * self.turquin_factor(self.view_complement(wo));
-            return weight.is_finite().then_some(BsdfSample { weight, ..s });
+            return if s.weight.is_finite() { Some(s) } else { None };
         }
         if !self.mixes(wo) || !valid_direction(wo) || !valid_uniforms(uc, u) {
             return self.single.sample_keyed(wo, uc, u, key);
         }
         let [p, _] = *self.mixture.at(wo.z);
+        // the view's lobe factor, off the path from the sampled direction to the weight
+        let h_o = self.lobe_at(self.axis.cell(wo.z));
         let (wi, f_cos_ss, pdf_ss) = if uc < p {
             // the single-scattering lobe's sample of a conductor seen from above (what its
             // `sample_keyed` runs after the checks done here; uc only chose the lobe): its weight
@@ -481,7 +482,9 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             let (f_cos, pdf) = self.single_at(wo, wi);
             (wi, f_cos, pdf)
         };
-        let f_cos = f_cos_ss + self.added(wo.z, wi.z) * wi.z;
+        // (wi is above the horizon; its cell from its own division, a few ulps from eval's
+        // shared one)
+        let f_cos = f_cos_ss + h_o * self.lobe_at(self.axis.cell(wi.z)) * wi.z;
         mixture_sample(wo, wi, f_cos, self.mixture_pdf(wo.z, pdf_ss, wi.z), 1.0)
     }
 

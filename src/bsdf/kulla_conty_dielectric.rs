@@ -112,7 +112,7 @@ struct SideLobes {
 /// `pdf` is the exact mixture density, and a sample's weight is f·|cos θi|/pdf at its
 /// direction, with f and pdf computed as `eval` and `pdf` compute them (the density the same
 /// bits; the single-scattering branch reuses its sampler's density, within 1e-5 of `pdf`'s).
-
+///
 /// **Tables.** Both families' tables at α = √(αx αy), blended in (α, η) once at
 /// construction (both sides read the same (r, u) coordinate), the direction axis
 /// x = √(μ (1 + α)/(μ + α)) interpolated linearly at run time; ΔR̄ and ΔT̄ are the exact

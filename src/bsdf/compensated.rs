@@ -606,3 +606,51 @@ fn fresnel_average(conductor: &Conductor) -> Vec3 {
     }
     (sum * h).as_vec3()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ComplexIor;
+
+    /// The added lobe's branch of the sampler takes single scattering's f·cos θi and density
+    /// in its sampler's form (`single_at`): the density is `pdf`'s, bit for bit, and f is
+    /// within 1e-5 of `eval`'s (relative, largest channel) on 20 000 random pairs of directions
+    /// above the horizon per case, GGX and Beckmann, α from 0.05 to 1, gold and copper.
+    #[test]
+    fn single_at_matches_eval_and_pdf() {
+        fn check<S: AlbedoTabulated>(slope: S, conductor: Conductor, worst: &mut f32) {
+            let b = CompensatedConductor::new(slope, conductor, Compensation::KullaConty).unwrap();
+            let mut state = 0x9e37_79b9_7f4a_7c15u64;
+            let mut next = || {
+                state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                ((state >> 40) as f32 + 0.5) / (1u64 << 24) as f32
+            };
+            let mut dir = || {
+                let z: f32 = next();
+                let phi = core::f32::consts::TAU * next();
+                let s = (1.0 - z * z).max(0.0).sqrt();
+                Vec3::new(s * phi.cos(), s * phi.sin(), z)
+            };
+            for _ in 0..20_000 {
+                let (wo, wi) = (dir(), dir());
+                let (f_cos, pdf) = b.single_at(wo, wi);
+                assert_eq!(pdf, b.single.pdf(wo, wi), "wo = {wo}, wi = {wi}");
+                let f = b.single.eval(wo, wi).f;
+                if f.max_element() < f32::MIN_POSITIVE {
+                    continue;
+                }
+                let err = ((f_cos / wi.z) - f).abs().max_element() / f.max_element();
+                *worst = worst.max(err);
+            }
+        }
+        let mut worst = 0.0f32;
+        for alpha in [0.05f32, 0.3, 1.0] {
+            for ior in [ComplexIor::GOLD, ComplexIor::COPPER] {
+                check(Ggx::isotropic(alpha).unwrap(), Conductor::new(ior), &mut worst);
+                check(Beckmann::isotropic(alpha).unwrap(), Conductor::new(ior), &mut worst);
+            }
+        }
+        println!("single_at against eval: largest relative difference {worst:.2e}");
+        assert!(worst <= 1e-5, "largest relative difference {worst:e}");
+    }
+}

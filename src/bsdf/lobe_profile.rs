@@ -241,15 +241,28 @@ impl MuProfile {
         let mut scaled: [f64; MU_CELLS] = core::array::from_fn(|k| cell_mass[k] / total * m);
         let mut alias: [usize; MU_CELLS] = core::array::from_fn(|k| k);
         let mut threshold = [1.0f64; MU_CELLS];
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..MU_CELLS).partition(|&k| scaled[k] < 1.0);
-        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
-            small.pop();
+        // the work lists of the cells below and above the mean, as fixed stacks (no allocation)
+        let (mut small, mut large) = ([0usize; MU_CELLS], [0usize; MU_CELLS]);
+        let (mut n_small, mut n_large) = (0, 0);
+        for (k, &p) in scaled.iter().enumerate() {
+            if p < 1.0 {
+                small[n_small] = k;
+                n_small += 1;
+            } else {
+                large[n_large] = k;
+                n_large += 1;
+            }
+        }
+        while n_small > 0 && n_large > 0 {
+            n_small -= 1;
+            let (s, l) = (small[n_small], large[n_large - 1]);
             threshold[s] = scaled[s];
             alias[s] = l;
             scaled[l] -= 1.0 - scaled[s];
             if scaled[l] < 1.0 {
-                large.pop();
-                small.push(l);
+                n_large -= 1;
+                small[n_small] = l;
+                n_small += 1;
             }
         }
         // (what is left holds 1 up to rounding)

@@ -12,47 +12,16 @@
 //! Usage: `compensated_calls {gold|glass} {none|single|kulla-conty|turquin|per-order}
 //! {eval|pdf|sample|eval_with_pdf|sample-first|sample-last} calls`
 
-use core::f32::consts::TAU;
 use microsurface::glam::{Vec2, Vec3};
-use microsurface::rand::{RngExt, SeedableRng};
 use microsurface::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, CompensatedConductor, CompensatedDielectric, Compensation,
     ComplexIor, Conductor, Dielectric, Ggx, KullaContyDielectric, MicrofacetBsdf, Technique,
 };
-use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
+use validation::inputs::{Inputs, N, inputs};
 
-/// The number of pre-generated inputs (the bench's).
-const N: usize = 1024;
 /// The roughness of every configuration (the bench's).
 const ALPHA: f32 = 0.5;
-
-/// A uniform direction on the upper hemisphere (or the whole sphere), never horizontal: the
-/// bench's generator, draw for draw.
-fn direction(rng: &mut Pcg64Mcg, sphere: bool) -> Vec3 {
-    let u = 1.0 - rng.random::<f32>();
-    let z = if sphere && rng.random::<bool>() { -u } else { u };
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = TAU * rng.random::<f32>();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-/// The bench's inputs: views, light directions, uniforms.
-struct Inputs {
-    wo: Vec<Vec3>,
-    wi: Vec<Vec3>,
-    uc: Vec<f32>,
-    u: Vec<Vec2>,
-}
-
-fn inputs(transmits: bool, seed: u64) -> Inputs {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let wo = (0..N).map(|_| direction(&mut rng, false)).collect();
-    let wi = (0..N).map(|_| direction(&mut rng, transmits)).collect();
-    let uc = (0..N).map(|_| rng.random::<f32>()).collect();
-    let u = (0..N).map(|_| Vec2::new(rng.random(), rng.random())).collect();
-    Inputs { wo, wi, uc, u }
-}
 
 /// A model whose every call is trivial: the driver loop's own cost.
 struct Nothing;

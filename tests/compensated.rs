@@ -9,7 +9,7 @@ use microsurface::{
     CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx, LAST_TABULATED_ORDER,
     ORDER_TABLES, Side, Transport,
 };
-use validation::check::{assert_finite_at_edges, draw};
+use validation::check::{assert_finite_at_edges, assert_side_flags, draw};
 use validation::chi2::{BsdfChi2, sampler_chi2};
 use validation::quadrature::{Domain, integrate_sphere};
 use validation::{Stats, assert_mean, dir, family_z, sidak, uniform32};
@@ -490,12 +490,7 @@ fn dielectric_sample_matches_pdf_and_weights_match_eval() {
     for (k, (label, b, theta)) in cases.iter().enumerate() {
         let wo = dir(*theta, 0.4);
         let each = |s: &microsurface::BsdfSample| {
-            let crossed = (s.wi.z > 0.0) != (wo.z > 0.0);
-            assert!(
-                s.flags.transmission == crossed && s.flags.reflection != crossed,
-                "{label}: flags {:?}",
-                s.flags
-            );
+            assert_side_flags(label, wo, s);
         };
         let mut rng = validation::rng(2600 + k as u64);
         let settings = BsdfChi2::sphere(100_000, 1e-4, 6, 1e-6);

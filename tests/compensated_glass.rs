@@ -11,7 +11,7 @@ use microsurface::{
     MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Side, Technique, Transport, UniformHeight,
     WalkTabulated,
 };
-use validation::check::{EDGE_VIEW_COSINES, assert_finite_at_edges, draw, edge_view};
+use validation::check::{EDGE_VIEW_COSINES, assert_finite_at_edges, assert_side_flags, draw, edge_view};
 use validation::chi2::{BsdfChi2, sampler_chi2};
 use validation::quadrature::{Domain, integrate_sphere};
 use validation::{Stats, assert_mean, dir, family_z, sidak, uniform32};
@@ -113,12 +113,7 @@ fn sample_matches_pdf_and_weights_match_eval() {
         let mut rng = validation::rng(16_600 + k as u64);
         let (mut reflected, mut transmitted) = (0usize, 0usize);
         let each = |s: &microsurface::BsdfSample| {
-            let crossed = (s.wi.z > 0.0) != (wo.z > 0.0);
-            assert!(
-                s.flags.transmission == crossed && s.flags.reflection != crossed,
-                "{label}: flags {:?}",
-                s.flags
-            );
+            let crossed = assert_side_flags(label, wo, s);
             if crossed {
                 transmitted += 1;
                 assert_ne!(s.eta, 1.0, "{label}: a transmission's η");

@@ -71,6 +71,20 @@ pub fn draw<B: Bsdf + ?Sized>(b: &B, wo: Vec3, rng: &mut TestRng) -> Option<Bsdf
     b.sample(wo, uc, u)
 }
 
+/// Asserts that the flags of a non-specular sample with an exact density name the side it
+/// leaves on for the view `wo` (transmission exactly when `wi` crosses the plane), and returns
+/// whether it crossed.
+#[track_caller]
+pub fn assert_side_flags(label: &str, wo: Vec3, s: &BsdfSample) -> bool {
+    let crossed = (s.wi.z > 0.0) != (wo.z > 0.0);
+    assert!(
+        s.flags.exact_pdf && s.flags.transmission == crossed && s.flags.reflection != crossed,
+        "{label}: flags {:?}",
+        s.flags
+    );
+    crossed
+}
+
 /// |a − b| ≤ rel·max(|a|, |b|) componentwise against the largest component: the relative
 /// comparison of two BSDF values or weights.
 #[must_use]

@@ -297,12 +297,13 @@ impl MuProfile {
         Self { columns, cells }
     }
 
-    /// The density ρ(μ²) μ/π of a direction with |cos θ| = μ on the hemisphere it was sampled
-    /// on: one multiply and one truncation to find the cell, a line in μ².
+    /// The density ρ(μ²) μ/π ≥ 0 of a direction with |cos θ| = μ on the hemisphere it was
+    /// sampled on: one multiply and one truncation to find the cell, a line in μ².
     #[inline(always)]
     pub(crate) fn pdf(&self, mu: f32) -> f32 {
         let c = &self.cells[mu_cell(mu)];
-        (c.intercept + c.slope * (mu * mu)) * mu
+        // (the line is ≥ 0 on its cell; rounding may leave −1e-12 at a node of value 0)
+        ((c.intercept + c.slope * (mu * mu)) * mu).max(0.0)
     }
 
     /// A direction in the upper hemisphere from u ∈ [0, 1)²: u.x picks a column and, with what
@@ -320,7 +321,9 @@ impl MuProfile {
         // s within the cell where the linear density ρ0 (1 − w) + ρ1 w has the CDF v:
         // w = v (ρ0 + ρ1)/(ρ0 + √(ρ0² + v (ρ1² − ρ0²))) (no cancellation; w = v for ρ0 = ρ1)
         let ProfileCell { start: r0, end: r1, .. } = self.cells[cell];
-        let w = (v * (r0 + r1) / (r0 + (r0 * r0 + v * (r1 * r1 - r0 * r0)).sqrt())).min(1.0);
+        let denominator = r0 + (r0 * r0 + v * (r1 * r1 - r0 * r0)).sqrt();
+        // (0 only for v = 0 at a node of value 0, where w = v = 0)
+        let w = if denominator > 0.0 { (v * (r0 + r1) / denominator).min(1.0) } else { v };
         // μ² = (cell² + w ((cell + 1)² − cell²))/M²
         let kf = cell as f32;
         let mu_sq = (kf * kf + w * (2.0 * kf + 1.0)) * (1.0 / (MU_CELLS * MU_CELLS) as f32);
@@ -486,5 +489,15 @@ mod tests {
             }
         }
         assert!((0..=10).all(|i| MuProfile::EMPTY.pdf(i as f32 / 10.0) == 0.0));
+        // a profile with empty cells: at the uniforms that land on a column's start (the rest of
+        // u.x exactly 0) and at every cosine, finite and non-negative
+        let sparse: [f32; 32] = core::array::from_fn(|i| if i < 9 || i == 20 { 0.0 } else { 1.0 });
+        let profile = MuProfile::new(&mu_cell_masses(&sparse, 0.05));
+        for k in 0..MU_CELLS {
+            if let Some(w) = profile.sample(Vec2::new(k as f32 / MU_CELLS as f32, 0.3)) {
+                assert!(w.is_finite() && w.z > 0.0 && w.z <= 1.0, "column {k}: {w}");
+            }
+        }
+        assert!((0..=1000).all(|i| profile.pdf(i as f32 / 1000.0) >= 0.0));
     }
 }

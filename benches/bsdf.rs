@@ -18,22 +18,20 @@
 //! `SingleScattering::eval_with_pdf`; its `sample` returns the density too), and
 //! `gold/single/sample-vs-vndf/{sample_d_wi|static}`.
 
-use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use microsurface::{
     Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
     Estimator, Ggx, KullaContyDielectric, Material, MicrofacetBsdf, Microsurface, MicrosurfaceSlope,
     PositionFree, ScatteringOrder, Shadowing, SingleScattering, SpecularLimit, Technique, UniformHeight,
 };
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
 
 use validation::clock::{Clock, config};
+use validation::inputs::{N, inputs};
 
-/// The number of pre-generated inputs (a power of two).
-const N: usize = 1024;
 /// The roughness of every configuration.
 const ALPHA: f32 = 0.5;
 
@@ -43,31 +41,6 @@ fn next(i: &mut usize) -> usize {
     let k = *i & (N - 1);
     *i = i.wrapping_add(1);
     k
-}
-
-/// A uniform direction on the upper hemisphere (or the whole sphere), never horizontal.
-fn direction(rng: &mut Pcg64Mcg, sphere: bool) -> Vec3 {
-    let u = 1.0 - rng.random::<f32>(); // (0, 1]
-    let z = if sphere && rng.random::<bool>() { -u } else { u };
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = TAU * rng.random::<f32>();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-struct Inputs {
-    wo: Vec<Vec3>,
-    wi: Vec<Vec3>,
-    uc: Vec<f32>,
-    u: Vec<Vec2>,
-}
-
-fn inputs(transmits: bool, seed: u64) -> Inputs {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let wo = (0..N).map(|_| direction(&mut rng, false)).collect();
-    let wi = (0..N).map(|_| direction(&mut rng, transmits)).collect();
-    let uc = (0..N).map(|_| rng.random::<f32>()).collect();
-    let u = (0..N).map(|_| Vec2::new(rng.random(), rng.random())).collect();
-    Inputs { wo, wi, uc, u }
 }
 
 /// The research-layer calls a technique wraps, in the adjoint orientation of the trait (the

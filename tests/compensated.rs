@@ -9,17 +9,10 @@ use microsurface::{
     CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx, LAST_TABULATED_ORDER,
     ORDER_TABLES, Side, Transport,
 };
-use validation::check::assert_finite_at_edges;
-use validation::chi2::{Chi2Grid, chi2_test};
+use validation::check::{assert_finite_at_edges, assert_side_flags, draw};
+use validation::chi2::{BsdfChi2, sampler_chi2};
 use validation::quadrature::{Domain, integrate_sphere};
 use validation::{Stats, assert_mean, dir, family_z, sidak, uniform32};
-
-/// The allowance for the quadrature error of ∫pdf (in the ∫pdf ≤ 1 check, and added to z·SE in
-/// the refusal rate): a deterministic margin over the absolute tolerance the adaptive
-/// quadrature is asked for (1e-5, or 1e-4 in the compensated tests), whose error estimate is
-/// not a rigorous bound where a density has a kink (its horizon cut-off); not a statistical
-/// allowance.
-const MASS_TOLERANCE: f64 = 1e-3;
 
 /// The tables' largest interpolation error of E (measured by the generator, `AlbedoTable`).
 const TABLE_ERROR_GGX: f64 = 1.2e-3;
@@ -41,18 +34,7 @@ fn gold() -> Conductor {
 /// no relative precision).
 fn rel_close(a: Vec3, b: Vec3, rel: f32) -> bool {
     let scale = a.abs().max(b.abs()).max_element();
-    (a - b).abs().max_element() <= rel * scale || scale < f32::MIN_POSITIVE
-}
-
-/// A sample from fresh uniforms.
-fn draw<B: Bsdf + ?Sized>(
-    b: &B,
-    wo: Vec3,
-    rng: &mut validation::TestRng,
-) -> Option<microsurface::BsdfSample> {
-    let uc = uniform32(rng);
-    let u = Vec2::new(uniform32(rng), uniform32(rng));
-    b.sample(wo, uc, u)
+    validation::check::rel_close(a, b, rel) || scale < f32::MIN_POSITIVE
 }
 
 /// The chi-square cases: (label, BSDF, θo).
@@ -106,47 +88,14 @@ fn sample_matches_pdf_and_weights_match_eval() {
     let cases = chi2_cases();
     let alpha = sidak(0.01, cases.len());
     let z = family_z(0.01, cases.len());
-    let n = 100_000;
     for (k, (label, b, theta)) in cases.iter().enumerate() {
-        let wo = dir(*theta, 0.4);
-        // the single-scattering lobe's reflections below the horizon are refused: ∫pdf < 1
-        let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 8, 16, Domain::Sphere, 1e-4, 6);
-        assert!(mass <= 1.0 + MASS_TOLERANCE, "{label}: ∫pdf = {mass} > 1");
+        // (the single-scattering lobe's reflections below the horizon are refused: ∫pdf < 1)
+        let each = |s: &microsurface::BsdfSample| {
+            assert!(s.flags.reflection && !s.flags.specular, "{label}: flags {:?}", s.flags);
+        };
         let mut rng = validation::rng(1600 + k as u64);
-        let out = chi2_test(
-            label,
-            Chi2Grid { quad_tol: 1e-4, max_depth: 6, ..Chi2Grid::sphere(20, 40) },
-            |w| f64::from(b.pdf(wo, w)),
-            || {
-                let s = draw(b.as_ref(), wo, &mut rng)?;
-                assert!(
-                    s.flags.exact_pdf && s.flags.reflection && !s.flags.specular,
-                    "{label}: flags {:?}",
-                    s.flags
-                );
-                let (v, pdf) = b.eval_with_pdf(wo, s.wi);
-                assert!(v.exact, "{label}: eval not exact");
-                assert!((pdf - s.pdf).abs() <= 1e-6 * pdf, "{label}: pdf {pdf} ≠ sample's {}", s.pdf);
-                assert_eq!(pdf, b.pdf(wo, s.wi), "{label}: eval_with_pdf and pdf disagree");
-                assert_eq!(v, b.eval(wo, s.wi), "{label}: eval_with_pdf and eval disagree");
-                let expected = v.f * (s.wi.z / s.pdf);
-                assert!(
-                    rel_close(s.weight, expected, 1e-4),
-                    "{label}: weight {} ≠ eval·cos/pdf = {expected} at wi = {}",
-                    s.weight,
-                    s.wi
-                );
-                Some(s.wi)
-            },
-            n,
-            alpha,
-            mass,
-        );
-        validation::assert_refusal_rate(label, out.failures, n, mass, MASS_TOLERANCE, z);
-        println!(
-            "{label}: χ² = {:.1}, dof = {}, p = {:.4}, ∫pdf = {mass:.5}",
-            out.statistic, out.dof, out.p_value
-        );
+        let settings = BsdfChi2::sphere(100_000, 1e-4, 6, 1e-6);
+        sampler_chi2(label, b.as_ref(), dir(*theta, 0.4), settings, &mut rng, each, alpha, z);
     }
 }
 
@@ -538,46 +487,14 @@ fn dielectric_sample_matches_pdf_and_weights_match_eval() {
     ];
     let alpha = sidak(0.01, cases.len());
     let z = family_z(0.01, cases.len());
-    let n = 100_000;
     for (k, (label, b, theta)) in cases.iter().enumerate() {
         let wo = dir(*theta, 0.4);
-        let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), 8, 16, Domain::Sphere, 1e-4, 6);
-        assert!(mass <= 1.0 + MASS_TOLERANCE, "{label}: ∫pdf = {mass} > 1");
+        let each = |s: &microsurface::BsdfSample| {
+            assert_side_flags(label, wo, s);
+        };
         let mut rng = validation::rng(2600 + k as u64);
-        let out = chi2_test(
-            label,
-            Chi2Grid { quad_tol: 1e-4, max_depth: 6, ..Chi2Grid::sphere(20, 40) },
-            |w| f64::from(b.pdf(wo, w)),
-            || {
-                let s = draw(b.as_ref(), wo, &mut rng)?;
-                let crossed = (s.wi.z > 0.0) != (wo.z > 0.0);
-                assert!(
-                    s.flags.exact_pdf && s.flags.transmission == crossed && s.flags.reflection != crossed,
-                    "{label}: flags {:?}",
-                    s.flags
-                );
-                let (v, pdf) = b.eval_with_pdf(wo, s.wi);
-                assert!((pdf - s.pdf).abs() <= 1e-6 * pdf, "{label}: pdf {pdf} ≠ sample's {}", s.pdf);
-                assert_eq!(pdf, b.pdf(wo, s.wi), "{label}: eval_with_pdf and pdf disagree");
-                assert_eq!(v, b.eval(wo, s.wi), "{label}: eval_with_pdf and eval disagree");
-                let expected = v.f * (s.wi.z.abs() / s.pdf);
-                assert!(
-                    rel_close(s.weight, expected, 1e-4),
-                    "{label}: weight {} ≠ eval·cos/pdf = {expected} at wi = {}",
-                    s.weight,
-                    s.wi
-                );
-                Some(s.wi)
-            },
-            n,
-            alpha,
-            mass,
-        );
-        validation::assert_refusal_rate(label, out.failures, n, mass, MASS_TOLERANCE, z);
-        println!(
-            "{label}: χ² = {:.1}, dof = {}, p = {:.4}, ∫pdf = {mass:.5}",
-            out.statistic, out.dof, out.p_value
-        );
+        let settings = BsdfChi2::sphere(100_000, 1e-4, 6, 1e-6);
+        sampler_chi2(label, b.as_ref(), wo, settings, &mut rng, each, alpha, z);
     }
 }
 

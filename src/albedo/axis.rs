@@ -11,12 +11,21 @@ pub(crate) fn scale_invariant_direction(mu: f32, alpha: f32) -> f32 {
 }
 
 /// The cell index i ∈ [0, `nodes` − 2] and the fraction within it of the fractional node
-/// coordinate t ∈ [0, `nodes` − 1] of an axis with `nodes` nodes (t beyond the last node
+/// coordinate t ∈ [0, `nodes` − 1] of an axis with `nodes` ≤ 256 nodes (t beyond the last node
 /// extrapolates the last cell; callers clamp their coordinates to [0, 1] first).
 #[inline(always)]
 pub(crate) fn node_cell(t: f32, nodes: usize) -> (usize, f32) {
-    let i = (t as usize).min(nodes - 2);
+    let i = floor_index(t, nodes - 2);
     (i, t - i as f32)
+}
+
+/// ⌊t⌋ clamped to [0, `last`] (NaN and negative t give 0), for `last` < 256: through the
+/// saturating conversion to u8, which compiles to a clamp and one conversion instruction (the
+/// saturating conversion to usize costs about a dozen instructions, to u32 about eight).
+#[inline(always)]
+pub(crate) fn floor_index(t: f32, last: usize) -> usize {
+    debug_assert!(last < 256);
+    usize::from(t as u8).min(last)
 }
 
 /// Below this value the log/√ blend axis [`log_sqrt_blend`] is 0 (its lookups read the first

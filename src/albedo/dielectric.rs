@@ -1,8 +1,9 @@
 //! The reflected and transmitted single-scattering albedo tables of dielectric microsurfaces
 //! and their interpolation.
 
-use super::axis::{DielectricDirection, log_sqrt_blend, node_cell};
+use super::axis::{DielectricDirection, log_sqrt_blend};
 use super::dielectric_data as data;
+use super::grid::SideGrids;
 use super::table::MAX_TABULATED_ALPHA;
 
 /// Nodes per axis of the dielectric tables: 16 × 16 × 16 per side of the interface.
@@ -13,10 +14,6 @@ pub const MAX_TABULATED_ETA: f32 = 3.0;
 
 /// The last node index, as a float.
 const LAST: f32 = (DIELECTRIC_TABLE_SIZE - 1) as f32;
-/// Nodes per table.
-const NODES: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;
-/// A row of the η axis: 16 × 16 nodes.
-const ROW: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;
 
 /// The η-axis coordinate u = ∛((η − 1)/2) ∈ [0, 1] of a relative index η ∈ [1, 3] (η = 1 + 2u³).
 #[inline(always)]
@@ -139,23 +136,26 @@ pub struct DielectricAlbedo {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DielectricAlbedoTable {
     name: &'static str,
-    outside: [&'static [f32; NODES]; 2],
-    inside: [&'static [f32; NODES]; 2],
+    grids: SideGrids,
 }
 
 impl DielectricAlbedoTable {
     /// The GGX (Trowbridge–Reitz) tables.
     pub const GGX: DielectricAlbedoTable = DielectricAlbedoTable {
         name: "ggx",
-        outside: [&data::GGX_OUTSIDE_REFLECTED, &data::GGX_OUTSIDE_TRANSMITTED],
-        inside: [&data::GGX_INSIDE_REFLECTED, &data::GGX_INSIDE_TRANSMITTED],
+        grids: SideGrids {
+            outside: [&data::GGX_OUTSIDE_REFLECTED, &data::GGX_OUTSIDE_TRANSMITTED],
+            inside: [&data::GGX_INSIDE_REFLECTED, &data::GGX_INSIDE_TRANSMITTED],
+        },
     };
 
     /// The Beckmann tables.
     pub const BECKMANN: DielectricAlbedoTable = DielectricAlbedoTable {
         name: "beckmann",
-        outside: [&data::BECKMANN_OUTSIDE_REFLECTED, &data::BECKMANN_OUTSIDE_TRANSMITTED],
-        inside: [&data::BECKMANN_INSIDE_REFLECTED, &data::BECKMANN_INSIDE_TRANSMITTED],
+        grids: SideGrids {
+            outside: [&data::BECKMANN_OUTSIDE_REFLECTED, &data::BECKMANN_OUTSIDE_TRANSMITTED],
+            inside: [&data::BECKMANN_INSIDE_REFLECTED, &data::BECKMANN_INSIDE_TRANSMITTED],
+        },
     };
 
     /// The slope family's name (`"ggx"`, `"beckmann"`).
@@ -178,9 +178,9 @@ impl DielectricAlbedoTable {
         {
             return None;
         }
-        let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let at = node_coordinates(mu, alpha, eta, eta_ge_1);
-        Some(DielectricAlbedo { reflected: trilinear(tables[0], at), transmitted: trilinear(tables[1], at) })
+        let (_, eta_ge_1) = self.grids.of(eta);
+        let (reflected, transmitted) = self.grids.at(eta, node_coordinates(mu, alpha, eta, eta_ge_1));
+        Some(DielectricAlbedo { reflected, transmitted })
     }
 
     /// The raw node values (R, T) of one side, `values[(l * 16 + j) * 16 + i]` at x = i/15,
@@ -188,38 +188,8 @@ impl DielectricAlbedoTable {
     /// its inverse from inside; the direction axis of the side), for export to shaders.
     #[must_use]
     pub fn nodes(&self, range: EtaRange) -> (&'static [f32], &'static [f32]) {
-        let t = match range {
-            EtaRange::AtLeastOne => &self.outside,
-            EtaRange::AtMostOne => &self.inside,
-        };
-        (t[0], t[1])
+        self.grids.nodes(range)
     }
-}
-
-/// The cell index ∈ [0, 14] and fraction of a fractional node coordinate t ∈ [0, 15].
-#[inline(always)]
-fn cell(t: f32) -> (usize, f32) {
-    node_cell(t, DIELECTRIC_TABLE_SIZE)
-}
-
-/// Trilinear interpolation of a 16³ grid (η slowest, direction fastest) at fractional node
-/// coordinates (i, j, l) ∈ [0, 15]³.
-#[inline(always)]
-fn trilinear(grid: &[f32; NODES], at: [f32; 3]) -> f32 {
-    let (i, fi) = cell(at[0]);
-    let (j, fj) = cell(at[1]);
-    let (l, fl) = cell(at[2]);
-    let bilinear = |base: usize| {
-        let (a, b) = (grid[base], grid[base + 1]);
-        let (c, d) = (grid[base + DIELECTRIC_TABLE_SIZE], grid[base + DIELECTRIC_TABLE_SIZE + 1]);
-        let lower = a + fi * (b - a);
-        let upper = c + fi * (d - c);
-        lower + fj * (upper - lower)
-    };
-    let base = l * ROW + j * DIELECTRIC_TABLE_SIZE + i;
-    let near = bilinear(base);
-    let far = bilinear(base + ROW);
-    near + fl * (far - near)
 }
 
 impl DielectricAlbedoTable {
@@ -238,19 +208,12 @@ impl DielectricAlbedoTable {
         {
             return None;
         }
-        let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let (j, fj) = cell(roughness_coordinate(alpha) * LAST);
-        let (l, fl) = cell(eta_coordinate(eta_ge_1) * LAST);
-        let blend = |grid: &[f32; NODES]| {
-            let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
-            for (i, o) in out.iter_mut().enumerate() {
-                let at = |jj: usize, ll: usize| grid[ll * ROW + jj * DIELECTRIC_TABLE_SIZE + i];
-                let near = at(j, l) + fj * (at(j + 1, l) - at(j, l));
-                let far = at(j, l + 1) + fj * (at(j + 1, l + 1) - at(j, l + 1));
-                *o = near + fl * (far - near);
-            }
-            out
-        };
-        Some((blend(tables[0]), blend(tables[1]), DielectricDirection::of(eta)))
+        let (_, eta_ge_1) = self.grids.of(eta);
+        let (r, t) = self.grids.direction_row(
+            eta,
+            roughness_coordinate(alpha) * LAST,
+            eta_coordinate(eta_ge_1) * LAST,
+        );
+        Some((r, t, DielectricDirection::of(eta)))
     }
 }

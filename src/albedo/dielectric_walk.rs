@@ -4,6 +4,7 @@
 use super::axis::{node_cell, scale_invariant_direction};
 use super::dielectric::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};
 use super::dielectric_walk_data as data;
+use super::grid::{NODES, SideGrids};
 use super::table::MAX_TABULATED_ALPHA;
 
 /// Walks per batch of the generator: a cell's walk count is a multiple of it.
@@ -14,10 +15,6 @@ pub const MAX_WALK_TABLE_SE: f32 = 2e-3;
 
 /// The last node index, as a float.
 const LAST: f32 = (DIELECTRIC_TABLE_SIZE - 1) as f32;
-/// Nodes per table.
-const NODES: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;
-/// A row of the η axis: 16 × 16 nodes.
-const ROW: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;
 
 /// The η-axis coordinate u = √((η − 1)/2) ∈ [0, 1] of η ∈ [1, 3] (the single-scattering
 /// dielectric tables' axis).
@@ -80,8 +77,7 @@ pub struct HigherOrders {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DielectricWalkTable {
     name: &'static str,
-    outside: [&'static [f32; NODES]; 2],
-    inside: [&'static [f32; NODES]; 2],
+    grids: SideGrids,
     batches: [&'static [u8; NODES]; 2],
 }
 
@@ -89,16 +85,20 @@ impl DielectricWalkTable {
     /// The GGX (Trowbridge–Reitz) tables.
     pub const GGX: DielectricWalkTable = DielectricWalkTable {
         name: "ggx",
-        outside: [&data::GGX_OUTSIDE_REFLECTED, &data::GGX_OUTSIDE_TRANSMITTED],
-        inside: [&data::GGX_INSIDE_REFLECTED, &data::GGX_INSIDE_TRANSMITTED],
+        grids: SideGrids {
+            outside: [&data::GGX_OUTSIDE_REFLECTED, &data::GGX_OUTSIDE_TRANSMITTED],
+            inside: [&data::GGX_INSIDE_REFLECTED, &data::GGX_INSIDE_TRANSMITTED],
+        },
         batches: [&data::GGX_OUTSIDE_BATCHES, &data::GGX_INSIDE_BATCHES],
     };
 
     /// The Beckmann tables.
     pub const BECKMANN: DielectricWalkTable = DielectricWalkTable {
         name: "beckmann",
-        outside: [&data::BECKMANN_OUTSIDE_REFLECTED, &data::BECKMANN_OUTSIDE_TRANSMITTED],
-        inside: [&data::BECKMANN_INSIDE_REFLECTED, &data::BECKMANN_INSIDE_TRANSMITTED],
+        grids: SideGrids {
+            outside: [&data::BECKMANN_OUTSIDE_REFLECTED, &data::BECKMANN_OUTSIDE_TRANSMITTED],
+            inside: [&data::BECKMANN_INSIDE_REFLECTED, &data::BECKMANN_INSIDE_TRANSMITTED],
+        },
         batches: [&data::BECKMANN_OUTSIDE_BATCHES, &data::BECKMANN_INSIDE_BATCHES],
     };
 
@@ -118,10 +118,11 @@ impl DielectricWalkTable {
         if !((0.0..=1.0).contains(&mu) && alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA && in_eta_range(eta)) {
             return None;
         }
-        let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
+        let (_, eta_ge_1) = self.grids.of(eta);
         let x = scale_invariant_direction(mu, alpha);
         let at = [x * LAST, alpha.sqrt() * LAST, eta_coordinate(eta_ge_1) * LAST];
-        Some(HigherOrders { reflected: trilinear(tables[0], at), transmitted: trilinear(tables[1], at) })
+        let (reflected, transmitted) = self.grids.at(eta, at);
+        Some(HigherOrders { reflected, transmitted })
     }
 
     /// The raw node values (ΔR, ΔT) of one side, `values[(l * 16 + j) * 16 + i]` at x = i/15,
@@ -129,11 +130,7 @@ impl DielectricWalkTable {
     /// shaders.
     #[must_use]
     pub fn nodes(&self, range: EtaRange) -> (&'static [f32], &'static [f32]) {
-        let t = match range {
-            EtaRange::AtLeastOne => &self.outside,
-            EtaRange::AtMostOne => &self.inside,
-        };
-        (t[0], t[1])
+        self.grids.nodes(range)
     }
 
     /// The number of walks behind node `k` of one side (0 for the limit rows, which are not
@@ -165,20 +162,8 @@ impl DielectricWalkTable {
         if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA && in_eta_range(eta)) {
             return None;
         }
-        let (tables, eta_ge_1) = if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) };
-        let (j, fj) = node_cell(alpha.sqrt() * LAST, DIELECTRIC_TABLE_SIZE);
-        let (l, fl) = node_cell(eta_coordinate(eta_ge_1) * LAST, DIELECTRIC_TABLE_SIZE);
-        let blend = |grid: &[f32; NODES]| {
-            let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
-            for (i, o) in out.iter_mut().enumerate() {
-                let at = |jj: usize, ll: usize| grid[ll * ROW + jj * DIELECTRIC_TABLE_SIZE + i];
-                let near = at(j, l) + fj * (at(j + 1, l) - at(j, l));
-                let far = at(j, l + 1) + fj * (at(j + 1, l + 1) - at(j, l + 1));
-                *o = near + fl * (far - near);
-            }
-            out
-        };
-        Some((blend(tables[0]), blend(tables[1])))
+        let (_, eta_ge_1) = self.grids.of(eta);
+        Some(self.grids.direction_row(eta, alpha.sqrt() * LAST, eta_coordinate(eta_ge_1) * LAST))
     }
 }
 
@@ -201,7 +186,7 @@ impl DielectricWalkTable {
         let var = |k: usize| self.standard_errors(range, k).map_or(0.0, |(_, t)| t * t);
         let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
         for (i, o) in out.iter_mut().enumerate() {
-            let at = |jj: usize, ll: usize| var(ll * ROW + jj * DIELECTRIC_TABLE_SIZE + i);
+            let at = |jj: usize, ll: usize| var(SideGrids::index(i, jj, ll));
             let (a, b) = ((1.0 - fj) * (1.0 - fl), fj * (1.0 - fl));
             let (c, d) = ((1.0 - fj) * fl, fj * fl);
             *o = a * a * at(j, l) + b * b * at(j + 1, l) + c * c * at(j, l + 1) + d * d * at(j + 1, l + 1);
@@ -214,24 +199,4 @@ impl DielectricWalkTable {
 #[inline(always)]
 fn in_eta_range(eta: f32) -> bool {
     (1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta)
-}
-
-/// Trilinear interpolation of a 16³ grid (η slowest, direction fastest) at fractional node
-/// coordinates (i, j, l) ∈ [0, 15]³.
-#[inline(always)]
-fn trilinear(grid: &[f32; NODES], at: [f32; 3]) -> f32 {
-    let (i, fi) = node_cell(at[0], DIELECTRIC_TABLE_SIZE);
-    let (j, fj) = node_cell(at[1], DIELECTRIC_TABLE_SIZE);
-    let (l, fl) = node_cell(at[2], DIELECTRIC_TABLE_SIZE);
-    let bilinear = |base: usize| {
-        let (a, b) = (grid[base], grid[base + 1]);
-        let (c, d) = (grid[base + DIELECTRIC_TABLE_SIZE], grid[base + DIELECTRIC_TABLE_SIZE + 1]);
-        let lower = a + fi * (b - a);
-        let upper = c + fi * (d - c);
-        lower + fj * (upper - lower)
-    };
-    let base = l * ROW + j * DIELECTRIC_TABLE_SIZE + i;
-    let near = bilinear(base);
-    let far = bilinear(base + ROW);
-    near + fl * (far - near)
 }

@@ -2,23 +2,30 @@
 //! higher orders restored from the single-scattering albedo tables ([`AlbedoTable`]), with a
 //! deterministic eval, an exact pdf and a sampler (Kulla and Conty 2017; Turquin 2019).
 
-use super::lobe_profile::LobeProfile;
+mod shared;
+
+pub(crate) use shared::{ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
+
+use super::lobe_profile::{
+    DirectionAxis, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
+};
 use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, valid_direction, valid_uniforms};
 use crate::albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
-    ORDER_TABLES, ScatteringOrderTable, node_cell,
+    ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, ORDER_TABLES,
+    ScatteringOrderTable, node_cell,
 };
 use crate::error::Error;
 use crate::material::Conductor;
+use crate::single_scattering::SingleScattering;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
 use glam::{DVec3, Vec2, Vec3};
 
+/// The conductor tables' direction axis (32 nodes).
+type Axis = DirectionAxis<ALBEDO_TABLE_SIZE>;
+
 /// The last node index of the tables, as a float.
 const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
-
-/// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
-const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// 16-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; symmetric).
 const GL16: [(f64, f64); 8] = [
@@ -127,15 +134,16 @@ pub enum Compensation {
 /// lobe by that error divided by E(μo)).
 ///
 /// **Sampling** (Kulla–Conty and per-order): with probability p = E(μo) (the energies of the
-/// two lobes for F = 1; E here interpolated linearly between the uniform nodes μ = i/31, so
-/// that the lookup needs no division or root, any p ∈ (0, 1] giving an exact mixture) the
-/// caller's uniforms drive the exact visible-normal sample of the single-scattering
-/// lobe (uc rescaled to uc/p), otherwise u samples the added lobe's profile (1 − E(μi)) μi
-/// tabulated per cell of the direction axis (a cell by its mass, μi² uniform in it, φ uniform:
-/// density d_cell μi/π); the density is the mixture pdf = p pdf_ss + (1 − p) d_cell μi/π, exact
-/// (the cell of a returned direction is recomputed from its f32 cosine, which moves at most a
-/// few ulps of μ² of probability between neighbouring cells). Turquin samples and has the density of
-/// the single-scattering lobe.
+/// two lobes for F = 1; E here taken at the centre of μo's cell on a uniform μ axis of 32
+/// cells, so that the lookup is one multiply and one truncation, any p ∈ (0, 1] giving an exact
+/// mixture) the caller's u drives the exact visible-normal sample of the single-scattering
+/// lobe, otherwise u samples the added lobe's profile (1 − E(μi)) μi by cells of the uniform μ
+/// axis: a density ρ(μi²) μi/π continuous and linear in μi² on each cell, a cell chosen by its
+/// mass with the alias method (no search), μi² within it by inverting the line, φ uniform. The
+/// density is the mixture pdf = p pdf_ss + (1 − p) ρ(μi²) μi/π, exact, the same bits in `pdf`,
+/// `eval_with_pdf` and the sample. In the added lobe's branch single scattering's f·cos θi is
+/// taken in its sampler's form F G2/G1 · pdf_ss (within 1e-5 of eval's, as its sampler's
+/// weight is). Turquin samples and has the density of the single-scattering lobe.
 ///
 /// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
 /// the Dirac mirror of the single-scattering BSDF, uncompensated (the energy the single
@@ -145,9 +153,10 @@ pub enum Compensation {
 ///
 /// **Cost.** Construction integrates F_avg (64 Fresnel evaluations) and the average (31 cells;
 /// the per-order scheme three more and the blend of six order tables): a few microseconds;
-/// build the BSDF once per material, it is `Copy`. Eval adds one (Turquin) or two (Kulla–Conty,
-/// per-order) branch-free 1D table lookups to the single-scattering eval, pdf one
-/// direction-axis lookup and one uniform-μ lookup (measured in `README.md`).
+/// build the BSDF once per material, it is `Copy`. Eval adds to the single-scattering eval one
+/// (Turquin) or two (Kulla–Conty, per-order, sharing one division) branch-free lookups of the
+/// direction axis; pdf two lookups of the uniform μ axis (no division, no root); sample the
+/// direction-axis lookups of eval and the uniform-μ lookups of pdf (measured in `README.md`).
 ///
 /// **Per-order** ([`Compensation::PerOrder`]) restores each channel's energy from the walk's
 /// per-order energies ([`ScatteringOrderTable`], standard error ≤ 1.95e-3 per node) instead of
@@ -183,18 +192,17 @@ pub struct CompensatedConductor<S> {
     /// Whether the scheme has an additive lobe with energy (Kulla–Conty or per-order, not
     /// a mirror, 1 − E_avg > 0): its sampler is a mixture.
     mixing: bool,
-    /// 31² (1 + α): the direction node coordinate is 31 x = √(min(μ · this/(μ + α), 31²)).
-    node_scale: f32,
-    /// The probability of the single-scattering lobe in the sampling mixture, at the uniform
-    /// nodes μ = i/31 (E(μ) there; linear in μ between them): a table without a division or a
-    /// square root per lookup.
-    single_probability: [f32; ALBEDO_TABLE_SIZE],
+    /// The tables' direction axis at this α.
+    axis: Axis,
+    /// The probabilities (p, 1 − p) of the single-scattering lobe and the added lobe in the
+    /// sampling mixture, per cell of the view's uniform μ axis (p = E(μ) at the cell's centre).
+    mixture: MixtureTable<2>,
     /// 1 − E at the direction nodes x = i/31, for this α.
     complement: [f32; ALBEDO_TABLE_SIZE],
     /// 1 − E_avg of the interpolated E.
     complement_average: f64,
-    /// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi.
-    profile: Profile,
+    /// The sampler of the added lobes' μi profile (1 − E(μi)) μi on the uniform μ axis.
+    profile: MuProfile,
     /// The additive lobe as a product h(μo) h(μi) per channel: h at the direction nodes
     /// (Kulla–Conty: √(F_ms/(π (1 − E_avg))) (1 − E); per order: g/√(π ḡ)).
     lobe: [Vec3; ALBEDO_TABLE_SIZE],
@@ -214,26 +222,19 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
     /// The compensated BRDF of a conductor on the given slopes.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`] (= 1), the
+    /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (= 1), the
     /// tables' range: there is no albedo to compensate with beyond it.
     pub fn new(slope: S, conductor: Conductor, scheme: Compensation) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
         // the slope's roughnesses are finite and > 0; their product may overflow to ∞ (rejected)
-        if alpha > MAX_TABULATED_ALPHA {
-            return Err(Error::InvalidParameter {
-                name: "alpha",
-                value: alpha,
-                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the albedo tables' range",
-            });
-        }
+        check_tabulated(alpha, None, Tables::Albedo)?;
         let single = MicrofacetBsdf::new(slope, conductor)?.with_technique(Technique::SingleScattering);
         // a Dirac mirror is not compensated (and √(αx αy) may underflow to 0 there)
         let (complement, complement_average, profile) = if single.is_specular() {
-            ([0.0; ALBEDO_TABLE_SIZE], 0.0, Profile::EMPTY)
+            ([0.0; ALBEDO_TABLE_SIZE], 0.0, MuProfile::EMPTY)
         } else {
             let c = blended_complement(&S::ALBEDO, alpha);
-            let (average, profile) = average_of_complement(&c, alpha);
-            (c, average, profile)
+            (c, profile_average(&c, alpha), MuProfile::new(&mu_cell_masses(&c, alpha)))
         };
         let fresnel_average = fresnel_average(&conductor);
         let fresnel_normal = conductor.fresnel(1.0);
@@ -266,28 +267,25 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
                 let mut norm = DVec3::ZERO;
                 for c in 0..3 {
                     let h: [f32; ALBEDO_TABLE_SIZE] = core::array::from_fn(|i| lobe[i][c]);
-                    norm[c] = core::f64::consts::PI * average_of_complement(&h, alpha).0;
+                    norm[c] = core::f64::consts::PI * profile_average(&h, alpha);
                 }
                 norm.as_vec3()
             }
         };
-        let node_scale = LAST * LAST * (1.0 + alpha);
-        let mut single_probability = [1.0; ALBEDO_TABLE_SIZE];
-        if !single.is_specular() {
-            for (i, p) in single_probability.iter_mut().enumerate() {
-                let mu = i as f32 / LAST;
-                let (k, f) = node_cell(direction_node(mu, alpha, node_scale), ALBEDO_TABLE_SIZE);
-                *p = 1.0 - (complement[k] + f * (complement[k + 1] - complement[k]));
-            }
-        }
+        let axis = Axis::new(alpha);
         let mixing = scheme != Compensation::Turquin && !single.is_specular() && complement_average > 0.0;
+        let mixture = MixtureTable::new(|k| {
+            // E ≥ 0.2 at every node: p is positive wherever the added lobe is sampled
+            let p = if mixing { 1.0 - row_at(&complement, axis.cell(mu_cell_centre(k))) } else { 1.0 };
+            [p, 1.0 - p]
+        });
         Ok(Self {
             single,
             scheme,
             mixing,
             alpha,
-            node_scale,
-            single_probability,
+            axis,
+            mixture,
             complement,
             complement_average,
             profile,
@@ -336,8 +334,7 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         if self.scheme == Compensation::Turquin || !(0.0..=1.0).contains(&mu) {
             return None;
         }
-        let (i, f) = self.cell(mu);
-        Some(self.lobe[i].lerp(self.lobe[i + 1], f) * self.lobe_norm)
+        Some(self.lobe_at(self.axis.cell(mu)) * self.lobe_norm)
     }
 
     /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel (Gauss–Legendre, error below 1e-7).
@@ -360,15 +357,7 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// axis x = √(μ (1 + α)/(μ + α)). Branch-free.
     #[inline(always)]
     fn complement_at(&self, mu: f32) -> f32 {
-        let (i, f) = self.cell(mu);
-        let (a, b) = (self.complement[i], self.complement[i + 1]);
-        a + f * (b - a)
-    }
-
-    /// The cell i ∈ [0, 30] of the direction axis that holds μ, and the fraction within it.
-    #[inline(always)]
-    fn cell(&self, mu: f32) -> (usize, f32) {
-        table_cell(direction_node(mu, self.alpha, self.node_scale))
+        row_at(&self.complement, self.axis.cell(mu))
     }
 
     /// Whether the sampler mixes in the additive lobe's profile for the view `wo`: a view
@@ -378,69 +367,60 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         self.mixing && wo.z > 0.0
     }
 
-    /// The probability p of the single-scattering lobe in the sampling mixture for a view
-    /// above the horizon at cos θo = μ: E(μ) at the nodes μ = i/31, linear between them
-    /// (within the conductor table's uniform-μ interpolation error of E, ≤ 7.4e-2; any p in
-    /// (0, 1] gives an exact mixture, this one keeps the weights near the lobes' energies).
+    /// The additive lobe's factor h at (cell, fraction) of the direction axis.
     #[inline(always)]
-    fn mixture_probability(&self, mu: f32) -> f32 {
-        let (i, f) = table_cell(mu * LAST);
-        let (a, b) = (self.single_probability[i], self.single_probability[i + 1]);
-        a + f * (b - a)
-    }
-
-    /// The density of the Kulla–Conty lobe's sampler at wi (upper hemisphere):
-    /// d_i μi/π with d_i the cell's probability over its Δμ² (see [`Profile`]).
-    #[inline(always)]
-    fn profile_pdf(&self, wi: Vec3) -> f32 {
-        if wi.z > 0.0 { self.profile.pdf(self.cell(wi.z).0, wi.z) } else { 0.0 }
-    }
-
-    /// Samples the Kulla–Conty lobe's sampler from u ∈ [0, 1)²: a cell by its probability,
-    /// μ² uniform in the cell, φ uniform. `None` on the horizon.
-    #[inline(always)]
-    fn sample_profile(&self, u: Vec2) -> Option<Vec3> {
-        self.profile.sample(u)
-    }
-
-    /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
-    #[inline(always)]
-    fn view_complement(&self, wo: Vec3) -> f32 {
-        if wo.z > 0.0 { self.complement_at(wo.z) } else { 0.0 }
-    }
-
-    /// The additive lobe's factor h(μo) of a view direction above the horizon, 0 otherwise
-    /// (no compensation).
-    #[inline(always)]
-    fn view_lobe(&self, wo: Vec3) -> Vec3 {
-        if wo.z <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let (i, f) = self.cell(wo.z);
+    fn lobe_at(&self, (i, f): (usize, f32)) -> Vec3 {
         self.lobe[i].lerp(self.lobe[i + 1], f)
     }
 
-    /// The additive lobe h(μo) h(μi) for the view factor `h_o`.
+    /// The additive lobe h(μo) h(μi) of directions above the horizon (both cells from one
+    /// division; symmetric in its arguments), 0 unless both are above it.
     #[inline(always)]
-    fn kc_lobe(&self, h_o: Vec3, wi: Vec3) -> Vec3 {
+    fn added(&self, mu_o: f32, mu_i: f32) -> Vec3 {
+        if !(mu_o > 0.0 && mu_i > 0.0) {
+            return Vec3::ZERO;
+        }
+        let (cell_o, cell_i) = self.axis.cells(mu_o, mu_i);
+        self.lobe_at(cell_o) * self.lobe_at(cell_i)
+    }
+
+    /// The mixture density p pdf_ss + (1 − p) d(μi) μi/π at a light direction of cosine
+    /// `mu_i` for a view above the horizon at cos θo = `mu_o` (the profile's density is 0 below
+    /// the horizon). Every density of this BSDF is this expression: pdf, eval_with_pdf and
+    /// both branches of sample agree bit for bit.
+    #[inline(always)]
+    fn mixture_pdf(&self, mu_o: f32, pdf_ss: f32, mu_i: f32) -> f32 {
+        let [p, q] = *self.mixture.at(mu_o);
+        p * pdf_ss + q * self.profile.pdf(mu_i.max(0.0))
+    }
+
+    /// Single scattering's density at a pair of valid directions with `wo` above the horizon:
+    /// for `wi` above it the mirror facets' density (the function single scattering's `pdf`,
+    /// `eval_with_pdf` and `sample` share, called here without their repeated checks), else
+    /// single scattering's `pdf`. The same bits as `self.single.pdf(wo, wi)`.
+    #[inline(always)]
+    fn single_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wi.z > 0.0 {
-            let (i, f) = self.cell(wi.z);
-            h_o * self.lobe[i].lerp(self.lobe[i + 1], f)
+            let pdf = SingleScattering::<S, Conductor>::mirror_density(self.single.surface().slope(), wo, wi);
+            if pdf.is_finite() { pdf } else { 0.0 }
         } else {
-            Vec3::ZERO
+            self.single.pdf(wo, wi)
         }
     }
 
-    /// The additive lobe f_ms and the mixture density at wi from one table lookup (the same
-    /// arithmetic as [`Self::kc_lobe`] and [`Self::mixture_pdf`], bit for bit).
+    /// Single scattering's f·cos θi and density at a pair of directions above the horizon, in
+    /// the form its sampler gives them for a sampled direction: F(ωo·ωh) G2/G1 · pdf, with
+    /// G2/G1 = 1/(1 + Λi/(1 + Λo)) from the f32 Λ and F at the half vector of the f32 directions
+    /// (within 1e-5 of eval's f64 form, as the sampler's weight is).
     #[inline(always)]
-    fn kc_lobe_and_pdf(&self, h_o: Vec3, p: f32, pdf_ss: f32, wi: Vec3) -> (Vec3, f32) {
-        if wi.z <= 0.0 {
-            return (Vec3::ZERO, p * pdf_ss + (1.0 - p) * 0.0);
-        }
-        let (i, f) = self.cell(wi.z);
-        let lobe = h_o * self.lobe[i].lerp(self.lobe[i + 1], f);
-        (lobe, p * pdf_ss + (1.0 - p) * self.profile.pdf(i, wi.z))
+    fn single_at(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let surface = self.single.surface();
+        let slope = surface.slope();
+        let pdf = self.single_pdf(wo, wi);
+        let shadowing = 1.0 / (1.0 + slope.lambda_unchecked(wi) / (1.0 + slope.lambda_unchecked(wo)));
+        // wo + wi ≠ 0 above the horizon
+        let cos = wo.dot((wo + wi).normalize());
+        (surface.material().fresnel(cos) * (shadowing * pdf), pdf)
     }
 
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
@@ -449,25 +429,10 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
         Vec3::ONE + self.scale * (c_o / (1.0 - c_o))
     }
 
-    /// The Kulla–Conty mixture density for the probability `p` of the single-scattering lobe.
+    /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
     #[inline(always)]
-    fn mixture_pdf(&self, p: f32, pdf_ss: f32, wi: Vec3) -> f32 {
-        p * pdf_ss + (1.0 - p) * self.profile_pdf(wi)
-    }
-
-    /// A sample from the weight-times-density `f_cos` (f·cos θi) and density `pdf` at `wi`,
-    /// `None` unless both are usable (the same filter as the single-scattering sampler).
-    #[inline(always)]
-    fn finish(wo: Vec3, wi: Vec3, f_cos: Vec3, pdf: f32) -> Option<BsdfSample> {
-        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite()) || wi.z == 0.0 || (wi.z > 0.0) != (wo.z > 0.0) {
-            return None;
-        }
-        let weight = f_cos / pdf;
-        if !weight.is_finite() || f_cos.max_element() < f32::MIN_POSITIVE * wi.z.abs() {
-            return None;
-        }
-        let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
-        Some(BsdfSample { wi, weight, pdf, eta: 1.0, flags })
+    fn view_complement(&self, wo: Vec3) -> f32 {
+        if wo.z > 0.0 { self.complement_at(wo.z) } else { 0.0 }
     }
 }
 
@@ -484,7 +449,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             return v;
         }
         let f = match self.scheme {
-            Compensation::KullaConty | Compensation::PerOrder => v.f + self.kc_lobe(self.view_lobe(wo), wi),
+            Compensation::KullaConty | Compensation::PerOrder => v.f + self.added(wo.z, wi.z),
             Compensation::Turquin => v.f * self.turquin_factor(self.view_complement(wo)),
         };
         BsdfValue { f, exact: true }
@@ -492,43 +457,45 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
-        if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) {
+        if self.scheme == Compensation::Turquin {
+            let mut s = self.single.sample_keyed(wo, uc, u, key)?;
+            if !self.single.is_specular() {
+                s.weight *= self.turquin_factor(self.view_complement(wo));
+            }
+            return if s.weight.is_finite() { Some(s) } else { None };
+        }
+        if !self.mixes(wo) || !valid_direction(wo) || !valid_uniforms(uc, u) {
             return self.single.sample_keyed(wo, uc, u, key);
         }
-        match self.scheme {
-            Compensation::Turquin => {
-                let s = self.single.sample_keyed(wo, uc, u, key)?;
-                let weight = s.weight * self.turquin_factor(self.view_complement(wo));
-                weight.is_finite().then_some(BsdfSample { weight, ..s })
-            }
-            Compensation::KullaConty | Compensation::PerOrder if !self.mixes(wo) => {
-                self.single.sample_keyed(wo, uc, u, key)
-            }
-            Compensation::KullaConty | Compensation::PerOrder => {
-                let (p, h_o) = (self.mixture_probability(wo.z), self.view_lobe(wo));
-                if uc < p {
-                    let s = self.single.sample_keyed(wo, (uc / p).min(ONE_MINUS_ULP), u, key)?;
-                    let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, s.pdf, s.wi);
-                    Self::finish(wo, s.wi, s.weight * s.pdf + lobe * s.wi.z.abs(), pdf)
-                } else {
-                    let wi = self.sample_profile(u)?;
-                    let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-                    let (lobe, pdf) = self.kc_lobe_and_pdf(h_o, p, pdf_ss, wi);
-                    Self::finish(wo, wi, (v.f + lobe) * wi.z, pdf)
-                }
-            }
-        }
+        let [p, _] = *self.mixture.at(wo.z);
+        // the view's lobe factor, off the path from the sampled direction to the weight
+        let h_o = self.lobe_at(self.axis.cell(wo.z));
+        let (wi, f_cos_ss, pdf_ss) = if uc < p {
+            // the single-scattering lobe's sample of a conductor seen from above (what its
+            // `sample_keyed` runs after the checks done here; uc only chose the lobe): its weight
+            // × pdf is f·cos θi, its density that of `single_pdf`, its direction above the horizon
+            let surface = self.single.surface();
+            let s = SingleScattering::sample_mirror_front(surface.slope(), surface.material(), wo, u.x, u.y)?;
+            (s.wo, s.weight * s.pdf, s.pdf)
+        } else {
+            let wi = self.profile.sample(u)?;
+            let (f_cos, pdf) = self.single_at(wo, wi);
+            (wi, f_cos, pdf)
+        };
+        // (wi is above the horizon; its cell from its own division, a few ulps from eval's
+        // shared one)
+        let f_cos = f_cos_ss + h_o * self.lobe_at(self.axis.cell(wi.z)) * wi.z;
+        mixture_sample(wo, wi, f_cos, self.mixture_pdf(wo.z, pdf_ss, wi.z), 1.0)
     }
 
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let pdf_ss = self.single.pdf(wo, wi);
         // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe,
         // whose pdf validates the directions
         if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) {
-            return pdf_ss;
+            return self.single.pdf(wo, wi);
         }
-        self.mixture_pdf(self.mixture_probability(wo.z), pdf_ss, wi)
+        self.mixture_pdf(wo.z, self.single_pdf(wo, wi), wi.z)
     }
 
     #[inline]
@@ -539,12 +506,8 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
         }
         match self.scheme {
             Compensation::KullaConty | Compensation::PerOrder => {
-                let f = v.f + self.kc_lobe(self.view_lobe(wo), wi);
-                let pdf = if self.mixes(wo) {
-                    self.mixture_pdf(self.mixture_probability(wo.z), pdf_ss, wi)
-                } else {
-                    pdf_ss
-                };
+                let f = v.f + self.added(wo.z, wi.z);
+                let pdf = if self.mixes(wo) { self.mixture_pdf(wo.z, pdf_ss, wi.z) } else { pdf_ss };
                 (BsdfValue { f, exact: true }, pdf)
             }
             Compensation::Turquin => {
@@ -552,22 +515,6 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             }
         }
     }
-}
-
-/// The cell i ∈ [0, 30] of a fractional node coordinate t ∈ [0, 31] and the fraction within
-/// it (t = 31 extrapolates cell 30 to its end). Through u32: a cheaper conversion than to usize
-/// (the callers' t is never negative or NaN).
-#[inline(always)]
-fn table_cell(t: f32) -> (usize, f32) {
-    let i = (t as u32).min(ALBEDO_TABLE_SIZE as u32 - 2);
-    (i as usize, t - i as f32)
-}
-
-/// The fractional direction node 31 x = 31 √(μ (1 + α)/(μ + α)) ∈ [0, 31] of μ ∈ [0, 1]
-/// (`node_scale` = 31² (1 + α)), with the square of the node scale folded into the root.
-#[inline(always)]
-fn direction_node(mu: f32, alpha: f32, node_scale: f32) -> f32 {
-    (mu * node_scale / (mu + alpha)).min(LAST * LAST).sqrt()
 }
 
 /// 1 − E at the direction nodes for roughness α: the table's two roughness rows around
@@ -587,23 +534,11 @@ fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZ
     out
 }
 
-/// The sampler of the Kulla–Conty lobe's μi profile (1 − E(μi)) μi on the tables' 32-node
-/// direction axis: the sample weight of the lobe is F_ms (1 − E(μo)) times (1 − E(μi)) over its
-/// mean in the cell (between 0 and 2 for a linear 1 − E).
-type Profile = LobeProfile<ALBEDO_TABLE_SIZE>;
-
-/// c̄ = ∫₀¹ c(μ) 2μ dμ for c linear in x on each cell [i/31, (i+1)/31] of the direction axis
-/// x = √(μ (1 + α)/(μ + α)), in closed form, and the sampler of c(μ) μ
-/// ([`LobeProfile::new`]).
-fn average_of_complement(c: &[f32; ALBEDO_TABLE_SIZE], alpha: f32) -> (f64, Profile) {
-    LobeProfile::new(c, alpha)
-}
-
 /// The factor h = g/√(π ḡ) of the per-order lobe g(μo) g(μi)/(π ḡ) at the direction nodes
 /// ([`Compensation::PerOrder`]): the order tables' two roughness rows around r = √α blended
 /// as [`blended_complement`] blends E's, g = (1 − E) Σ_k e_k F̄^k/Σ_k e_k per channel (pure
 /// order 2 where the walk recorded no higher order), ḡ in closed form for g linear in x per
-/// cell ([`average_of_complement`]). In f64.
+/// cell ([`profile_average`]). In f64.
 fn per_order_lobe(
     orders: &ScatteringOrderTable,
     alpha: f32,
@@ -648,7 +583,7 @@ fn per_order_lobe(
     }
     let mut h = [Vec3::ZERO; ALBEDO_TABLE_SIZE];
     for (c, g) in g.iter().enumerate() {
-        let (average, _) = average_of_complement(g, alpha);
+        let average = profile_average(g, alpha);
         let norm = if average > 0.0 { 1.0 / (core::f64::consts::PI * average).sqrt() } else { 0.0 };
         for (h, &gi) in h.iter_mut().zip(g) {
             h[c] = (f64::from(gi) * norm) as f32;
@@ -675,44 +610,47 @@ fn fresnel_average(conductor: &Conductor) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ComplexIor;
 
-    /// The closed-form average equals a brute-force quadrature of the same interpolant (in
-    /// f64: the run-time f32 lookup of x = √X near x = 1 limits 1 − E to a relative 6e-5 at
-    /// α = 1e-3, 5e-9 absolute).
+    /// The added lobe's branch of the sampler takes single scattering's f·cos θi and density
+    /// in its sampler's form (`single_at`): the density is `pdf`'s, bit for bit, and f is
+    /// within 1e-5 of `eval`'s (relative, largest channel) on 20 000 random pairs of directions
+    /// above the horizon per case, GGX and Beckmann, α from 0.05 to 1, gold and copper.
     #[test]
-    fn closed_form_average_matches_quadrature() {
-        for alpha in [1e-3f32, 0.01, 0.1, 0.37, 1.0] {
-            let b = CompensatedConductor::new(
-                Ggx::isotropic(alpha).unwrap(),
-                Conductor::perfect(),
-                Compensation::KullaConty,
-            )
-            .unwrap();
-            let a = f64::from(alpha);
-            let lookup = |mu: f64| {
-                let t = (mu * (1.0 + a) / (mu + a)).min(1.0).sqrt() * f64::from(LAST);
-                let i = (t as usize).min(ALBEDO_TABLE_SIZE - 2);
-                let (c0, c1) = (f64::from(b.complement[i]), f64::from(b.complement[i + 1]));
-                c0 + (t - i as f64) * (c1 - c0)
+    fn single_at_matches_eval_and_pdf() {
+        fn check<S: AlbedoTabulated>(slope: S, conductor: Conductor, worst: &mut f32) {
+            let b = CompensatedConductor::new(slope, conductor, Compensation::KullaConty).unwrap();
+            let mut state = 0x9e37_79b9_7f4a_7c15u64;
+            let mut next = || {
+                state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                ((state >> 40) as f32 + 0.5) / (1u64 << 24) as f32
             };
-            // ∫ c(μ) 2μ dμ = 2∫ c(μ) μ² d(ln μ) over ln μ ∈ [ln 1e-9, 0], midpoint rule
-            let (lo, n) = (1e-9f64.ln(), 400_000);
-            let h = -lo / n as f64;
-            let sum: f64 = (0..n)
-                .map(|k| {
-                    let mu = (lo + (k as f64 + 0.5) * h).exp();
-                    2.0 * lookup(mu) * mu * mu * h
-                })
-                .sum();
-            let exact = b.complement_average;
-            let cdf = *b.profile.cdf();
-            assert!(
-                cdf[0] == 0.0 && cdf[ALBEDO_TABLE_SIZE - 1] == 1.0 && cdf.windows(2).all(|w| w[0] <= w[1])
-            );
-            assert!(
-                (sum - exact).abs() <= 1e-7 * exact,
-                "α = {alpha}: quadrature {sum:e}, closed form {exact:e}"
-            );
+            let mut dir = || {
+                let z: f32 = next();
+                let phi = core::f32::consts::TAU * next();
+                let s = (1.0 - z * z).max(0.0).sqrt();
+                Vec3::new(s * phi.cos(), s * phi.sin(), z)
+            };
+            for _ in 0..20_000 {
+                let (wo, wi) = (dir(), dir());
+                let (f_cos, pdf) = b.single_at(wo, wi);
+                assert_eq!(pdf, b.single.pdf(wo, wi), "wo = {wo}, wi = {wi}");
+                let f = b.single.eval(wo, wi).f;
+                if f.max_element() < f32::MIN_POSITIVE {
+                    continue;
+                }
+                let err = ((f_cos / wi.z) - f).abs().max_element() / f.max_element();
+                *worst = worst.max(err);
+            }
         }
+        let mut worst = 0.0f32;
+        for alpha in [0.05f32, 0.3, 1.0] {
+            for ior in [ComplexIor::GOLD, ComplexIor::COPPER] {
+                check(Ggx::isotropic(alpha).unwrap(), Conductor::new(ior), &mut worst);
+                check(Beckmann::isotropic(alpha).unwrap(), Conductor::new(ior), &mut worst);
+            }
+        }
+        println!("single_at against eval: largest relative difference {worst:.2e}");
+        assert!(worst <= 1e-5, "largest relative difference {worst:e}");
     }
 }

@@ -3,12 +3,10 @@
 //! loses (Turquin 2019), from this crate's dielectric albedo tables
 //! ([`crate::DielectricAlbedoTable`]).
 
-use super::compensated::AlbedoTabulated;
+use super::compensated::{AlbedoTabulated, Tables, check_tabulated};
 use super::microfacet::{MicrofacetBsdf, Technique};
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction};
-use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, DielectricDirection, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, node_cell,
-};
+use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricDirection, node_cell};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::slope::MicrosurfaceSlope;
@@ -82,26 +80,13 @@ impl<S: AlbedoTabulated> CompensatedDielectric<S> {
     /// The compensated BSDF of a dielectric interface on the given slopes.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`] (`"alpha"`) or the
-    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`], [`MAX_TABULATED_ETA`]] = [1/3, 3]
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA)] = [1/3, 3]
     /// (`"eta"`): the tables' range, beyond which there is no albedo to compensate with.
     pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
-        if alpha > MAX_TABULATED_ALPHA {
-            return Err(Error::InvalidParameter {
-                name: "alpha",
-                value: alpha,
-                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the albedo tables' range",
-            });
-        }
         let eta = dielectric.eta();
-        if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) {
-            return Err(Error::InvalidParameter {
-                name: "eta",
-                value: eta,
-                expected: "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric albedo tables' range",
-            });
-        }
+        check_tabulated(alpha, Some(eta), Tables::Albedo)?;
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let mut albedo = [[1.0; DIELECTRIC_TABLE_SIZE]; 2];
         let mut axis = [DielectricDirection::of(eta), DielectricDirection::of(1.0 / eta)];
@@ -109,11 +94,7 @@ impl<S: AlbedoTabulated> CompensatedDielectric<S> {
         if !single.is_specular() {
             for ((side, side_axis), seen) in albedo.iter_mut().zip(&mut axis).zip([eta, 1.0 / eta]) {
                 let (r, t, row_axis) =
-                    S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(Error::InvalidParameter {
-                        name: "eta",
-                        value: seen,
-                        expected: "a relative index in [1/3, 3] seen from either side",
-                    })?;
+                    S::DIELECTRIC_ALBEDO.direction_row(alpha, seen).ok_or(Tables::Albedo.eta_error(seen))?;
                 *side_axis = row_axis;
                 for ((e, r), t) in side.iter_mut().zip(r).zip(t) {
                     *e = r + t;

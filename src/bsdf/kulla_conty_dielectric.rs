@@ -3,15 +3,16 @@
 //! higher orders' reflected and transmitted energy, from the walk's tables
 //! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
 
-use super::compensated::AlbedoTabulated;
-use super::lobe_profile::{LobeProfile, PROFILE_NODES, profile_cell, profile_cells, row_at};
-use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
+use super::compensated::{AlbedoTabulated, ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
+use super::lobe_profile::{
+    DirectionAxis, MU_CELLS, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
-use crate::albedo::{DielectricWalkTable, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
+use super::microfacet::{MicrofacetBsdf, Technique};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
+use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
+use crate::single_scattering::SingleScattering;
 use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
 use core::f64::consts::PI;
 use glam::{Vec2, Vec3};
@@ -19,8 +20,13 @@ use glam::{Vec2, Vec3};
 /// The cells (index, fraction) of the view's and the light's cosine on the direction axis.
 type Cells = ((usize, f32), (usize, f32));
 
-/// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
-const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
+/// Nodes of the walk tables' direction axis.
+const PROFILE_NODES: usize = DIELECTRIC_TABLE_SIZE;
+
+/// The smallest share of the single-scattering lobe in the sampling mixture, relative to the
+/// lobes' total: keeps its density positive wherever it scatters, should the tables give it
+/// no energy (η → 1 at grazing views).
+const MIN_SINGLE_SHARE: f64 = 1e-3;
 
 /// A slope family with the random walk's dielectric tables: the families a
 /// [`KullaContyDielectric`] can be built on.
@@ -40,25 +46,23 @@ impl WalkTabulated for Beckmann {
 /// The rows and samplers of one side of the interface (the side of the view).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct SideLobes {
-    /// The sampling mixture's probabilities of the single-scattering lobe and of the reflection
-    /// lobe at the direction nodes: E_ss, ΔR over E_ss + ΔR + c ΔT (E_ss = R_ss + T_ss); the
-    /// transmission lobe has the rest.
-    mixture: [[f32; 2]; PROFILE_NODES],
-    /// ΔR at the direction nodes.
-    reflected: [f32; PROFILE_NODES],
-    /// ΔT at the direction nodes, times this side's reciprocity factor c.
-    transmitted: [f32; PROFILE_NODES],
-    /// 1/(π ΔR̄) (0 without a lobe).
-    reflected_scale: f32,
-    /// 1/(π ΔT̄′) of the *other* side's scaled ΔT′ (0 without a lobe): the normalization of
-    /// the transmission from this side.
+    /// The sampling mixture's probabilities of the single-scattering, the reflection and the
+    /// transmission lobe per cell of the view's uniform μ axis: E_ss : ΔR : c ΔT at the cell's
+    /// centre (E_ss = R_ss + T_ss), normalized.
+    mixture: MixtureTable<3>,
+    /// The added lobes' factors of the view at the direction nodes, by whether the light
+    /// crosses the interface: ΔR of this side, and ΔT of this side times its reciprocity
+    /// factor c.
+    view_rows: [[f32; PROFILE_NODES]; 2],
+    /// Their factors of the light: ΔR of this side, c ΔT of the other side.
+    light_rows: [[f32; PROFILE_NODES]; 2],
+    /// Their normalizations: 1/(π ΔR̄), and 1/(π c ΔT̄) of the other side times the transport
+    /// factor of a transmission from this side (0 without a lobe).
+    scales: [f32; 2],
+    /// 1/(π c ΔT̄) of the other side (0 without a lobe).
     transmitted_scale: f32,
-    /// The radiance factor (η_wo/η_wi)² of a transmission from this side, or 1 (importance).
-    transmitted_transport: f32,
-    /// The sampler of ΔR(μ) μ on this side.
-    reflected_profile: LobeProfile<PROFILE_NODES>,
-    /// The sampler of ΔT(μ) μ on this side (used for light arriving from the other side).
-    transmitted_profile: LobeProfile<PROFILE_NODES>,
+    /// The samplers of the light's factor times μ: ΔR(μ) μ of this side, ΔT(μ) μ of the other.
+    profiles: [MuProfile; 2],
 }
 
 /// A dielectric microfacet BSDF compensated with the random walk's higher orders, reflection
@@ -97,16 +101,17 @@ struct SideLobes {
 /// (an average of 0) there is no transmission lobe.
 /// f_R is symmetric.
 ///
-/// **Sampling.** A mixture chosen by the view's energies: at every direction node the
-/// probabilities of the single-scattering sample, the reflection lobe and the transmission
-/// lobe are E_ss : ΔR_a : c_a ΔT_a (E_ss = R_ss + T_ss from [`crate::DielectricAlbedoTable`]),
-/// normalized at construction and interpolated linearly in x at μo (no division at run time);
-/// each lobe samples its profile g(μi) μi per cell of the direction axis (a cell by its mass,
-/// μi² uniform in it, φ uniform) on its hemisphere. `pdf` is the exact mixture density, and a
-/// sample's weight is f·|cos θi|/pdf at its direction, with f and pdf computed as `eval` and
-/// `pdf` compute them (both cosines located on the axis with one shared division; the lobe is
-/// chosen with μo located alone, a few ulps of a cell fraction apart, which changes a lobe
-/// probability by a relative ~1e-7).
+/// **Sampling.** A mixture chosen by the view's energies: per cell of a uniform μ axis of the
+/// view (32 cells, one multiply and one truncation to find one) the probabilities of the
+/// single-scattering sample, the reflection lobe and the transmission lobe are
+/// E_ss : ΔR_a : c_a ΔT_a at the cell's centre (E_ss = R_ss + T_ss from
+/// [`crate::DielectricAlbedoTable`], at least 1e-3 of the total), normalized at construction;
+/// each lobe samples the profile g(μi) μi of its light factor on its hemisphere by cells of the
+/// uniform μ axis (a density continuous and linear in μi² on each cell, a cell by its mass with
+/// the alias method, φ uniform: no division, root or search to find a cell or its density).
+/// `pdf` is the exact mixture density, and a sample's weight is f·|cos θi|/pdf at its
+/// direction, with f and pdf computed as `eval` and `pdf` compute them (the density the same
+/// bits; the single-scattering branch reuses its sampler's density, within 1e-5 of `pdf`'s).
 ///
 /// **Tables.** Both families' tables at α = √(αx αy), blended in (α, η) once at
 /// construction (both sides read the same (r, u) coordinate), the direction axis
@@ -147,6 +152,8 @@ pub struct KullaContyDielectric<S> {
     transport: Transport,
     /// The tables' roughness √(αx αy).
     alpha: f32,
+    /// The walk tables' direction axis at this α.
+    axis: DirectionAxis<PROFILE_NODES>,
     /// η_wi/η_wo of a transmission from outside (η) and from inside (1/η).
     transmitted_eta: [f32; 2],
     /// The view's side: outside (0), inside (1).
@@ -160,42 +167,28 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
     /// transport).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`] (`"alpha"`) or the
-    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`], [`MAX_TABULATED_ETA`]] = [1/3, 3]
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA)] = [1/3, 3]
     /// (`"eta"`): the tables' range.
     pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
-        if alpha > MAX_TABULATED_ALPHA {
-            return Err(Error::InvalidParameter {
-                name: "alpha",
-                value: alpha,
-                expected: "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the walk tables' range",
-            });
-        }
         let eta = dielectric.eta();
-        let eta_error = |value| Error::InvalidParameter {
-            name: "eta",
-            value,
-            expected: "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric walk tables' range",
-        };
-        if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) {
-            return Err(eta_error(eta));
-        }
+        check_tabulated(alpha, Some(eta), Tables::Walk)?;
+        let eta_error = |value| Tables::Walk.eta_error(value);
         let single = MicrofacetBsdf::new(slope, dielectric)?.with_technique(Technique::SingleScattering);
         let empty = SideLobes {
-            mixture: [[1.0, 0.0]; PROFILE_NODES],
-            reflected: [0.0; PROFILE_NODES],
-            transmitted: [0.0; PROFILE_NODES],
-            reflected_scale: 0.0,
+            mixture: MixtureTable::new(|_| [1.0, 0.0, 0.0]),
+            view_rows: [[0.0; PROFILE_NODES]; 2],
+            light_rows: [[0.0; PROFILE_NODES]; 2],
+            scales: [0.0; 2],
             transmitted_scale: 0.0,
-            transmitted_transport: 1.0,
-            reflected_profile: LobeProfile::EMPTY,
-            transmitted_profile: LobeProfile::EMPTY,
+            profiles: [MuProfile::EMPTY; 2],
         };
         let mut b = Self {
             single,
             transport: Transport::Radiance,
             alpha,
+            axis: DirectionAxis::new(if single.is_specular() { 1.0 } else { alpha }),
             transmitted_eta: [eta, 1.0 / eta],
             sides: [empty; 2],
             mismatch: 0.0,
@@ -206,33 +199,31 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         }
         let mut averages = [0.0f64; 2];
         let mut variances = [0.0f64; 2];
-        let mut single = [[0.0f32; PROFILE_NODES]; 2];
+        let mut single = [[0.0f32; MU_CELLS]; 2];
+        let mut transmitted_profiles = [MuProfile::EMPTY; 2];
         // the averages are linear in the nodes: their weights, from the unit rows
         let node_weights: [f64; PROFILE_NODES] = core::array::from_fn(|i| {
             let mut unit = [0.0; PROFILE_NODES];
             unit[i] = 1.0;
-            LobeProfile::new(&unit, alpha).0
+            profile_average(&unit, alpha)
         });
         for (s, seen) in [eta, 1.0 / eta].into_iter().enumerate() {
             let (dr, dt) = S::DIELECTRIC_WALK.direction_row(alpha, seen).ok_or(eta_error(seen))?;
-            // E_ss = R + T at the walk table's direction nodes μ = α X/(1 + α − X), X = (i/15)²
-            // (the single-scattering table has its own direction axis; E_ss only sets the
-            // sampling mixture, for which any positive weights give an exact density)
-            for (i, e) in single[s].iter_mut().enumerate() {
-                let x_sq = (i as f32 / (PROFILE_NODES - 1) as f32).powi(2);
-                let mu = (alpha * x_sq / (1.0 + alpha - x_sq)).min(1.0);
-                let v = S::DIELECTRIC_ALBEDO.albedo(mu, alpha, seen).ok_or(eta_error(seen))?;
+            // E_ss = R + T at the centres of the uniform μ cells (it only sets the sampling
+            // mixture, for which any positive weights give an exact density)
+            for (k, e) in single[s].iter_mut().enumerate() {
+                let v = S::DIELECTRIC_ALBEDO.albedo(mu_cell_centre(k), alpha, seen).ok_or(eta_error(seen))?;
                 *e = v.reflected + v.transmitted;
             }
             let side = &mut b.sides[s];
-            side.reflected = dr;
-            side.transmitted = dt;
-            let (r_avg, r_profile) = LobeProfile::new(&dr, alpha);
-            let (t_avg, t_profile) = LobeProfile::new(&dt, alpha);
-            side.reflected_scale = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
-            side.reflected_profile = r_profile;
-            side.transmitted_profile = t_profile;
-            averages[s] = t_avg;
+            side.view_rows = [dr, dt];
+            let r_avg = profile_average(&dr, alpha);
+            side.scales[0] = if r_avg > 0.0 { (1.0 / (PI * r_avg)) as f32 } else { 0.0 };
+            side.profiles[0] = MuProfile::new(&mu_cell_masses(&dr, alpha));
+            // the sampler of ΔT μ (the same for c ΔT, a constant factor), for light crossing
+            // from the other side
+            transmitted_profiles[s] = MuProfile::new(&mu_cell_masses(&dt, alpha));
+            averages[s] = profile_average(&dt, alpha);
             let var = S::DIELECTRIC_WALK.transmitted_row_variance(alpha, seen).ok_or(eta_error(seen))?;
             variances[s] = node_weights.iter().zip(var).map(|(w, v)| w * w * f64::from(v)).sum();
         }
@@ -250,20 +241,32 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
         } else {
             [0.0, 0.0]
         };
-        for s in 0..2 {
-            for v in &mut b.sides[s].transmitted {
-                *v = (f64::from(*v) * c[s]) as f32;
+        for (side, c) in b.sides.iter_mut().zip(c) {
+            for v in &mut side.view_rows[1] {
+                *v = (f64::from(*v) * c) as f32;
             }
+        }
+        for s in 0..2 {
             // the transmission from side s is normalized by the other side's scaled average
             let other = c[1 - s] * averages[1 - s];
-            b.sides[s].transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
-            let side = &mut b.sides[s];
-            for (i, m) in side.mixture.iter_mut().enumerate() {
-                let w =
-                    [f64::from(single[s][i]), f64::from(side.reflected[i]), f64::from(side.transmitted[i])];
-                let total = w[0] + w[1] + w[2];
-                *m = if total > 0.0 { [(w[0] / total) as f32, (w[1] / total) as f32] } else { [1.0, 0.0] };
-            }
+            let other_row = b.sides[1 - s].view_rows[1];
+            let (axis, side) = (b.axis, &mut b.sides[s]);
+            side.transmitted_scale = if other > 0.0 { (1.0 / (PI * other)) as f32 } else { 0.0 };
+            side.light_rows = [side.view_rows[0], other_row];
+            side.profiles[1] = transmitted_profiles[1 - s];
+            side.mixture = MixtureTable::new(|k| {
+                let cell = axis.cell(mu_cell_centre(k));
+                let (dr, dt) = (row_at(&side.view_rows[0], cell), row_at(&side.view_rows[1], cell));
+                let (dr, dt) = (f64::from(dr.max(0.0)), f64::from(dt.max(0.0)));
+                let single = f64::from(single[s][k]).max(MIN_SINGLE_SHARE * (dr + dt));
+                let total = single + dr + dt;
+                if total > 0.0 {
+                    let (p0, p1) = ((single / total) as f32, (dr / total) as f32);
+                    [p0, p1, (1.0 - p0 - p1).max(0.0)]
+                } else {
+                    [1.0, 0.0, 0.0]
+                }
+            });
         }
         Ok(b.with_transport(Transport::Radiance))
     }
@@ -278,10 +281,11 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
         // (η_wo/η_wi)² of a transmission: from outside 1/η², from inside η²
         let radiance = [1.0 / (eta * eta), eta * eta];
         for (side, r) in b.sides.iter_mut().zip(radiance) {
-            side.transmitted_transport = match transport {
+            let transport = match transport {
                 Transport::Radiance => r,
                 Transport::Importance => 1.0,
             };
+            side.scales[1] = side.transmitted_scale * transport;
         }
         b
     }
@@ -310,55 +314,46 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
             return None;
         }
         let s = &self.sides[side_index(side)];
-        let cell = profile_cell(mu, self.alpha);
-        Some((row_at(&s.reflected, cell), row_at(&s.transmitted, cell)))
+        let cell = self.axis.cell(mu);
+        Some((row_at(&s.view_rows[0], cell), row_at(&s.view_rows[1], cell)))
     }
 
     /// The added lobe f_R or f_T at (wo, wi), both off the horizon, from their cells.
     #[inline(always)]
-    fn added(&self, a: &SideLobes, cells: Cells, wo: Vec3, wi: Vec3) -> Vec3 {
-        let (cell_o, cell_i) = cells;
-        let f = if (wi.z > 0.0) == (wo.z > 0.0) {
-            row_at(&a.reflected, cell_o) * row_at(&a.reflected, cell_i) * a.reflected_scale
-        } else {
-            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
-            row_at(&a.transmitted, cell_o)
-                * row_at(&b.transmitted, cell_i)
-                * (a.transmitted_scale * a.transmitted_transport)
-        };
-        Vec3::splat(f)
+    fn added(a: &SideLobes, (cell_o, cell_i): Cells, wo: Vec3, wi: Vec3) -> Vec3 {
+        let c = crossing(wo, wi);
+        Vec3::splat(row_at(&a.view_rows[c], cell_o) * row_at(&a.light_rows[c], cell_i) * a.scales[c])
     }
 
-    /// The mixture's lobe probabilities (single, reflection, transmission) for the view's cell:
-    /// the normalized node probabilities interpolated (no division at run time), the third
-    /// the complement of the first two.
+    /// The view's side and its mixture probabilities (single, reflection, transmission).
     #[inline(always)]
-    fn probabilities(a: &SideLobes, (i, f): (usize, f32)) -> [f32; 3] {
-        let (lo, hi) = (a.mixture[i], a.mixture[i + 1]);
-        let p0 = lo[0] + f * (hi[0] - lo[0]);
-        let p1 = lo[1] + f * (hi[1] - lo[1]);
-        [p0, p1, (1.0 - p0 - p1).max(0.0)]
-    }
-
-    /// The mixture density at wi (off the horizon, in cell `cell_i`) for the view's
-    /// probabilities.
-    #[inline(always)]
-    fn mixture_pdf(&self, a: &SideLobes, p: [f32; 3], cell_i: usize, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        let mu_i = wi.z.abs();
-        let lobe = if (wi.z > 0.0) == (wo.z > 0.0) {
-            p[1] * a.reflected_profile.pdf(cell_i, mu_i)
-        } else {
-            let b = &self.sides[side_index(Side::above_or_inside(wi.z))];
-            p[2] * b.transmitted_profile.pdf(cell_i, mu_i)
-        };
-        p[0] * pdf_ss + lobe
-    }
-
-    /// The view's side and the cells of both directions.
-    #[inline(always)]
-    fn side_and_cells(&self, wo: Vec3, wi: Vec3) -> (&SideLobes, Cells) {
+    fn view(&self, wo: Vec3) -> (&SideLobes, [f32; 3]) {
         let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        (a, profile_cells(wo.z.abs(), wi.z.abs(), self.alpha))
+        (a, *a.mixture.at(wo.z.abs()))
+    }
+
+    /// The mixture density at wi (off the horizon) for the view's side `a` and probabilities
+    /// `p`: no table of the direction axis, one lookup of the uniform μ axis.
+    #[inline(always)]
+    fn mixture_pdf(a: &SideLobes, p: [f32; 3], wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        let c = crossing(wo, wi);
+        p[0] * pdf_ss + p[1 + c] * a.profiles[c].pdf(wi.z.abs())
+    }
+
+    /// Single scattering's density at valid directions off the horizon of a rough surface:
+    /// its research-layer density without the trait's repeated checks (the same bits as
+    /// `self.single.pdf(wo, wi)`).
+    #[inline(always)]
+    fn single_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let surface = self.single.surface();
+        let pdf = SingleScattering::new(*surface.slope(), *surface.material()).pdf_unchecked(wo, wi);
+        if pdf.is_finite() { pdf } else { 0.0 }
+    }
+
+    /// The cells of both directions on the direction axis (one division).
+    #[inline(always)]
+    fn cells(&self, wo: Vec3, wi: Vec3) -> Cells {
+        self.axis.cells(wo.z.abs(), wi.z.abs())
     }
 
     /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
@@ -367,24 +362,12 @@ impl<S: MicrosurfaceSlope> KullaContyDielectric<S> {
     fn compensates(&self, wo: Vec3, wi: Vec3) -> bool {
         !self.single.is_specular() && valid_direction(wo) && valid_direction(wi) && wo.z != 0.0 && wi.z != 0.0
     }
+}
 
-    /// A sample from f·|cos θi| and the density at wi, `None` unless both are usable (the
-    /// filter of the single-scattering sampler).
-    #[inline(always)]
-    fn finish(&self, wo: Vec3, wi: Vec3, f_cos: Vec3, pdf: f32) -> Option<BsdfSample> {
-        if !(pdf >= f32::MIN_POSITIVE && pdf.is_finite()) || wi.z == 0.0 {
-            return None;
-        }
-        let weight = f_cos / pdf;
-        if !weight.is_finite() || f_cos.max_element() < f32::MIN_POSITIVE * wi.z.abs() {
-            return None;
-        }
-        let reflection = (wi.z > 0.0) == (wo.z > 0.0);
-        let eta =
-            if reflection { 1.0 } else { self.transmitted_eta[side_index(Side::above_or_inside(wo.z))] };
-        let flags = SampleFlags { reflection, transmission: !reflection, specular: false, exact_pdf: true };
-        Some(BsdfSample { wi, weight, pdf, eta, flags })
-    }
+/// Whether the light crosses the interface (1) or stays on the view's side (0).
+#[inline(always)]
+fn crossing(wo: Vec3, wi: Vec3) -> usize {
+    usize::from((wi.z > 0.0) != (wo.z > 0.0))
 }
 
 /// The index of a side in [`KullaContyDielectric::sides`].
@@ -408,8 +391,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return v;
         }
-        let (a, cells) = self.side_and_cells(wo, wi);
-        BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }
+        let (a, _) = self.view(wo);
+        BsdfValue { f: v.f + Self::added(a, self.cells(wo, wi), wo, wi), exact: true }
     }
 
     #[inline]
@@ -417,35 +400,36 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if self.single.is_specular() || !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z == 0.0 {
             return self.single.sample_keyed(wo, uc, u, key);
         }
-        let a = &self.sides[side_index(Side::above_or_inside(wo.z))];
-        let cell_o = profile_cell(wo.z.abs(), self.alpha);
-        let p = Self::probabilities(a, cell_o);
-        let flip = |v: Vec3| if wo.z > 0.0 { v } else { -v };
-        let wi = if uc < p[0] {
+        let (a, p) = self.view(wo);
+        let (wi, f_cos_ss, pdf_ss) = if uc < p[0] {
+            // the single-scattering lobe: its sample carries f·|cos θi| (weight × pdf) and its
+            // density
             let s = self.single.sample_keyed(wo, (uc / p[0]).min(ONE_MINUS_ULP), u, key)?;
-            // f and the density as eval and pdf compute them (the cells located together)
-            let (_, cells) = self.side_and_cells(wo, s.wi);
-            let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, s.wi, s.pdf);
-            let f_cos = s.weight * s.pdf + self.added(a, cells, wo, s.wi) * s.wi.z.abs();
-            return self.finish(wo, s.wi, f_cos, pdf);
-        } else if uc < p[0] + p[1] {
-            flip(a.reflected_profile.sample(u)?)
+            (s.wi, s.weight * s.pdf, s.pdf)
         } else {
-            let b = &self.sides[1 - side_index(Side::above_or_inside(wo.z))];
-            -flip(b.transmitted_profile.sample(u)?)
+            // the added lobe of the light's side: its profile's direction on the view's side,
+            // mirrored through the interface for a transmission
+            let c = usize::from(uc >= p[0] + p[1]);
+            let w = a.profiles[c].sample(u)?;
+            let wi = if (wo.z > 0.0) == (c == 0) { w } else { -w };
+            // f and the density as eval and pdf compute them
+            (wi, self.single.eval_keyed(wo, wi, key).f * wi.z.abs(), self.single_pdf(wo, wi))
         };
-        let (v, pdf) = self.eval_with_pdf_keyed(wo, wi, key);
-        self.finish(wo, wi, v.f * wi.z.abs(), pdf)
+        if wi.z == 0.0 {
+            return None;
+        }
+        let f_cos = f_cos_ss + Self::added(a, self.cells(wo, wi), wo, wi) * wi.z.abs();
+        let eta = self.transmitted_eta[side_index(Side::above_or_inside(wo.z))];
+        mixture_sample(wo, wi, f_cos, Self::mixture_pdf(a, p, wo, wi, pdf_ss), eta)
     }
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let pdf_ss = self.single.pdf(wo, wi);
         if !self.compensates(wo, wi) {
-            return pdf_ss;
+            return self.single.pdf(wo, wi);
         }
-        let (a, (cell_o, cell_i)) = self.side_and_cells(wo, wi);
-        self.mixture_pdf(a, Self::probabilities(a, cell_o), cell_i.0, wo, wi, pdf_ss)
+        let (a, p) = self.view(wo);
+        Self::mixture_pdf(a, p, wo, wi, self.single_pdf(wo, wi))
     }
 
     #[inline]
@@ -454,8 +438,8 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
         if !self.compensates(wo, wi) {
             return (v, pdf_ss);
         }
-        let (a, cells) = self.side_and_cells(wo, wi);
-        let pdf = self.mixture_pdf(a, Self::probabilities(a, cells.0), cells.1.0, wo, wi, pdf_ss);
-        (BsdfValue { f: v.f + self.added(a, cells, wo, wi), exact: true }, pdf)
+        let (a, p) = self.view(wo);
+        let pdf = Self::mixture_pdf(a, p, wo, wi, pdf_ss);
+        (BsdfValue { f: v.f + Self::added(a, self.cells(wo, wi), wo, wi), exact: true }, pdf)
     }
 }

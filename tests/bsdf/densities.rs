@@ -4,13 +4,6 @@
 use super::fixtures::*;
 use super::weights::{albedo_stats, check_weight_vs_albedo};
 
-/// The allowance for the quadrature error of ∫pdf (in the ∫pdf ≤ 1 check, and added to z·SE in
-/// the refusal rate): a deterministic margin over the absolute tolerance the adaptive
-/// quadrature is asked for (1e-5, or 1e-4 in the compensated tests), whose error estimate is
-/// not a rigorous bound where a density has a kink (its horizon cut-off); not a statistical
-/// allowance.
-const MASS_TOLERANCE: f64 = 1e-3;
-
 /// Samples per chi-square test.
 const CHI2_N: usize = 200_000;
 
@@ -28,7 +21,8 @@ fn pdf_mass<B: Bsdf>(b: &B, wo: Vec3) -> f64 {
 /// For a BSDF with an exact density: ∫pdf ≤ 1; `sample` passes the chi-square test against
 /// `pdf` (scaled by `pdf_scale`, 1 except in the negative controls), its refusals (`None`)
 /// match the mass ∫pdf leaves out (binomial, z·SE + the quadrature's 1e-3), and every
-/// sample's weight is eval·|cos θi|/pdf (relative 1e-4). Returns (p-value, ∫pdf).
+/// sample's weight is eval·|cos θi|/pdf (relative 1e-4): [`validation::chi2::bsdf_chi2`], with
+/// ∫pdf from 16 × 32 panels to 1e-5. Returns (p-value, ∫pdf).
 pub(crate) fn chi2_exact<B: Bsdf>(
     label: &str,
     b: &B,
@@ -37,38 +31,22 @@ pub(crate) fn chi2_exact<B: Bsdf>(
     z: f64,
     pdf_scale: f64,
 ) -> (f64, f64) {
-    let mass = pdf_mass(b, wo);
-    assert!(mass <= 1.0 + MASS_TOLERANCE, "{label}: ∫pdf = {mass} > 1");
     let mut rng = validation::rng(seed);
     let mut eval_rng = validation::rng(seed + 7);
-    let out = chi2_test(
+    let settings =
+        BsdfChi2 { grid: chi2_grid(), mass: (16, 32, 1e-5, 7), n: CHI2_N, pdf_scale, pdf_consistency: None };
+    let out = bsdf_chi2(
         label,
-        chi2_grid(),
-        |w| pdf_scale * f64::from(b.pdf(wo, w)),
-        || {
-            let s = b.sample_rng(wo, &mut rng)?;
-            assert!(s.flags.exact_pdf, "{label}: exact_pdf flag not set");
-            let v = b.eval_rng(wo, s.wi, &mut eval_rng);
-            assert!(v.exact, "{label}: eval not flagged exact");
-            let expected = v.f * (s.wi.z.abs() / s.pdf);
-            assert!(
-                rel_close(s.weight, expected, 1e-4),
-                "{label}: weight {} ≠ eval·|cos θi|/pdf = {expected} at wi = {}",
-                s.weight,
-                s.wi
-            );
-            Some(s.wi)
-        },
-        CHI2_N,
+        b,
+        wo,
+        settings,
+        || b.sample_rng(wo, &mut rng),
+        |wi| b.eval_rng(wo, wi, &mut eval_rng),
+        |_| {},
         chi2_alpha(),
-        pdf_scale * mass,
+        z,
     );
-    validation::assert_refusal_rate(label, out.failures, CHI2_N, mass, MASS_TOLERANCE, z);
-    println!(
-        "{label}: χ² = {:.1}, dof = {}, p = {:.4}, ∫pdf = {mass:.5}",
-        out.statistic, out.dof, out.p_value
-    );
-    (out.p_value, mass)
+    (out.chi2.p_value, out.mass)
 }
 
 /// The classic BRDFs of one NDF: both maskings at θo = 0.8, and the exact masking near

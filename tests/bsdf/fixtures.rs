@@ -9,7 +9,8 @@ pub(crate) use microsurface::{
     ScatteringOrder, ShadingFrame, Shadowing, SpecularLimit, Technique, Transport, sample_cosine_hemisphere,
 };
 pub(crate) use std::f64::consts::PI;
-pub(crate) use validation::chi2::{Chi2Grid, chi2_test};
+pub(crate) use validation::check::rel_close;
+pub(crate) use validation::chi2::{BsdfChi2, Chi2Grid, bsdf_chi2};
 pub(crate) use validation::quadrature::{Domain, integrate_sphere};
 pub(crate) use validation::{
     Stats, TestRng, assert_two_sample, dir, family_z, par_map, sidak, uniform_sphere, uniform32, uniform64,
@@ -97,9 +98,4 @@ pub(crate) const ALL_TECHNIQUES: [(&str, Technique); 6] = [
 pub(crate) fn eta_ratio_sq(wo: Vec3, wi: Vec3) -> f32 {
     let eta = |w: Vec3| if w.z > 0.0 { 1.0 } else { ETA };
     (eta(wo) / eta(wi)).powi(2)
-}
-
-pub(crate) fn rel_close(a: Vec3, b: Vec3, rel: f32) -> bool {
-    let scale = a.abs().max(b.abs()).max_element();
-    (a - b).abs().max_element() <= rel * scale
 }

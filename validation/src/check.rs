@@ -1,8 +1,10 @@
 //! Assertions and helpers shared by the deterministic tests: rejected parameters, caught
-//! panics, f32 spacings, finite answers at a BSDF's edges.
+//! panics, f32 spacings, finite answers at a BSDF's edges, relative comparisons of values, a
+//! sample from fresh uniforms.
 
+use crate::{TestRng, uniform32};
 use glam::{Vec2, Vec3};
-use microsurface::{Bsdf, Error};
+use microsurface::{Bsdf, BsdfSample, Error};
 
 /// The largest f32 below 1: the top uniform a renderer's sampler can hand over.
 pub const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -60,6 +62,35 @@ pub fn assert_rejects<T: std::fmt::Debug>(result: Result<T, Error>, name: &str, 
     }
     let shown = err.to_string();
     assert!(shown.contains(name), "Display `{shown}` does not name `{name}`");
+}
+
+/// A sample of `b` for the view `wo` from three fresh uniforms of `rng` (uc, then u).
+pub fn draw<B: Bsdf + ?Sized>(b: &B, wo: Vec3, rng: &mut TestRng) -> Option<BsdfSample> {
+    let uc = uniform32(rng);
+    let u = Vec2::new(uniform32(rng), uniform32(rng));
+    b.sample(wo, uc, u)
+}
+
+/// Asserts that the flags of a non-specular sample with an exact density name the side it
+/// leaves on for the view `wo` (transmission exactly when `wi` crosses the plane), and returns
+/// whether it crossed.
+#[track_caller]
+pub fn assert_side_flags(label: &str, wo: Vec3, s: &BsdfSample) -> bool {
+    let crossed = (s.wi.z > 0.0) != (wo.z > 0.0);
+    assert!(
+        s.flags.exact_pdf && s.flags.transmission == crossed && s.flags.reflection != crossed,
+        "{label}: flags {:?}",
+        s.flags
+    );
+    crossed
+}
+
+/// |a − b| ≤ rel·max(|a|, |b|) componentwise against the largest component: the relative
+/// comparison of two BSDF values or weights.
+#[must_use]
+pub fn rel_close(a: Vec3, b: Vec3, rel: f32) -> bool {
+    let scale = a.abs().max(b.abs()).max_element();
+    (a - b).abs().max_element() <= rel * scale
 }
 
 /// The message of a caught panic (`String` or `&str` payloads).

@@ -10,8 +10,10 @@
 //! below 5 are pooled into one cell. The statistic is compared with the chi-square
 //! distribution at a Šidák-corrected significance chosen by the caller.
 
-use crate::quadrature::{CrossMap, integrate, uv_of, visible_frame};
+use crate::check::rel_close;
+use crate::quadrature::{CrossMap, Domain, integrate, integrate_sphere, uv_of, visible_frame};
 use glam::Vec3;
+use microsurface::{Bsdf, BsdfSample, BsdfValue};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// Binning and quadrature settings.
@@ -390,4 +392,128 @@ pub fn slope_chi2(
         ));
     }
     Ok(SlopeChi2Outcome { statistic: stat, dof, p_value: p, integral: total })
+}
+
+/// The margin of the ∫pdf checks of [`bsdf_chi2`] (∫pdf ≤ 1, the refusal rate): a deterministic
+/// allowance for the adaptive quadrature's error over the absolute tolerance it is asked for
+/// (1e-5 or 1e-4), whose error estimate is not a rigorous bound where a density has a kink (its
+/// horizon cut-off); not a statistical allowance.
+pub const MASS_TOLERANCE: f64 = 1e-3;
+
+/// The settings of [`bsdf_chi2`].
+#[derive(Debug, Clone, Copy)]
+pub struct BsdfChi2 {
+    /// The chi-square test's cells and quadrature.
+    pub grid: Chi2Grid,
+    /// The quadrature of ∫pdf over the sphere: initial panels in cos θ and φ, absolute
+    /// tolerance, maximum depth.
+    pub mass: (usize, usize, f64, u32),
+    /// Samples.
+    pub n: usize,
+    /// The density the samples are tested against is `pdf_scale` × pdf (1, or a negative
+    /// control's wrong scale).
+    pub pdf_scale: f64,
+    /// If set, each sample's density is also checked against the BSDF's own: `eval_with_pdf`
+    /// at its direction gives the density of `pdf` (the same bits) within this relative
+    /// tolerance of the sample's, and the value of `eval` (the same bits).
+    pub pdf_consistency: Option<f32>,
+}
+
+impl BsdfChi2 {
+    /// `n` samples in 20 × 40 equal-area cells of the sphere, the cells' densities and ∫pdf
+    /// (from 8 × 16 panels) integrated to the absolute tolerance `tol` at depth `depth`, each
+    /// sample's density equal to `pdf`'s within `pdf_rel` (see [`Self::pdf_consistency`]).
+    pub fn sphere(n: usize, tol: f64, depth: u32, pdf_rel: f32) -> Self {
+        Self {
+            grid: Chi2Grid { quad_tol: tol, max_depth: depth, ..Chi2Grid::sphere(20, 40) },
+            mass: (8, 16, tol, depth),
+            n,
+            pdf_scale: 1.0,
+            pdf_consistency: Some(pdf_rel),
+        }
+    }
+}
+
+/// [`bsdf_chi2`] of `b.sample` from fresh uniforms of `rng` ([`crate::check::draw`]: uc, then
+/// u) against `b.eval`.
+#[allow(clippy::too_many_arguments)]
+pub fn sampler_chi2(
+    label: &str,
+    b: &dyn Bsdf,
+    wo: Vec3,
+    settings: BsdfChi2,
+    rng: &mut crate::TestRng,
+    each: impl FnMut(&BsdfSample),
+    alpha: f64,
+    z: f64,
+) -> BsdfChi2Outcome {
+    bsdf_chi2(label, b, wo, settings, || crate::check::draw(b, wo, rng), |wi| b.eval(wo, wi), each, alpha, z)
+}
+
+/// The outcome of [`bsdf_chi2`]: the chi-square test's and ∫pdf.
+#[derive(Debug, Clone)]
+pub struct BsdfChi2Outcome {
+    pub chi2: Chi2Outcome,
+    pub mass: f64,
+}
+
+/// The test of a BSDF sampler with an exact density, for the view `wo`: ∫pdf ≤ 1 (within
+/// [`MASS_TOLERANCE`]); `sample` (each call one sample, `None` a refusal) passes the
+/// chi-square test against `pdf` at significance `alpha`; it refuses exactly the mass 1 − ∫pdf
+/// ([`crate::assert_refusal_rate`], z·SE + [`MASS_TOLERANCE`]); and each sample carries the
+/// `exact_pdf` flag and a weight equal to f·|cos θi|/pdf (relative 1e-4, [`crate::check::rel_close`])
+/// with f = `eval(wi)`, flagged exact, and the density checks of
+/// [`BsdfChi2::pdf_consistency`]. `each` makes the caller's own checks of a sample (flags,
+/// counts). Prints and returns χ², the degrees of freedom, p and ∫pdf.
+#[allow(clippy::too_many_arguments)]
+pub fn bsdf_chi2(
+    label: &str,
+    b: &dyn Bsdf,
+    wo: Vec3,
+    settings: BsdfChi2,
+    mut sample: impl FnMut() -> Option<BsdfSample>,
+    mut eval: impl FnMut(Vec3) -> BsdfValue,
+    mut each: impl FnMut(&BsdfSample),
+    alpha: f64,
+    z: f64,
+) -> BsdfChi2Outcome {
+    let (nz, nphi, tol, depth) = settings.mass;
+    let mass = integrate_sphere(&mut |w| f64::from(b.pdf(wo, w)), nz, nphi, Domain::Sphere, tol, depth);
+    assert!(mass <= 1.0 + MASS_TOLERANCE, "{label}: ∫pdf = {mass} > 1");
+    let scale = settings.pdf_scale;
+    let chi2 = chi2_test(
+        label,
+        settings.grid,
+        |w| scale * f64::from(b.pdf(wo, w)),
+        || {
+            let s = sample()?;
+            assert!(s.flags.exact_pdf, "{label}: exact_pdf flag not set ({:?})", s.flags);
+            each(&s);
+            let v = eval(s.wi);
+            assert!(v.exact, "{label}: eval not flagged exact");
+            if let Some(tol) = settings.pdf_consistency {
+                let (value, pdf) = b.eval_with_pdf(wo, s.wi);
+                assert!((pdf - s.pdf).abs() <= tol * pdf, "{label}: pdf {pdf} ≠ sample's {}", s.pdf);
+                assert_eq!(pdf, b.pdf(wo, s.wi), "{label}: eval_with_pdf and pdf disagree");
+                assert_eq!(value, v, "{label}: eval_with_pdf and eval disagree");
+            }
+            let expected = v.f * (s.wi.z.abs() / s.pdf);
+            assert!(
+                rel_close(s.weight, expected, 1e-4),
+                "{label}: weight {} ≠ eval·|cos θi|/pdf = {expected} at wi = {}",
+                s.weight,
+                s.wi
+            );
+            Some(s.wi)
+        },
+        settings.n,
+        alpha,
+        scale * mass,
+    );
+    crate::assert_refusal_rate(label, chi2.failures, settings.n, mass, MASS_TOLERANCE, z);
+    println!(
+        "{label}: χ² = {:.1}, dof = {}, p = {:.4}, ∫pdf = {mass:.5}",
+        chi2.statistic, chi2.dof, chi2.p_value
+    );
+    BsdfChi2Outcome { chi2, mass }
 }

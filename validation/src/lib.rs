@@ -38,6 +38,7 @@
 pub mod check;
 pub mod chi2;
 pub mod clock;
+pub mod inputs;
 pub mod leadr;
 pub mod quadrature;
 pub mod reference;

@@ -504,15 +504,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             }
         };
         let s = s?;
-        // the walk returns its sample through memory, written field by field (8 + 4 bytes per
-        // vector): read it back the same way. Left to itself the optimizer loads ωo and the
-        // first weight component as one 16-byte vector, a load that spans three of the
-        // walk's stores and so cannot be forwarded from them: it then waits until the walk
-        // has retired, and everything after it (the density, the checks) with it (about
-        // 20 ns of a 110 ns gold walk sample, DESIGN.md, “renderer trait speed, session 6”).
-        // `black_box` makes each 12-byte vector a copy of its own
-        let walk_out = Vec3::from_array(core::hint::black_box(s.wo.to_array()));
-        let weight = Vec3::from_array(core::hint::black_box(s.weight.to_array()));
+        let (walk_out, weight) = (s.wo, s.weight);
         let pdf = self.research_pdf_out(walk_in, walk_out);
         // every check in one test (one branch): the order, a finite weight (its components are
         // ≥ 0, so a finite sum means finite components) and a unit direction, then those of

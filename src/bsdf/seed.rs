@@ -62,7 +62,8 @@ impl Hasher {
     /// The hash of an evaluation: seed, key and the directions (wo, wi).
     #[inline(always)]
     pub(crate) fn directions(seed: u64, key: u64, a: Vec3, b: Vec3) -> Self {
-        Self::of(seed, key, [pair(a.x, a.y), pair(a.z, b.x), pair(b.y, b.z)])
+        // the pairs (x, y) and the two z, the pieces a `Vec3` is stored in
+        Self::of(seed, key, [pair(a.x, a.y), pair(b.x, b.y), pair(a.z, b.z)])
     }
 
     /// The hash of a sample: seed, key, the direction wo and the caller's uniforms.

@@ -585,10 +585,22 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
+        if !valid_direction(wo) || !valid_direction(wi) {
             return 0.0;
         }
-        let pdf = self.research_pdf_out(wo, wi);
+        let pdf = if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
+            // the exact reflection density (the single-scattering density of a view from
+            // above: 0 for a light below the horizon), without the Dirac and technique tests
+            if wi.z > 0.0 {
+                SingleScattering::<S, M>::mirror_density(self.surface.slope(), wo, wi)
+            } else {
+                0.0
+            }
+        } else if self.dirac(wo) {
+            return 0.0;
+        } else {
+            self.research_pdf_out(wo, wi)
+        };
         if pdf.is_finite() { pdf } else { 0.0 }
     }
 }

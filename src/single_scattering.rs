@@ -141,8 +141,9 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// ([`SingleScattering::pdf`] at the returned direction, bit for bit). The masking ratio
     /// is formed in f64 (from logarithms where Λ underflows, backfacing Beckmann views), so
     /// that the weight equals f·|cos θo|/pdf at the returned f32 direction to a few f32 ulps;
-    /// for a conductor seen from above the horizon it is formed from the f32 Λ (no
-    /// cancellation there) and the density is GGX's f32 form (relative error below 4e-6, see
+    /// for a conductor seen from above the horizon it is formed from the f32 projected areas
+    /// (a few f32 ulps, see `sample_mirror_front`) and the density is GGX's f32 form (relative
+    /// error below 4e-6, see
     /// [`SingleScattering::pdf`]), so the weight equals f·|cos θo|/pdf to within 1e-5 (with
     /// the Fresnel term taken at the sampled normal, see [`Conductor`](crate::Conductor)).
     /// `None` if ωi cannot light the material (on the horizon, or at the nadir of an opaque

@@ -75,8 +75,10 @@ impl ComplexIor {
 /// Rs = (a² + b² − 2a cos θ + cos²θ)/(a² + b² + 2a cos θ + cos²θ),
 /// Rp = Rs (cos²θ (a² + b²) − 2a cos θ s² + s⁴)/(cos²θ (a² + b²) + 2a cos θ s² + s⁴),
 /// F = (Rs + Rp)/2 (Born and Wolf, Principles of Optics, §14.2), evaluated as Rs R/(R + S)
-/// with R and S the numerator's and denominator's terms of Rp/Rs (one division). F ∈ [0, 1];
-/// 1 at grazing.
+/// with R and S the numerator's and denominator's terms of Rp/Rs (one division), from
+/// η² − k² − 1 and 4η²k² precomputed with the index. F ∈ [0, 1]; 1 at grazing. In f32 the
+/// absolute error is below 2e-6 against a complex-arithmetic f64 evaluation (measured
+/// 8.5e-7 over the presets and 40 random indices, `tests/fresnel.rs`).
 ///
 /// Invalid input ([policy](crate#invalid-input)): a `cos_theta_i` that is NaN or beyond
 /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives `Vec3::NAN` (a debug

@@ -141,8 +141,9 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// ([`SingleScattering::pdf`] at the returned direction, bit for bit). The masking ratio
     /// is formed in f64 (from logarithms where Λ underflows, backfacing Beckmann views), so
     /// that the weight equals f·|cos θo|/pdf at the returned f32 direction to a few f32 ulps;
-    /// for a conductor seen from above the horizon it is formed from the f32 Λ (no
-    /// cancellation there) and the density is GGX's f32 form (relative error below 4e-6, see
+    /// for a conductor seen from above the horizon it is formed from the f32 projected areas
+    /// (a few f32 ulps, see `sample_mirror_front`) and the density is GGX's f32 form (relative
+    /// error below 4e-6, see
     /// [`SingleScattering::pdf`]), so the weight equals f·|cos θo|/pdf to within 1e-5 (with
     /// the Fresnel term taken at the sampled normal, see [`Conductor`](crate::Conductor)).
     /// `None` if ωi cannot light the material (on the horizon, or at the nadir of an opaque
@@ -245,8 +246,10 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::sample`] of mirror facets ([`Material::MIRROR_FACETS`]: conductors)
     /// seen from above the horizon (ωi.z > 0, unit), from the two uniforms of the visible
     /// normal: ωm ~ D_ωi, ωo = reflect(ωi, ωm), the weight F·G2/G1 with G2/G1 = (1 + Λi)/(1 +
-    /// Λi + Λo) from the f32 Λ (above the horizon Λ has no cancellation and saturates only at
-    /// cos θ = 0: a few f32 ulps), written 1/(1 + Λo/(1 + Λi)) so that it cannot overflow, and
+    /// Λi + Λo) from the f32 projected areas A = (1 + Λ) cos θ, as Ai zo/(Ai zo + zi (Ao − zo))
+    /// (z = cos θ; one division, and Ai is the density's): the rounding of Ao − zo = Λo zo,
+    /// which cancels where Λo is small, is at most ε Ao, and relative to the denominator (at
+    /// least zi zo max(1, Λo)) that is at most 3ε, so the ratio keeps a few f32 ulps; and
     /// the density `pdf` gives at the returned direction. The weight is finite (F ∈ [0, 1],
     /// G2/G1 ∈ (0, 1]) and ωo unit (renormalized). `None` if ωo points into the surface or
     /// lies within rounding of −ωi (no visible half vector: eval is 0 there).
@@ -265,7 +268,11 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         if !exits {
             return None;
         }
-        let last = 1.0 / (1.0 + slope.lambda_unchecked(s.wo) / (1.0 + slope.lambda_unchecked(wi)));
+        // G2/G1 = (1 + Λi)/(1 + Λi + Λo) with 1 + Λ = A/cos θ: Ai zo/(Ai zo + zi (Ao − zo))
+        let (zi, zo) = (wi.z, s.wo.z);
+        let (area_i, area_o) = (slope.projected_area_unchecked(wi), slope.projected_area_unchecked(s.wo));
+        let front = area_i * zo;
+        let last = front / (front + zi * (area_o - zo));
         let pdf = Self::mirror_density(slope, wi, s.wo);
         (last > 0.0 && pdf > 0.0).then(|| SingleSample { wo: s.wo, weight: s.weight * last, pdf })
     }

@@ -224,8 +224,9 @@ fn conductor_matches_complex_fresnel_equations() {
                 let r = conductor_ref(f64::from(c as f32), f64::from(eta[ch]), f64::from(k[ch]));
                 let err = (f64::from(f[ch]) - r).abs();
                 worst = worst.max(err);
-                // f32 evaluation of a² + b² = √(t² + 4η²k²) and of the quotients
-                assert!(err <= 2e-5, "{name} channel {ch}: F({c}) = {}, reference {r}", f[ch]);
+                // f32 evaluation of a² + b² = √(t² + 4η²k²) and of the quotient: the bound
+                // `fresnel_conductor` states
+                assert!(err <= 2e-6, "{name} channel {ch}: F({c}) = {}, reference {r}", f[ch]);
             }
         }
     }

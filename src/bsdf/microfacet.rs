@@ -156,6 +156,10 @@ pub struct MicrofacetBsdf<S, M> {
     transport: Transport,
     seed: u64,
     specular: bool,
+    /// Mirror facets ([`Material::MIRROR_FACETS`]) with single scattering and no Dirac limit:
+    /// the sample of a view from above is the exact reflection off a visible normal drawn
+    /// from the caller's uniforms (the one flag the trait's fast path tests).
+    exact_mirror: bool,
 }
 
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
@@ -185,7 +189,18 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             transport: Transport::default(),
             seed: 0,
             specular,
-        })
+            exact_mirror: false,
+        }
+        .with_derived())
+    }
+
+    /// The BSDF with its derived flag `exact_mirror` recomputed (after a change of technique
+    /// or of the Dirac limit).
+    #[inline]
+    fn with_derived(self) -> Self {
+        let exact_mirror =
+            M::MIRROR_FACETS && self.technique == Technique::SingleScattering && !self.specular;
+        Self { exact_mirror, ..self }
     }
 
     /// The same BSDF evaluated as a rough microfacet lobe however smooth it is: the Dirac limit
@@ -195,12 +210,12 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     #[must_use]
     pub fn without_smooth_limit(self) -> Self {
         let specular = self.surface.material().always_specular();
-        Self { specular, ..self }
+        Self { specular, ..self }.with_derived()
     }
 
     /// The same BSDF evaluated with another technique.
     pub fn with_technique(self, technique: Technique) -> Self {
-        Self { technique, ..self }
+        Self { technique, ..self }.with_derived()
     }
 
     /// The same BSDF truncated to the given orders (ignored by single scattering).
@@ -380,13 +395,33 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         pdf: f32,
         exact_pdf: bool,
     ) -> Option<BsdfSample> {
+        self.finish_sample_if(true, wo, wi, weight, pdf, exact_pdf)
+    }
+
+    /// [`Self::finish_sample`] if `usable` (the caller's own checks, folded into the same
+    /// single test).
+    #[inline(always)]
+    fn finish_sample_if(
+        &self,
+        usable: bool,
+        wo: Vec3,
+        wi: Vec3,
+        weight: Vec3,
+        pdf: f32,
+        exact_pdf: bool,
+    ) -> Option<BsdfSample> {
         let weight = weight * self.transport_scale(wo, wi);
-        let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z.abs());
-        // NaN fails every comparison; wi.z = 0 gives f_max = ∞ or NaN
-        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf)
-            && (f64::from(f32::MIN_POSITIVE)..=f64::MAX).contains(&f_max)
-            && weight.max_element() <= f32::MAX)
-        {
+        let w_max = weight.max_element();
+        // f = weight·pdf/|cos θi| ≥ f32::MIN_POSITIVE without the division: both products are
+        // exact in f64 (of two f32s, and of a power of two and an f32). NaN fails every
+        // comparison, and so does wi.z = 0 (where f would be ∞ or NaN); f cannot overflow f64
+        // (at most f32::MAX²/2⁻¹⁴⁹)
+        let usable = usable
+            & (f32::MIN_POSITIVE..=f32::MAX).contains(&pdf)
+            & (f64::from(w_max) * f64::from(pdf) >= f64::from(f32::MIN_POSITIVE) * f64::from(wi.z.abs()))
+            & (wi.z != 0.0)
+            & (w_max <= f32::MAX);
+        if !usable {
             return None;
         }
         // light never crosses an opaque surface: under a normal map wo and wi may lie on
@@ -401,8 +436,12 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     /// `sample_keyed`).
     #[inline(always)]
     fn exact_reflection(&self, wo: Vec3, wi: Vec3, weight: Vec3, pdf: f32) -> Option<BsdfSample> {
-        let f_max = f64::from(weight.max_element()) * f64::from(pdf) / f64::from(wi.z);
-        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf) && f_max >= f64::from(f32::MIN_POSITIVE)) {
+        // f = weight·pdf/cos θi ≥ f32::MIN_POSITIVE without the division (both products are
+        // exact in f64)
+        let f_times_cos = f64::from(weight.max_element()) * f64::from(pdf);
+        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf)
+            && f_times_cos >= f64::from(f32::MIN_POSITIVE) * f64::from(wi.z))
+        {
             return None;
         }
         let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
@@ -425,6 +464,54 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             eta,
             flags,
         })
+    }
+    /// [`Bsdf::sample_keyed`] for valid arguments, except the exact mirror reflection.
+    #[inline(never)]
+    fn sample_general_outlined(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        self.sample_general(wo, uc, u, key)
+    }
+
+    /// [`Bsdf::sample_keyed`] for valid arguments (see `sample_general_outlined`).
+    #[inline(always)]
+    fn sample_general(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        if self.dirac(wo) {
+            return self.sample_specular(wo, uc);
+        }
+        // (the exact mirror reflection of a view from above was handled by `sample_keyed`)
+        let seed = self.seed;
+        let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
+        let uniforms = [u.x, u.y, uc];
+        let walk_in = wo;
+        let s = match self.technique {
+            Technique::SingleScattering => {
+                // at most the phase function's uniforms: the private generator (and its hash)
+                // is built only if a material draws more than the caller gave. The research
+                // sample's weight is finite and its direction unit (`SingleScattering::sample`)
+                let mut rng = PrimedRng::new(&uniforms, hash);
+                let s = self.single().sample_unchecked(walk_in, &mut rng)?;
+                return self.finish_sample(wo, s.wo, s.weight, s.pdf, M::EXACT_PHASE_PDF);
+            }
+            Technique::RandomWalk => {
+                // the walk draws the height of its first intersection first: from the private
+                // generator, so that the caller's uniforms drive the first visible normal
+                let mut rng = PrimedPcg::after_one_private(&uniforms, hash());
+                self.surface.sample(walk_in, &mut rng)
+            }
+            Technique::PositionFree { shadowing, .. } => {
+                // the estimators draw beyond the caller's uniforms from the first bounce on
+                let mut rng = PrimedPcg::new(&uniforms, hash());
+                self.position_free(shadowing).sample(walk_in, &mut rng)
+            }
+        };
+        let s = s?;
+        let (walk_out, weight) = (s.wo, s.weight);
+        let pdf = self.research_pdf_out(walk_in, walk_out);
+        // every check in one test (one branch): the order, a finite weight (its components are
+        // ≥ 0, so a finite sum means finite components) and a unit direction, then those of
+        // `finish_sample`
+        let usable =
+            self.order.includes(s.bounces) & weight.element_sum().is_finite() & super::is_direction(walk_out);
+        self.finish_sample_if(usable, wo, walk_out, weight, pdf, false)
     }
 }
 
@@ -455,10 +542,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
         if !valid_direction(wo) || !valid_uniforms(uc, u) {
             return None;
         }
-        if self.dirac(wo) {
-            return self.sample_specular(wo, uc);
-        }
-        if M::MIRROR_FACETS && self.technique == Technique::SingleScattering && wo.z > 0.0 {
+        if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
             // a conductor seen from above: the caller's (u.x, u.y) are the visible normal's
             // uniforms, taken as they are (no generator, no hash); the research sample's
             // weight is finite and its direction unit and above the horizon by construction
@@ -466,37 +550,12 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
             let s = SingleScattering::sample_mirror_front(slope, material, wo, u.x, u.y)?;
             return self.exact_reflection(wo, s.wo, s.weight, s.pdf);
         }
-        let seed = self.seed;
-        let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
-        let uniforms = [u.x, u.y, uc];
-        let walk_in = wo;
-        let s = match self.technique {
-            Technique::SingleScattering => {
-                // at most the phase function's uniforms: the private generator (and its hash)
-                // is built only if a material draws more than the caller gave. The research
-                // sample's weight is finite and its direction unit (`SingleScattering::sample`)
-                let mut rng = PrimedRng::new(&uniforms, hash);
-                let s = self.single().sample_unchecked(walk_in, &mut rng)?;
-                return self.finish_sample(wo, s.wo, s.weight, s.pdf, M::EXACT_PHASE_PDF);
-            }
-            Technique::RandomWalk => {
-                // the walk draws the height of its first intersection first: from the private
-                // generator, so that the caller's uniforms drive the first visible normal
-                let mut rng = PrimedPcg::after_one_private(&uniforms, hash());
-                self.surface.sample(walk_in, &mut rng)
-            }
-            Technique::PositionFree { shadowing, .. } => {
-                // the estimators draw beyond the caller's uniforms from the first bounce on
-                let mut rng = PrimedPcg::new(&uniforms, hash());
-                self.position_free(shadowing).sample(walk_in, &mut rng)
-            }
-        };
-        let s = s.filter(|s| self.order.includes(s.bounces))?;
-        let walk_out = s.wo;
-        if !(s.weight.is_finite() && super::is_direction(walk_out)) {
-            return None;
+        if M::MIRROR_FACETS {
+            // out of line: the fast path above keeps a small frame
+            self.sample_general_outlined(wo, uc, u, key)
+        } else {
+            self.sample_general(wo, uc, u, key)
         }
-        self.finish_sample(wo, walk_out, s.weight, self.research_pdf_out(walk_in, walk_out), false)
     }
 
     /// One validation of the directions for both; single scattering also shares the half
@@ -526,10 +585,22 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
+        if !valid_direction(wo) || !valid_direction(wi) {
             return 0.0;
         }
-        let pdf = self.research_pdf_out(wo, wi);
+        let pdf = if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
+            // the exact reflection density (the single-scattering density of a view from
+            // above: 0 for a light below the horizon), without the Dirac and technique tests
+            if wi.z > 0.0 {
+                SingleScattering::<S, M>::mirror_density(self.surface.slope(), wo, wi)
+            } else {
+                0.0
+            }
+        } else if self.dirac(wo) {
+            return 0.0;
+        } else {
+            self.research_pdf_out(wo, wi)
+        };
         if pdf.is_finite() { pdf } else { 0.0 }
     }
 }

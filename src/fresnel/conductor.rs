@@ -5,13 +5,39 @@ use crate::error::Error;
 use glam::{Vec3, Vec3A};
 
 /// A complex index of refraction η + i k per RGB channel, relative to the outside medium.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Clone, Copy, PartialEq)]
 pub struct ComplexIor {
-    pub(super) eta: Vec3,
-    pub(super) k: Vec3,
+    eta: Vec3,
+    k: Vec3,
+    /// η² − k² − 1 per channel: t = η² − k² − sin²θ of the Fresnel term is `t0` + cos²θ.
+    t0: Vec3A,
+    /// 4η²k² per channel.
+    four_eta_k_sq: Vec3A,
+}
+
+impl core::fmt::Debug for ComplexIor {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("ComplexIor").field("eta", &self.eta).field("k", &self.k).finish()
+    }
 }
 
 impl ComplexIor {
+    /// The index η + i k with the constants of its Fresnel term (the callers check the domain).
+    pub(super) const fn from_parts(eta: Vec3, k: Vec3) -> Self {
+        const fn sq(e: f32, k: f32) -> f32 {
+            e * e - k * k - 1.0
+        }
+        const fn m(e: f32, k: f32) -> f32 {
+            4.0 * (e * e) * (k * k)
+        }
+        Self {
+            eta,
+            k,
+            t0: Vec3A::new(sq(eta.x, k.x), sq(eta.y, k.y), sq(eta.z, k.z)),
+            four_eta_k_sq: Vec3A::new(m(eta.x, k.x), m(eta.y, k.y), m(eta.z, k.z)),
+        }
+    }
+
     /// A complex IOR with real part `eta` > 0 and extinction `k` ≥ 0 per channel.
     ///
     /// # Errors
@@ -24,7 +50,7 @@ impl ComplexIor {
         for e in k.to_array() {
             Error::check_non_negative("k", e)?;
         }
-        Ok(Self { eta, k })
+        Ok(Self::from_parts(eta, k))
     }
 
     /// Real part η.
@@ -48,7 +74,11 @@ impl ComplexIor {
 /// a² + b² = √(t² + 4η²k²), a = √((a² + b² + t)/2):
 /// Rs = (a² + b² − 2a cos θ + cos²θ)/(a² + b² + 2a cos θ + cos²θ),
 /// Rp = Rs (cos²θ (a² + b²) − 2a cos θ s² + s⁴)/(cos²θ (a² + b²) + 2a cos θ s² + s⁴),
-/// F = (Rs + Rp)/2 (Born and Wolf, Principles of Optics, §14.2). F ∈ [0, 1]; 1 at grazing.
+/// F = (Rs + Rp)/2 (Born and Wolf, Principles of Optics, §14.2), evaluated as Rs R/(R + S)
+/// with R and S the numerator's and denominator's terms of Rp/Rs (one division), from
+/// η² − k² − 1 and 4η²k² precomputed with the index. F ∈ [0, 1]; 1 at grazing. In f32 the
+/// absolute error is below 2e-6 against a complex-arithmetic f64 evaluation (measured
+/// 8.5e-7 over the presets and 40 random indices, `tests/fresnel.rs`).
 ///
 /// Invalid input ([policy](crate#invalid-input)): a `cos_theta_i` that is NaN or beyond
 /// ±(1 + [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)) gives `Vec3::NAN` (a debug
@@ -69,17 +99,20 @@ pub(crate) fn conductor_reflectance(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 
         // grazing: every interface reflects fully (and the formula would be 0/0 at η = 1, k = 0)
         return Vec3::ONE;
     }
-    // the three channels in one SIMD register (Vec3A): the same IEEE operations lane by lane as
-    // the scalar Vec3 form (whose powf(0.5) the compiler emitted as a square root), so the same
-    // bits, with one division and one square root instruction per step instead of three
+    // the three channels in one SIMD register (Vec3A): one division and one square root
+    // instruction per step for the three
     let c = Vec3A::splat(cos_theta);
     let c2 = c * c;
     let s2 = Vec3A::ONE - c2;
-    let (eta, k) = (Vec3A::from(ior.eta), Vec3A::from(ior.k));
-    let t = eta * eta - k * k - s2;
-    let a2b2 = (t * t + 4.0 * eta * eta * k * k).sqrt();
+    // t = η² − k² − sin²θ and a² + b² = √(t² + 4η²k²), from the index's constants
+    let t = ior.t0 + c2;
+    let a2b2 = (t * t + ior.four_eta_k_sq).sqrt();
     let a = (0.5 * (a2b2 + t)).max(Vec3A::ZERO).sqrt();
-    let rs = (a2b2 - 2.0 * a * c + c2) / (a2b2 + 2.0 * a * c + c2);
-    let rp = rs * (c2 * a2b2 - 2.0 * a * c * s2 + s2 * s2) / (c2 * a2b2 + 2.0 * a * c * s2 + s2 * s2);
-    Vec3::from((0.5 * (rs + rp)).clamp(Vec3A::ZERO, Vec3A::ONE))
+    // Rs = (P − Q)/(P + Q) and Rp = Rs (R − S)/(R + S) with P = a² + b² + cos²θ, Q = 2a cos θ,
+    // R = cos²θ (a² + b²) + s⁴, S = Q s²: (Rs + Rp)/2 = Rs R/(R + S), one division
+    let p = a2b2 + c2;
+    let q = 2.0 * a * c;
+    let r = c2 * a2b2 + s2 * s2;
+    let f = (p - q) * r / ((p + q) * (r + q * s2));
+    Vec3::from(f.clamp(Vec3A::ZERO, Vec3A::ONE))
 }

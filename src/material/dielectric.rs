@@ -228,7 +228,10 @@ impl Material for Dielectric {
         Vec3::splat(self.seen_from(it.wi_side()).vertex_outside(slope, &it.seen_from_outside()))
     }
 
-    #[inline]
+    // out of line: the walk instantiated with the renderer layer's primed generator inlined
+    // it and ran 25 % slower than with the research layer's generator, which does not
+    // (DESIGN.md, “renderer trait speed, session 6”)
+    #[inline(never)]
     fn sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,

@@ -221,7 +221,7 @@ impl MicrosurfaceSlope for Ggx {
         self.sample_d_wi_unchecked(wi, u1, u2)
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_spherical_cap(self, wi, u1, u2)
     }
@@ -244,7 +244,7 @@ impl MicrosurfaceSlope for Ggx {
         let len_sq = h.length_squared();
         let ratio = len_sq / t;
         let density = FRAC_1_4PI * (ratio * ratio) / (ax * ay * self.projected_area_unchecked(wi));
-        if len_sq.min(t) >= F32_DENSITY_MIN_SUM && density.is_normal() {
+        if len_sq >= F32_DENSITY_MIN_SUM && t >= F32_DENSITY_MIN_SUM && density.is_normal() {
             density
         } else {
             reflection_density64(self, wi, wo)

@@ -1,0 +1,231 @@
+//! A profiling driver for `benches/bsdf.rs`: runs `calls` calls of one of its configurations
+//! (the same materials, roughness, pre-generated inputs, seeds and call forms: the research
+//! calls through the bench's `Research` dispatch, the trait's through `black_box(&bsdf)` or
+//! `&dyn Bsdf`), for instruction counts under `valgrind --tool=callgrind`. Run it with two call
+//! counts that differ by a multiple of 1024 (a whole number of passes through the inputs) and
+//! take the difference per call, which removes the start-up cost; then subtract the same
+//! difference for the `loop` variant of the call (the rotation through the same inputs,
+//! behind the same `black_box`es, without the call).
+//!
+//! Usage: `bsdf_calls {gold|glass} {single|walk|pt|bdpt} {eval|pdf|eval_with_pdf|sample}
+//! {research|research+pdf|static|dyn|loop|loop-research} calls`, and
+//! `bsdf_calls gold single sample {vndf|vndf-static|vndf-loop} calls` for the
+//! `gold/single/sample-vs-vndf` group (its own inputs). `loop` is the baseline of the trait's
+//! calls and of the research `eval`, `pdf` and `eval_with_pdf` (the same inputs read);
+//! `loop-research` that of the research `sample` (which reads only wo).
+
+use microsurface::glam::{Vec2, Vec3};
+use microsurface::rand::{RngExt, SeedableRng};
+use microsurface::{
+    Bsdf, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
+    MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SingleScattering, SpecularLimit, Technique,
+    UniformHeight,
+};
+use rand_pcg::Pcg64Mcg;
+use std::f32::consts::TAU;
+use std::hint::black_box;
+
+/// The number of pre-generated inputs (as in the bench).
+const N: usize = 1024;
+/// The roughness of every configuration.
+const ALPHA: f32 = 0.5;
+
+fn direction(rng: &mut Pcg64Mcg, sphere: bool) -> Vec3 {
+    let u = 1.0 - rng.random::<f32>();
+    let z = if sphere && rng.random::<bool>() { -u } else { u };
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = TAU * rng.random::<f32>();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+struct Inputs {
+    wo: Vec<Vec3>,
+    wi: Vec<Vec3>,
+    uc: Vec<f32>,
+    u: Vec<Vec2>,
+}
+
+fn inputs(transmits: bool, seed: u64) -> Inputs {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let wo = (0..N).map(|_| direction(&mut rng, false)).collect();
+    let wi = (0..N).map(|_| direction(&mut rng, transmits)).collect();
+    let uc = (0..N).map(|_| rng.random::<f32>()).collect();
+    let u = (0..N).map(|_| Vec2::new(rng.random(), rng.random())).collect();
+    Inputs { wo, wi, uc, u }
+}
+
+/// The bench's research-layer calls (`benches/bsdf.rs`, `Research`).
+struct Research<S, M> {
+    surface: Microsurface<UniformHeight, S, M>,
+    technique: Technique,
+}
+
+impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
+    fn pf(&self, shadowing: Shadowing) -> PositionFree<S, M> {
+        PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
+    }
+
+    fn single(&self) -> SingleScattering<S, M> {
+        SingleScattering::new(*self.surface.slope(), *self.surface.material())
+    }
+
+    #[inline(always)]
+    fn eval(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
+        match self.technique {
+            Technique::SingleScattering => self.single().eval(walk_in, walk_out, rng),
+            Technique::RandomWalk => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
+            Technique::PositionFree { estimator, shadowing } => {
+                self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn pdf(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
+        match self.technique {
+            Technique::SingleScattering => self.single().pdf(walk_in, walk_out),
+            _ => self.pf(Shadowing::Correlated).pdf(walk_in, walk_out),
+        }
+    }
+
+    #[inline(always)]
+    fn sample(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
+        match self.technique {
+            Technique::SingleScattering => {
+                self.single().sample(walk_in, rng).map(|s| (s.wo, s.weight, s.pdf))
+            }
+            Technique::RandomWalk => self.surface.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
+            Technique::PositionFree { shadowing, .. } => {
+                self.pf(shadowing).sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0))
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn sample_with_pdf(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
+        let (wo, weight, pdf) = self.sample(walk_in, rng)?;
+        let pdf = if self.technique == Technique::SingleScattering { pdf } else { self.pdf(walk_in, wo) };
+        Some((wo, weight, pdf))
+    }
+}
+
+/// The calls, one loop per closure (monomorphized: no dispatch in the loop).
+#[inline(never)]
+fn drive(calls: usize, mut f: impl FnMut(usize, u64) -> f32) -> f32 {
+    let mut sum = 0.0;
+    for i in 0..calls {
+        sum += f(i & (N - 1), i as u64);
+    }
+    sum
+}
+
+/// A value to sum, so that no part of a sample can be dropped.
+fn first(x: Option<(Vec3, Vec3, f32)>) -> f32 {
+    x.map_or(0.0, |(w, f, p)| w.x + f.x + p)
+}
+
+fn run<M: Material + SpecularLimit>(
+    material: M,
+    seed: u64,
+    technique: Technique,
+    call: &str,
+    variant: &str,
+    calls: usize,
+) -> f32 {
+    let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
+    let x = inputs(M::TRANSMITS, seed);
+    let bsdf = MicrofacetBsdf::new(slope, material).expect("α ≤ MAX_WALK_ALPHA").with_technique(technique);
+    let dynamic: &dyn Bsdf = &bsdf;
+    let research = Research { surface: Microsurface::new(UniformHeight, slope, material), technique };
+    let single = research.single();
+    let mut rng = Pcg64Mcg::seed_from_u64(seed + 1);
+    let (wo, wi, uc, u) = (&x.wo, &x.wi, &x.uc, &x.u);
+    match (call, variant) {
+        ("eval" | "eval_with_pdf", "loop") => {
+            drive(calls, |k, key| black_box(wo[k]).x + black_box(wi[k]).x + key as f32)
+        }
+        ("pdf", "loop") => drive(calls, |k, _| black_box(wo[k]).x + black_box(wi[k]).x),
+        ("sample", "loop") => drive(calls, |k, _| black_box(wo[k]).x + black_box(uc[k]) + black_box(u[k]).x),
+        (_, "loop-research") => drive(calls, |k, _| black_box(wo[k]).x),
+        ("eval", "research") => {
+            drive(calls, |k, _| black_box(&research).eval(black_box(wo[k]), black_box(wi[k]), &mut rng).x)
+        }
+        ("eval", "static") => {
+            drive(calls, |k, key| black_box(&bsdf).eval_keyed(black_box(wo[k]), black_box(wi[k]), key).f.x)
+        }
+        ("eval", "dyn") => {
+            drive(calls, |k, key| black_box(dynamic).eval_keyed(black_box(wo[k]), black_box(wi[k]), key).f.x)
+        }
+        ("pdf", "research") => {
+            drive(calls, |k, _| black_box(&research).pdf(black_box(wo[k]), black_box(wi[k])))
+        }
+        ("pdf", "static") => drive(calls, |k, _| black_box(&bsdf).pdf(black_box(wo[k]), black_box(wi[k]))),
+        ("pdf", "dyn") => drive(calls, |k, _| black_box(dynamic).pdf(black_box(wo[k]), black_box(wi[k]))),
+        ("eval_with_pdf", "research") => drive(calls, |k, _| {
+            let (f, p) = black_box(&single).eval_with_pdf(black_box(wo[k]), black_box(wi[k]), &mut rng);
+            f.x + p
+        }),
+        ("eval_with_pdf", "static") => drive(calls, |k, key| {
+            let (f, p) = black_box(&bsdf).eval_with_pdf_keyed(black_box(wo[k]), black_box(wi[k]), key);
+            f.f.x + p
+        }),
+        ("eval_with_pdf", "dyn") => drive(calls, |k, key| {
+            let (f, p) = black_box(dynamic).eval_with_pdf_keyed(black_box(wo[k]), black_box(wi[k]), key);
+            f.f.x + p
+        }),
+        ("sample", "research") => {
+            drive(calls, |k, _| first(black_box(&research).sample(black_box(wo[k]), &mut rng)))
+        }
+        ("sample", "research+pdf") => {
+            drive(calls, |k, _| first(black_box(&research).sample_with_pdf(black_box(wo[k]), &mut rng)))
+        }
+        ("sample", "static") => drive(calls, |k, _| {
+            first(
+                black_box(&bsdf)
+                    .sample(black_box(wo[k]), black_box(uc[k]), black_box(u[k]))
+                    .map(|s| (s.wi, s.weight, s.pdf)),
+            )
+        }),
+        ("sample", "dyn") => drive(calls, |k, _| {
+            first(
+                black_box(dynamic)
+                    .sample(black_box(wo[k]), black_box(uc[k]), black_box(u[k]))
+                    .map(|s| (s.wi, s.weight, s.pdf)),
+            )
+        }),
+        ("sample", "vndf") => drive(calls, |k, _| {
+            black_box(&slope).sample_d_wi(black_box(wo[k]), black_box(u[k].x), black_box(u[k].y)).x
+        }),
+        ("sample", "vndf-loop") => {
+            drive(calls, |k, _| black_box(wo[k]).x + black_box(u[k].x) + black_box(u[k].y))
+        }
+        _ => panic!("unknown call {call} {variant}"),
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let [_, material, technique, call, variant, calls] = &args[..] else {
+        panic!("usage: bsdf_calls {{gold|glass}} {{single|walk|pt|bdpt}} call variant calls");
+    };
+    let calls: usize = calls.parse().expect("a call count");
+    let technique = match technique.as_str() {
+        "single" => Technique::SingleScattering,
+        "walk" => Technique::RandomWalk,
+        "pt" => Technique::PositionFree { estimator: Estimator::Pt, shadowing: Shadowing::Correlated },
+        "bdpt" => Technique::PositionFree { estimator: Estimator::Bdpt, shadowing: Shadowing::Correlated },
+        t => panic!("unknown technique {t}"),
+    };
+    // the sample-vs-vndf group has its own inputs (seed 77)
+    let (seed_gold, variant) = match variant.as_str() {
+        "vndf-static" => (77, "static"),
+        v @ ("vndf" | "vndf-loop") => (77, v),
+        v => (100, v),
+    };
+    let sum = match material.as_str() {
+        "gold" => run(Conductor::new(ComplexIor::GOLD), seed_gold, technique, call, variant, calls),
+        "glass" => run(Dielectric::new(1.5).expect("valid index"), 200, technique, call, variant, calls),
+        m => panic!("unknown material {m}"),
+    };
+    println!("{sum}");
+}

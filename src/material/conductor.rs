@@ -1,8 +1,8 @@
 //! Conductor microfacets.
 
 use super::{
-    Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect, reflection_density,
-    reflection_half_vector,
+    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
+    reflection_density, reflection_half_vector,
 };
 use crate::contract::{is_cosine, is_direction};
 use crate::fresnel::{ComplexIor, conductor_reflectance};
@@ -114,6 +114,15 @@ impl Material for Conductor {
         it: &Interaction,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        if let (Some(area), true) = (it.incident_area(), it.is_outside_reflection()) {
+            // the walk's next-event estimation: A(ωi) known, the half vector unnormalized
+            let Some(sum) = HalfSum::visible(it.wi(), it.wo()) else { return Vec3::ZERO };
+            let density = sum.density(slope, area);
+            return match &self.ior {
+                None => Vec3::splat(density),
+                Some(ior) => conductor_reflectance(sum.cos_ih(), ior) * density,
+            };
+        }
         let Some(wh) = Self::half_vector(it) else { return Vec3::ZERO };
         let wi = it.wi();
         self.reflectance(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh, it.incident_area())

@@ -1,7 +1,7 @@
 //! Dielectric microfacets.
 
 use super::{
-    Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
+    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
     reflection_half_vector,
 };
 use crate::contract::is_direction;
@@ -131,6 +131,11 @@ impl Dielectric {
         let (wi, wo) = (it.wi(), it.wo());
         match it.wo_side() {
             Side::Outside => {
+                if let Some(area) = it.incident_area() {
+                    // the walk's next-event estimation: A(ωi) known, the half vector unnormalized
+                    let Some(sum) = HalfSum::visible(wi, wo) else { return 0.0 };
+                    return dielectric_reflectance(sum.cos_ih(), self.eta) * sum.density(slope, area);
+                }
                 let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
                 dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
                     * phase_reflection(slope, wi, wh, it.incident_area())

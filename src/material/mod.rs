@@ -279,6 +279,43 @@ pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<DVec3> {
     (wh.z > 0.0 && wi.as_dvec3().dot(wh) > 0.0).then_some(wh)
 }
 
+/// The half vector of a reflection ωi → ωo unnormalized, h = ωi + ωo in f64 (exact: a sum
+/// of two f32), with ωi·h: what the walk's next-event estimation needs of it (D is a
+/// function of the direction of h only, [`MicrosurfaceSlope::d64_of_sum_unchecked`]; the
+/// cosine ωi·ωh only for a Fresnel term).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct HalfSum {
+    h: DVec3,
+    wi_dot_h: f64,
+}
+
+impl HalfSum {
+    /// The sum of a reflection ωi → ωo if its direction is a valid microfacet normal for the
+    /// pair (h.z > 0 and ωi·h > 0: the tests of [`reflection_half_vector`], whose normalized
+    /// vector has the same signs).
+    #[inline(always)]
+    pub(crate) fn visible(wi: Vec3, wo: Vec3) -> Option<Self> {
+        let i = wi.as_dvec3();
+        let h = i + wo.as_dvec3();
+        let wi_dot_h = i.dot(h);
+        (h.z > 0.0 && wi_dot_h > 0.0).then_some(Self { h, wi_dot_h })
+    }
+
+    /// ωi·ωh with ωh = h/|h| (in f64, rounded once to f32).
+    #[inline(always)]
+    pub(crate) fn cos_ih(&self) -> f32 {
+        (self.wi_dot_h / self.h.length()) as f32
+    }
+
+    /// The reflection density D(ωh)/(4 A(ωi)) for A(ωi) = `area` > 0 known (the walk's, see
+    /// [`Interaction`]): [`phase_reflection`] without normalizing the half vector, D in f64
+    /// ([`MicrosurfaceSlope::d64_of_sum_unchecked`]) and one rounding to f32.
+    #[inline(always)]
+    pub(crate) fn density<S: MicrosurfaceSlope>(&self, slope: &S, area: f32) -> f32 {
+        front_density(slope.d64_of_sum_unchecked(self.h), area)
+    }
+}
+
 /// The reflection of `wi` about the unit normal `wm`: 2(ωi·ωm)ωm − ωi.
 #[inline(always)]
 pub(crate) fn reflect(wi: Vec3, wm: Vec3) -> Vec3 {

@@ -3,6 +3,7 @@
 
 use super::Microsurface;
 use super::geometry::{ScaledDepth, flip_ln_c1, next_ln_c1};
+use super::logexp;
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::{Interaction, Material, Side};
@@ -138,7 +139,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else { break };
             ln_c1 = hit.ln_c1;
             let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
-            let escape = || (lambda_o * if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) }).exp();
+            let escape =
+                || logexp::exp_f32(lambda_o * if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) });
             let includes = order.includes(bounce);
             if bounce == last {
                 if includes {

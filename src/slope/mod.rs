@@ -229,6 +229,18 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         self.d64(wm)
     }
 
+    /// D(ωh) in double precision for the direction ωh = h/|h| of a vector `h` given
+    /// unnormalized (D depends on the direction only), 0 for h.z ≤ 0: the materials pass the
+    /// reflection half vector's sum ωi + ωo, exact in f64, and skip its normalization. No
+    /// argument check (crate-internal hot path). The default normalizes and calls
+    /// [`Self::d64_unchecked`]; [`Ggx`] evaluates its homogeneous form directly (the same
+    /// accuracy: a few f64 ulps).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d64_of_sum_unchecked(&self, h: DVec3) -> f64 {
+        self.d64_unchecked(h.normalize_or_zero())
+    }
+
     /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[inline(always)]

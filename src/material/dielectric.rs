@@ -7,7 +7,7 @@ use super::{
 use crate::contract::is_direction;
 use crate::error::Error;
 use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
-use crate::rng::uniform;
+use crate::rng::{uniform, uniform_pair};
 use crate::slope::{MicrosurfaceSlope, normalize_fast, renormalize};
 use crate::special::beta;
 use glam::{DVec3, Vec3};
@@ -243,7 +243,10 @@ impl Material for Dielectric {
     ) -> PhaseSample {
         let this = self.seen_from(side);
         let wi_local = side.frame(wi);
-        let wm = slope.sample_d_wi_unchecked(wi_local, uniform(rng), uniform(rng));
+        let wm = {
+            let (u1, u2) = uniform_pair(rng);
+            slope.sample_d_wi_unchecked(wi_local, u1, u2)
+        };
         let f = dielectric_reflectance(wi_local.dot(wm), this.eta);
         let (wo_local, wo_side) = if uniform(rng) < f {
             (renormalize(reflect(wi_local, wm), wm), side)

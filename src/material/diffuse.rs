@@ -4,7 +4,7 @@ use super::{Interaction, Material, PhaseSample, Side, g2_reflection};
 use crate::basis::basis;
 use crate::contract::is_direction;
 use crate::error::Error;
-use crate::rng::uniform;
+use crate::rng::uniform_pair;
 use crate::sampling::cosine_hemisphere;
 use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
@@ -71,7 +71,8 @@ impl Diffuse {
     /// about ωm), weighted by the albedo.
     #[inline(always)]
     fn sample_at_facet(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
-        let local = cosine_hemisphere(uniform(rng), uniform(rng));
+        let (u1, u2) = uniform_pair(rng);
+        let local = cosine_hemisphere(u1, u2);
         let (t, b) = basis(wm);
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
         PhaseSample { wo, weight: self.albedo, side: Side::Outside }
@@ -92,7 +93,10 @@ impl Material for Diffuse {
         if !it.is_outside_reflection() {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
+        let wm = {
+            let (u1, u2) = uniform_pair(rng);
+            slope.sample_d_wi_unchecked(it.wi(), u1, u2)
+        };
         self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
     }
 
@@ -115,7 +119,10 @@ impl Material for Diffuse {
         if !it.is_outside_reflection() || wi.z == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        let wm = {
+            let (u1, u2) = uniform_pair(rng);
+            slope.sample_d_wi_unchecked(wi, u1, u2)
+        };
         self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
@@ -127,7 +134,10 @@ impl Material for Diffuse {
         _side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        let wm = {
+            let (u1, u2) = uniform_pair(rng);
+            slope.sample_d_wi_unchecked(wi, u1, u2)
+        };
         self.sample_at_facet(wm, rng)
     }
 
@@ -142,7 +152,10 @@ impl Material for Diffuse {
         it: &Interaction,
         rng: &mut impl Rng,
     ) -> (Vec3, PhaseSample) {
-        let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
+        let wm = {
+            let (u1, u2) = uniform_pair(rng);
+            slope.sample_d_wi_unchecked(it.wi(), u1, u2)
+        };
         let phase = if it.is_outside_reflection() {
             self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
         } else {
@@ -167,7 +180,10 @@ impl Material for Diffuse {
         if g2 == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
+        let wm = {
+            let (u1, u2) = uniform_pair(rng);
+            slope.sample_d_wi_unchecked(wi, u1, u2)
+        };
         // (1 + Λi)/(1 + Λi + Λo) in f64: the f32 factors saturate near grazing
         let k = 1.0 + slope.lambda64(wi);
         let g2_given_g1 = (k / (k + slope.lambda64(wo))) as f32;

@@ -139,14 +139,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             let Some(hit) = self.next_hit(wr, ln_c1, side, rng) else { break };
             ln_c1 = hit.ln_c1;
             let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
-            let escape =
-                || logexp::exp_f32(lambda_o * if side == wo_side { ln_c1 } else { flip_ln_c1(ln_c1) });
             let includes = order.includes(bounce);
             if bounce == last {
                 if includes {
                     let phase = self.material.eval_phase_unchecked(slope, &it, rng);
                     if phase != Vec3::ZERO {
-                        sum += throughput * phase * escape();
+                        sum += throughput * phase * escape(lambda_o, ln_c1, side == wo_side);
                     }
                 }
                 break;
@@ -155,7 +153,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 // next-event estimation and the next direction in one material call
                 let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
                 if phase != Vec3::ZERO {
-                    sum += throughput * phase * escape();
+                    sum += throughput * phase * escape(lambda_o, ln_c1, side == wo_side);
                 }
                 s
             } else {
@@ -330,6 +328,15 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let ln_c1 = next_ln_c1(w.z, lambda, ln_c1, uniform(rng))?;
         Some(Hit { ln_c1, incident_area: incident_area(w.z, lambda) })
     }
+}
+
+/// The masking C¹^Λ(ωo) of the point with ln C¹ = `ln_c1` (in the frame of the walk's side)
+/// for ωo with Λ(ωo) = `lambda_o` seen from its own side (supplement §3.1; through the other
+/// side, ln(1 − C¹), for a dielectric's ωo across the interface): the probability that a ray
+/// from there escapes along ωo.
+#[inline(always)]
+fn escape(lambda_o: f32, ln_c1: f32, same_side: bool) -> f32 {
+    logexp::exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) })
 }
 
 /// An intersection of the walk's ray with the microsurface.

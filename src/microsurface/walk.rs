@@ -140,11 +140,13 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             ln_c1 = hit.ln_c1;
             let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
             let includes = order.includes(bounce);
+            // the masking of ωo at the hit: in closed form at the first hit on ωo's side
+            let first = (bounce == 1 && side == wo_side).then_some(hit.lambda);
             if bounce == last {
                 if includes {
                     let phase = self.material.eval_phase_unchecked(slope, &it, rng);
                     if phase != Vec3::ZERO {
-                        sum += throughput * phase * escape(lambda_o, ln_c1, side == wo_side);
+                        sum += throughput * phase * masking(first, lambda_o, ln_c1, side == wo_side);
                     }
                 }
                 break;
@@ -153,7 +155,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 // next-event estimation and the next direction in one material call
                 let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
                 if phase != Vec3::ZERO {
-                    sum += throughput * phase * escape(lambda_o, ln_c1, side == wo_side);
+                    sum += throughput * phase * masking(first, lambda_o, ln_c1, side == wo_side);
                 }
                 s
             } else {
@@ -326,17 +328,32 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let w = side.frame(wr);
         let lambda = self.geometry.slope().lambda_unchecked(w);
         let ln_c1 = next_ln_c1(w.z, lambda, ln_c1, uniform(rng))?;
-        Some(Hit { ln_c1, incident_area: incident_area(w.z, lambda) })
+        Some(Hit { ln_c1, lambda, incident_area: incident_area(w.z, lambda) })
     }
 }
 
-/// The masking C¹^Λ(ωo) of the point with ln C¹ = `ln_c1` (in the frame of the walk's side)
-/// for ωo with Λ(ωo) = `lambda_o` seen from its own side (supplement §3.1; through the other
-/// side, ln(1 − C¹), for a dielectric's ωo across the interface): the probability that a ray
-/// from there escapes along ωo.
+/// The masking factor of the next-event estimate at a hit with ln C¹ = `ln_c1` (in the frame
+/// of the walk's side), for ωo with Λ(ωo) = `lambda_o` seen from its own side: C¹^Λ(ωo), the
+/// probability that a ray from there escapes along ωo (supplement §3.1; through the other
+/// side, ln(1 − C¹), for a dielectric's ωo across the interface).
+///
+/// At the walk's first hit on ωo's side (`first` = Λ(−ωi) = −(1 + Λ(ωi)) of the arriving ray,
+/// in that side's frame) its conditional expectation given ωi instead, which is known in closed
+/// form: the first hit of a ray from above the surface has C¹₁ with the CDF c^{1 + Λ(ωi)}
+/// (Algorithm 1 from h = +∞), so E[C¹₁^Λ(ωo)] = (1 + Λ(ωi))/(1 + Λ(ωi) + Λ(ωo)). The phase
+/// function and the throughput of the first next-event term do not depend on the height, so
+/// replacing the factor by its expectation keeps the estimate unbiased (Rao–Blackwell) and
+/// removes the first term's variance; the walk continues from the sampled height. In f64 (no
+/// overflow where Λ saturates at grazing angles), rounded once.
 #[inline(always)]
-fn escape(lambda_o: f32, ln_c1: f32, same_side: bool) -> f32 {
-    logexp::exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) })
+fn masking(first: Option<f32>, lambda_o: f32, ln_c1: f32, same_side: bool) -> f32 {
+    match first {
+        Some(lambda) => {
+            let lambda = f64::from(lambda);
+            (lambda / (lambda - f64::from(lambda_o))) as f32
+        }
+        None => logexp::exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) }),
+    }
 }
 
 /// An intersection of the walk's ray with the microsurface.
@@ -344,6 +361,8 @@ fn escape(lambda_o: f32, ln_c1: f32, same_side: bool) -> f32 {
 struct Hit {
     /// ln C¹ of its height, in the frame of the ray's side.
     ln_c1: f32,
+    /// Λ(ωr) of the ray, in the same frame.
+    lambda: f32,
     /// A(ωi) of the incident direction ωi = −ωr there, in the same frame, where known.
     incident_area: Option<f32>,
 }

@@ -145,8 +145,8 @@ impl Dielectric {
                 let eta = f64::from(self.eta);
                 // D_ωi(ωh) = (ωi·ωh) D(ωh)/A(ωi), with A known where the walk computed it
                 let d_wi = match it.incident_area() {
-                    Some(area) if wi.z > 0.0 => r.cos_ih * slope.d64_unchecked(r.wh) / f64::from(area),
-                    _ => slope.d_wi64_unchecked(wi, r.wh),
+                    Some(area) => r.cos_ih * slope.d64_unchecked(r.wh) / f64::from(area),
+                    None => slope.d_wi64_unchecked(wi, r.wh),
                 };
                 (eta * eta * r.transmittance * d_wi * (-r.cos_oh) / r.denom_sq) as f32
             }

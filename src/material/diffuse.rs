@@ -1,12 +1,11 @@
 //! Diffuse (Lambertian) microfacets.
 
 use super::{Interaction, Material, PhaseSample, Side, g2_reflection};
-use crate::basis::basis;
 use crate::contract::is_direction;
 use crate::error::Error;
 use crate::rng::uniform_pair;
-use crate::sampling::cosine_hemisphere;
-use crate::slope::{MicrosurfaceSlope, normalize_fast};
+use crate::sampling::cosine_about;
+use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
 use rand::Rng;
@@ -68,14 +67,11 @@ impl Diffuse {
 
 impl Diffuse {
     /// A direction from the Lambertian lobe of the facet with normal `wm` (cosine-weighted
-    /// about ωm), weighted by the albedo.
+    /// about ωm, [`cosine_about`]: no frame about ωm), weighted by the albedo.
     #[inline(always)]
     fn sample_at_facet(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
         let (u1, u2) = uniform_pair(rng);
-        let local = cosine_hemisphere(u1, u2);
-        let (t, b) = basis(wm);
-        let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
-        PhaseSample { wo, weight: self.albedo, side: Side::Outside }
+        PhaseSample { wo: cosine_about(wm, u1, u2), weight: self.albedo, side: Side::Outside }
     }
 }
 

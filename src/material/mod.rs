@@ -342,7 +342,7 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
 /// error: that of D_ωi (a few f64 ulps times the condition numbers of D, see
 /// [`MicrosurfaceSlope::d64`]) plus the final rounding to f32.
 ///
-/// `area` is A(ωi) where the caller knows it (ωi above the horizon: [`Interaction`]'s cache).
+/// `area` is A(ωi) where the caller knows it ([`Interaction`]'s cache), used where ωi faces up.
 #[inline(always)]
 pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(
     slope: &S,

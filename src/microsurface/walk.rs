@@ -368,14 +368,19 @@ struct Hit {
 }
 
 /// The projected area A(ωi) = (1 + Λ(ωi)) cos θi (supplement §2.2) of the incident direction
-/// ωi = −ω of a vertex that the ray ω with z-component `z` and Λ(ω) = `lambda` reached going
-/// down: with Λ(ω) = −1 − Λ(ωi), A(ωi) = Λ(ω)·ω.z, one f32 product (relative error below
-/// 2⁻²³ beyond that of Λ). `None` for a ray going up or horizontally (ωi backfacing or
-/// grazing, whose density the materials form in f64 instead) and where Λ saturated at
-/// −`f32::MAX` (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
+/// ωi = −ω of a vertex that the ray ω with z-component `z` and Λ(ω) = `lambda` reached: with
+/// Λ(ω) = −1 − Λ(ωi), A(ωi) = Λ(ω)·ω.z, one f32 product (relative error below 2⁻²³ beyond
+/// that of Λ). This holds on both sides of the horizon: for a ray going up, ωi is backfacing
+/// and A(ωi) = Λ(−ωi)|cos θi| (the full-spherical Smith model, Wang et al. 2022, eq. 10).
+/// `None` where the product is not a normal f32 (a ray straight up, Λ = 0; a horizontal ray;
+/// a Λ(ω) that underflowed, as Beckmann's does for steep rays going up at low roughness: the
+/// materials then form the density in f64) and where Λ saturated at ±`f32::MAX`
+/// (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
 #[inline(always)]
 fn incident_area(z: f32, lambda: f32) -> Option<f32> {
-    (z < 0.0 && lambda > -f32::MAX).then_some(lambda * z)
+    // Λ(ω) and ω.z have the same sign (Λ ≤ −1 below the horizon), so the product is ≥ 0
+    let area = lambda * z;
+    (area >= f32::MIN_POSITIVE && lambda.abs() < f32::MAX).then_some(area)
 }
 
 #[cfg(test)]
@@ -395,38 +400,69 @@ mod tests {
     }
 
     /// The largest relative error of Λ(ωr)·cos θr against the f64 projected area of ωi = −ωr
-    /// over θi and α (the anisotropic case through the azimuth).
-    fn worst<S: MicrosurfaceSlope>(slope: S) -> f64 {
-        let mut worst = 0.0f64;
-        for cos in [1.0f32, 0.9, 0.5, 0.1, 1e-2, 1e-3, 1e-6] {
+    /// over θi and α (the anisotropic case through the azimuth), for rays going down
+    /// (`up` = false: ωi facing up) or up (ωi backfacing), and the number of cases compared
+    /// (those with a normal f32 area; `None` is required where the f64 area is not a normal
+    /// f32).
+    fn worst<S: MicrosurfaceSlope>(slope: S, up: bool) -> (f64, usize) {
+        let (mut worst, mut compared) = (0.0f64, 0);
+        for cos in [1.0f32, 0.99, 0.9, 0.5, 0.1, 1e-2, 1e-3, 1e-6] {
             for phi in [0.0f32, 0.7, 1.6] {
                 let sin = (1.0 - cos * cos).sqrt();
-                let wi = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+                let wi = Vec3::new(sin * phi.cos(), sin * phi.sin(), if up { -cos } else { cos });
                 let wr = -wi;
-                let area = incident_area(wr.z, slope.lambda_unchecked(wr)).expect("a ray going down");
-                worst = worst.max(ulps(area, slope.projected_area64(wi)));
+                let exact = slope.projected_area64(wi);
+                match incident_area(wr.z, slope.lambda_unchecked(wr)) {
+                    Some(area) => {
+                        worst = worst.max(ulps(area, exact));
+                        compared += 1;
+                    }
+                    None => assert!(
+                        up && !(exact >= f64::from(f32::MIN_POSITIVE)),
+                        "no area for ωi = {wi}, where it is {exact:e}"
+                    ),
+                }
             }
         }
-        worst
+        (worst, compared)
     }
 
-    /// A(ωi) = Λ(ωr)·cos θr for a ray ωr = −ωi going down (Λ(ωr) = −1 − Λ(ωi)): within 4 f32
-    /// ulps of the projected area in f64 (Λ to 2 ulps in the crate's f32 forms, the product
-    /// one rounding more), for GGX and Beckmann from the zenith to 1e-6 from the horizon.
+    /// A(ωi) = Λ(ωr)·cos θr for the ray ωr = −ωi (Λ(ωr) = −1 − Λ(ωi)): within 4 f32 ulps of the
+    /// projected area in f64 (Λ to 2 ulps in the crate's f32 forms, the product one rounding
+    /// more), for GGX and Beckmann from the zenith to 1e-6 from the horizon, for rays going
+    /// down (ωi facing up) and going up (ωi backfacing, A(ωi) = Λ(−ωi)|cos θi|, down to where
+    /// it leaves the normal f32 range: Beckmann's Λ(−ωi) ≈ e^{−a²} underflows at low α).
     #[test]
     fn incident_area_is_the_projected_area_of_the_incident_direction() {
-        for alpha in [0.01f32, 0.3, 1.0, 2.5] {
-            let g = worst(Ggx::new(alpha, 0.6 * alpha).expect("valid roughness"));
-            let b = worst(Beckmann::new(alpha, 0.6 * alpha).expect("valid roughness"));
-            assert!(g <= 4.0 && b <= 4.0, "α = {alpha}: GGX {g} ulps, Beckmann {b} ulps");
+        let mut backfacing = 0;
+        for alpha in [0.01f32, 0.1, 0.3, 1.0, 2.5] {
+            for up in [false, true] {
+                let (g, gn) = worst(Ggx::new(alpha, 0.6 * alpha).expect("valid roughness"), up);
+                let (b, bn) = worst(Beckmann::new(alpha, 0.6 * alpha).expect("valid roughness"), up);
+                assert!(g <= 4.0 && b <= 4.0, "α = {alpha}, up = {up}: GGX {g} ulps, Beckmann {b} ulps");
+                // straight up (cos θ = 1) Λ = 0: no area (A(−z) = 0)
+                assert!(
+                    gn == if up { 21 } else { 24 } && (up || bn == 24),
+                    "α = {alpha}, up = {up}: {gn}, {bn} compared"
+                );
+                if up {
+                    backfacing += bn;
+                }
+            }
         }
+        assert!(backfacing > 80, "only {backfacing} backfacing Beckmann areas compared");
     }
 
-    /// No area for a ray going up or horizontally (the incident direction is backfacing or
-    /// grazing) or with Λ saturated.
+    /// No area for a horizontal ray, a ray straight up (Λ = 0), a Λ or a product outside the
+    /// normal f32 range, or Λ saturated.
     #[test]
     fn incident_area_is_none_where_it_is_not_the_area() {
-        assert_eq!(incident_area(0.3, 0.2), None);
+        assert_eq!(incident_area(0.3, 0.2), Some(0.3 * 0.2));
+        assert_eq!(incident_area(1.0, 0.0), None);
+        assert_eq!(incident_area(0.5, 1e-45), None);
+        assert_eq!(incident_area(1e-20, 1e-20), None);
+        assert_eq!(incident_area(0.0, f32::MAX), None);
+        assert_eq!(incident_area(1e-30, f32::MAX), None);
         assert_eq!(incident_area(0.0, -f32::MAX), None);
         assert_eq!(incident_area(-1e-30, -f32::MAX), None);
         assert_eq!(incident_area(-1e-30, f32::NEG_INFINITY), None);

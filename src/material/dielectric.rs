@@ -61,6 +61,9 @@ struct Refraction {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dielectric {
     eta: f32,
+    /// 1/η, kept so that the inside view ([`Dielectric::flipped`]) and the refraction need no
+    /// division.
+    inv_eta: f32,
 }
 
 impl Dielectric {
@@ -70,7 +73,8 @@ impl Dielectric {
     /// # Errors
     /// [`Error::InvalidParameter`] if `eta` is NaN, infinite or ≤ 0.
     pub fn new(eta: f32) -> Result<Self, Error> {
-        Ok(Self { eta: Error::check_positive("eta", eta)? })
+        let eta = Error::check_positive("eta", eta)?;
+        Ok(Self { eta, inv_eta: 1.0 / eta })
     }
 
     /// The relative index η = η_inside/η_outside.
@@ -91,11 +95,12 @@ impl Dielectric {
         }
     }
 
-    /// The same interface seen from inside: η ↦ 1/η.
+    /// The same interface seen from inside: η ↦ 1/η (1/η rounded once, as
+    /// `Dielectric::new(1.0 / eta)` gives it; flipping twice gives back η itself).
     #[inline]
     #[must_use]
     pub fn flipped(&self) -> Self {
-        Self { eta: 1.0 / self.eta }
+        Self { eta: self.inv_eta, inv_eta: self.eta }
     }
 
     /// The refraction half vector −(ωi + η ωo), normalized and turned to the upper hemisphere,
@@ -175,14 +180,30 @@ impl Dielectric {
         }
     }
 
-    /// The refraction of ωi through the facet ωm (ωi·ωm ≥ 0, no total internal reflection).
+    /// The Fresnel reflectance F at a facet seen at cos θi = `c` (taken as |c|, at most 1) and
+    /// cos θt of the refraction through it, 0 under total internal reflection (F = 1): the
+    /// arithmetic of `dielectric_reflectance` (f64, η² cos²θt = c² + (η − 1)(η + 1) without
+    /// cancellation near grazing or near η = 1), with cos θt returned for [`Self::refract`]
+    /// instead of being formed a second time.
     #[inline(always)]
-    fn refract(&self, wi: Vec3, wm: Vec3) -> Vec3 {
+    fn reflectance_at_facet(&self, c: f32) -> (f32, f32) {
+        let c = f64::from(c.abs().min(1.0));
+        let eta = f64::from(self.eta);
+        let eta2_cos2_t = c * c + (eta - 1.0) * (eta + 1.0);
+        if eta2_cos2_t <= 0.0 {
+            return (1.0, 0.0);
+        }
+        let cos_t = eta2_cos2_t.sqrt() / eta;
+        (fresnel_dielectric_cosines(c, cos_t, eta) as f32, cos_t as f32)
+    }
+
+    /// The refraction of ωi through the facet ωm with cos θt = `cos_t` (ωi·ωm ≥ 0, no total
+    /// internal reflection; `cos_t` from [`Self::reflectance_at_facet`]):
+    /// (ωi·ωm/η − cos θt) ωm − ωi/η, normalized.
+    #[inline(always)]
+    fn refract(&self, wi: Vec3, wm: Vec3, cos_t: f32) -> Vec3 {
         let c = wi.dot(wm);
-        // η² cos²θt = c² + (η − 1)(η + 1), as in `fresnel_dielectric` (no cancellation near
-        // grazing or near η = 1)
-        let cos_t = (c * c + (self.eta - 1.0) * (self.eta + 1.0)).max(0.0).sqrt() / self.eta;
-        normalize_fast((c / self.eta - cos_t) * wm - wi / self.eta, -wm)
+        normalize_fast((c * self.inv_eta - cos_t) * wm - wi * self.inv_eta, -wm)
     }
 }
 
@@ -247,11 +268,11 @@ impl Material for Dielectric {
             let (u1, u2) = uniform_pair(rng);
             slope.sample_d_wi_unchecked(wi_local, u1, u2)
         };
-        let f = dielectric_reflectance(wi_local.dot(wm), this.eta);
+        let (f, cos_t) = this.reflectance_at_facet(wi_local.dot(wm));
         let (wo_local, wo_side) = if uniform(rng) < f {
             (renormalize(reflect(wi_local, wm), wm), side)
         } else {
-            (this.refract(wi_local, wm), side.flipped())
+            (this.refract(wi_local, wm, cos_t), side.flipped())
         };
         PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
     }

@@ -178,7 +178,7 @@ pub(crate) fn next_c1(z: f32, lambda: f32, c1: f32, u: f32) -> Option<f32> {
 /// The smallest |ln C¹| of a point where a ray hit the microsurface: hits lie strictly inside
 /// the surface (C¹ < 1), also after rounding, so that the point on the other side of a
 /// dielectric interface has ln C¹ = ln(1 − C¹) finite.
-const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
+pub(crate) const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
 
 /// Algorithm 1 of the supplement in log-C¹ space, the state of the random walks: the
 /// ln C¹ of the next intersection's height, or `None` if the ray escapes. `ln_c1` = 0 is a ray

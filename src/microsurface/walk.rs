@@ -129,6 +129,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// map) starts with the full-spherical first intersection of
     /// [`Microsurface::eval_from_below`].
     ///
+    /// The next-event masking C¹^Λ(ωo) is replaced by its conditional expectation where that
+    /// is known in closed form, a/(a + Λ(ωo)): at the first hit on ωi's side (a = 1 + Λ(ωi))
+    /// and, for opaque materials, at every hit reached since by rays going up, whose height the
+    /// walk does not draw (its law stays a e^{aℓ}; see DESIGN.md, “Walk speed, session 6”).
+    /// The estimate stays unbiased and its variance drops; order 1 is the exact single
+    /// scattering term. The next-event phase function of a reflection is formed from the
+    /// unnormalized half vector in f64 (the same accuracy as [`Material::eval_phase`]).
+    ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
@@ -213,6 +221,10 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// A transparent material ([`Material::is_transparent`]) returns ωo = −ωi with weight 1
     /// and one bounce without walking: the walk would cross the interface about Λ(ωi) times
     /// (unboundedly many at grazing incidence) without ever changing direction.
+    ///
+    /// For opaque materials the heights of hits reached by rays going up are not drawn: such a
+    /// ray escapes with probability a/(a + Λ(ωr)), a = 1 + Λ(ωi), which is the walk's law
+    /// (DESIGN.md, “Walk speed, session 6”); a height is drawn when a ray goes down.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
@@ -573,7 +585,7 @@ mod tests {
                         compared += 1;
                     }
                     None => assert!(
-                        up && !(exact >= f64::from(f32::MIN_POSITIVE)),
+                        up && exact < f64::from(f32::MIN_POSITIVE),
                         "no area for ωi = {wi}, where it is {exact:e}"
                     ),
                 }

@@ -5,7 +5,7 @@
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::position_free::{Incident, PositionFree, Shadowing, VertexRole};
-use crate::rng::uniform_pair;
+use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
@@ -218,7 +218,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     pub(crate) fn sample_unchecked(&self, wi: Vec3, rng: &mut impl Rng) -> Option<SingleSample> {
         if M::MIRROR_FACETS && wi.z > 0.0 {
             // the uniforms in the order the material's own sampler draws them
-            let (u1, u2) = uniform_pair(rng);
+            let (u1, u2) = (uniform(rng), uniform(rng));
             return Self::sample_mirror_front(self.model.slope(), self.model.material(), wi, u1, u2);
         }
         let at = PositionFree::<S, M>::incident(wi)?;

@@ -6,7 +6,7 @@ use super::{
 };
 use crate::contract::{is_cosine, is_direction};
 use crate::fresnel::{ComplexIor, conductor_reflectance};
-use crate::rng::uniform_pair;
+use crate::rng::{uniform, uniform_pair};
 use crate::slope::{MicrosurfaceSlope, renormalize};
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -170,6 +170,19 @@ impl Material for Conductor {
         rng: &mut impl Rng,
     ) -> PhaseSample {
         // the uniforms in the order drawn: the visible normal's u1, then u2
+        let (u1, u2) = (uniform(rng), uniform(rng));
+        self.sample_mirror_unchecked(slope, wi, u1, u2)
+    }
+
+    /// The visible normal's two uniforms from one 64-bit draw (the walks' stream).
+    #[inline]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
         let (u1, u2) = uniform_pair(rng);
         self.sample_mirror_unchecked(slope, wi, u1, u2)
     }

@@ -205,6 +205,31 @@ impl Dielectric {
         let c = wi.dot(wm);
         normalize_fast((c * self.inv_eta - cos_t) * wm - wi * self.inv_eta, -wm)
     }
+
+    /// A sample of the phase function from ωi on `side` with the visible normal drawn from
+    /// the uniforms (u1, u2) (supplement §3.4, Algorithm 7): ωm ~ D_ωi, reflect with
+    /// probability F(ωi·ωm) (a third uniform), refract otherwise.
+    #[inline(always)]
+    fn sample_at_facet<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        u1: f32,
+        u2: f32,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let this = self.seen_from(side);
+        let wi_local = side.frame(wi);
+        let wm = slope.sample_d_wi_unchecked(wi_local, u1, u2);
+        let (f, cos_t) = this.reflectance_at_facet(wi_local.dot(wm));
+        let (wo_local, wo_side) = if uniform(rng) < f {
+            (renormalize(reflect(wi_local, wm), wm), side)
+        } else {
+            (this.refract(wi_local, wm, cos_t), side.flipped())
+        };
+        PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
+    }
 }
 
 impl Material for Dielectric {
@@ -262,19 +287,21 @@ impl Material for Dielectric {
         side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let this = self.seen_from(side);
-        let wi_local = side.frame(wi);
-        let wm = {
-            let (u1, u2) = uniform_pair(rng);
-            slope.sample_d_wi_unchecked(wi_local, u1, u2)
-        };
-        let (f, cos_t) = this.reflectance_at_facet(wi_local.dot(wm));
-        let (wo_local, wo_side) = if uniform(rng) < f {
-            (renormalize(reflect(wi_local, wm), wm), side)
-        } else {
-            (this.refract(wi_local, wm, cos_t), side.flipped())
-        };
-        PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
+        let (u1, u2) = (uniform(rng), uniform(rng));
+        self.sample_at_facet(slope, wi, side, u1, u2, rng)
+    }
+
+    /// The visible normal's two uniforms from one 64-bit draw (the walks' stream).
+    #[inline]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let (u1, u2) = uniform_pair(rng);
+        self.sample_at_facet(slope, wi, side, u1, u2, rng)
     }
 
     /// The single-scattering terms of the type's documentation; for ωi below the surface, the

@@ -1,11 +1,12 @@
 //! Diffuse (Lambertian) microfacets.
 
 use super::{Interaction, Material, PhaseSample, Side, g2_reflection};
+use crate::basis::basis;
 use crate::contract::is_direction;
 use crate::error::Error;
-use crate::rng::uniform_pair;
-use crate::sampling::cosine_about;
-use crate::slope::MicrosurfaceSlope;
+use crate::rng::{uniform, uniform_pair};
+use crate::sampling::{cosine_about, cosine_hemisphere};
+use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
 use rand::Rng;
@@ -67,9 +68,19 @@ impl Diffuse {
 
 impl Diffuse {
     /// A direction from the Lambertian lobe of the facet with normal `wm` (cosine-weighted
-    /// about ωm, [`cosine_about`]: no frame about ωm), weighted by the albedo.
+    /// about ωm), weighted by the albedo.
     #[inline(always)]
     fn sample_at_facet(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
+        let local = cosine_hemisphere(uniform(rng), uniform(rng));
+        let (t, b) = basis(wm);
+        let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
+        PhaseSample { wo, weight: self.albedo, side: Side::Outside }
+    }
+
+    /// [`Diffuse::sample_at_facet`] as the walks draw it: the same lobe as normalize(ωm + s),
+    /// s uniform on the sphere ([`cosine_about`]: no frame about ωm), from one 64-bit draw.
+    #[inline(always)]
+    fn sample_at_facet_walk(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
         let (u1, u2) = uniform_pair(rng);
         PhaseSample { wo: cosine_about(wm, u1, u2), weight: self.albedo, side: Side::Outside }
     }
@@ -89,10 +100,7 @@ impl Material for Diffuse {
         if !it.is_outside_reflection() {
             return Vec3::ZERO;
         }
-        let wm = {
-            let (u1, u2) = uniform_pair(rng);
-            slope.sample_d_wi_unchecked(it.wi(), u1, u2)
-        };
+        let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
         self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
     }
 
@@ -115,10 +123,7 @@ impl Material for Diffuse {
         if !it.is_outside_reflection() || wi.z == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = {
-            let (u1, u2) = uniform_pair(rng);
-            slope.sample_d_wi_unchecked(wi, u1, u2)
-        };
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
@@ -130,11 +135,23 @@ impl Material for Diffuse {
         _side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let wm = {
-            let (u1, u2) = uniform_pair(rng);
-            slope.sample_d_wi_unchecked(wi, u1, u2)
-        };
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         self.sample_at_facet(wm, rng)
+    }
+
+    /// Both pairs of uniforms (the visible normal's, the lobe's) from one 64-bit draw each,
+    /// the lobe without a frame (the walks' stream).
+    #[inline]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let (u1, u2) = uniform_pair(rng);
+        let wm = slope.sample_d_wi_unchecked(wi, u1, u2);
+        self.sample_at_facet_walk(wm, rng)
     }
 
     /// One visible facet ωm ~ D_ωi for both: the estimate (a/π)⟨ωo, ωm⟩⁺ of the phase function
@@ -148,16 +165,14 @@ impl Material for Diffuse {
         it: &Interaction,
         rng: &mut impl Rng,
     ) -> (Vec3, PhaseSample) {
-        let wm = {
-            let (u1, u2) = uniform_pair(rng);
-            slope.sample_d_wi_unchecked(it.wi(), u1, u2)
-        };
+        let (u1, u2) = uniform_pair(rng);
+        let wm = slope.sample_d_wi_unchecked(it.wi(), u1, u2);
         let phase = if it.is_outside_reflection() {
             self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
         } else {
             Vec3::ZERO
         };
-        (phase, self.sample_at_facet(wm, rng))
+        (phase, self.sample_at_facet_walk(wm, rng))
     }
 
     /// (a/π) ⟨ωo, ωm⟩ (1 + Λ(ωi))/(1 + Λ(ωi) + Λ(ωo)) with ωm drawn from D_ωi: the
@@ -176,10 +191,7 @@ impl Material for Diffuse {
         if g2 == 0.0 {
             return Vec3::ZERO;
         }
-        let wm = {
-            let (u1, u2) = uniform_pair(rng);
-            slope.sample_d_wi_unchecked(wi, u1, u2)
-        };
+        let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
         // (1 + Λi)/(1 + Λi + Λo) in f64: the f32 factors saturate near grazing
         let k = 1.0 + slope.lambda64(wi);
         let g2_given_g1 = (k / (k + slope.lambda64(wo))) as f32;

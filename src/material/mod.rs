@@ -220,6 +220,25 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: Side::Outside }
     }
 
+    /// [`Material::sample_phase`] as the crate's random walks draw it (crate-internal hot
+    /// path): the same distribution, with each pair of uniforms the sampler maps together (the
+    /// visible normal's, a diffuse lobe's) taken from one 64-bit draw (`rng::uniform_pair`) —
+    /// the walks' own random stream; a diffuse lobe is built without a frame about ωm
+    /// (`sampling::cosine_about`). By default the plain unchecked sampler. The other callers
+    /// (single scattering, the position-free estimators) keep the plain sampler's stream.
+    #[doc(hidden)]
+    #[inline(always)]
+    #[must_use]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        self.sample_phase_unchecked(slope, wi, side, rng)
+    }
+
     /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[must_use]
@@ -234,10 +253,11 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// The phase function at the interaction `it` (as [`Material::eval_phase`]) and a sample
     /// of p(ωi, ·) from the same incident direction and side (as [`Material::sample_phase`]):
     /// the two calls of a bounce of the walk's next-event estimation (supplement §3.1,
-    /// Algorithm 2). By default the two separate unchecked calls, in that order (the random
-    /// stream of the separate calls). A material whose evaluation is itself stochastic may
-    /// share its random facet between the two: the evaluation's expectation given everything
-    /// before it is unchanged, so the walk's estimate stays unbiased (crate-internal hot path).
+    /// Algorithm 2). By default the two separate unchecked calls, in that order, the sample as
+    /// the walks draw it ([`Material::sample_phase_walk_unchecked`]). A material whose
+    /// evaluation is itself stochastic may share its random facet between the two: the
+    /// evaluation's expectation given everything before it is unchanged, so the walk's
+    /// estimate stays unbiased (crate-internal hot path).
     #[doc(hidden)]
     #[inline(always)]
     #[must_use]
@@ -248,7 +268,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         rng: &mut impl Rng,
     ) -> (Vec3, PhaseSample) {
         let phase = self.eval_phase_unchecked(slope, it, rng);
-        (phase, self.sample_phase_unchecked(slope, it.wi(), it.wi_side(), rng))
+        (phase, self.sample_phase_walk_unchecked(slope, it.wi(), it.wi_side(), rng))
     }
 
     /// [`Material::connection`] without the argument check (crate-internal hot path): by

@@ -193,7 +193,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 }
                 s
             } else {
-                self.material.sample_phase_unchecked(slope, -wr, side, rng)
+                self.material.sample_phase_walk_unchecked(slope, -wr, side, rng)
             };
             let next_side = Self::side_after(s.side);
             if next_side != side {
@@ -245,7 +245,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 return Some(WalkSample { wo: wr, weight, bounces });
             };
             depth = hit.depth;
-            let s = self.material.sample_phase_unchecked(slope, -wr, side, rng);
+            let s = self.material.sample_phase_walk_unchecked(slope, -wr, side, rng);
             let next_side = Self::side_after(s.side);
             if next_side != side {
                 depth = Depth::at(flip_ln_c1(Self::drawn(depth, rng)));
@@ -308,7 +308,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
                 }
                 sampled
             } else {
-                continues.then(|| self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng))
+                continues.then(|| self.material.sample_phase_walk_unchecked(slope, -wr, Side::Outside, rng))
             };
             let Some(s) = sampled else { break };
             wr = s.wo;
@@ -342,7 +342,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let mut depth = ScaledDepth::first(slope.ln_lambda(wr), uniform(rng))?;
         let mut weight = Vec3::ONE;
         for bounces in 1..=MAX_BOUNCES {
-            let s = self.material.sample_phase_unchecked(slope, -wr, Side::Outside, rng);
+            let s = self.material.sample_phase_walk_unchecked(slope, -wr, Side::Outside, rng);
             wr = s.wo;
             weight *= s.weight;
             if weight == Vec3::ZERO {

@@ -8,7 +8,7 @@ use crate::contract::is_direction;
 use crate::error::Error;
 use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
 use crate::rng::{uniform, uniform_pair};
-use crate::slope::{MicrosurfaceSlope, normalize_fast, renormalize};
+use crate::slope::{MicrosurfaceSlope, renormalize};
 use crate::special::beta;
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -199,11 +199,14 @@ impl Dielectric {
 
     /// The refraction of ωi through the facet ωm with cos θt = `cos_t` (ωi·ωm ≥ 0, no total
     /// internal reflection; `cos_t` from [`Self::reflectance_at_facet`]):
-    /// (ωi·ωm/η − cos θt) ωm − ωi/η, normalized.
+    /// (ωi·ωm/η − cos θt) ωm − ωi/η. Unit in exact arithmetic (its squared length is
+    /// (1 − c²)/η² + cos²θt = sin²θt + cos²θt), so the rounding is corrected by one Newton step
+    /// ([`renormalize`]: no square root or division on the walk's critical path), with a full
+    /// normalization where it is off by more than 2⁻¹².
     #[inline(always)]
     fn refract(&self, wi: Vec3, wm: Vec3, cos_t: f32) -> Vec3 {
         let c = wi.dot(wm);
-        normalize_fast((c * self.inv_eta - cos_t) * wm - wi * self.inv_eta, -wm)
+        renormalize((c * self.inv_eta - cos_t) * wm - wi * self.inv_eta, -wm)
     }
 
     /// A sample of the phase function from ωi on `side` with the visible normal drawn from

@@ -267,8 +267,8 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         it: &Interaction,
         rng: &mut impl Rng,
     ) -> (Vec3, PhaseSample) {
-        let phase = self.eval_phase_unchecked(slope, it, rng);
-        (phase, self.sample_phase_walk_unchecked(slope, it.wi(), it.wi_side(), rng))
+        let sample = self.sample_phase_walk_unchecked(slope, it.wi(), it.wi_side(), rng);
+        (self.eval_phase_unchecked(slope, it, rng), sample)
     }
 
     /// [`Material::connection`] without the argument check (crate-internal hot path): by

@@ -332,7 +332,7 @@ impl HalfSum {
     /// ([`MicrosurfaceSlope::d64_of_sum_unchecked`]) and one rounding to f32.
     #[inline(always)]
     pub(crate) fn density<S: MicrosurfaceSlope>(&self, slope: &S, area: f32) -> f32 {
-        front_density(slope.d64_of_sum_unchecked(self.h), area)
+        slope.reflection_density_of_sum_unchecked(self.h, area)
     }
 }
 

@@ -241,6 +241,16 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         self.d64_unchecked(h.normalize_or_zero())
     }
 
+    /// The reflection density D(ωh)/(4 A(ωi)) from the unnormalized half vector h = ωi + ωo
+    /// (h.z > 0, the caller has tested the visibility) and A(ωi) = `area` > 0 known, in f64,
+    /// rounded once: 0.25 [`Self::d64_of_sum_unchecked`](h)/A by default; [`Ggx`] folds the
+    /// divisions into one. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn reflection_density_of_sum_unchecked(&self, h: DVec3, area: f32) -> f32 {
+        (0.25 * self.d64_of_sum_unchecked(h) / f64::from(area)) as f32
+    }
+
     /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[inline(always)]

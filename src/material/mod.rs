@@ -328,8 +328,8 @@ impl HalfSum {
     }
 
     /// The reflection density D(ωh)/(4 A(ωi)) for A(ωi) = `area` > 0 known (the walk's, see
-    /// [`Interaction`]): [`phase_reflection`] without normalizing the half vector, D in f64
-    /// ([`MicrosurfaceSlope::d64_of_sum_unchecked`]) and one rounding to f32.
+    /// [`Interaction`]): [`phase_reflection`] without normalizing the half vector, in f64
+    /// ([`MicrosurfaceSlope::reflection_density_of_sum_unchecked`]), rounded once.
     #[inline(always)]
     pub(crate) fn density<S: MicrosurfaceSlope>(&self, slope: &S, area: f32) -> f32 {
         slope.reflection_density_of_sum_unchecked(self.h, area)

@@ -327,6 +327,18 @@ impl HalfSum {
         (self.wi_dot_h / self.h.length()) as f32
     }
 
+    /// ωi·h, unnormalized (> 0).
+    #[inline(always)]
+    pub(crate) fn wi_dot_h(&self) -> f64 {
+        self.wi_dot_h
+    }
+
+    /// |h|².
+    #[inline(always)]
+    pub(crate) fn length_sq(&self) -> f64 {
+        self.h.length_squared()
+    }
+
     /// The reflection density D(ωh)/(4 A(ωi)) for A(ωi) = `area` > 0 known (the walk's, see
     /// [`Interaction`]): [`phase_reflection`] without normalizing the half vector, in f64
     /// ([`MicrosurfaceSlope::reflection_density_of_sum_unchecked`]), rounded once.

@@ -33,6 +33,17 @@ pub(crate) fn uniform(rng: &mut impl Rng) -> f32 {
     (rng.next_u32() >> 8) as f32 * INV_2_POW_24
 }
 
+/// Two uniforms as [`uniform`] returns them, from one 64-bit draw: the first from the low 32
+/// bits (the value `uniform` would return from the same generator state, since `next_u32` is
+/// the low half of `next_u64` for the crate's generators), the second from the top 24 bits.
+/// Half the generator steps of two [`uniform`] calls, for the samplers that take their
+/// uniforms in pairs (a visible normal, a cosine lobe).
+#[inline(always)]
+pub(crate) fn uniform_pair(rng: &mut impl Rng) -> (f32, f32) {
+    let bits = rng.next_u64();
+    ((bits as u32 >> 8) as f32 * INV_2_POW_24, (bits >> 40) as f32 * INV_2_POW_24)
+}
+
 /// clamp(u, 2⁻²⁴, 1 − 2⁻²⁴): a uniform with both tails cut at [`TAIL_CUT`] (module doc),
 /// applied by every sampler to each uniform it maps through a quantile. NaN stays NaN.
 #[inline(always)]

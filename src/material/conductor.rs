@@ -1,12 +1,12 @@
 //! Conductor microfacets.
 
 use super::{
-    Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect, reflection_density,
-    reflection_half_vector,
+    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
+    reflection_density, reflection_half_vector,
 };
 use crate::contract::{is_cosine, is_direction};
 use crate::fresnel::{ComplexIor, conductor_reflectance};
-use crate::rng::uniform;
+use crate::rng::{uniform, uniform_pair};
 use crate::slope::{MicrosurfaceSlope, renormalize};
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -114,6 +114,15 @@ impl Material for Conductor {
         it: &Interaction,
         _rng: &mut impl Rng,
     ) -> Vec3 {
+        if let (Some(area), true) = (it.incident_area(), it.is_outside_reflection()) {
+            // the walk's next-event estimation: A(ωi) known, the half vector unnormalized
+            let Some(sum) = HalfSum::visible(it.wi(), it.wo()) else { return Vec3::ZERO };
+            let density = sum.density(slope, area);
+            return match &self.ior {
+                None => Vec3::splat(density),
+                Some(ior) => conductor_reflectance(sum.cos_ih(), ior) * density,
+            };
+        }
         let Some(wh) = Self::half_vector(it) else { return Vec3::ZERO };
         let wi = it.wi();
         self.reflectance(wi.as_dvec3().dot(wh) as f32) * phase_reflection(slope, wi, wh, it.incident_area())
@@ -162,6 +171,19 @@ impl Material for Conductor {
     ) -> PhaseSample {
         // the uniforms in the order drawn: the visible normal's u1, then u2
         let (u1, u2) = (uniform(rng), uniform(rng));
+        self.sample_mirror_unchecked(slope, wi, u1, u2)
+    }
+
+    /// The visible normal's two uniforms from one 64-bit draw (the walks' stream).
+    #[inline]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let (u1, u2) = uniform_pair(rng);
         self.sample_mirror_unchecked(slope, wi, u1, u2)
     }
 

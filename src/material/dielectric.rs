@@ -1,14 +1,14 @@
 //! Dielectric microfacets.
 
 use super::{
-    Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
+    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
     reflection_half_vector,
 };
 use crate::contract::is_direction;
 use crate::error::Error;
 use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
-use crate::rng::uniform;
-use crate::slope::{MicrosurfaceSlope, normalize_fast, renormalize};
+use crate::rng::{uniform, uniform_pair};
+use crate::slope::{MicrosurfaceSlope, renormalize};
 use crate::special::beta;
 use glam::{DVec3, Vec3};
 use rand::Rng;
@@ -61,6 +61,9 @@ struct Refraction {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dielectric {
     eta: f32,
+    /// 1/η, kept so that the inside view ([`Dielectric::flipped`]) and the refraction need no
+    /// division.
+    inv_eta: f32,
 }
 
 impl Dielectric {
@@ -70,7 +73,8 @@ impl Dielectric {
     /// # Errors
     /// [`Error::InvalidParameter`] if `eta` is NaN, infinite or ≤ 0.
     pub fn new(eta: f32) -> Result<Self, Error> {
-        Ok(Self { eta: Error::check_positive("eta", eta)? })
+        let eta = Error::check_positive("eta", eta)?;
+        Ok(Self { eta, inv_eta: 1.0 / eta })
     }
 
     /// The relative index η = η_inside/η_outside.
@@ -91,11 +95,12 @@ impl Dielectric {
         }
     }
 
-    /// The same interface seen from inside: η ↦ 1/η.
+    /// The same interface seen from inside: η ↦ 1/η (1/η rounded once, as
+    /// `Dielectric::new(1.0 / eta)` gives it; flipping twice gives back η itself).
     #[inline]
     #[must_use]
     pub fn flipped(&self) -> Self {
-        Self { eta: 1.0 / self.eta }
+        Self { eta: self.inv_eta, inv_eta: self.eta }
     }
 
     /// The refraction half vector −(ωi + η ωo), normalized and turned to the upper hemisphere,
@@ -131,6 +136,12 @@ impl Dielectric {
         let (wi, wo) = (it.wi(), it.wo());
         match it.wo_side() {
             Side::Outside => {
+                if let Some(area) = it.incident_area() {
+                    // the walk's next-event estimation: A(ωi) known, the half vector unnormalized
+                    let Some(sum) = HalfSum::visible(wi, wo) else { return 0.0 };
+                    let (f, _) = self.reflectance_scaled(sum.wi_dot_h(), sum.length_sq());
+                    return f as f32 * sum.density(slope, area);
+                }
                 let Some(wh) = reflection_half_vector(wi, wo) else { return 0.0 };
                 dielectric_reflectance(wi.as_dvec3().dot(wh) as f32, self.eta)
                     * phase_reflection(slope, wi, wh, it.incident_area())
@@ -140,8 +151,8 @@ impl Dielectric {
                 let eta = f64::from(self.eta);
                 // D_ωi(ωh) = (ωi·ωh) D(ωh)/A(ωi), with A known where the walk computed it
                 let d_wi = match it.incident_area() {
-                    Some(area) if wi.z > 0.0 => r.cos_ih * slope.d64_unchecked(r.wh) / f64::from(area),
-                    _ => slope.d_wi64_unchecked(wi, r.wh),
+                    Some(area) => r.cos_ih * slope.d64_unchecked(r.wh) / f64::from(area),
+                    None => slope.d_wi64_unchecked(wi, r.wh),
                 };
                 (eta * eta * r.transmittance * d_wi * (-r.cos_oh) / r.denom_sq) as f32
             }
@@ -170,14 +181,67 @@ impl Dielectric {
         }
     }
 
-    /// The refraction of ωi through the facet ωm (ωi·ωm ≥ 0, no total internal reflection).
+    /// The Fresnel reflectance F for cos θi = k/l with l = √`l_sq` (k ≥ 0), and s = l η cos θt
+    /// (0 under total internal reflection, where F = 1), in f64: `fresnel_dielectric_cosines`
+    /// with its terms multiplied through by l (and Rp's by η), s = √(k² + (η − 1)(η + 1) l²),
+    /// Rs = (k − s)/(k + s), Rp = (η²k − s)/(η²k + s), F = (Rs² + Rp²)/2. The same quantities
+    /// without cancellation near grazing or near η = 1, but one square root and one (paired)
+    /// division in all: neither cos θi = k/l nor cos θt = s/(lη) is formed. The walks' next-event
+    /// estimate passes the half vector's unnormalized ωi·h and |h|², the sampler a facet's
+    /// cosine with l = 1.
     #[inline(always)]
-    fn refract(&self, wi: Vec3, wm: Vec3) -> Vec3 {
-        let c = wi.dot(wm);
-        // η² cos²θt = c² + (η − 1)(η + 1), as in `fresnel_dielectric` (no cancellation near
-        // grazing or near η = 1)
-        let cos_t = (c * c + (self.eta - 1.0) * (self.eta + 1.0)).max(0.0).sqrt() / self.eta;
-        normalize_fast((c / self.eta - cos_t) * wm - wi / self.eta, -wm)
+    fn reflectance_scaled(&self, k: f64, l_sq: f64) -> (f64, f64) {
+        let eta = f64::from(self.eta);
+        let s_sq = k * k + (eta - 1.0) * (eta + 1.0) * l_sq;
+        if s_sq <= 0.0 {
+            return (1.0, 0.0);
+        }
+        let s = s_sq.sqrt();
+        let eta2_k = eta * eta * k;
+        let (den_s, den_p) = (k + s, eta2_k + s);
+        if den_s <= 0.0 || den_p <= 0.0 {
+            return (1.0, s);
+        }
+        let (rs, rp) = ((k - s) / den_s, (eta2_k - s) / den_p);
+        (0.5 * (rs * rs + rp * rp), s)
+    }
+
+    /// The refraction of ωi through the facet ωm with c = ωi·ωm ≥ 0 and s = η cos θt
+    /// (no total internal reflection; s from [`Self::reflectance_scaled`] with l = 1):
+    /// ((c − s) ωm − ωi)/η. Unit in exact arithmetic (its squared length is
+    /// ((c − s)² − 2c(c − s) + 1)/η² = (s² − c² + 1)/η² = sin²θt + cos²θt), so the rounding is
+    /// corrected by one Newton step ([`renormalize`]: no square root or division on the walk's
+    /// critical path), with a full normalization where it is off by more than 2⁻¹². c − s is
+    /// formed in f64 (it cancels near η = 1).
+    #[inline(always)]
+    fn refract(&self, wi: Vec3, wm: Vec3, c: f64, s: f64) -> Vec3 {
+        renormalize(((c - s) as f32 * wm - wi) * self.inv_eta, -wm)
+    }
+
+    /// A sample of the phase function from ωi on `side` with the visible normal drawn from
+    /// the uniforms (u1, u2) (supplement §3.4, Algorithm 7): ωm ~ D_ωi, reflect with
+    /// probability F(ωi·ωm) (a third uniform), refract otherwise.
+    #[inline(always)]
+    fn sample_at_facet<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        u1: f32,
+        u2: f32,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let this = self.seen_from(side);
+        let wi_local = side.frame(wi);
+        let wm = slope.sample_d_wi_unchecked(wi_local, u1, u2);
+        let c = f64::from(wi_local.dot(wm).abs().min(1.0));
+        let (f, s) = this.reflectance_scaled(c, 1.0);
+        let (wo_local, wo_side) = if uniform(rng) < f as f32 {
+            (renormalize(reflect(wi_local, wm), wm), side)
+        } else {
+            (this.refract(wi_local, wm, c, s), side.flipped())
+        };
+        PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
     }
 }
 
@@ -239,16 +303,21 @@ impl Material for Dielectric {
         side: Side,
         rng: &mut impl Rng,
     ) -> PhaseSample {
-        let this = self.seen_from(side);
-        let wi_local = side.frame(wi);
-        let wm = slope.sample_d_wi_unchecked(wi_local, uniform(rng), uniform(rng));
-        let f = dielectric_reflectance(wi_local.dot(wm), this.eta);
-        let (wo_local, wo_side) = if uniform(rng) < f {
-            (renormalize(reflect(wi_local, wm), wm), side)
-        } else {
-            (this.refract(wi_local, wm), side.flipped())
-        };
-        PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
+        let (u1, u2) = (uniform(rng), uniform(rng));
+        self.sample_at_facet(slope, wi, side, u1, u2, rng)
+    }
+
+    /// The visible normal's two uniforms from one 64-bit draw (the walks' stream).
+    #[inline]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let (u1, u2) = uniform_pair(rng);
+        self.sample_at_facet(slope, wi, side, u1, u2, rng)
     }
 
     /// The single-scattering terms of the type's documentation; for ωi below the surface, the
@@ -281,5 +350,45 @@ impl Material for Dielectric {
                 / (f64::from(wi.z) * r.denom_sq)) as f32
         };
         Vec3::splat(value)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `reflectance_scaled` is `fresnel_dielectric_cosines` for cos θi = k/l: F within 1e-13
+    /// (absolute, F ∈ [0, 1]) of the f64 form with cos θt = √(c² + (η − 1)(η + 1))/η, and
+    /// s = l η cos θt within 1e-13 relative, for η from 1/2.4 to 2.4 (total internal reflection
+    /// included: F = 1, s = 0), η within 1e-6 of 1, cosines from 1e-6 to 1 and scales l from
+    /// 1e-3 to 2 (the half vector's length).
+    #[test]
+    fn scaled_reflectance_is_the_fresnel_term() {
+        let (mut compared, mut reflected) = (0, 0);
+        for eta in [1.0 / 2.4f32, 1.0 / 1.5, 1.0 - 1e-6, 1.0 + 1e-6, 1.33, 1.5, 2.4] {
+            let glass = Dielectric::new(eta).expect("valid index");
+            let eta = f64::from(eta);
+            for c in [1e-6f64, 1e-3, 0.05, 0.3, 0.5, 0.7453, 0.9, 0.999, 1.0] {
+                for l in [1e-3f64, 0.5, 1.0, 1.7, 2.0] {
+                    let (f, s) = glass.reflectance_scaled(c * l, l * l);
+                    let e2 = c * c + (eta - 1.0) * (eta + 1.0);
+                    if e2 <= 0.0 {
+                        assert_eq!((f, s), (1.0, 0.0), "η = {eta}, c = {c}: total internal reflection");
+                        reflected += 1;
+                        continue;
+                    }
+                    let cos_t = e2.sqrt() / eta;
+                    let reference = fresnel_dielectric_cosines(c, cos_t, eta);
+                    assert!(
+                        (f - reference).abs() <= 1e-13,
+                        "η = {eta}, c = {c}, l = {l}: {f} vs {reference}"
+                    );
+                    let rel = (s / (l * eta) - cos_t).abs() / cos_t;
+                    assert!(rel <= 1e-13, "η = {eta}, c = {c}, l = {l}: cos θt {} vs {cos_t}", s / (l * eta));
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared > 200 && reflected > 50, "{compared} cases compared, {reflected} totally reflected");
     }
 }

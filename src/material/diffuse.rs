@@ -4,8 +4,8 @@ use super::{Interaction, Material, PhaseSample, Side, g2_reflection};
 use crate::basis::basis;
 use crate::contract::is_direction;
 use crate::error::Error;
-use crate::rng::uniform;
-use crate::sampling::cosine_hemisphere;
+use crate::rng::{uniform, uniform_pair};
+use crate::sampling::{cosine_about, cosine_hemisphere};
 use crate::slope::{MicrosurfaceSlope, normalize_fast};
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
@@ -76,6 +76,14 @@ impl Diffuse {
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);
         PhaseSample { wo, weight: self.albedo, side: Side::Outside }
     }
+
+    /// [`Diffuse::sample_at_facet`] as the walks draw it: the same lobe as normalize(ωm + s),
+    /// s uniform on the sphere ([`cosine_about`]: no frame about ωm), from one 64-bit draw.
+    #[inline(always)]
+    fn sample_at_facet_walk(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
+        let (u1, u2) = uniform_pair(rng);
+        PhaseSample { wo: cosine_about(wm, u1, u2), weight: self.albedo, side: Side::Outside }
+    }
 }
 
 impl Material for Diffuse {
@@ -131,6 +139,21 @@ impl Material for Diffuse {
         self.sample_at_facet(wm, rng)
     }
 
+    /// Both pairs of uniforms (the visible normal's, the lobe's) from one 64-bit draw each,
+    /// the lobe without a frame (the walks' stream).
+    #[inline]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        _side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        let (u1, u2) = uniform_pair(rng);
+        let wm = slope.sample_d_wi_unchecked(wi, u1, u2);
+        self.sample_at_facet_walk(wm, rng)
+    }
+
     /// One visible facet ωm ~ D_ωi for both: the estimate (a/π)⟨ωo, ωm⟩⁺ of the phase function
     /// (unbiased given the walk so far, as in `eval_phase`) and the direction sampled from the
     /// same facet. Saves one visible-normal sample per bounce of the walk's `eval`; the walk's
@@ -142,13 +165,14 @@ impl Material for Diffuse {
         it: &Interaction,
         rng: &mut impl Rng,
     ) -> (Vec3, PhaseSample) {
-        let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
+        let (u1, u2) = uniform_pair(rng);
+        let wm = slope.sample_d_wi_unchecked(it.wi(), u1, u2);
         let phase = if it.is_outside_reflection() {
             self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
         } else {
             Vec3::ZERO
         };
-        (phase, self.sample_at_facet(wm, rng))
+        (phase, self.sample_at_facet_walk(wm, rng))
     }
 
     /// (a/π) ⟨ωo, ωm⟩ (1 + Λ(ωi))/(1 + Λ(ωi) + Λ(ωo)) with ωm drawn from D_ωi: the

@@ -32,8 +32,9 @@ pub enum Event {
 /// Inside a dielectric the configuration is evaluated flipped (supplement §3.4). The crate's
 /// random walk also stores the projected area A(ωi) it already knows from the height step
 /// (Λ(−ωi) of the arriving ray gives A(ωi) = Λ(−ωi)·(−cos θi), Heitz et al. 2016, supplement
-/// §2.2), so that a phase-function evaluation does not compute it again; an interaction
-/// built with [`Interaction::new`] carries none and the material computes it.
+/// §2.2, for a backfacing ωi too), so that a phase-function evaluation does not compute it
+/// again; an interaction built with [`Interaction::new`] carries none and the material
+/// computes it.
 ///
 /// # Examples
 /// ```
@@ -55,7 +56,7 @@ pub struct Interaction {
     wo: Vec3,
     wi_side: Side,
     wo_side: Side,
-    /// A(ωi) in the frame of ωi's side, where the caller knows it and ωi faces up there.
+    /// A(ωi) in the frame of ωi's side, where the caller knows it (a normal f32, to a few ulps).
     incident_area: Option<f32>,
 }
 
@@ -126,7 +127,8 @@ impl Interaction {
     }
 
     /// The same event with the projected area A(ωi) in the frame of ωi's side known to be
-    /// `area` (ωi facing up in that frame). Set by the crate's walk only.
+    /// `area` (a normal f32, on either side of that frame's horizon). Set by the crate's walk
+    /// only.
     #[inline(always)]
     pub(crate) fn with_incident_area(mut self, area: Option<f32>) -> Self {
         self.incident_area = area;

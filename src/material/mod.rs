@@ -220,6 +220,25 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: Side::Outside }
     }
 
+    /// [`Material::sample_phase`] as the crate's random walks draw it (crate-internal hot
+    /// path): the same distribution, with each pair of uniforms the sampler maps together (the
+    /// visible normal's, a diffuse lobe's) taken from one 64-bit draw (`rng::uniform_pair`) —
+    /// the walks' own random stream; a diffuse lobe is built without a frame about ωm
+    /// (`sampling::cosine_about`). By default the plain unchecked sampler. The other callers
+    /// (single scattering, the position-free estimators) keep the plain sampler's stream.
+    #[doc(hidden)]
+    #[inline(always)]
+    #[must_use]
+    fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> PhaseSample {
+        self.sample_phase_unchecked(slope, wi, side, rng)
+    }
+
     /// [`Material::pdf_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[must_use]
@@ -234,10 +253,11 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     /// The phase function at the interaction `it` (as [`Material::eval_phase`]) and a sample
     /// of p(ωi, ·) from the same incident direction and side (as [`Material::sample_phase`]):
     /// the two calls of a bounce of the walk's next-event estimation (supplement §3.1,
-    /// Algorithm 2). By default the two separate unchecked calls, in that order (the random
-    /// stream of the separate calls). A material whose evaluation is itself stochastic may
-    /// share its random facet between the two: the evaluation's expectation given everything
-    /// before it is unchanged, so the walk's estimate stays unbiased (crate-internal hot path).
+    /// Algorithm 2). By default the two separate unchecked calls, in that order, the sample as
+    /// the walks draw it ([`Material::sample_phase_walk_unchecked`]). A material whose
+    /// evaluation is itself stochastic may share its random facet between the two: the
+    /// evaluation's expectation given everything before it is unchanged, so the walk's
+    /// estimate stays unbiased (crate-internal hot path).
     #[doc(hidden)]
     #[inline(always)]
     #[must_use]
@@ -247,8 +267,8 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         it: &Interaction,
         rng: &mut impl Rng,
     ) -> (Vec3, PhaseSample) {
-        let phase = self.eval_phase_unchecked(slope, it, rng);
-        (phase, self.sample_phase_unchecked(slope, it.wi(), it.wi_side(), rng))
+        let sample = self.sample_phase_walk_unchecked(slope, it.wi(), it.wi_side(), rng);
+        (self.eval_phase_unchecked(slope, it, rng), sample)
     }
 
     /// [`Material::connection`] without the argument check (crate-internal hot path): by
@@ -309,6 +329,55 @@ pub(crate) fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<DVec3> {
     (wh.z > 0.0 && wi.dot(wh) > 0.0).then_some(wh)
 }
 
+/// The half vector of a reflection ωi → ωo unnormalized, h = ωi + ωo in f64 (exact: a sum
+/// of two f32), with ωi·h: what the walk's next-event estimation needs of it (D is a
+/// function of the direction of h only, [`MicrosurfaceSlope::d64_of_sum_unchecked`]; the
+/// cosine ωi·ωh only for a Fresnel term).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct HalfSum {
+    h: DVec3,
+    wi_dot_h: f64,
+}
+
+impl HalfSum {
+    /// The sum of a reflection ωi → ωo if its direction is a valid microfacet normal for the
+    /// pair (h.z > 0 and ωi·h > 0: the tests of [`reflection_half_vector`], whose normalized
+    /// vector has the same signs).
+    #[inline(always)]
+    pub(crate) fn visible(wi: Vec3, wo: Vec3) -> Option<Self> {
+        let i = wi.as_dvec3();
+        let h = i + wo.as_dvec3();
+        let wi_dot_h = i.dot(h);
+        (h.z > 0.0 && wi_dot_h > 0.0).then_some(Self { h, wi_dot_h })
+    }
+
+    /// ωi·ωh with ωh = h/|h| (in f64, rounded once to f32).
+    #[inline(always)]
+    pub(crate) fn cos_ih(&self) -> f32 {
+        (self.wi_dot_h / self.h.length()) as f32
+    }
+
+    /// ωi·h, unnormalized (> 0).
+    #[inline(always)]
+    pub(crate) fn wi_dot_h(&self) -> f64 {
+        self.wi_dot_h
+    }
+
+    /// |h|².
+    #[inline(always)]
+    pub(crate) fn length_sq(&self) -> f64 {
+        self.h.length_squared()
+    }
+
+    /// The reflection density D(ωh)/(4 A(ωi)) for A(ωi) = `area` > 0 known (the walk's, see
+    /// [`Interaction`]): [`phase_reflection`] without normalizing the half vector, in f64
+    /// ([`MicrosurfaceSlope::reflection_density_of_sum_unchecked`]), rounded once.
+    #[inline(always)]
+    pub(crate) fn density<S: MicrosurfaceSlope>(&self, slope: &S, area: f32) -> f32 {
+        slope.reflection_density_of_sum_unchecked(self.h, area)
+    }
+}
+
 /// The reflection of `wi` about the unit normal `wm`: 2(ωi·ωm)ωm − ωi.
 #[inline(always)]
 pub(crate) fn reflect(wi: Vec3, wm: Vec3) -> Vec3 {
@@ -335,7 +404,7 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
 /// error: that of D_ωi (a few f64 ulps times the condition numbers of D, see
 /// [`MicrosurfaceSlope::d64`]) plus the final rounding to f32.
 ///
-/// `area` is A(ωi) where the caller knows it (ωi above the horizon: [`Interaction`]'s cache).
+/// `area` is A(ωi) where the caller knows it ([`Interaction`]'s cache), used where ωi faces up.
 #[inline(always)]
 pub(crate) fn phase_reflection<S: MicrosurfaceSlope>(
     slope: &S,

@@ -1,6 +1,7 @@
 //! Material-independent geometry of the microsurface: masking and the height of the next
 //! intersection (Heitz et al. 2016, supplement §3.1).
 
+use super::logexp;
 use crate::contract::{is_direction, is_uniform};
 use crate::height::MicrosurfaceHeight;
 use crate::rng::cut_tails;
@@ -177,7 +178,7 @@ pub(crate) fn next_c1(z: f32, lambda: f32, c1: f32, u: f32) -> Option<f32> {
 /// The smallest |ln C¹| of a point where a ray hit the microsurface: hits lie strictly inside
 /// the surface (C¹ < 1), also after rounding, so that the point on the other side of a
 /// dielectric interface has ln C¹ = ln(1 − C¹) finite.
-const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
+pub(crate) const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
 
 /// Algorithm 1 of the supplement in log-C¹ space, the state of the random walks: the
 /// ln C¹ of the next intersection's height, or `None` if the ray escapes. `ln_c1` = 0 is a ray
@@ -188,13 +189,32 @@ const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
 /// Λ ≤ −1 and it decreases). One logarithm per intersection, and the masking of the next
 /// event is exp(Λ ln C¹'): heights themselves are never needed (supplement §1.1). A horizontal
 /// ray (Λ saturated at `f32::MAX`) hits at its own height, or escapes from above the surface.
+///
+/// An escape needs no logarithm where −u ≤ Λ ln C¹ already: ln(1 − u) ≤ −u, so the test
+/// ln(1 − u) ≤ Λ ln C¹ holds, and it also holds in floating point (see the body). The decisions
+/// are those of the logarithm itself, bit for bit; most rays going up escape this way.
 #[inline(always)]
 pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32> {
     // tails cut and 1 − u: see `next_c1`
-    let ln_1mu = (1.0 - cut_tails(u)).ln();
-    if z >= 0.0 && (lambda == 0.0 || ln_1mu <= lambda * ln_c1) {
-        return None;
+    let one_minus_u = 1.0 - cut_tails(u);
+    if z >= 0.0 {
+        let bound = lambda * ln_c1;
+        // −u′ = (1 − u) − 1 with u′ the uniform 1 − u stands for (exact for 1 − u ≥ ½;
+        // below, where the subtraction may round by 2⁻²⁵, ln(1 − u) < −u′ − 0.19): then
+        // ln(1 − u) ≤ −u′ ≤ Λ ln C¹, and the f32 logarithm (within 1e-10 of ln(1 − u),
+        // which is below −u′ by u′²/2 ≥ 2⁻⁴⁹ relative to u′) would round to at most the f32
+        // Λ ln C¹ too
+        if lambda == 0.0 || one_minus_u - 1.0 <= bound {
+            return None;
+        }
+        let ln_1mu = logexp::ln_f32(one_minus_u);
+        if ln_1mu <= bound {
+            return None;
+        }
+        return Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH));
     }
+    // the logarithm inline (`logexp`, correctly rounded but for 0.002 ulp)
+    let ln_1mu = logexp::ln_f32(one_minus_u);
     Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
 }
 
@@ -304,12 +324,13 @@ fn exponential(u: f32) -> f64 {
 /// vertically flipped frame (h ↦ −h; the height distributions are symmetric; supplement §3.4).
 ///
 /// ln(1 − eˣ) without cancellation on either side of x = −ln 2 (Mächler 2012, “Accurately
-/// computing log(1 − exp(−|a|))”): ln(−expm1(x)) near the top (x → 0⁻, 1 − C¹ small) and
-/// ln_1p(−eˣ) below (C¹ < ½, the result small). Within 4 f32 ulps for every hit depth
-/// x ∈ [−f32::MAX, −f32::MIN_POSITIVE]; −0 where eˣ underflows (x < −104).
+/// computing log(1 − exp(−|a|))”; in f64 and inline, `logexp::ln_1m_exp_f32`): ln(−x) plus a
+/// series near the top (x → 0⁻, 1 − C¹ small) and ln_1p(−eˣ) below (C¹ < ½, the result
+/// small). Within 0.51 f32 ulp for every hit depth x ∈ [−f32::MAX, −f32::MIN_POSITIVE]; −0
+/// where eˣ underflows (x < −104).
 #[inline(always)]
 pub(crate) fn flip_ln_c1(ln_c1: f32) -> f32 {
-    if ln_c1 > -core::f32::consts::LN_2 { (-ln_c1.exp_m1()).ln() } else { (-ln_c1.exp()).ln_1p() }
+    logexp::ln_1m_exp_f32(ln_c1)
 }
 
 #[cfg(test)]
@@ -395,6 +416,54 @@ mod tests {
         }
         // straight up (Λ = 0) always escapes, even from the bottom
         assert_eq!(next_ln_c1(1.0, 0.0, -50.0, 0.5), None);
+    }
+
+    /// The escapes decided without the logarithm (−u ≤ Λ ln C¹) are exactly those the
+    /// logarithm decides: `next_ln_c1` against the plain form, bit for bit, for rays going up
+    /// over Λ from 1e-7 to `f32::MAX`, depths from −1e-38 to −100, and uniforms on the crate's
+    /// 2⁻²⁴ grid and off it (including its extremes).
+    #[test]
+    fn next_ln_c1_escapes_without_the_logarithm_as_with_it() {
+        let plain = |lambda: f32, ln_c1: f32, u: f32| {
+            let ln_1mu = logexp::ln_f32(1.0 - cut_tails(u));
+            if lambda == 0.0 || ln_1mu <= lambda * ln_c1 {
+                return None;
+            }
+            Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut escaped, mut hit) = (0u32, 0u32);
+        for k in 0..2_000_000u32 {
+            let bits = next();
+            let lambda = if k % 97 == 0 {
+                f32::MAX
+            } else {
+                10f32.powf(-7.0 + 10.0 * (bits >> 40) as f32 / 16_777_216.0)
+            };
+            let ln_c1 =
+                -(10f32.powf(-38.0 + 40.0 * ((bits >> 16) & 0xff_ffff) as f32 / 16_777_216.0)).min(100.0);
+            let u = match k % 4 {
+                0 => (bits & 0xff_ffff) as f32 / 16_777_216.0,
+                1 => f32::from_bits(0x3f80_0000 | (bits as u32 & 0x7f_ffff)) - 1.0,
+                2 => ((bits & 0xff) as f32) / 16_777_216.0,
+                _ => 1.0 - ((bits & 0xff) as f32 + 1.0) / 16_777_216.0,
+            };
+            let got = next_ln_c1(0.5, lambda, ln_c1, u);
+            assert_eq!(
+                got.map(f32::to_bits),
+                plain(lambda, ln_c1, u).map(f32::to_bits),
+                "Λ = {lambda:e}, ln C¹ = {ln_c1:e}, u = {u:e}"
+            );
+            if got.is_some() { hit += 1 } else { escaped += 1 }
+        }
+        assert!(escaped > 100_000 && hit > 100_000, "escaped {escaped}, hit {hit}");
+        assert_eq!(next_ln_c1(0.5, 0.0, -1.0, 0.3), None);
     }
 
     /// A horizontal ray (Λ saturated at f32::MAX) hits at its own height, or escapes from

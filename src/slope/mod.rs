@@ -229,6 +229,28 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         self.d64(wm)
     }
 
+    /// D(ωh) in double precision for the direction ωh = h/|h| of a vector `h` given
+    /// unnormalized (D depends on the direction only), 0 for h.z ≤ 0: the materials pass the
+    /// reflection half vector's sum ωi + ωo, exact in f64, and skip its normalization. No
+    /// argument check (crate-internal hot path). The default normalizes and calls
+    /// [`Self::d64_unchecked`]; [`Ggx`] evaluates its homogeneous form directly (the same
+    /// accuracy: a few f64 ulps).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d64_of_sum_unchecked(&self, h: DVec3) -> f64 {
+        self.d64_unchecked(h.normalize_or_zero())
+    }
+
+    /// The reflection density D(ωh)/(4 A(ωi)) from the unnormalized half vector h = ωi + ωo
+    /// (h.z > 0, the caller has tested the visibility) and A(ωi) = `area` > 0 known, in f64,
+    /// rounded once: 0.25 [`Self::d64_of_sum_unchecked`](h)/A by default; [`Ggx`] folds the
+    /// divisions into one. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn reflection_density_of_sum_unchecked(&self, h: DVec3, area: f32) -> f32 {
+        (0.25 * self.d64_of_sum_unchecked(h) / f64::from(area)) as f32
+    }
+
     /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[inline(always)]

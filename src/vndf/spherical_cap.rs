@@ -95,14 +95,15 @@ pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> 
     let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
     let (sin_phi, cos_phi) = sin_cos_turns(u2);
     let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
-    if h.length_squared() >= NEAR_OPPOSITE_SQ * (len * len) {
+    // |h| ≥ h.z: the height alone clears the test for all but the bottom of the cap
+    if h_z >= NEAR_OPPOSITE * len || h.length_squared() >= NEAR_OPPOSITE * NEAR_OPPOSITE * (len * len) {
         return h;
     }
     cap_near_opposite(v, u1, u2).unwrap_or(h)
 }
 
-/// |h|² below this fraction of len² is recomputed by [`cap_near_opposite`].
-const NEAR_OPPOSITE_SQ: f32 = 1.0 / 4096.0;
+/// |h| below this fraction of len is recomputed by [`cap_near_opposite`].
+const NEAR_OPPOSITE: f32 = 1.0 / 64.0;
 
 /// h = v + len c for a cap point c near −v̂, in double precision and in the azimuth frame of v:
 /// with s = |v_xy|, ê = v_xy/s, ψ = 2π u2 − φo the azimuth of c_xy measured from −ê (φo the

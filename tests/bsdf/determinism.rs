@@ -75,8 +75,15 @@ fn identical_inputs_give_identical_bits() {
     }
     // with_seed reaches the estimator, and the sample's later bounces
     let walk = mf(ggx(ALPHA_MS, ALPHA_MS), Conductor::perfect());
-    let (wo, wi) = (dir(0.7, 0.4), dir(0.9, 2.5));
-    assert_ne!(walk.eval(wo, wi), walk.with_seed(1).eval(wo, wi));
+    let wo = dir(0.7, 0.4);
+    // the walk's first order is exact (its next-event masking in closed form), so one call
+    // gives the same value for both seeds wherever both walks end after one bounce (about half
+    // the time): the seed must change the estimate of some of 16 calls
+    let differs = (0..16).any(|k| {
+        let wi = dir(0.9, 2.5 + 0.1 * k as f64);
+        walk.eval(wo, wi) != walk.with_seed(1).eval(wo, wi)
+    });
+    assert!(differs, "the seed does not reach the walk's estimate");
     let samples = |b: &Mf<Ggx, Conductor>| -> Vec<Option<BsdfSample>> {
         (0..32).map(|k| b.sample(wo, 0.5, Vec2::new(k as f32 / 32.0, 0.3))).collect()
     };

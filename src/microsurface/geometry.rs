@@ -1,11 +1,11 @@
 //! Material-independent geometry of the microsurface: masking and the height of the next
 //! intersection (Heitz et al. 2016, supplement §3.1).
 
-use super::logexp;
 use crate::contract::{is_direction, is_uniform};
 use crate::height::MicrosurfaceHeight;
 use crate::rng::cut_tails;
 use crate::slope::MicrosurfaceSlope;
+use crate::special::{ln_1m_exp_f32, ln_f32};
 use glam::Vec3;
 
 /// Where a ray leaving a point of the microsurface goes next (supplement §3.1, Algorithm 1).
@@ -207,14 +207,14 @@ pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32>
         if lambda == 0.0 || one_minus_u - 1.0 <= bound {
             return None;
         }
-        let ln_1mu = logexp::ln_f32(one_minus_u);
+        let ln_1mu = ln_f32(one_minus_u);
         if ln_1mu <= bound {
             return None;
         }
         return Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH));
     }
-    // the logarithm inline (`logexp`, correctly rounded but for 0.002 ulp)
-    let ln_1mu = logexp::ln_f32(one_minus_u);
+    // the logarithm inline (`special::ln_f32`, correctly rounded but for 0.002 ulp)
+    let ln_1mu = ln_f32(one_minus_u);
     Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
 }
 
@@ -324,13 +324,13 @@ fn exponential(u: f32) -> f64 {
 /// vertically flipped frame (h ↦ −h; the height distributions are symmetric; supplement §3.4).
 ///
 /// ln(1 − eˣ) without cancellation on either side of x = −ln 2 (Mächler 2012, “Accurately
-/// computing log(1 − exp(−|a|))”; in f64 and inline, `logexp::ln_1m_exp_f32`): ln(−x) plus a
+/// computing log(1 − exp(−|a|))”; in f64 and inline, `ln_1m_exp_f32`): ln(−x) plus a
 /// series near the top (x → 0⁻, 1 − C¹ small) and ln_1p(−eˣ) below (C¹ < ½, the result
 /// small). Within 0.51 f32 ulp for every hit depth x ∈ [−f32::MAX, −f32::MIN_POSITIVE]; −0
 /// where eˣ underflows (x < −104).
 #[inline(always)]
 pub(crate) fn flip_ln_c1(ln_c1: f32) -> f32 {
-    logexp::ln_1m_exp_f32(ln_c1)
+    ln_1m_exp_f32(ln_c1)
 }
 
 #[cfg(test)]
@@ -425,7 +425,7 @@ mod tests {
     #[test]
     fn next_ln_c1_escapes_without_the_logarithm_as_with_it() {
         let plain = |lambda: f32, ln_c1: f32, u: f32| {
-            let ln_1mu = logexp::ln_f32(1.0 - cut_tails(u));
+            let ln_1mu = ln_f32(1.0 - cut_tails(u));
             if lambda == 0.0 || ln_1mu <= lambda * ln_c1 {
                 return None;
             }

@@ -2,7 +2,6 @@
 //! multiple-scattering BSDF (Heitz et al. 2016, supplement §3).
 
 mod geometry;
-mod logexp;
 mod walk;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};

@@ -3,12 +3,12 @@
 
 use super::Microsurface;
 use super::geometry::{MIN_HIT_DEPTH, ScaledDepth, flip_ln_c1, next_ln_c1};
-use super::logexp;
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::{Interaction, Material, Side};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
+use crate::special::exp_f32;
 use core::num::NonZeroU32;
 use glam::Vec3;
 use rand::Rng;
@@ -468,7 +468,7 @@ fn masking(closed: Option<f32>, depth: Depth, lambda_o: f32, same_side: bool) ->
         (None, depth) => {
             // `closed` holds the rate of every undrawn depth, so this is ln C¹ ≤ 0
             let ln_c1 = depth.0.min(0.0);
-            logexp::exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) })
+            exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) })
         }
     }
 }

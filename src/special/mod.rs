@@ -10,6 +10,7 @@ mod erfinv;
 mod exp;
 mod gamma;
 mod gaussian;
+mod ln;
 mod tail_ratio;
 mod trig;
 
@@ -21,5 +22,6 @@ pub(crate) use erfinv::{NO_LOG_BELOW, erfc_inv_f32, erfinv_central, erfinv_from_
 pub(crate) use exp::{EXP_NONPOSITIVE_FROM, ROUNDING_MAGIC, exp_nonpositive};
 pub use gamma::{beta, ln_beta, ln_gamma};
 pub(crate) use gaussian::gaussian_integral_and_half;
+pub(crate) use ln::{exp_f32, ln_1m_exp_f32, ln_f32};
 pub(crate) use tail_ratio::tail_ratio;
 pub use trig::sin_cos_turns;

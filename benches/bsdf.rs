@@ -19,11 +19,10 @@
 //! `gold/single/sample-vs-vndf/{sample_d_wi|static}`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use glam::Vec3;
 use microsurface::{
     Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
     Estimator, Ggx, KullaContyDielectric, Material, MicrofacetBsdf, Microsurface, MicrosurfaceSlope,
-    PositionFree, ScatteringOrder, Shadowing, SingleScattering, SpecularLimit, Technique, UniformHeight,
+    Shadowing, SpecularLimit, Technique, UniformHeight,
 };
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -31,6 +30,7 @@ use std::hint::black_box;
 
 use validation::clock::{Clock, config};
 use validation::inputs::{N, inputs};
+use validation::research::Research;
 
 /// The roughness of every configuration.
 const ALPHA: f32 = 0.5;
@@ -41,67 +41,6 @@ fn next(i: &mut usize) -> usize {
     let k = *i & (N - 1);
     *i = i.wrapping_add(1);
     k
-}
-
-/// The research-layer calls a technique wraps, in the adjoint orientation of the trait (the
-/// walk enters along the renderer's wo).
-struct Research<S, M> {
-    surface: Microsurface<UniformHeight, S, M>,
-    technique: Technique,
-}
-
-impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
-    fn pf(&self, shadowing: Shadowing) -> PositionFree<S, M> {
-        PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
-    }
-
-    fn single(&self) -> SingleScattering<S, M> {
-        SingleScattering::new(*self.surface.slope(), *self.surface.material())
-    }
-
-    #[inline(always)]
-    fn eval(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
-        match self.technique {
-            Technique::SingleScattering => self.single().eval(walk_in, walk_out, rng),
-            Technique::RandomWalk => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
-            Technique::PositionFree { estimator, shadowing } => {
-                self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
-            }
-        }
-    }
-
-    #[inline(always)]
-    fn pdf(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
-        match self.technique {
-            Technique::SingleScattering => self.single().pdf(walk_in, walk_out),
-            _ => self.pf(Shadowing::Correlated).pdf(walk_in, walk_out),
-        }
-    }
-
-    /// The sampled direction and weight, and for single scattering its density (what the
-    /// trait's sample returns): all of it is returned, so that the optimizer cannot drop the
-    /// density (mapping to the direction alone let it: 411 instead of 530 instructions).
-    #[inline(always)]
-    fn sample(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
-        match self.technique {
-            Technique::SingleScattering => {
-                self.single().sample(walk_in, rng).map(|s| (s.wo, s.weight, s.pdf))
-            }
-            Technique::RandomWalk => self.surface.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
-            Technique::PositionFree { shadowing, .. } => {
-                self.pf(shadowing).sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0))
-            }
-        }
-    }
-
-    /// The research sample followed by the density of its direction: what the trait's sample
-    /// of a stochastic technique computes.
-    #[inline(always)]
-    fn sample_with_pdf(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
-        let (wo, weight, pdf) = self.sample(walk_in, rng)?;
-        let pdf = if self.technique == Technique::SingleScattering { pdf } else { self.pdf(walk_in, wo) };
-        Some((wo, weight, pdf))
-    }
 }
 
 const TECHNIQUES: [(&str, Technique); 4] = [

@@ -14,100 +14,19 @@
 //! calls and of the research `eval`, `pdf` and `eval_with_pdf` (the same inputs read);
 //! `loop-research` that of the research `sample` (which reads only wo).
 
-use microsurface::glam::{Vec2, Vec3};
-use microsurface::rand::{RngExt, SeedableRng};
+use microsurface::glam::Vec3;
+use microsurface::rand::SeedableRng;
 use microsurface::{
     Bsdf, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
-    MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SingleScattering, SpecularLimit, Technique,
-    UniformHeight,
+    MicrosurfaceSlope, Shadowing, SpecularLimit, Technique, UniformHeight,
 };
 use rand_pcg::Pcg64Mcg;
-use std::f32::consts::TAU;
 use std::hint::black_box;
+use validation::inputs::{N, inputs};
+use validation::research::Research;
 
-/// The number of pre-generated inputs (as in the bench).
-const N: usize = 1024;
 /// The roughness of every configuration.
 const ALPHA: f32 = 0.5;
-
-fn direction(rng: &mut Pcg64Mcg, sphere: bool) -> Vec3 {
-    let u = 1.0 - rng.random::<f32>();
-    let z = if sphere && rng.random::<bool>() { -u } else { u };
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = TAU * rng.random::<f32>();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-struct Inputs {
-    wo: Vec<Vec3>,
-    wi: Vec<Vec3>,
-    uc: Vec<f32>,
-    u: Vec<Vec2>,
-}
-
-fn inputs(transmits: bool, seed: u64) -> Inputs {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let wo = (0..N).map(|_| direction(&mut rng, false)).collect();
-    let wi = (0..N).map(|_| direction(&mut rng, transmits)).collect();
-    let uc = (0..N).map(|_| rng.random::<f32>()).collect();
-    let u = (0..N).map(|_| Vec2::new(rng.random(), rng.random())).collect();
-    Inputs { wo, wi, uc, u }
-}
-
-/// The bench's research-layer calls (`benches/bsdf.rs`, `Research`).
-struct Research<S, M> {
-    surface: Microsurface<UniformHeight, S, M>,
-    technique: Technique,
-}
-
-impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
-    fn pf(&self, shadowing: Shadowing) -> PositionFree<S, M> {
-        PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
-    }
-
-    fn single(&self) -> SingleScattering<S, M> {
-        SingleScattering::new(*self.surface.slope(), *self.surface.material())
-    }
-
-    #[inline(always)]
-    fn eval(&self, walk_in: Vec3, walk_out: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
-        match self.technique {
-            Technique::SingleScattering => self.single().eval(walk_in, walk_out, rng),
-            Technique::RandomWalk => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
-            Technique::PositionFree { estimator, shadowing } => {
-                self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
-            }
-        }
-    }
-
-    #[inline(always)]
-    fn pdf(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
-        match self.technique {
-            Technique::SingleScattering => self.single().pdf(walk_in, walk_out),
-            _ => self.pf(Shadowing::Correlated).pdf(walk_in, walk_out),
-        }
-    }
-
-    #[inline(always)]
-    fn sample(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
-        match self.technique {
-            Technique::SingleScattering => {
-                self.single().sample(walk_in, rng).map(|s| (s.wo, s.weight, s.pdf))
-            }
-            Technique::RandomWalk => self.surface.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
-            Technique::PositionFree { shadowing, .. } => {
-                self.pf(shadowing).sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0))
-            }
-        }
-    }
-
-    #[inline(always)]
-    fn sample_with_pdf(&self, walk_in: Vec3, rng: &mut Pcg64Mcg) -> Option<(Vec3, Vec3, f32)> {
-        let (wo, weight, pdf) = self.sample(walk_in, rng)?;
-        let pdf = if self.technique == Technique::SingleScattering { pdf } else { self.pdf(walk_in, wo) };
-        Some((wo, weight, pdf))
-    }
-}
 
 /// The calls, one loop per closure (monomorphized: no dispatch in the loop).
 #[inline(never)]

@@ -43,6 +43,7 @@ pub mod leadr;
 pub mod quadrature;
 pub mod reference;
 pub mod report;
+pub mod research;
 pub mod stability;
 mod stats;
 pub mod stochastic;

@@ -2,9 +2,7 @@
 //! per-strategy path densities and the balance heuristic.
 
 use super::shadowing::{VertexRole, inv_g1};
-use super::{
-    Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability,
-};
+use super::{BDPT_ROULETTE_FROM, Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, Roulette};
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::microsurface::ScatteringOrder;
@@ -82,17 +80,36 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_bdpt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_bdpt_counted(wi, wo, order, rng).0
+    }
+
+    /// [`Self::eval_bdpt`] for validated directions, with the lengths of its camera and light
+    /// sub-paths (sampled directions).
+    #[inline(always)]
+    pub(crate) fn eval_bdpt_counted(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        order: ScatteringOrder,
+        rng: &mut impl Rng,
+    ) -> (Vec3, usize, usize) {
         let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0, 0);
         };
         let last = order.last() as usize;
         let max_sub = (last - 1).min(BDPT_MAX_SUBPATH);
         let mut camera = [EMPTY_CAMERA; BDPT_MAX_SUBPATH];
         let mut light = [EMPTY_LIGHT; BDPT_MAX_SUBPATH];
         let to_wo = self.exit(wo, wo_side);
-        let n_camera = self.camera_subpath(start, to_wo, max_sub, &mut camera, rng);
+        let k_start = inv_g1(&self.slope, start.in_frame());
+        // the (0, 0) connection (single scattering) first: the camera's roulette compares with it
+        let single =
+            order.includes(1).then(|| self.connect_known(start, k_start, to_wo, VertexRole::Last, rng));
+        let roulette = Roulette::new(self, start, k_start, single);
+        let n_camera = self.camera_subpath(start, k_start, to_wo, max_sub, &mut camera, &roulette, rng);
         let n_light = self.light_subpath(wo, wo_side, max_sub, &mut light, rng);
-        let paths = self.subpaths(start, to_wo, &camera[..n_camera], &light[..n_light]);
+        let paths =
+            Subpaths::new(self, start, k_start, to_wo, single, &camera[..n_camera], &light[..n_light]);
 
         let mut densities = PathDensities::EMPTY;
         let mut sum = DVec3::ZERO;
@@ -111,23 +128,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 sum += throughput * c.contribution * densities.balance_weight(s, n);
             }
         }
-        sum.as_vec3()
-    }
-
-    /// The two sub-paths with the per-vertex data every connection shares: 1 + L̃ of every
-    /// camera incident direction and the exit data of every light outgoing direction.
-    fn subpaths<'a>(
-        &self,
-        start: Incident,
-        to_wo: Exit,
-        camera: &'a [CameraVertex],
-        light: &'a [LightVertex],
-    ) -> Subpaths<'a> {
-        let mut exits = [to_wo; BDPT_MAX_SUBPATH + 1];
-        for (exit, l) in exits[1..].iter_mut().zip(light) {
-            *exit = self.exit(-l.incident.w, l.incident.side);
-        }
-        Subpaths { start, k_start: inv_g1(&self.slope, start.in_frame()), camera, light, exits }
+        (sum.as_vec3(), n_camera, n_light)
     }
 
     /// The connection of the first `s` camera directions to the first `t` light directions
@@ -146,7 +147,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let out = paths.exits[t];
         let connection = if t == 0 {
             let (contribution, reverse) = match s {
-                0 => (self.connect_known(at, k_at, out, VertexRole::Last, rng), 0.0),
+                0 => (paths.single?, 0.0),
                 _ => (
                     paths.camera[s - 1].connection,
                     f64::from(self.material.pdf_phase_unchecked(&self.slope, &at.towards(out).reversed())),
@@ -184,16 +185,19 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     }
 
     /// Samples up to `max` directions from ωi; returns how many were stored.
+    #[allow(clippy::too_many_arguments)]
     fn camera_subpath(
         &self,
         start: Incident,
+        k_start: f64,
         to_wo: Exit,
         max: usize,
         out: &mut [CameraVertex; BDPT_MAX_SUBPATH],
+        roulette: &Roulette,
         rng: &mut impl Rng,
     ) -> usize {
         let mut at = start;
-        let mut k_at = inv_g1(&self.slope, start.in_frame());
+        let mut k_at = k_start;
         let mut throughput = DVec3::ONE;
         for (j, slot) in out.iter_mut().enumerate().take(max) {
             let Some((next, k_next, ratio)) = self.extend_known(at, k_at, rng) else { return j };
@@ -208,8 +212,8 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 f64::from(self.material.pdf_phase_unchecked(&self.slope, &step.reversed()));
             // the connection of the new vertex to ωo, the (s, 0) strategy's
             let connection = self.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
-            if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
-                let q = survival_probability(throughput, k_next);
+            if j + 1 >= BDPT_ROULETTE_FROM {
+                let q = roulette.survival(self, throughput, next, k_next);
                 if f64::from(uniform(rng)) >= q {
                     return j;
                 }
@@ -256,7 +260,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             let pdf_reverse = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step.reversed()));
             let pdf_forward_out =
                 if i == 0 { 0.0 } else { f64::from(self.material.pdf_phase_unchecked(&self.slope, &step)) };
-            if i as u32 + 1 >= ROULETTE_FROM_BOUNCE {
+            if i + 1 >= BDPT_ROULETTE_FROM {
                 let q = throughput.max_element().min(1.0);
                 if f64::from(uniform(rng)) >= q {
                     return i;
@@ -284,9 +288,30 @@ struct Subpaths<'a> {
     light: &'a [LightVertex],
     /// The exit data of ωo (index 0) and of the outgoing direction of light vertex t (index t).
     exits: [Exit; BDPT_MAX_SUBPATH + 1],
+    /// The (0, 0) connection (single scattering), where the evaluated orders include it.
+    single: Option<DVec3>,
 }
 
-impl Subpaths<'_> {
+impl<'a> Subpaths<'a> {
+    /// The two sub-paths of `pf` with the per-vertex data every connection shares: 1 + L̃ of
+    /// ωi (`k_start`), the single-scattering connection and the exit data of ωo and of every
+    /// light outgoing direction.
+    fn new<S: MicrosurfaceSlope, M: Material>(
+        pf: &PositionFree<S, M>,
+        start: Incident,
+        k_start: f64,
+        to_wo: Exit,
+        single: Option<DVec3>,
+        camera: &'a [CameraVertex],
+        light: &'a [LightVertex],
+    ) -> Self {
+        let mut exits = [to_wo; BDPT_MAX_SUBPATH + 1];
+        for (exit, l) in exits[1..].iter_mut().zip(light) {
+            *exit = pf.exit(-l.incident.w, l.incident.side);
+        }
+        Subpaths { start, k_start, camera, light, exits, single }
+    }
+
     /// The incident state and its 1 + L̃ at the end of the first `s` camera directions.
     #[inline]
     fn camera_end(&self, s: usize) -> (Incident, f64) {

@@ -1,7 +1,7 @@
 //! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
 
 use super::shadowing::{VertexRole, inv_g1};
-use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability};
+use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, Roulette};
 use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
@@ -26,9 +26,23 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_pt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_pt_counted(wi, wo, order, rng).0
+    }
+
+    /// [`Self::eval_pt`] for validated directions, with the number of path extensions (sampled
+    /// directions) it made.
+    #[inline(always)]
+    pub(crate) fn eval_pt_counted(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        order: ScatteringOrder,
+        rng: &mut impl Rng,
+    ) -> (Vec3, u32) {
         let (Some(mut at), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0);
         };
+        let mut extensions = 0;
         let last = order.last();
         // the exit data of ωo (constant) and 1 + L̃ of the current incident direction: one Λ
         // per bounce
@@ -36,15 +50,24 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let mut k_in = inv_g1(&self.slope, at.in_frame());
         let mut throughput = DVec3::ONE;
         let mut sum = DVec3::ZERO;
+        // the reference is the single-scattering term, set at the first vertex where it is evaluated
+        let mut roulette =
+            if order.includes(1) { Roulette::UNSET } else { Roulette::new(self, at, k_in, None) };
         for bounce in 1..=last {
             if order.includes(bounce) {
-                sum += throughput * self.connect_known(at, k_in, to_wo, VertexRole::Last, rng);
+                let contribution = self.connect_known(at, k_in, to_wo, VertexRole::Last, rng);
+                if bounce == 1 {
+                    // the single-scattering term is the roulette's reference
+                    roulette.set_reference(self, at, k_in, contribution);
+                }
+                sum += throughput * contribution;
             }
             if bounce == last {
                 break;
             }
             match self.extend_known(at, k_in, rng) {
                 Some((next, k_next, ratio)) => {
+                    extensions += 1;
                     throughput *= ratio;
                     (at, k_in) = (next, k_next);
                 }
@@ -54,14 +77,14 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 break;
             }
             if bounce >= ROULETTE_FROM_BOUNCE {
-                let q = survival_probability(throughput, k_in);
+                let q = roulette.survival(self, throughput, at, k_in);
                 if f64::from(uniform(rng)) >= q {
                     break;
                 }
                 throughput /= q;
             }
         }
-        sum.as_vec3()
+        (sum.as_vec3(), extensions)
     }
 
     /// Samples the next direction from the incident state `at` (with 1 + L̃ = `k_in`) and
@@ -69,7 +92,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// w·S_middle/G1(ωin) = w·k_in·S_middle. Λ of the sampled direction serves both this
     /// vertex's continuing factor and the next incident masking (Λ(−ω) = −1 − Λ(ω)), so a
     /// bounce evaluates Λ once.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn extend_known(
         &self,
         at: Incident,

@@ -48,8 +48,9 @@ struct LightVertex {
     pdf_forward_out: f64,
 }
 
+// all bits zero (Side::Outside and None are the first variants): the slots are cleared, not copied
 const EMPTY_CAMERA: CameraVertex = CameraVertex {
-    next: Incident { w: Vec3::Z, side: Side::Outside },
+    next: Incident { w: Vec3::ZERO, side: Side::Outside },
     k_next: 0.0,
     connection: DVec3::ZERO,
     throughput: DVec3::ZERO,
@@ -57,7 +58,7 @@ const EMPTY_CAMERA: CameraVertex = CameraVertex {
     pdf_reverse_prev: 0.0,
 };
 const EMPTY_LIGHT: LightVertex = LightVertex {
-    out_next: Exit { w: Vec3::Z, side: Side::Outside, lambda: None },
+    out_next: Exit { w: Vec3::ZERO, side: Side::Outside, lambda: None },
     throughput: DVec3::ZERO,
     pdf_reverse: 0.0,
     pdf_forward_out: 0.0,
@@ -100,9 +101,12 @@ impl<T: Copy> Vertices<T> {
     /// The vertex `i` (< the number pushed).
     #[inline(always)]
     fn get(&self, i: usize) -> &T {
+        if i < INLINE_VERTICES {
+            return &self.head[i];
+        }
         match &self.tail {
-            Some(tail) if i >= INLINE_VERTICES => &tail[i - INLINE_VERTICES],
-            _ => &self.head[i],
+            Some(tail) => &tail[i - INLINE_VERTICES],
+            None => &self.head[INLINE_VERTICES - 1],
         }
     }
 }
@@ -192,14 +196,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             let (contribution, reverse) = match s {
                 0 => (paths.single?, 0.0),
                 _ => {
+                    let contribution = paths.camera.get(s - 1).connection;
+                    if contribution == DVec3::ZERO {
+                        return None;
+                    }
                     // p← from ωo, whose projected area is (1 + Λo) cos θo
                     let area =
                         out.lambda.and_then(|lambda| known_area(out.side.frame(out.w).z, 1.0 + lambda));
                     let reverse = at.towards(out).reversed().with_incident_area(area);
-                    (
-                        paths.camera.get(s - 1).connection,
-                        f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse)),
-                    )
+                    (contribution, f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse)))
                 }
             };
             Connection { contribution, forward: 0.0, reverse }

@@ -92,7 +92,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// w·S_middle/G1(ωin) = w·k_in·S_middle. Λ of the sampled direction serves both this
     /// vertex's continuing factor and the next incident masking (Λ(−ω) = −1 − Λ(ω)), so a
     /// bounce evaluates Λ once.
-    #[inline(always)]
+    #[inline]
     pub(crate) fn extend_known(
         &self,
         at: Incident,

@@ -36,8 +36,9 @@ struct CameraVertex {
 /// one.
 #[derive(Debug, Clone, Copy)]
 struct LightVertex {
-    /// The exit data of the reverse of its sampled incident direction, the outgoing direction of the next light vertex (and of
-    /// the connection vertex of the strategies that end the light side here).
+    /// The exit data of the reverse of its sampled incident direction: the outgoing direction
+    /// of the next light vertex, and of the connection vertex of the strategies whose light
+    /// side ends here.
     out_next: Exit,
     /// Product of the forward contributions / reverse densities of the light vertices so far.
     throughput: DVec3,
@@ -117,7 +118,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     ///
     /// A camera sub-path is sampled from ωi and a light sub-path from ωo (each with the
     /// phase-function sampler; the light sub-path samples incident directions from outgoing
-    /// ones). Every pair of prefixes is joined through one connection vertex, and each path is
+    /// ones), each ended by Russian roulette from its second direction on (the camera's with
+    /// the survival probability of [`PositionFree::eval_pt`], the light's with its throughput).
+    /// Every pair of prefixes is joined through one connection vertex, and each path is
     /// weighted by the balance heuristic over all the ways of building a path of its length,
     /// P_s / Σ_t P_t with P_t = Π_{j≤t} p→(x_j) Π_{j>t} p←(x_j). Contributions are always
     /// evaluated from ωi to ωo, which keeps the non-reciprocal correlated model consistent.

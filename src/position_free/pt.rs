@@ -17,9 +17,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// A path is extended by sampling the phase function (exact full-spherical VNDF
     /// sampling): the vertex term and the sampling density cancel up to w/G1(ωin), so the
     /// throughput of a bounce is w·S_middle/G1(ωin) (w: the sample weight). Russian roulette
-    /// from the fourth vertex on, with survival probability min(1, max throughput × max(1, G1)),
-    /// G1 of the next incident direction, keeps it unbiased and of finite variance (see
-    /// `survival_probability`); the throughput is carried in f64. `order` selects all orders (no
+    /// from the fourth vertex on, with survival probability min(1, T·max(1, Φ)), T the
+    /// throughput and Φ the next vertex's masking G1 capped at a multiple of its phase
+    /// function's peak relative to this path's single-scattering term, keeps it unbiased and
+    /// of finite variance and ends the paths lit from below a smooth surface (see
+    /// `Roulette::survival`); the throughput is carried in f64. `order` selects all orders (no
     /// truncation; [`crate::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit

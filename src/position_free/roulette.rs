@@ -161,7 +161,9 @@ pub(crate) struct PeakScales {
     /// opaque materials; for a dielectric the refraction's largest Jacobian factor
     /// 4(1 − F)⟨ωi, ωh⟩|⟨ωo, ωh⟩| r²/(⟨ωi, ωh⟩ − r|⟨ωo, ωh⟩|)² ≤ 4r²/(1 − r)² (at normal
     /// incidence on the facet; r the index ratio of either direction, 36 for η = 1.5, +∞ for
-    /// η = 1).
+    /// η = 1). A diffuse facet's phase function is at most albedo/π, which the mirror's peak
+    /// D(m*)/(4A) exceeds wherever 4A < π D(m*); elsewhere (A < 1 on the vertices that use it)
+    /// it can fall short by a factor below 4, which the margin C absorbs.
     pub(crate) material: f64,
     /// `material` times the least of D at the zenith and at the normals 1e-3 above the horizon
     /// along x and y: a lower bound of D over the hemisphere for the axis-aligned GGX and

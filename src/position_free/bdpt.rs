@@ -2,9 +2,7 @@
 //! per-strategy path densities and the balance heuristic.
 
 use super::shadowing::{VertexRole, inv_g1};
-use super::{
-    Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, ROULETTE_FROM_BOUNCE, survival_probability,
-};
+use super::{BDPT_ROULETTE_FROM, Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, Roulette};
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::microsurface::ScatteringOrder;
@@ -38,8 +36,10 @@ struct CameraVertex {
 /// one.
 #[derive(Debug, Clone, Copy)]
 struct LightVertex {
-    /// The sampled incident direction (towards the previous vertex) and its side.
-    incident: Incident,
+    /// The exit data of the reverse of its sampled incident direction: the outgoing direction
+    /// of the next light vertex, and of the connection vertex of the strategies whose light
+    /// side ends here.
+    out_next: Exit,
     /// Product of the forward contributions / reverse densities of the light vertices so far.
     throughput: DVec3,
     /// Density of the incident direction given the outgoing one (how it was sampled).
@@ -49,8 +49,9 @@ struct LightVertex {
     pdf_forward_out: f64,
 }
 
+// all bits zero (Side::Outside and None are the first variants): the slots are cleared, not copied
 const EMPTY_CAMERA: CameraVertex = CameraVertex {
-    next: Incident { w: Vec3::Z, side: Side::Outside },
+    next: Incident { w: Vec3::ZERO, side: Side::Outside },
     k_next: 0.0,
     connection: DVec3::ZERO,
     throughput: DVec3::ZERO,
@@ -58,11 +59,58 @@ const EMPTY_CAMERA: CameraVertex = CameraVertex {
     pdf_reverse_prev: 0.0,
 };
 const EMPTY_LIGHT: LightVertex = LightVertex {
-    incident: Incident { w: Vec3::Z, side: Side::Outside },
+    out_next: Exit { w: Vec3::ZERO, side: Side::Outside, lambda: None },
     throughput: DVec3::ZERO,
     pdf_reverse: 0.0,
     pdf_forward_out: 0.0,
 };
+
+/// The vertices of a sub-path stored inline; the rest go to an overflow array formed only when a
+/// sub-path grows beyond them.
+const INLINE_VERTICES: usize = 8;
+
+/// The vertices of one sub-path: the first [`INLINE_VERTICES`] inline, the rest (up to
+/// [`BDPT_MAX_SUBPATH`]) in an array formed only when the sub-path grows beyond them. Filling
+/// all 48 slots of both sub-paths on every evaluation cost more than the connections of a
+/// typical evaluation at α = 1 (DESIGN.md, “BDPT against PT where BDPT loses”).
+struct Vertices<T: Copy> {
+    head: [T; INLINE_VERTICES],
+    tail: Option<[T; BDPT_MAX_SUBPATH - INLINE_VERTICES]>,
+    len: usize,
+}
+
+impl<T: Copy> Vertices<T> {
+    /// No vertices; `empty` fills the slots.
+    #[inline(always)]
+    fn new(empty: T) -> Self {
+        Self { head: [empty; INLINE_VERTICES], tail: None, len: 0 }
+    }
+
+    /// Appends a vertex (at most [`BDPT_MAX_SUBPATH`]); `empty` fills the overflow array when it
+    /// is formed.
+    #[inline(always)]
+    fn push(&mut self, vertex: T, empty: T) {
+        if self.len < INLINE_VERTICES {
+            self.head[self.len] = vertex;
+        } else {
+            self.tail.get_or_insert([empty; BDPT_MAX_SUBPATH - INLINE_VERTICES])
+                [self.len - INLINE_VERTICES] = vertex;
+        }
+        self.len += 1;
+    }
+
+    /// The vertex `i` (< the number pushed).
+    #[inline(always)]
+    fn get(&self, i: usize) -> &T {
+        if i < INLINE_VERTICES {
+            return &self.head[i];
+        }
+        match &self.tail {
+            Some(tail) => &tail[i - INLINE_VERTICES],
+            None => &self.head[INLINE_VERTICES - 1],
+        }
+    }
+}
 
 impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// Evaluates f·|cos θo| by bidirectional path tracing (Wang et al. 2022, eqs. 27–29).
@@ -70,7 +118,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     ///
     /// A camera sub-path is sampled from ωi and a light sub-path from ωo (each with the
     /// phase-function sampler; the light sub-path samples incident directions from outgoing
-    /// ones). Every pair of prefixes is joined through one connection vertex, and each path is
+    /// ones), each ended by Russian roulette from its second direction on (the camera's with
+    /// the survival probability of [`PositionFree::eval_pt`], the light's with its throughput).
+    /// Every pair of prefixes is joined through one connection vertex, and each path is
     /// weighted by the balance heuristic over all the ways of building a path of its length,
     /// P_s / Σ_t P_t with P_t = Π_{j≤t} p→(x_j) Π_{j>t} p←(x_j). Contributions are always
     /// evaluated from ωi to ωo, which keeps the non-reciprocal correlated model consistent.
@@ -82,19 +132,37 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_bdpt(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
+        self.eval_bdpt_counted(wi, wo, order, rng).0
+    }
+
+    /// [`Self::eval_bdpt`] for validated directions, with the lengths of its camera and light
+    /// sub-paths (sampled directions).
+    #[inline(always)]
+    pub(crate) fn eval_bdpt_counted(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        order: ScatteringOrder,
+        rng: &mut impl Rng,
+    ) -> (Vec3, usize, usize) {
         let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0, 0);
         };
         let last = order.last() as usize;
         let max_sub = (last - 1).min(BDPT_MAX_SUBPATH);
-        let mut camera = [EMPTY_CAMERA; BDPT_MAX_SUBPATH];
-        let mut light = [EMPTY_LIGHT; BDPT_MAX_SUBPATH];
+        let mut camera = Vertices::new(EMPTY_CAMERA);
+        let mut light = Vertices::new(EMPTY_LIGHT);
         let to_wo = self.exit(wo, wo_side);
-        let n_camera = self.camera_subpath(start, to_wo, max_sub, &mut camera, rng);
-        let n_light = self.light_subpath(wo, wo_side, max_sub, &mut light, rng);
-        let paths = self.subpaths(start, to_wo, &camera[..n_camera], &light[..n_light]);
+        let k_start = inv_g1(&self.slope, start.in_frame());
+        // the (0, 0) connection (single scattering) first: the camera's roulette compares with it
+        let single =
+            order.includes(1).then(|| self.connect_known(start, k_start, to_wo, VertexRole::Last, rng));
+        let roulette = Roulette::new(self, start, k_start, single);
+        self.camera_subpath(start, k_start, to_wo, max_sub, &mut camera, &roulette, rng);
+        self.light_subpath(to_wo, max_sub, &mut light, rng);
+        let (n_camera, n_light) = (camera.len, light.len);
+        let paths = Subpaths { start, k_start, to_wo, single, camera: &camera, light: &light };
 
-        let mut densities = PathDensities::EMPTY;
         let mut sum = DVec3::ZERO;
         for s in 0..=n_camera {
             for t in 0..=n_light {
@@ -107,27 +175,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     continue;
                 }
                 let Some(c) = self.connect_subpaths(&paths, s, t, rng) else { continue };
-                densities.fill(&paths, s, t, &c);
-                sum += throughput * c.contribution * densities.balance_weight(s, n);
+                sum += throughput * c.contribution * paths.balance_weight(s, t, &c);
             }
         }
-        sum.as_vec3()
-    }
-
-    /// The two sub-paths with the per-vertex data every connection shares: 1 + L̃ of every
-    /// camera incident direction and the exit data of every light outgoing direction.
-    fn subpaths<'a>(
-        &self,
-        start: Incident,
-        to_wo: Exit,
-        camera: &'a [CameraVertex],
-        light: &'a [LightVertex],
-    ) -> Subpaths<'a> {
-        let mut exits = [to_wo; BDPT_MAX_SUBPATH + 1];
-        for (exit, l) in exits[1..].iter_mut().zip(light) {
-            *exit = self.exit(-l.incident.w, l.incident.side);
-        }
-        Subpaths { start, k_start: inv_g1(&self.slope, start.in_frame()), camera, light, exits }
+        (sum.as_vec3(), n_camera, n_light)
     }
 
     /// The connection of the first `s` camera directions to the first `t` light directions
@@ -143,14 +194,21 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         rng: &mut impl Rng,
     ) -> Option<Connection> {
         let (at, k_at) = paths.camera_end(s);
-        let out = paths.exits[t];
+        let out = paths.exit(t);
         let connection = if t == 0 {
             let (contribution, reverse) = match s {
-                0 => (self.connect_known(at, k_at, out, VertexRole::Last, rng), 0.0),
-                _ => (
-                    paths.camera[s - 1].connection,
-                    f64::from(self.material.pdf_phase_unchecked(&self.slope, &at.towards(out).reversed())),
-                ),
+                0 => (paths.single?, 0.0),
+                _ => {
+                    let contribution = paths.camera.get(s - 1).connection;
+                    if contribution == DVec3::ZERO {
+                        return None;
+                    }
+                    // p← from ωo, whose projected area is (1 + Λo) cos θo
+                    let area =
+                        out.lambda.and_then(|lambda| known_area(out.side.frame(out.w).z, 1.0 + lambda));
+                    let reverse = at.towards(out).reversed().with_incident_area(area);
+                    (contribution, f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse)))
+                }
             };
             Connection { contribution, forward: 0.0, reverse }
         } else if k_at < LAMBDA_RATIO_LOG_BELOW {
@@ -183,91 +241,95 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         (connection.contribution != DVec3::ZERO).then_some(connection)
     }
 
-    /// Samples up to `max` directions from ωi; returns how many were stored.
+    /// Samples up to `max` directions from ωi into `out`.
+    #[allow(clippy::too_many_arguments)]
     fn camera_subpath(
         &self,
         start: Incident,
+        k_start: f64,
         to_wo: Exit,
         max: usize,
-        out: &mut [CameraVertex; BDPT_MAX_SUBPATH],
+        out: &mut Vertices<CameraVertex>,
+        roulette: &Roulette,
         rng: &mut impl Rng,
-    ) -> usize {
+    ) {
         let mut at = start;
-        let mut k_at = inv_g1(&self.slope, start.in_frame());
+        let mut k_at = k_start;
         let mut throughput = DVec3::ONE;
-        for (j, slot) in out.iter_mut().enumerate().take(max) {
-            let Some((next, k_next, ratio)) = self.extend_known(at, k_at, rng) else { return j };
+        for j in 0..max {
+            let Some((next, k_next, ratio)) = self.extend_known(at, k_at, rng) else { return };
             throughput *= ratio;
             if throughput == DVec3::ZERO {
-                return j;
+                return;
             }
-            let x = -next.w;
-            let step = at.to(x, next.side);
-            let pdf_forward = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step));
-            let pdf_reverse_prev =
-                f64::from(self.material.pdf_phase_unchecked(&self.slope, &step.reversed()));
-            // the connection of the new vertex to ωo, the (s, 0) strategy's
-            let connection = self.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
-            if j as u32 + 1 >= ROULETTE_FROM_BOUNCE {
-                let q = survival_probability(throughput, k_next);
+            if j + 1 >= BDPT_ROULETTE_FROM {
+                let q = roulette.survival(self, throughput, next, k_next);
                 if f64::from(uniform(rng)) >= q {
-                    return j;
+                    return;
                 }
                 throughput /= q;
             }
-            *slot = CameraVertex { next, k_next, connection, throughput, pdf_forward, pdf_reverse_prev };
+            // the densities of x_j and of its reverse, with the projected areas A = (1 + L̃)cos θ
+            // the step already knows (1 + Λ(x) for x facing up: 1 + k_next)
+            let x = -next.w;
+            let step = at.to(x, next.side).with_incident_area(known_area(at.in_frame().z, k_at));
+            let pdf_forward = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step));
+            let reverse = step.reversed().with_incident_area(known_area(-next.in_frame().z, 1.0 + k_next));
+            let pdf_reverse_prev = f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse));
+            // the connection of the new vertex to ωo, the (s, 0) strategy's
+            let connection = self.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
+            let vertex = CameraVertex { next, k_next, connection, throughput, pdf_forward, pdf_reverse_prev };
+            out.push(vertex, EMPTY_CAMERA);
             (at, k_at) = (next, k_next);
         }
-        max
     }
 
-    /// Samples up to `max` incident directions backwards from ωo; returns how many were
-    /// stored. Each vertex contributes v(ωin, ωout)·S / p←(ωin | ωout), where
+    /// Samples up to `max` incident directions backwards from ωo (exit data `to_wo`) into
+    /// `out`. Each vertex contributes v(ωin, ωout)·S / p←(ωin | ωout), where
     /// v/p← = w·(ηo/ηi)²·A(ωout)/|cos θin| (w: the sample weight, A: the projected area of
     /// ωout in its side frame).
-    fn light_subpath(
-        &self,
-        wo: Vec3,
-        wo_side: Side,
-        max: usize,
-        out: &mut [LightVertex; BDPT_MAX_SUBPATH],
-        rng: &mut impl Rng,
-    ) -> usize {
-        let (mut b, mut b_side) = (wo, wo_side);
+    fn light_subpath(&self, to_wo: Exit, max: usize, out: &mut Vertices<LightVertex>, rng: &mut impl Rng) {
+        let mut b = to_wo;
         let mut throughput = DVec3::ONE;
-        for (i, slot) in out.iter_mut().enumerate().take(max) {
-            let s = self.material.sample_phase_unchecked(&self.slope, b, b_side, rng);
+        for i in 0..max {
+            let s = self.material.sample_phase_unchecked(&self.slope, b.w, b.side, rng);
             let a = Incident { w: s.wo, side: s.side };
-            let k_in = inv_g1(&self.slope, a.in_frame());
+            let a_frame = a.in_frame();
+            let k_in = inv_g1(&self.slope, a_frame);
             if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
-                return i;
+                return;
             }
             // the vertex at ωo is the path's last, every later one a middle vertex
             let role = if i == 0 { VertexRole::Last } else { VertexRole::Middle };
-            let factor = self.shadowing_factor(a, k_in, self.exit(b, b_side), role)
-                * f64::from(self.material.relative_eta_sq(a.side, b_side))
-                * f64::from(self.slope.projected_area_unchecked(b_side.frame(b)))
+            // A(ωout) = (1 + Λ(ωout)) cos θout where ωout faces up in its frame (Λ known)
+            let b_frame_z = b.side.frame(b.w).z;
+            let b_area = b.lambda.and_then(|lambda| known_area(b_frame_z, 1.0 + lambda));
+            let factor = self.shadowing_factor(a, k_in, b, role)
+                * f64::from(self.material.relative_eta_sq(a.side, b.side))
+                * f64::from(b_area.unwrap_or_else(|| self.slope.projected_area_unchecked(b.side.frame(b.w))))
                 / f64::from(a.w.z.abs());
             throughput *= s.weight.as_dvec3() * factor;
             if throughput == DVec3::ZERO || !throughput.is_finite() {
-                return i;
+                return;
             }
-            let step = a.to(b, b_side);
-            let pdf_reverse = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step.reversed()));
-            let pdf_forward_out =
-                if i == 0 { 0.0 } else { f64::from(self.material.pdf_phase_unchecked(&self.slope, &step)) };
-            if i as u32 + 1 >= ROULETTE_FROM_BOUNCE {
+            if i + 1 >= BDPT_ROULETTE_FROM {
                 let q = throughput.max_element().min(1.0);
                 if f64::from(uniform(rng)) >= q {
-                    return i;
+                    return;
                 }
                 throughput /= q;
             }
-            *slot = LightVertex { incident: a, throughput, pdf_reverse, pdf_forward_out };
-            b = -a.w;
-            b_side = a.side;
+            let step = a.to(b.w, b.side).with_incident_area(known_area(a_frame.z, k_in));
+            let reverse = step.reversed().with_incident_area(b_area);
+            let pdf_reverse = f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse));
+            let pdf_forward_out =
+                if i == 0 { 0.0 } else { f64::from(self.material.pdf_phase_unchecked(&self.slope, &step)) };
+            // −a can leave the surface where a points down in its frame, and then its Λ is
+            // 1 + L̃ of a (Λ(−ω) = −1 − Λ(ω)): the exit data without another Λ
+            let out_next = Exit { w: -a.w, side: a.side, lambda: (a_frame.z < 0.0).then_some(k_in) };
+            out.push(LightVertex { out_next, throughput, pdf_reverse, pdf_forward_out }, EMPTY_LIGHT);
+            b = out_next;
         }
-        max
     }
 }
 
@@ -278,30 +340,74 @@ struct Subpaths<'a> {
     start: Incident,
     /// 1 + L̃ of ωi in its side frame.
     k_start: f64,
+    /// The exit data of ωo.
+    to_wo: Exit,
+    /// The (0, 0) connection (single scattering), where the evaluated orders include it.
+    single: Option<DVec3>,
     /// The sampled camera vertices.
-    camera: &'a [CameraVertex],
+    camera: &'a Vertices<CameraVertex>,
     /// The sampled light vertices.
-    light: &'a [LightVertex],
-    /// The exit data of ωo (index 0) and of the outgoing direction of light vertex t (index t).
-    exits: [Exit; BDPT_MAX_SUBPATH + 1],
+    light: &'a Vertices<LightVertex>,
 }
 
 impl Subpaths<'_> {
     /// The incident state and its 1 + L̃ at the end of the first `s` camera directions.
-    #[inline]
+    #[inline(always)]
     fn camera_end(&self, s: usize) -> (Incident, f64) {
         match s {
             0 => (self.start, self.k_start),
-            _ => (self.camera[s - 1].next, self.camera[s - 1].k_next),
+            _ => {
+                let v = self.camera.get(s - 1);
+                (v.next, v.k_next)
+            }
+        }
+    }
+
+    /// The exit data of the outgoing direction at the end of the first `t` light directions:
+    /// ωo for t = 0.
+    #[inline(always)]
+    fn exit(&self, t: usize) -> Exit {
+        match t {
+            0 => self.to_wo,
+            _ => self.light.get(t - 1).out_next,
         }
     }
 
     /// The product of the two sub-paths' throughputs for the prefixes of lengths `s`, `t`.
-    #[inline]
+    #[inline(always)]
     fn throughput(&self, s: usize, t: usize) -> DVec3 {
-        let camera = if s == 0 { DVec3::ONE } else { self.camera[s - 1].throughput };
-        let light = if t == 0 { DVec3::ONE } else { self.light[t - 1].throughput };
+        let camera = if s == 0 { DVec3::ONE } else { self.camera.get(s - 1).throughput };
+        let light = if t == 0 { DVec3::ONE } else { self.light.get(t - 1).throughput };
         camera * light
+    }
+
+    /// The balance-heuristic weight of the path of `s` camera directions, the connection `c`
+    /// and `t` light directions (n = s + t + 1 vertices, directions x_1 … x_{n−1}), from the
+    /// densities the sub-paths stored ([`balance_weight_of`]).
+    #[inline(always)]
+    fn balance_weight(&self, s: usize, t: usize, c: &Connection) -> f64 {
+        let n = s + t + 1;
+        // p→(x_j): camera steps, then the connection, then the light steps read forwards
+        let forward = |j: usize| {
+            if j <= s {
+                self.camera.get(j - 1).pdf_forward
+            } else if j == s + 1 {
+                c.forward
+            } else {
+                self.light.get(n - j).pdf_forward_out
+            }
+        };
+        // p←(x_j): the camera's reverse densities, the connection's, then the light's sampled ones
+        let reverse = |j: usize| {
+            if j < s {
+                self.camera.get(j).pdf_reverse_prev
+            } else if j == s {
+                c.reverse
+            } else {
+                self.light.get(n - j - 1).pdf_reverse
+            }
+        };
+        balance_weight_of(n - 1, s, forward, reverse)
     }
 }
 
@@ -315,66 +421,43 @@ struct Connection {
     reverse: f64,
 }
 
-/// The densities of the directions x_1 … x_{n−1} of one path (index j − 1): p→ as sampled
-/// from the camera side, p← as sampled from the light side.
-struct PathDensities {
-    forward: [f64; 2 * BDPT_MAX_SUBPATH + 1],
-    reverse: [f64; 2 * BDPT_MAX_SUBPATH + 1],
-}
-
-impl PathDensities {
-    const EMPTY: Self =
-        Self { forward: [0.0; 2 * BDPT_MAX_SUBPATH + 1], reverse: [0.0; 2 * BDPT_MAX_SUBPATH + 1] };
-
-    /// The densities of the path of `s` camera directions, the connection `c` and `t` light
-    /// directions (n = s + t + 1 vertices).
-    #[inline]
-    fn fill(&mut self, paths: &Subpaths<'_>, s: usize, t: usize, c: &Connection) {
-        let n = s + t + 1;
-        for j in 1..=s {
-            self.forward[j - 1] = paths.camera[j - 1].pdf_forward;
-            if j < s {
-                self.reverse[j - 1] = paths.camera[j].pdf_reverse_prev;
-            }
-        }
-        if s >= 1 {
-            self.reverse[s - 1] = c.reverse;
-        }
-        if t >= 1 {
-            self.forward[s] = c.forward;
-            for j in (s + 1)..n {
-                let i = n - j; // light vertex whose sampled incident direction is −x_j
-                self.reverse[j - 1] = paths.light[i - 1].pdf_reverse;
-                if j > s + 1 {
-                    self.forward[j - 1] = paths.light[i].pdf_forward_out;
-                }
-            }
-        }
-    }
-
-    /// The balance-heuristic weight of the strategy with `s` camera directions for the
-    /// filled path of `n` vertices.
-    #[inline]
-    fn balance_weight(&self, s: usize, n: usize) -> f64 {
-        balance_weight(&self.forward[..n - 1], &self.reverse[..n - 1], s)
-    }
+/// The projected area A(ω) = (1 + L̃(ω)) cos θ of a direction facing up in its side frame
+/// (z-component `z` > 0) with 1 + L̃ = `k` known, rounded once to f32 (`None` otherwise: the
+/// materials form a backfacing direction's density in f64 from the slope): the area the
+/// densities of [`Material::pdf_phase`] would otherwise evaluate again.
+#[inline(always)]
+fn known_area(z: f32, k: f64) -> Option<f32> {
+    (z > 0.0).then(|| (k * f64::from(z)) as f32)
 }
 
 /// The balance-heuristic weight P_s / Σ_t P_t of the strategy that sampled s directions
 /// from the camera side, for a path whose directions x_1 … x_{n−1} have forward densities
 /// `forward[j−1]` and reverse densities `reverse[j−1]` (P_t = Π_{j≤t} p→_j Π_{j>t} p←_j).
-/// Computed from the ratios P_t/P_s, whose factors are sampled densities (> 0).
-#[inline]
+#[cfg(test)]
 fn balance_weight(forward: &[f64], reverse: &[f64], s: usize) -> f64 {
+    balance_weight_of(forward.len(), s, |j| forward[j - 1], |j| reverse[j - 1])
+}
+
+/// The balance-heuristic weight P_s / Σ_t P_t of the strategy that sampled s of the `dirs`
+/// directions x_1 … x_dirs from the camera side, with the forward and reverse densities of x_j
+/// given by `forward(j)` and `reverse(j)` (P_t = Π_{j≤t} p→_j Π_{j>t} p←_j). Computed from the
+/// ratios P_t/P_s, whose factors are sampled densities (> 0).
+#[inline(always)]
+fn balance_weight_of(
+    dirs: usize,
+    s: usize,
+    forward: impl Fn(usize) -> f64,
+    reverse: impl Fn(usize) -> f64,
+) -> f64 {
     let mut total = 1.0;
     let mut r = 1.0;
-    for j in (s + 1)..=forward.len() {
-        r *= density_ratio(forward[j - 1], reverse[j - 1]);
+    for j in (s + 1)..=dirs {
+        r *= density_ratio(forward(j), reverse(j));
         total += r;
     }
     r = 1.0;
     for j in (1..=s).rev() {
-        r *= density_ratio(reverse[j - 1], forward[j - 1]);
+        r *= density_ratio(reverse(j), forward(j));
         total += r;
     }
     if total.is_finite() { 1.0 / total } else { 0.0 }

@@ -277,12 +277,12 @@ impl Material for Dielectric {
         Vec3::splat(self.pdf_phase_unchecked(slope, it))
     }
 
-    #[inline]
+    #[inline(always)]
     fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
         self.seen_from(it.wi_side()).eval_phase_outside(slope, &it.seen_from_outside())
     }
 
-    #[inline]
+    #[inline(always)]
     fn vertex_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,

@@ -307,8 +307,11 @@ impl Material for Dielectric {
         self.sample_at_facet(slope, wi, side, u1, u2, rng)
     }
 
-    /// The visible normal's two uniforms from one 64-bit draw (the walks' stream).
-    #[inline]
+    /// The visible normal's two uniforms from one 64-bit draw (the walks' stream). Out of
+    /// line: inlined with the GGX visible normal into the walk's loop, the listing's GGX
+    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Integration,
+    /// session 6”).
+    #[inline(never)]
     fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
         &self,
         slope: &S,

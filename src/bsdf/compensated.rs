@@ -444,10 +444,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        let v = self.single.eval_keyed(wo, wi, key);
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
-            return v;
+            return self.single.eval_keyed(wo, wi, key);
         }
+        let v = self.single.eval_valid(wo, wi, key);
         let f = match self.scheme {
             Compensation::KullaConty | Compensation::PerOrder => v.f + self.added(wo.z, wi.z),
             Compensation::Turquin => v.f * self.turquin_factor(self.view_complement(wo)),
@@ -500,10 +500,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
-            return (v, pdf_ss);
+            return self.single.eval_with_pdf_keyed(wo, wi, key);
         }
+        let (v, pdf_ss) = self.single.eval_with_pdf_valid(wo, wi, key);
         match self.scheme {
             Compensation::KullaConty | Compensation::PerOrder => {
                 let f = v.f + self.added(wo.z, wi.z);

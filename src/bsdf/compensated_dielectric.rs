@@ -169,11 +169,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedDielectric<S> {
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        let v = self.single.eval_keyed(wo, wi, key);
-        if !valid_direction(wo) {
-            return v;
+        if !valid_direction(wo) || !valid_direction(wi) {
+            return self.single.eval_keyed(wo, wi, key);
         }
-        Self::scaled(v, self.factor(wo))
+        Self::scaled(self.single.eval_valid(wo, wi, key), self.factor(wo))
     }
 
     #[inline]
@@ -193,10 +192,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedDielectric<S> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        let (v, pdf) = self.single.eval_with_pdf_keyed(wo, wi, key);
-        if !valid_direction(wo) {
-            return (v, pdf);
+        if !valid_direction(wo) || !valid_direction(wi) {
+            return self.single.eval_with_pdf_keyed(wo, wi, key);
         }
+        let (v, pdf) = self.single.eval_with_pdf_valid(wo, wi, key);
         (Self::scaled(v, self.factor(wo)), pdf)
     }
 }

@@ -19,9 +19,13 @@ use rand::Rng;
 /// D_ωi where an integral over the visible normals is estimated:
 /// - phase function p(ωi, ωo) = (a/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm, estimated with one ωm
 ///   (supplement §3.3, Algorithm 5): unbiased, stochastic;
-/// - `pdf_phase`: an approximation, 1/(8π) + max(0, cos θo)/(2π): the exact density
-///   (1/π) ∫⟨ωo, ωm⟩ D_ωi(ωm) dωm has no closed form. Positive on the whole sphere, so that
-///   MIS weights built on it never exclude a path;
+/// - `pdf_phase`: an approximation of the exact density (1/π) ∫⟨ωo, ωm⟩⁺ D_ωi(ωm) dωm, which
+///   has no closed form: 1/(8π) + cos θo/(2π) for ωo above the horizon, and below it
+///   min(1/(8π), A(ωo)/(π A(ωi))) (A the projected area), the second term an upper bound of
+///   the exact density, which is of order e^{−a²} there below a smooth surface unless ωi is as
+///   far below. Positive on the whole sphere (up to f32 underflow), so that MIS weights built
+///   on it exclude no path; its shape below the horizon keeps the bidirectional estimator's
+///   weights off strategies that practically never sample a path;
 /// - vertex term: (a/π) ⟨ωo, ωm⟩ A(ωi)/|cos θi|, an unbiased estimate of
 ///   (1/|cos θi|) ∫ (a/π) ⟨ωi, ωm⟩⟨ωo, ωm⟩ D(ωm) dωm;
 /// - sampling: ωm from D_ωi, then ωo cosine-distributed about ωm; weight a;
@@ -86,9 +90,45 @@ impl Diffuse {
     }
 }
 
+/// Below this projected area (f64) the bound of [`pdf_below_horizon`] is formed from logarithms.
+const AREA_LOG_BELOW: f64 = 1e-280;
+
+/// The approximate density of a diffuse phase function at an ωo below the horizon:
+/// min(1/(8π), A(ωo)/(π A(ωi))), A the projected area. The second term is an upper bound of
+/// the exact density: p(ωo | ωi) = K(ωi, ωo)/A(ωi) with the symmetric kernel
+/// K = (1/π) ∫⟨ωi, ωm⟩⁺⟨ωo, ωm⟩⁺ D(ωm) dωm ≤ A(ωo)/π. Below a smooth surface A(ωo) ≈ e^{−a²}
+/// (Beckmann, a = |cot θo|/α), and so is the exact density unless ωi is as far below; the
+/// constant 1/(8π) alone overstated it by up to e^{a²}, and the bidirectional estimator's
+/// balance weights gave the light sub-path's strategies a share of paths it practically never
+/// samples (a bias, DESIGN.md, “BDPT and diffuse facets lit from below”). The ratio is formed
+/// from ln Λ where an area underflows f64 (Beckmann, a > 26).
+#[inline(never)]
+fn pdf_below_horizon<S: MicrosurfaceSlope>(slope: &S, it: &Interaction) -> f32 {
+    const FLOOR: f32 = 0.125 / PI;
+    let (wi, wo) = (it.wi(), it.wo());
+    let area_o = slope.projected_area64(wo);
+    let area_i = it.incident_area().map_or_else(|| slope.projected_area64(wi), f64::from);
+    let ratio = if area_o >= AREA_LOG_BELOW && area_i >= AREA_LOG_BELOW {
+        area_o / area_i
+    } else {
+        // ln A(ω) = ln Λ(−ω) + ln|cos θ| below the horizon; above it A ≥ cos θ does not underflow
+        let ln_area = |w: Vec3, area: f64| {
+            if w.z < 0.0 { slope.ln_lambda(-w) + f64::from(-w.z).ln() } else { area.ln() }
+        };
+        let ln_i = ln_area(wi, area_i);
+        if ln_i == f64::NEG_INFINITY {
+            // ωi sees no facet: no bound
+            return FLOOR;
+        }
+        (ln_area(wo, area_o) - ln_i).exp()
+    };
+    FLOOR.min((ratio * core::f64::consts::FRAC_1_PI) as f32)
+}
+
 impl Material for Diffuse {
     const TRANSMITS: bool = false;
     const EXACT_PHASE_PDF: bool = false;
+    const VERTEX_HAS_INCIDENT_AREA: bool = true;
 
     #[inline]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(
@@ -105,11 +145,15 @@ impl Material for Diffuse {
     }
 
     #[inline]
-    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, _slope: &S, it: &Interaction) -> f32 {
+    fn pdf_phase_unchecked<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
         if !it.is_outside_reflection() {
             return 0.0;
         }
-        0.125 / PI + 0.5 * FRAC_1_PI * it.wo().z.max(0.0)
+        let wo = it.wo();
+        if wo.z >= 0.0 {
+            return 0.125 / PI + 0.5 * FRAC_1_PI * wo.z;
+        }
+        pdf_below_horizon(slope, it)
     }
 
     #[inline]

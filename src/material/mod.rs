@@ -78,6 +78,14 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     #[doc(hidden)]
     const MIRROR_FACETS: bool = false;
 
+    /// Whether the vertex term carries the incident projected area A(ωi)/|cos θi| as a factor
+    /// (diffuse facets: their phase function is estimated from D_ωi). For a backfacing ωi that
+    /// factor is Λ(−ωi), below f32's range once Λ(−ωi) < 1e-38 (Beckmann, a = |cot θi|/αᵢ > 9.4),
+    /// so the position-free estimators form such a vertex as phase function × the relative
+    /// shadowing factor instead.
+    #[doc(hidden)]
+    const VERTEX_HAS_INCIDENT_AREA: bool = false;
+
     /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
     /// interaction's sides. Stochastic (unbiased) for the diffuse material, exact otherwise
     /// (the formulas are on each material's type).

@@ -125,8 +125,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// P_s / Σ_t P_t with P_t = Π_{j≤t} p→(x_j) Π_{j>t} p←(x_j). Contributions are always
     /// evaluated from ωi to ωo, which keeps the non-reciprocal correlated model consistent.
     /// The densities are exact for conductors and dielectrics; for diffuse facets the MIS
-    /// weights use [`Material::pdf_phase`]'s deterministic approximation, which keeps the
-    /// estimator unbiased (the weights still sum to one).
+    /// weights use [`Material::pdf_phase`]'s deterministic approximation. The weights still sum
+    /// to one, which keeps the estimator unbiased in principle; in practice the approximation
+    /// must also be small where a strategy's true density is negligible (a strategy given
+    /// weight on paths it never samples loses their energy): below the horizon it is bounded
+    /// by A(ωo)/(π A(ωi)), an upper bound of the true density (see [`crate::Diffuse`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
@@ -211,9 +214,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                 }
             };
             Connection { contribution, forward: 0.0, reverse }
-        } else if k_at < LAMBDA_RATIO_LOG_BELOW {
-            // a backfacing camera end whose Λ(−ωin) is below f64's range: v·S = p·(k_in S)
-            // with the relative factor (see `connect_known`); the densities separately
+        } else if k_at < LAMBDA_RATIO_LOG_BELOW || (M::VERTEX_HAS_INCIDENT_AREA && k_at < 1.0) {
+            // a backfacing camera end whose Λ(−ωin) is below f64's range, or whose vertex term
+            // carries Λ(−ωin) itself (diffuse facets: it underflows f32 below 1e-38, and the
+            // connection was lost, BDPT's order 3 from below at a = 28.9 7.5 % low): v·S =
+            // p·(k_in S) with the relative factor (see `connect_known`); the densities separately
             let factor = self.relative_shadowing(at, k_at, out).middle;
             if factor == 0.0 {
                 return None;

@@ -500,10 +500,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
         if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
-            return self.single.eval_with_pdf_keyed(wo, wi, key);
+            return (v, pdf_ss);
         }
-        let (v, pdf_ss) = self.single.eval_with_pdf_valid(wo, wi, key);
         match self.scheme {
             Compensation::KullaConty | Compensation::PerOrder => {
                 let f = v.f + self.added(wo.z, wi.z);

@@ -192,10 +192,10 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedDielectric<S> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return self.single.eval_with_pdf_keyed(wo, wi, key);
+        let (v, pdf) = self.single.eval_with_pdf_keyed(wo, wi, key);
+        if !valid_direction(wo) {
+            return (v, pdf);
         }
-        let (v, pdf) = self.single.eval_with_pdf_valid(wo, wi, key);
         (Self::scaled(v, self.factor(wo)), pdf)
     }
 }

@@ -434,10 +434,10 @@ impl<S: MicrosurfaceSlope> Bsdf for KullaContyDielectric<S> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
         if !self.compensates(wo, wi) {
-            return self.single.eval_with_pdf_keyed(wo, wi, key);
+            return (v, pdf_ss);
         }
-        let (v, pdf_ss) = self.single.eval_with_pdf_valid(wo, wi, key);
         let (a, p) = self.view(wo);
         let pdf = Self::mixture_pdf(a, p, wo, wi, pdf_ss);
         (BsdfValue { f: v.f + Self::added(a, self.cells(wo, wi), wo, wi), exact: true }, pdf)

@@ -476,32 +476,6 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         BsdfValue { f: self.f_checked(wo, wi, key), exact }
     }
 
-    /// [`Bsdf::eval_with_pdf_keyed`] for directions the caller has validated
-    /// (`valid_direction`); single scattering shares the half vector, D and Λ of the view
-    /// ([`SingleScattering::eval_with_pdf`]).
-    #[inline(always)]
-    pub(crate) fn eval_with_pdf_valid(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        let exact = self.exact_eval(wo);
-        if self.dirac(wo) {
-            return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
-        }
-        if self.technique == Technique::SingleScattering && wi.z != 0.0 {
-            // one half vector, D and Λ(wo) for both (the walk enters along wo)
-            let seed = self.seed;
-            let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
-            let (f_cos_wi, pdf) = self.single().eval_with_pdf_unchecked(wo, wi, &mut rng);
-            let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
-            let f = if f.is_finite() { f } else { Vec3::ZERO };
-            return (BsdfValue { f, exact }, if pdf.is_finite() { pdf } else { 0.0 });
-        }
-        let pdf = self.research_pdf_out(wo, wi);
-        let pdf = if pdf.is_finite() { pdf } else { 0.0 };
-        if wi.z == 0.0 {
-            return (BsdfValue { f: Vec3::ZERO, exact }, pdf);
-        }
-        (BsdfValue { f: self.f_checked(wo, wi, key), exact }, pdf)
-    }
-
     /// [`Bsdf::sample_keyed`] for valid arguments, except the exact mirror reflection.
     #[inline(never)]
     fn sample_general_outlined(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
@@ -598,10 +572,25 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
     /// vector, D and Λ of the view ([`SingleScattering::eval_with_pdf`]).
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return (BsdfValue { f: Vec3::ZERO, exact: self.exact_eval(wo) }, 0.0);
+        let exact = self.exact_eval(wo);
+        if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
+            return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
         }
-        self.eval_with_pdf_valid(wo, wi, key)
+        if self.technique == Technique::SingleScattering && wi.z != 0.0 {
+            // one half vector, D and Λ(wo) for both (the walk enters along wo)
+            let seed = self.seed;
+            let mut rng = PrimedRng::new(&[], || Hasher::directions(seed, key, wo, wi));
+            let (f_cos_wi, pdf) = self.single().eval_with_pdf_unchecked(wo, wi, &mut rng);
+            let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
+            let f = if f.is_finite() { f } else { Vec3::ZERO };
+            return (BsdfValue { f, exact }, if pdf.is_finite() { pdf } else { 0.0 });
+        }
+        let pdf = self.research_pdf_out(wo, wi);
+        let pdf = if pdf.is_finite() { pdf } else { 0.0 };
+        if wi.z == 0.0 {
+            return (BsdfValue { f: Vec3::ZERO, exact }, pdf);
+        }
+        (BsdfValue { f: self.f_checked(wo, wi, key), exact }, pdf)
     }
 
     #[inline]

@@ -390,8 +390,14 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     /// both branches of sample agree bit for bit.
     #[inline(always)]
     fn mixture_pdf(&self, mu_o: f32, pdf_ss: f32, mu_i: f32) -> f32 {
+        self.mixture_pdf_above(mu_o, pdf_ss, mu_i.max(0.0))
+    }
+
+    /// [`Self::mixture_pdf`] for a light above the horizon (`mu_i` ≥ 0), the same bits.
+    #[inline(always)]
+    fn mixture_pdf_above(&self, mu_o: f32, pdf_ss: f32, mu_i: f32) -> f32 {
         let [p, q] = *self.mixture.at(mu_o);
-        p * pdf_ss + q * self.profile.pdf(mu_i.max(0.0))
+        p * pdf_ss + q * self.profile.pdf(mu_i)
     }
 
     /// Single scattering's density at a pair of valid directions with `wo` above the horizon:
@@ -492,10 +498,14 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe,
         // whose pdf validates the directions
-        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) {
+        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) || !(wi.z > 0.0) {
+            // (a light below the horizon: single scattering's density, 0 for a view from above
+            // — the mixture's p·0 + q·0)
             return self.single.pdf(wo, wi);
         }
-        self.mixture_pdf(wo.z, self.single_pdf(wo, wi), wi.z)
+        // `single_pdf` of a light above the horizon, without its test
+        let pdf_ss = SingleScattering::<S, Conductor>::mirror_density(self.single.surface().slope(), wo, wi);
+        self.mixture_pdf_above(wo.z, if pdf_ss.is_finite() { pdf_ss } else { 0.0 }, wi.z)
     }
 
     #[inline]

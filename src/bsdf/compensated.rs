@@ -498,7 +498,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe,
         // whose pdf validates the directions
-        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) || !(wi.z > 0.0) {
+        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) || wi.z <= 0.0 {
             // (a light below the horizon: single scattering's density, 0 for a view from above
             // — the mixture's p·0 + q·0)
             return self.single.pdf(wo, wi);

@@ -106,7 +106,8 @@ pub enum Compensation {
     ///
     /// per channel, with e_k the F = 1 walk's energy of order k = 2 … 6 and the tail (weighted
     /// as the geometric continuation of orders 6 and above: e_6 F̄⁶ ρF̄/(1 − ρF̄),
-    /// ρ = e_tail/(e_6 + e_tail), which is e_tail at F̄ = 1). Its albedo is exactly g(μo): the
+    /// ρ = e_tail/(e_6 + e_tail), which is e_tail at F̄ = 1; where the walk recorded e_6 = 0
+    /// and a tail, the tail is placed at order 7, e_tail F̄⁷). Its albedo is exactly g(μo): the
     /// energy of each order k weighted by F̄ᵏ (each bounce reflects F_avg), the split of
     /// 1 − E(μ) between the orders taken from the walk instead of Kulla and Conty's
     /// geometric series in E_avg. For F = 1 it is [`Compensation::KullaConty`].
@@ -578,11 +579,16 @@ fn per_order_lobe(
                     .enumerate()
                     .map(|(k, &ek)| ek * fbar.powi(k as i32 + 2))
                     .sum();
-                if last + tail > 0.0 {
+                if last > 0.0 {
                     // the tail as the geometric continuation e_K ρ^m of order K = 6
                     let rho = tail / (last + tail);
                     weighted +=
                         last * fbar.powi(LAST_TABULATED_ORDER as i32) * rho * fbar / (1.0 - rho * fbar);
+                } else {
+                    // no walk of this node ended at order K but some went beyond (the tables'
+                    // noise: a few of 2¹⁶ walks): no ratio to continue, so the tail is placed at
+                    // the first order it can have, K + 1 (ρ = 1 made it 0·∞ = NaN for F̄ = 1)
+                    weighted += tail * fbar.powi(LAST_TABULATED_ORDER as i32 + 1);
                 }
                 weighted / total
             } else {
@@ -599,6 +605,7 @@ fn per_order_lobe(
             h[c] = (f64::from(gi) * norm) as f32;
         }
     }
+    debug_assert!(h.iter().all(|v| v.is_finite()), "per-order lobe not finite at α = {alpha}: {h:?}");
     h
 }
 

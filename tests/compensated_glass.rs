@@ -11,7 +11,9 @@ use microsurface::{
     MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Side, Technique, Transport, UniformHeight,
     WalkTabulated,
 };
-use validation::check::{EDGE_VIEW_COSINES, assert_finite_at_edges, assert_side_flags, draw, edge_view};
+use validation::check::{
+    EDGE_VIEW_COSINES, assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw, edge_view,
+};
 use validation::chi2::{BsdfChi2, sampler_chi2};
 use validation::quadrature::{Domain, integrate_sphere};
 use validation::{Stats, assert_mean, dir, family_z, sidak, uniform32};
@@ -516,4 +518,31 @@ fn anisotropic_slopes_read_the_geometric_mean() {
     let b = KullaContyDielectric::new(Ggx::new(0.2, 0.8).unwrap(), glass(1.5)).unwrap();
     assert!((b.table_alpha() - 0.4).abs() <= 1e-6);
     assert!(b.single_scattering().surface().slope().alpha_x() == 0.2);
+}
+
+/// No non-finite value from the compensated glass lobes on an (α, η) scan: 48 roughnesses
+/// (k/48)², the η nodes of the tables' axis η = 1 + 2u³ (u = i/15) seen from outside and
+/// from inside (1/η) plus 1.5 and 1/1.5, `KullaContyDielectric` for GGX and Beckmann and
+/// Turquin's `CompensatedDielectric` for GGX, 20 random pairs of directions on the sphere each
+/// (the scan that found the per-order conductor lobe's NaN bands, `tests/compensated.rs`).
+#[test]
+fn every_compensated_glass_is_finite_on_a_roughness_and_eta_scan() {
+    let mut rng = validation::rng(2052);
+    let etas: Vec<f32> = (1..16)
+        .map(|i| 1.0 + 2.0 * (i as f32 / 15.0).powi(3))
+        .chain([1.5])
+        .flat_map(|eta| [eta, 1.0 / eta])
+        .collect();
+    for k in 1..=48 {
+        let a = (k as f32 / 48.0).powi(2);
+        for &eta in &etas {
+            let label = |name: &str| format!("{name} α = {a} η = {eta}");
+            let b = KullaContyDielectric::new(ggx(a), glass(eta)).unwrap();
+            assert_finite_on_sphere(&b, 20, &mut rng, &label("KullaContyDielectric GGX"));
+            let b = KullaContyDielectric::new(beckmann(a), glass(eta)).unwrap();
+            assert_finite_on_sphere(&b, 20, &mut rng, &label("KullaContyDielectric Beckmann"));
+            let b = microsurface::CompensatedDielectric::new(ggx(a), glass(eta)).unwrap();
+            assert_finite_on_sphere(&b, 20, &mut rng, &label("CompensatedDielectric GGX"));
+        }
+    }
 }

@@ -40,6 +40,36 @@ pub fn assert_finite_at_edges(b: &dyn Bsdf, wis: &[Vec3], label: &str) {
     }
 }
 
+/// No NaN or infinity from `eval`, `pdf`, `eval_with_pdf` or `sample` at `n` pairs of
+/// directions uniform on the sphere (both sides of the surface) and fresh uniforms: the
+/// scan for the tables' rows and cells where a lobe's construction could go non-finite.
+/// `label` names the BSDF on failure.
+#[track_caller]
+pub fn assert_finite_on_sphere(b: &dyn Bsdf, n: usize, rng: &mut TestRng, label: &str) {
+    let unit = |rng: &mut TestRng| {
+        let z = 2.0 * uniform32(rng) - 1.0;
+        let phi = core::f32::consts::TAU * uniform32(rng);
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(s * phi.cos(), s * phi.sin(), z)
+    };
+    for _ in 0..n {
+        let (wo, wi) = (unit(rng), unit(rng));
+        let (f, pdf) = (b.eval(wo, wi).f, b.pdf(wo, wi));
+        let (v, q) = b.eval_with_pdf(wo, wi);
+        assert!(
+            f.is_finite() && pdf.is_finite() && v.f.is_finite() && q.is_finite(),
+            "{label} wo = {wo} wi = {wi}: f = {f}, pdf = {pdf}, eval_with_pdf = ({}, {q})",
+            v.f
+        );
+        if let Some(s) = draw(b, wo, rng) {
+            assert!(
+                s.weight.is_finite() && s.pdf.is_finite() && s.pdf > 0.0 && s.wi.is_finite(),
+                "{label} wo = {wo}: {s:?}"
+            );
+        }
+    }
+}
+
 /// Asserts that `result` is `Error::InvalidParameter` for `name` with the rejected `value`
 /// (the same bits, or both NaN), a non-empty `expected`, and a Display that names `name`.
 #[track_caller]

@@ -504,9 +504,13 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
             // — the mixture's p·0 + q·0)
             return self.single.pdf(wo, wi);
         }
+        // the mixture's table lookups first (independent of the mirror density, their
+        // latency overlaps it); the same expression as `mixture_pdf_above`, the same bits
+        let [p, q] = *self.mixture.at(wo.z);
+        let added = q * self.profile.pdf(wi.z);
         // `single_pdf` of a light above the horizon, without its test
         let pdf_ss = SingleScattering::<S, Conductor>::mirror_density(self.single.surface().slope(), wo, wi);
-        self.mixture_pdf_above(wo.z, if pdf_ss.is_finite() { pdf_ss } else { 0.0 }, wi.z)
+        p * if pdf_ss.is_finite() { pdf_ss } else { 0.0 } + added
     }
 
     #[inline]

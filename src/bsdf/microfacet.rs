@@ -365,6 +365,9 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     #[inline(always)]
     fn f_checked(&self, wo: Vec3, wi: Vec3, key: u64) -> Vec3 {
         let (walk_in, walk_out) = (wo, wi);
+        // the factor from f·|cos θi| to f, ahead of the estimate (its division then runs
+        // alongside the walk instead of after it)
+        let scale = self.transport_scale(wo, wi) / wi.z.abs();
         let seed = self.seed;
         let hash = || Hasher::directions(seed, key, wo, wi);
         let f_cos_wi = if self.technique == Technique::SingleScattering {
@@ -375,7 +378,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             // bookkeeping on each of the walk's draws
             self.research_f_cos_out(walk_in, walk_out, &mut hash().generator())
         };
-        let f = f_cos_wi * (self.transport_scale(wo, wi) / wi.z.abs());
+        let f = f_cos_wi * scale;
         if f.is_finite() { f } else { Vec3::ZERO }
     }
 

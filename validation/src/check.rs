@@ -2,7 +2,7 @@
 //! panics, f32 spacings, finite answers at a BSDF's edges, relative comparisons of values, a
 //! sample from fresh uniforms.
 
-use crate::{TestRng, uniform32};
+use crate::{TestRng, uniform_sphere, uniform32};
 use glam::{Vec2, Vec3};
 use microsurface::{Bsdf, BsdfSample, Error};
 
@@ -46,14 +46,8 @@ pub fn assert_finite_at_edges(b: &dyn Bsdf, wis: &[Vec3], label: &str) {
 /// `label` names the BSDF on failure.
 #[track_caller]
 pub fn assert_finite_on_sphere(b: &dyn Bsdf, n: usize, rng: &mut TestRng, label: &str) {
-    let unit = |rng: &mut TestRng| {
-        let z = 2.0 * uniform32(rng) - 1.0;
-        let phi = core::f32::consts::TAU * uniform32(rng);
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(s * phi.cos(), s * phi.sin(), z)
-    };
     for _ in 0..n {
-        let (wo, wi) = (unit(rng), unit(rng));
+        let (wo, wi) = (uniform_sphere(rng), uniform_sphere(rng));
         let (f, pdf) = (b.eval(wo, wi).f, b.pdf(wo, wi));
         let (v, q) = b.eval_with_pdf(wo, wi);
         assert!(

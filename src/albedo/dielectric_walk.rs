@@ -2,9 +2,8 @@
 //! and transmission, and their interpolation.
 
 use super::axis::{node_cell, scale_invariant_direction};
-use super::dielectric::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};
 use super::dielectric_walk_data as data;
-use super::grid::{NODES, SideGrids};
+use super::grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA, NODES, SideGrids};
 use super::table::MAX_TABULATED_ALPHA;
 
 /// Walks per batch of the generator: a cell's walk count is a multiple of it.

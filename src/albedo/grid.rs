@@ -3,7 +3,38 @@
 //! slowest and the direction fastest, and their interpolation.
 
 use super::axis::node_cell;
-use super::dielectric::{DIELECTRIC_TABLE_SIZE, EtaRange};
+
+/// Nodes per axis of the dielectric tables: 16 × 16 × 16 per side of the interface.
+pub const DIELECTRIC_TABLE_SIZE: usize = 16;
+
+/// The largest relative index the dielectric tables cover; the smallest is its inverse.
+pub const MAX_TABULATED_ETA: f32 = 3.0;
+
+/// Which of a family's two dielectric tables: the one of relative indices η ≥ 1 (light
+/// arriving from the side of the lower index, external incidence) or the one of η ≤ 1 (from
+/// the side of the higher index, internal incidence, with total internal reflection beyond the
+/// critical angle). For an interface of index η ≥ 1 (glass in air) light from
+/// [`crate::Side::Outside`] reads [`EtaRange::AtLeastOne`] at η and light from
+/// [`crate::Side::Inside`] reads [`EtaRange::AtMostOne`] at 1/η; [`EtaRange::of`] selects by
+/// the relative index seen by the light.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EtaRange {
+    /// Relative indices η ∈ [1, [`MAX_TABULATED_ETA`]].
+    AtLeastOne,
+    /// Relative indices η ∈ [1/[`MAX_TABULATED_ETA`], 1].
+    AtMostOne,
+}
+
+impl EtaRange {
+    /// The table of the relative index η seen by the light: [`EtaRange::AtLeastOne`] for
+    /// η ≥ 1, [`EtaRange::AtMostOne`] otherwise (NaN included).
+    #[must_use]
+    #[inline]
+    pub fn of(eta: f32) -> Self {
+        if eta >= 1.0 { Self::AtLeastOne } else { Self::AtMostOne }
+    }
+}
+
 
 /// Nodes per grid.
 pub(crate) const NODES: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;

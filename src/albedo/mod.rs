@@ -22,9 +22,8 @@ mod grid;
 mod table;
 
 pub(crate) use axis::{DielectricDirection, floor_index, node_cell, scale_invariant_direction};
-pub use dielectric::{
-    DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable, EtaRange, MAX_TABULATED_ETA,
-};
+pub use dielectric::{DielectricAlbedo, DielectricAlbedoTable};
+pub use grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};
 pub use dielectric_walk::{DielectricWalkTable, HigherOrders, MAX_WALK_TABLE_SE, WALK_BATCH};
 pub use orders::{
     LAST_TABULATED_ORDER, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable, TabulatedOrder,

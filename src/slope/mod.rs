@@ -10,6 +10,7 @@ mod extract;
 mod ggx;
 mod grid;
 mod noncentral;
+mod stretch;
 mod tabulated;
 
 pub use beckmann::Beckmann;
@@ -22,6 +23,9 @@ pub use ggx::Ggx;
 pub use grid::GridSlope;
 pub use noncentral::Noncentral;
 pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
+
+pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
+pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;

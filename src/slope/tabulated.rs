@@ -5,7 +5,7 @@ use super::MicrosurfaceSlope;
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
 use crate::vector::ensure_visible;
-use crate::vndf::Azimuth;
+use super::stretch::Azimuth;
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
 

@@ -6,7 +6,9 @@ use crate::error::Error;
 use crate::special::{
     EXP_NONPOSITIVE_FROM, PSI_SERIES_FROM, exp_nonpositive, one_minus_scaled_erfcx, tail_ratio,
 };
-use crate::vndf::{sample_visible_normal, visible_slopes};
+mod inversion;
+
+pub(crate) use inversion::{gaussian_slope, sample_visible_normal, visible_slope_x_above, visible_slopes};
 use glam::{DVec3, Vec2, Vec3};
 
 /// 1/π.

@@ -4,7 +4,7 @@
 //! in the azimuth frame of ωs are rotated back and scaled by (αx, αy). Written once, for f32
 //! and f64 callers alike, with the same operations in either precision.
 
-use crate::slope::MicrosurfaceSlope;
+use super::MicrosurfaceSlope;
 use crate::vector::normal_from_slopes;
 use core::ops::{Add, Div, Mul, Sub};
 use glam::{DVec3, Vec2, Vec3};

@@ -5,7 +5,9 @@ use super::{
     reflection_density64, smith_d_wi64,
 };
 use crate::error::Error;
-use crate::vndf::{sample_spherical_cap, sample_visible_hemisphere};
+mod visible;
+
+use visible::{sample_spherical_cap, sample_visible_hemisphere};
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
 

@@ -126,6 +126,8 @@ mod leadr;
 mod material;
 mod merl;
 mod microsurface;
+mod path;
+mod noncentral;
 mod position_free;
 mod rng;
 mod sampling;
@@ -146,7 +148,7 @@ pub use basis::orthonormal_basis;
 pub use bsdf::{
     AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
     CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, KullaContyDielectric,
-    MAX_WALK_ALPHA, MicrofacetBsdf, NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SMOOTH_ALPHA,
+    MAX_WALK_ALPHA, MicrofacetBsdf, NoncentralBsdf, NoncentralMasking, SMOOTH_ALPHA,
     SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport, WalkTabulated,
 };
 pub use contract::DIRECTION_TOLERANCE;
@@ -165,7 +167,8 @@ pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half
 pub use microsurface::{
     HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
 };
-pub use position_free::{Estimator, PositionFree, Shadowing};
+pub use path::Shadowing;
+pub use position_free::{Estimator, PositionFree};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
 pub use sampling::{concentric_disk, sample_cosine_hemisphere};
@@ -185,3 +188,4 @@ pub use vndf::{
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+pub use noncentral::NoncentralMaterial;

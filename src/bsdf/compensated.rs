@@ -18,7 +18,7 @@ use crate::albedo::{
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;
-use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+use crate::slope::{AxisAlignedSlope, Beckmann, Elliptical, Ggx, MicrosurfaceSlope};
 use glam::{DVec3, Vec2, Vec3};
 
 /// The conductor tables' direction axis (32 nodes).
@@ -73,6 +73,18 @@ impl AlbedoTabulated for Beckmann {
     const ALBEDO: AlbedoTable = AlbedoTable::BECKMANN;
     const DIELECTRIC_ALBEDO: DielectricAlbedoTable = DielectricAlbedoTable::BECKMANN;
     const ORDERS: ScatteringOrderTable = ScatteringOrderTable::BECKMANN;
+}
+
+impl<S: AxisAlignedSlope + AlbedoTabulated> AlbedoTabulated for Elliptical<S> {
+    const ALBEDO: AlbedoTable = S::ALBEDO;
+    const DIELECTRIC_ALBEDO: DielectricAlbedoTable = S::DIELECTRIC_ALBEDO;
+    const ORDERS: ScatteringOrderTable = S::ORDERS;
+
+    /// √(α₁ α₂): the compensated lobe of the rotated ellipse is that of the axis-aligned one.
+    #[inline]
+    fn albedo_alpha(&self) -> f32 {
+        self.axis_aligned().albedo_alpha()
+    }
 }
 
 /// How a [`CompensatedConductor`] restores the energy single scattering loses.

@@ -9,7 +9,8 @@ use crate::error::Error;
 use crate::height::UniformHeight;
 use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
-use crate::position_free::{Estimator, PositionFree, Shadowing};
+use crate::path::Shadowing;
+use crate::position_free::{Estimator, PositionFree};
 use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use glam::{Vec2, Vec3};
@@ -355,7 +356,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn research_pdf_out(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
         match self.technique {
             Technique::SingleScattering => self.single().pdf_unchecked(walk_in, walk_out),
-            _ => self.position_free(Shadowing::Correlated).pdf_unchecked(walk_in, walk_out),
+            _ => self.single().mis_pdf_unchecked(walk_in, walk_out),
         }
     }
 

@@ -34,7 +34,7 @@ pub use compensated_dielectric::CompensatedDielectric;
 pub use frame::ShadingFrame;
 pub use kulla_conty_dielectric::{KullaContyDielectric, WalkTabulated};
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
-pub use noncentral::{NoncentralBsdf, NoncentralMasking, NoncentralMaterial};
+pub use noncentral::{NoncentralBsdf, NoncentralMasking};
 pub use specular::{SpecularEvent, SpecularLimit};
 
 use glam::{Vec2, Vec3};

@@ -3,51 +3,10 @@
 
 use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::error::Error;
-use crate::material::{Conductor, Material};
-use crate::microsurface::WalkSample;
+use crate::material::Conductor;
+use crate::noncentral::NoncentralMaterial;
 use crate::slope::{MicrosurfaceSlope, Noncentral};
 use glam::{Vec2, Vec3};
-
-/// The materials a [`NoncentralBsdf`] scatters with: [`Conductor`] only.
-///
-/// Sealed. The thesis' noncentral BRDF (Dupuy 2015, eq. 2.9 with eqs. 3.2–3.3) is a reflection
-/// model; a dielectric's refraction through the sheared facets (with the transmitted side's
-/// masking below the base plane, where eq. 3.3 gives 0) is not derived here, so
-/// [`Dielectric`](crate::Dielectric) and [`Diffuse`](crate::Diffuse) do not implement this
-/// trait and `NoncentralBsdf<S, Dielectric>` does not compile.
-pub trait NoncentralMaterial: Material + crate::sealed::Sealed {
-    /// f·|cos| of the research layer: the single-scattering BRDF times cos θo for light from
-    /// `wi` leaving along `wo` ([`Noncentral::eval_single_scattering`]).
-    #[doc(hidden)]
-    fn eval_single<S: MicrosurfaceSlope>(&self, surface: &Noncentral<S>, wi: Vec3, wo: Vec3) -> Vec3;
-
-    /// The research layer's sample of the exit direction for light entering along `wi`
-    /// ([`Noncentral::sample_single_scattering`]).
-    #[doc(hidden)]
-    fn sample_single<S: MicrosurfaceSlope>(
-        &self,
-        surface: &Noncentral<S>,
-        wi: Vec3,
-        u: Vec2,
-    ) -> Option<WalkSample>;
-}
-
-impl NoncentralMaterial for Conductor {
-    #[inline]
-    fn eval_single<S: MicrosurfaceSlope>(&self, surface: &Noncentral<S>, wi: Vec3, wo: Vec3) -> Vec3 {
-        surface.eval_single_scattering(self, wi, wo)
-    }
-
-    #[inline]
-    fn sample_single<S: MicrosurfaceSlope>(
-        &self,
-        surface: &Noncentral<S>,
-        wi: Vec3,
-        u: Vec2,
-    ) -> Option<WalkSample> {
-        surface.sample_single_scattering(self, wi, u.x, u.y)
-    }
-}
 
 /// The masking-shadowing of a [`NoncentralBsdf`]: the thesis' G1 (eq. 3.3), or that G1 clamped
 /// to 1 so that the lobe conserves energy.

@@ -10,7 +10,7 @@ pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::{Interaction, Material, PhaseSample, Side};
-use crate::position_free::{PositionFree, Shadowing};
+use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
@@ -122,8 +122,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if !M::TRANSMITS && (wi.z <= 0.0 || wo.z <= 0.0) {
             if wi.z < 0.0 && wo.z > 0.0 {
-                let pf = PositionFree::new(*self.slope(), self.material, Shadowing::Correlated);
-                return pf.eval_single_scattering(wi, wo, rng);
+                return SingleScattering::new(*self.slope(), self.material).eval_unchecked(wi, wo, rng);
             }
             return Vec3::ZERO;
         }

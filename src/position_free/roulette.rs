@@ -1,7 +1,8 @@
 //! Russian roulette of the camera paths (PT and BDPT's camera sub-path): the survival
 //! probability and the quantities it compares.
 
-use super::{Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree};
+use super::PositionFree;
+use crate::path::{Incident, LAMBDA_RATIO_LOG_BELOW};
 use crate::material::{Material, Side};
 use crate::slope::MicrosurfaceSlope;
 use core::f64::consts::PI;
@@ -210,10 +211,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let scale = 0.25 * self.peaks.material;
         let z = f64::from(w.z);
         if z >= 0.0 {
-            return scale * self.slope.d64_unchecked(DVec3::Z) / (k * z);
+            return scale * self.model.slope.d64_unchecked(DVec3::Z) / (k * z);
         }
         let (x, y) = (f64::from(w.x), f64::from(w.y));
-        let (ax, ay) = (f64::from(self.slope.alpha_x()), f64::from(self.slope.alpha_y()));
+        let (ax, ay) = (f64::from(self.model.slope.alpha_x()), f64::from(self.model.slope.alpha_y()));
         let (ax2, ay2) = (ax * ax, ay * ay);
         let q = ax2 * x * x + ay2 * y * y;
         if q <= 0.0 || q.is_nan() {
@@ -224,12 +225,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let l = z / q;
         let m = DVec3::new(-l * ax2 * x, -l * ay2 * y, 1.0).normalize();
         if k >= LAMBDA_RATIO_LOG_BELOW {
-            return scale * self.slope.d64_unchecked(m) / (k * -z);
+            return scale * self.model.slope.d64_unchecked(m) / (k * -z);
         }
         // Λ(−ω) below f64's range: D(m*) underflows with it; D/A from the visible-normal
         // density just inside m*, which forms it in log space
         let w64 = w.as_dvec3();
         let inside = (m + 1e-9 * w64).normalize();
-        scale * self.slope.d_wi64_unchecked(w, inside) / w64.dot(inside)
+        scale * self.model.slope.d_wi64_unchecked(w, inside) / w64.dot(inside)
     }
 }

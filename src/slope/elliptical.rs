@@ -2,8 +2,6 @@
 //! tangent plane (Dupuy 2015, thesis §2.3).
 
 use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction, is_direction64, is_uniform};
-use crate::albedo::{AlbedoTable, DielectricAlbedoTable};
-use crate::bsdf::AlbedoTabulated;
 use crate::error::Error;
 use crate::vector::ensure_visible;
 use glam::{DVec3, Vec3};
@@ -231,18 +229,6 @@ impl<S> Elliptical<S> {
             (self.sin_phi * x + self.cos_phi * y) as f32,
             m.z,
         )
-    }
-}
-
-impl<S: AxisAlignedSlope + AlbedoTabulated> AlbedoTabulated for Elliptical<S> {
-    const ALBEDO: AlbedoTable = S::ALBEDO;
-    const DIELECTRIC_ALBEDO: DielectricAlbedoTable = S::DIELECTRIC_ALBEDO;
-    const ORDERS: crate::ScatteringOrderTable = S::ORDERS;
-
-    /// √(α₁ α₂): the compensated lobe of the rotated ellipse is that of the axis-aligned one.
-    #[inline]
-    fn albedo_alpha(&self) -> f32 {
-        self.axis_aligned.albedo_alpha()
     }
 }
 

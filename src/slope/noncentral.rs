@@ -3,8 +3,6 @@
 
 use super::{MicrosurfaceSlope, is_direction, is_direction64, is_uniform, normalize_fast};
 use crate::error::Error;
-use crate::material::Conductor;
-use crate::microsurface::WalkSample;
 use crate::vector::ensure_visible;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -141,7 +139,7 @@ impl<S: MicrosurfaceSlope> Noncentral<S> {
     }
 
     #[inline(always)]
-    fn d_unchecked(&self, wm: DVec3) -> f64 {
+    pub(crate) fn d_unchecked(&self, wm: DVec3) -> f64 {
         if wm.z.is_nan() || wm.z <= 0.0 {
             return 0.0;
         }
@@ -189,7 +187,7 @@ impl<S: MicrosurfaceSlope> Noncentral<S> {
     }
 
     #[inline(always)]
-    fn g1_unchecked(&self, w: Vec3) -> f64 {
+    pub(crate) fn g1_unchecked(&self, w: Vec3) -> f64 {
         if w.z.is_nan() || w.z <= 0.0 {
             return 0.0;
         }
@@ -213,7 +211,7 @@ impl<S: MicrosurfaceSlope> Noncentral<S> {
     /// log-space D_ωi); the visibility is decided on the given pair, the central value rescaled
     /// by the ratio of the two cosines (which differ only by the rounding of k̂).
     #[inline(always)]
-    fn d_wi_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
+    pub(crate) fn d_wi_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
         let cos_im = wi.as_dvec3().dot(wm);
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;
@@ -247,80 +245,10 @@ impl<S: MicrosurfaceSlope> Noncentral<S> {
     }
 
     #[inline(always)]
-    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+    pub(crate) fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let k = self.unsheared_view(wi);
         let m = self.central.sample_d_wi_unchecked((k / k.length()).as_vec3(), u1, u2).as_dvec3();
         let h = DVec3::new(m.x - self.mean_x * m.z, m.y - self.mean_y * m.z, m.z);
         ensure_visible(wi, (h / h.length()).as_vec3())
-    }
-
-    /// The single-scattering BRDF times |cos θo| of a conductor on the sheared microsurface
-    /// (the research layer's convention, as [`Microsurface::eval_single_scattering`](crate::Microsurface::eval_single_scattering)):
-    /// F(⟨ωi, ωh⟩) D(ωh) G1(ωi) G1(ωo)/(4 cos θi) with ωh = (ωi + ωo)/‖·‖ (Dupuy 2015, eq. 2.9
-    /// with eqs. 3.2–3.3 and the separable G2, see the type's documentation), for ωi and ωo above
-    /// the base plane; 0 otherwise. Evaluated in f64, saturated to `f32::MAX`.
-    ///
-    /// Invalid input ([policy](crate#invalid-input)): non-unit directions give 0.
-    pub fn eval_single_scattering(&self, conductor: &Conductor, wi: Vec3, wo: Vec3) -> Vec3 {
-        require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
-        let cos_ih = wi.as_dvec3().dot(wh);
-        if cos_ih <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let value =
-            self.d_unchecked(wh) * self.g1_unchecked(wi) * self.g1_unchecked(wo) / (4.0 * f64::from(wi.z));
-        conductor.fresnel(cos_ih as f32) * value.min(f64::from(f32::MAX)) as f32
-    }
-
-    /// The density over ωo of [`Self::sample_single_scattering`]: D_ωi(ωh)/(4⟨ωo, ωh⟩) for a
-    /// reflection ωo above the base plane, 0 otherwise (the samples that would leave below it
-    /// are not returned).
-    ///
-    /// Invalid input ([policy](crate#invalid-input)): non-unit directions give 0.
-    pub fn pdf_single_scattering(&self, wi: Vec3, wo: Vec3) -> f32 {
-        require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        if wo.z <= 0.0 {
-            return 0.0;
-        }
-        let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
-        let cos_oh = wo.as_dvec3().dot(wh);
-        if cos_oh <= 0.0 {
-            return 0.0;
-        }
-        (self.d_wi_unchecked(wi, wh) / (4.0 * cos_oh)) as f32
-    }
-
-    /// Samples the single-scattering reflection of a conductor from ωi above the base plane: ωh
-    /// from D_ωi (eq. 3.4), ωo its mirror reflection, weight F(⟨ωi, ωh⟩)·G1(ωo) (= f|cos θo|/pdf
-    /// with [`Self::eval_single_scattering`] and [`Self::pdf_single_scattering`]); `bounces` is 1.
-    /// `None` where ωo would leave below the base plane (the base plane masks it) and for ωi at
-    /// or below the horizon.
-    ///
-    /// Invalid input ([policy](crate#invalid-input)): a non-unit `wi` or a uniform outside
-    /// [0, 1] gives `None`.
-    pub fn sample_single_scattering(
-        &self,
-        conductor: &Conductor,
-        wi: Vec3,
-        u1: f32,
-        u2: f32,
-    ) -> Option<WalkSample> {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), None; wi, u1, u2);
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let wh = self.sample_d_wi_unchecked(wi, u1, u2);
-        let cos_ih = wi.dot(wh);
-        let wo = normalize_fast(2.0 * cos_ih * wh - wi, Vec3::Z);
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let weight =
-            conductor.fresnel(cos_ih.max(0.0)) * (self.g1_unchecked(wo).min(f64::from(f32::MAX)) as f32);
-        Some(WalkSample { wo, weight, bounces: 1 })
     }
 }

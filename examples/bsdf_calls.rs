@@ -16,10 +16,9 @@
 
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::{
-    Bsdf, ComplexIor, Conductor, Dielectric, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
-    MicrosurfaceSlope, Shadowing, SpecularLimit, Technique, UniformHeight,
-};
+use microsurface::research::{Estimator, Material, Microsurface, Shadowing, SpecularLimit, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Bsdf, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
 use validation::inputs::{N, inputs};

@@ -28,10 +28,11 @@
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::{RngExt, SeedableRng};
+use microsurface::research::{Estimator, Microsurface, Shadowing, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
-    Estimator, Ggx, KullaContyDielectric, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Shadowing,
-    Technique, Transport, UniformHeight,
+    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
+    KullaContyDielectric, MicrofacetBsdf, Technique, Transport,
 };
 use std::fmt::Write as _;
 use std::time::Instant;

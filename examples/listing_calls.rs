@@ -11,10 +11,11 @@
 
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, UniformHeight,
+use microsurface::research::{
+    Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
 

@@ -19,10 +19,11 @@
 
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, Side, sample_cosine_hemisphere,
+use microsurface::research::{
+    Material, PositionFree, ScatteringOrder, Shadowing, Side, sample_cosine_hemisphere,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::hint::black_box;

@@ -8,7 +8,8 @@
 //! Usage: `sampler_calls {beckmann|ggx} theta calls [α]` (α = 0.5 by default)
 
 use microsurface::glam::Vec3;
-use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Ggx};
 use std::hint::black_box;
 
 /// Inputs cycled through by the loop.

@@ -74,7 +74,8 @@
 //! ## For research: the random walks themselves
 //!
 //! ```
-//! use microsurface::{Conductor, Ggx, Microsurface, ScatteringOrder, UniformHeight};
+//! use microsurface::{Conductor, Ggx};
+//! use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
 //! use glam::Vec3;
 //! use rand::SeedableRng;
 //!
@@ -115,74 +116,98 @@
 
 #[macro_use]
 mod contract;
-mod albedo;
 mod basis;
 mod bsdf;
 mod constants;
 mod error;
-mod fresnel;
 mod height;
-mod leadr;
 mod material;
-mod merl;
 mod microsurface;
-mod path;
+#[cfg(feature = "leadr")]
 mod noncentral;
+mod path;
+#[cfg(feature = "position-free")]
 mod position_free;
 mod rng;
 mod sampling;
 mod sealed;
 mod single_scattering;
-mod slope;
-mod special;
 mod vector;
-mod vndf;
 
-pub use albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
-    DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
-    MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable,
-    TabulatedOrder, WALK_BATCH,
-};
-pub use basis::orthonormal_basis;
+pub mod compensation;
+pub mod fresnel;
+#[cfg(feature = "leadr")]
+pub mod leadr;
+pub mod slope;
+pub mod special;
+#[cfg(feature = "data-driven")]
+pub mod tabulated;
+pub mod vndf;
+
+// The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, KullaContyDielectric,
-    MAX_WALK_ALPHA, MicrofacetBsdf, NoncentralBsdf, NoncentralMasking, SMOOTH_ALPHA,
-    SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport, WalkTabulated,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, MAX_WALK_ALPHA,
+    MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Technique, Transport,
 };
+pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
-pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+pub use fresnel::ComplexIor;
+pub use material::{Conductor, Dielectric, Diffuse};
+pub use slope::{Beckmann, Elliptical, Ggx};
+
 /// The vector library of the public API, re-exported so that users on another `glam` version
 /// can name the crate's types.
 pub use glam;
-pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
-pub use leadr::{
-    CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, MomentLevel,
-    SlopeMoments,
-};
-pub use material::{Conductor, Dielectric, Diffuse, Event, Interaction, Material, PhaseSample, Side};
-pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
-pub use microsurface::{
-    HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
-};
-pub use path::Shadowing;
-pub use position_free::{Estimator, PositionFree};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
-pub use sampling::{concentric_disk, sample_cosine_hemisphere};
-pub use single_scattering::{SingleSample, SingleScattering};
-pub use slope::{
-    AxisAlignedSlope, BackscatterShadowing, Beckmann, Elliptical, Extraction, Ggx, GridExtraction, GridSlope,
-    MAX_RINGS, MicrosurfaceSlope, Noncentral, StretchedTabulated, TabulatedSlope, extract_anisotropic,
-    extract_anisotropic_fn, extract_fresnel, extract_isotropic, extract_isotropic_fn,
-};
-pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
-pub use vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
-};
+
+/// The research layer: the papers' models with the papers' interfaces.
+///
+/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`]: heights,
+/// slopes and a material, evaluated and sampled by tracing a ray through the microsurface),
+/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`]), the
+/// position-free estimators of Wang et al. 2022 ([`PositionFree`], feature `position-free`),
+/// the height distributions, the materials' phase functions ([`Material`]) and the geometry
+/// queries of the microsurface ([`MicrosurfaceGeometry`]).
+///
+/// Conventions (the papers'): `eval(wi, wo)` with `wi` towards the light and `wo` towards the
+/// viewer returns f·|cos θo| per RGB channel; stochastic evaluations take `&mut impl Rng` and
+/// are unbiased estimates; a walk sample's weight is f·|cos θo|/pdf. The renderer layer
+/// ([`Bsdf`](crate::Bsdf)) is built on these types.
+///
+/// # Examples
+///
+/// ```
+/// use microsurface::glam::Vec3;
+/// use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
+/// use microsurface::{Conductor, Ggx};
+/// use rand::SeedableRng;
+///
+/// let surface = Microsurface::new(UniformHeight, Ggx::isotropic(0.5)?, Conductor::perfect());
+/// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
+/// let (wi, wo) = (Vec3::new(0.3, 0.0, 0.954).normalize(), Vec3::Z);
+/// let n = 10_000;
+/// // f·|cos θo|, averaged over independent walks
+/// let f_cos: f32 = (0..n).map(|_| surface.eval(wi, wo, ScatteringOrder::All, &mut rng).x).sum::<f32>() / n as f32;
+/// let single = surface.eval_single_scattering(wi, wo, &mut rng).x;
+/// assert!(f_cos > single); // multiple scattering adds energy
+/// # Ok::<(), microsurface::Error>(())
+/// ```
+pub mod research {
+    pub use crate::basis::orthonormal_basis;
+    pub use crate::bsdf::{EnergyByOrder, SpecularEvent, SpecularLimit};
+    pub use crate::height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+    pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
+    pub use crate::microsurface::{
+        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
+    };
+    pub use crate::path::Shadowing;
+    #[cfg(feature = "position-free")]
+    pub use crate::position_free::{Estimator, PositionFree};
+    pub use crate::sampling::{concentric_disk, sample_cosine_hemisphere};
+    pub use crate::single_scattering::{SingleSample, SingleScattering};
+}
 
 /// The README's code blocks, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

@@ -56,7 +56,8 @@ pub struct SingleSample {
 ///
 /// ```
 /// use microsurface::glam::Vec3;
-/// use microsurface::{ComplexIor, Conductor, Ggx, SingleScattering};
+/// use microsurface::{ComplexIor, Conductor, Ggx};
+/// use microsurface::research::SingleScattering;
 /// use rand::SeedableRng;
 ///
 /// let gold = SingleScattering::new(Ggx::isotropic(0.5)?, Conductor::new(ComplexIor::GOLD));
@@ -189,8 +190,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::eval_with_pdf`] for directions the caller has validated.
     #[inline(always)]
     pub(crate) fn eval_with_pdf_unchecked(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> (Vec3, f32) {
-        let (Some(at), Some(wo_side)) =
-            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        let (Some(at), Some(wo_side)) = (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
         else {
             return (Vec3::ZERO, 0.0);
         };

@@ -10,7 +10,8 @@
 mod render;
 
 use glam::DVec3;
-use microsurface::{Beckmann, LeadrMap};
+use microsurface::Beckmann;
+use microsurface::leadr::LeadrMap;
 use render::Scene;
 use validation::leadr::surface::{NormalMip, direction, procedural_height_map};
 use validation::leadr::validate::{filter_errors, texel_lobe};
@@ -109,7 +110,7 @@ fn main() {
 
 /// The table: relative L1 error of the BRDF of a coarse texel (mean over `TEXELS`) against the
 /// average BRDF of its fine texels, LEADR and naive.
-fn table(map: &microsurface::HeightMap, normals: &NormalMip, quick: bool) {
+fn table(map: &microsurface::leadr::HeightMap, normals: &NormalMip, quick: bool) {
     let alphas: &[f32] = if quick { &[0.1, 0.3] } else { &[0.1, 0.2, 0.4] };
     let levels: &[usize] = if quick { &[1, 2, 3] } else { &[1, 2, 3, 4] };
     let thetas: &[f64] = if quick { &[0.0, 60.0, 80.0] } else { &[0.0, 30.0, 60.0, 75.0, 85.0] };

@@ -3,7 +3,7 @@
 //! normal-map MIP with the base roughness.
 
 use glam::{DVec2, DVec3, Vec2};
-use microsurface::{LeadrLobe, LeadrMap};
+use microsurface::leadr::{LeadrLobe, LeadrMap};
 use validation::leadr::surface::NormalMip;
 use validation::leadr::validate::{f_cos, texel_lobe};
 

@@ -26,7 +26,9 @@
 
 use super::quadrature::{Family, GL16};
 use glam::{DVec3, Vec3};
-use microsurface::{Beckmann, Ggx, MicrosurfaceSlope, beta};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::special::beta;
+use microsurface::{Beckmann, Ggx};
 
 /// Beyond this w = ρ/α the Beckmann slope density is below e^{−81}.
 const BECKMANN_W_MAX: f64 = 9.0;

@@ -29,8 +29,8 @@ use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Nodes per axis (as `microsurface::ALBEDO_TABLE_SIZE`).
-const N: usize = microsurface::ALBEDO_TABLE_SIZE;
+/// Nodes per axis (as `microsurface::compensation::ALBEDO_TABLE_SIZE`).
+const N: usize = microsurface::compensation::ALBEDO_TABLE_SIZE;
 /// The roughness at which the r = 0 row (the α → 0 limit profile) is evaluated.
 const ALPHA_LIMIT: f64 = 1e-6;
 /// Quadrature panels per variable for the shipped values, and for the error estimate.
@@ -167,10 +167,10 @@ fn interpolation_error(family: Family) -> (f64, f64, f64) {
     (max, rms, avg_errors.iter().copied().fold(0.0, f64::max))
 }
 
-fn table_of(family: Family) -> microsurface::AlbedoTable {
+fn table_of(family: Family) -> microsurface::compensation::AlbedoTable {
     match family {
-        Family::Ggx => microsurface::AlbedoTable::GGX,
-        Family::Beckmann => microsurface::AlbedoTable::BECKMANN,
+        Family::Ggx => microsurface::compensation::AlbedoTable::GGX,
+        Family::Beckmann => microsurface::compensation::AlbedoTable::BECKMANN,
     }
 }
 
@@ -234,14 +234,14 @@ fn write_readme(dir: &std::path::Path) -> std::io::Result<()> {
          trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n",
     );
     readme.push_str(
-        "\nSee microsurface::AlbedoTable and microsurface::DielectricAlbedoTable for the definitions and the \
+        "\nSee microsurface::compensation::AlbedoTable and microsurface::compensation::DielectricAlbedoTable for the definitions and the \
          measured errors.\n",
     );
     std::fs::write(dir.join("README.txt"), readme)
 }
 
-/// Nodes per axis of the dielectric tables (as `microsurface::DIELECTRIC_TABLE_SIZE`).
-const ND: usize = microsurface::DIELECTRIC_TABLE_SIZE;
+/// Nodes per axis of the dielectric tables (as `microsurface::compensation::DIELECTRIC_TABLE_SIZE`).
+const ND: usize = microsurface::compensation::DIELECTRIC_TABLE_SIZE;
 /// Quadrature panels (16-point Gauss–Legendre) per variable and piece of the shipped
 /// dielectric nodes, and of their error estimate (the integrand is split at all its kinks and
 /// graded towards its square-root features, so few panels suffice).
@@ -319,18 +319,18 @@ fn build_dielectric(family: Family, side: Side) -> DielectricTables {
     }
 }
 
-fn dielectric_table_of(family: Family) -> microsurface::DielectricAlbedoTable {
+fn dielectric_table_of(family: Family) -> microsurface::compensation::DielectricAlbedoTable {
     match family {
-        Family::Ggx => microsurface::DielectricAlbedoTable::GGX,
-        Family::Beckmann => microsurface::DielectricAlbedoTable::BECKMANN,
+        Family::Ggx => microsurface::compensation::DielectricAlbedoTable::GGX,
+        Family::Beckmann => microsurface::compensation::DielectricAlbedoTable::BECKMANN,
     }
 }
 
 /// The table light from `side` reads (outside η ≥ 1, inside 1/η ≤ 1).
-fn range_of(side: Side) -> microsurface::EtaRange {
+fn range_of(side: Side) -> microsurface::compensation::EtaRange {
     match side {
-        Side::Outside => microsurface::EtaRange::AtLeastOne,
-        Side::Inside => microsurface::EtaRange::AtMostOne,
+        Side::Outside => microsurface::compensation::EtaRange::AtLeastOne,
+        Side::Inside => microsurface::compensation::EtaRange::AtMostOne,
     }
 }
 
@@ -474,8 +474,8 @@ fn quick() {
     }
     // the walk tables: a few cells recomputed with another seed, within the combined SE
     let walk_table = |family: Family| match family {
-        Family::Ggx => microsurface::DielectricWalkTable::GGX,
-        Family::Beckmann => microsurface::DielectricWalkTable::BECKMANN,
+        Family::Ggx => microsurface::compensation::DielectricWalkTable::GGX,
+        Family::Beckmann => microsurface::compensation::DielectricWalkTable::BECKMANN,
     };
     let shipped_cell = |family: Family, side: Side, k: usize| {
         let t = walk_table(family);

@@ -12,13 +12,15 @@ use super::quadrature::Family;
 use super::{N, alpha_of_node, mu_of, par_map};
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::{Beckmann, Conductor, Ggx, Microsurface, MicrosurfaceSlope, UniformHeight};
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Ggx};
 use std::fmt::Write as _;
 
 /// Walks per cell: 2¹⁶, so that every cell's standard error is at most 0.5/256 < 2e-3.
 pub(crate) const WALKS: usize = 1 << 16;
 /// The last order tabulated by itself (orders 2 … K); the tail k > K is one more table.
-const K: usize = microsurface::LAST_TABULATED_ORDER;
+const K: usize = microsurface::compensation::LAST_TABULATED_ORDER;
 /// Tables per family: orders 2 … K and the tail.
 const TABLES: usize = K;
 /// The generator's seed.
@@ -126,7 +128,7 @@ pub(crate) fn build(family: Family) -> OrderTables {
     println!(
         "{name}: per-order energies, {WALKS} walks per cell, largest standard error {worst_se:.2e}, largest tail (k > {K}) {worst_tail:.3}"
     );
-    assert!(worst_se <= f64::from(microsurface::ORDER_TABLE_MAX_STANDARD_ERROR));
+    assert!(worst_se <= f64::from(microsurface::compensation::ORDER_TABLE_MAX_STANDARD_ERROR));
     OrderTables { directional, average }
 }
 
@@ -193,7 +195,7 @@ pub(crate) fn export(tables: &[(Family, OrderTables)], dir: &std::path::Path) ->
          standard error at most {:.1e}). <family>_order_<k>_average.f32: 32 values, their\n\
          cosine-weighted averages 2 int e_k mu dmu at r = j/31 (linear in r). A conductor with a\n\
          per-channel mean Fresnel Fbar has multiple-scattering energy ~ sum_k e_k Fbar^k.\n",
-        microsurface::ORDER_TABLE_MAX_STANDARD_ERROR
+        microsurface::compensation::ORDER_TABLE_MAX_STANDARD_ERROR
     );
     let path = dir.join("README.txt");
     let mut readme = std::fs::read_to_string(&path).unwrap_or_default();
@@ -217,8 +219,8 @@ pub(crate) fn quick() -> usize {
     let z = validation::family_z(1e-3, comparisons);
     for family in [Family::Ggx, Family::Beckmann] {
         let table = match family {
-            Family::Ggx => microsurface::ScatteringOrderTable::GGX,
-            Family::Beckmann => microsurface::ScatteringOrderTable::BECKMANN,
+            Family::Ggx => microsurface::compensation::ScatteringOrderTable::GGX,
+            Family::Beckmann => microsurface::compensation::ScatteringOrderTable::BECKMANN,
         };
         let shipped = |t: usize, c: usize| {
             if c < N * N { table.directional_nodes(t)[c] } else { table.average_nodes(t)[c - N * N] }

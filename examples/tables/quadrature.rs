@@ -22,7 +22,8 @@
 //! the panels.
 
 use glam::Vec3;
-use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Ggx};
 
 /// The slope families the tables cover.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -24,11 +24,12 @@ use crate::par_map;
 use crate::quadrature::Family;
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::{Beckmann, Dielectric, Ggx, Microsurface, UniformHeight};
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::{Beckmann, Dielectric, Ggx};
 use std::fmt::Write as _;
 
 /// Nodes per axis (as the single-scattering dielectric tables).
-pub const ND: usize = microsurface::DIELECTRIC_TABLE_SIZE;
+pub const ND: usize = microsurface::compensation::DIELECTRIC_TABLE_SIZE;
 /// Nodes per table.
 pub const NODES: usize = ND * ND * ND;
 /// Walks per batch.
@@ -246,7 +247,7 @@ pub fn export(tables: &[(Family, Side, Vec<Cell>)], dir: &std::path::Path) -> st
          [1, 3]; r = j/15, alpha = r^2; x = i/15, mu = X alpha/(1 + alpha - X) with X = x^2 (node\n\
          x = 0 estimated at mu = 1e-7). Lookup of (mu, alpha, eta): x = sqrt(mu (1 + alpha)/(mu +\n\
          alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2), trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n\
-         See microsurface::DielectricWalkTable and microsurface::KullaContyDielectric.\n",
+         See microsurface::compensation::DielectricWalkTable and microsurface::KullaContyDielectric.\n",
     )?;
     Ok(())
 }
@@ -299,7 +300,7 @@ fn sidak_z(level: f64, m: f64) -> f64 {
     let (mut lo, mut hi) = (0.0f64, 10.0f64);
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
-        if f64::from(microsurface::erfc((mid / std::f64::consts::SQRT_2) as f32)) > per {
+        if f64::from(microsurface::special::erfc((mid / std::f64::consts::SQRT_2) as f32)) > per {
             lo = mid;
         } else {
             hi = mid;

@@ -36,7 +36,7 @@ pub const SMOOTH_ALPHA: f32 = 1e-3;
 /// A walk's length grows linearly with α: for a perfect GGX conductor seen at normal
 /// incidence the mean number of bounces was measured at 2.3 (α = 1), 9.2 (α = 4), 26 (α = 10)
 /// and 305 (α = 100), i.e. about 2.7α, and a sample's cost with it (≈ 2.6 µs at α = 10 on the
-/// development machine). From α ≈ 300 on walks reach the bounce cap [`crate::MAX_BOUNCES`]
+/// development machine). From α ≈ 300 on walks reach the bounce cap [`crate::research::MAX_BOUNCES`]
 /// and lose their energy (at α = 10⁶ every walk does: 0.33 ms per sample and no light).
 /// Roughnesses above 10 describe no real surface, so the renderer layer rejects them rather
 /// than let a scene's cost explode; the research layer ([`Microsurface`], [`PositionFree`])
@@ -54,9 +54,9 @@ pub enum Technique {
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
     /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term or GGX's f32
-    /// conductor density, see [`crate::SingleScattering::pdf`]) for every
+    /// conductor density, see [`crate::research::SingleScattering::pdf`]) for every
     /// roughness; samples whose pdf or f would be subnormal are not returned (at most
-    /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::SingleScattering::sample`] for the f32
+    /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::research::SingleScattering::sample`] for the f32
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
@@ -113,7 +113,7 @@ impl EnergyByOrder {
 /// The microsurface BSDF does not depend on the height distribution (Heitz et al. 2016,
 /// §3.2: the walk is invariant under a monotonic change of heights), so there is none to
 /// choose here; the height distribution matters only to the geometry queries of the research
-/// layer ([`crate::MicrosurfaceGeometry`]).
+/// layer ([`crate::research::MicrosurfaceGeometry`]).
 ///
 /// Orientation: the research-layer models are evaluated and sampled *from the viewer* — the
 /// walk enters along the renderer's `wo` and leaves along `wi` (the adjoint orientation), with

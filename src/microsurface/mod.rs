@@ -27,12 +27,13 @@ use rand::Rng;
 /// C¹(h) (supplement §1.1), so they carry ln C¹ instead of h, and their results are the same
 /// for every height distribution (bit for bit, given the same random numbers). `H` serves the
 /// height-space queries of [`MicrosurfaceGeometry`]; `tests/walk/random_walk.rs` checks the walks against
-/// the supplement's height-space algorithm run on [`UniformHeight`](crate::UniformHeight) and
-/// [`GaussianHeight`](crate::GaussianHeight).
+/// the supplement's height-space algorithm run on [`UniformHeight`](crate::research::UniformHeight) and
+/// [`GaussianHeight`](crate::research::GaussianHeight).
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Dielectric, Ggx, Microsurface, ScatteringOrder, UniformHeight};
+/// use microsurface::{Dielectric, Ggx};
+/// use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
 /// use microsurface::glam::Vec3;
 /// use microsurface::rand::SeedableRng;
 ///

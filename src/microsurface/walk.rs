@@ -20,7 +20,7 @@ use rand::Rng;
 /// through a dielectric with η within a few f32 ulps of 1, which crosses the nearly
 /// index-matched interface about Λ(ωi) ≈ αᵢ tan θi/2 times before refraction turns it (at
 /// most about 10⁴ bounces); η = 1 exactly is transparent
-/// ([`crate::Material::is_transparent`]). Loss bound (`tests/walk/cap.rs`, 99 % family-wise
+/// ([`crate::research::Material::is_transparent`]). Loss bound (`tests/walk/cap.rs`, 99 % family-wise
 /// confidence): below 1e-4 of the albedo for every material at α = 2, and no capped walk for
 /// |η − 1| ≥ 1e-7 at cos θi ≥ 1e-3. The measurements behind the value are in DESIGN.md
 /// (“The bounce cap”).

@@ -1,7 +1,11 @@
-//! Single scattering on noncentral (sheared) microsurfaces (Dupuy 2015, thesis §3.2): the
-//! research-layer BSDFs of a [`Noncentral`](crate::slope::Noncentral) slope distribution with a
-//! material, which the renderer's `NoncentralBsdf` and the LEADR lobes are built on.
+//! Noncentral (sheared) microsurfaces (Dupuy 2015, thesis §3.2): the slope distribution
+//! offset by a mean slope, single scattering on it with a material, and its renderer BSDF,
+//! the lobe a LEADR-filtered texel evaluates.
 
+mod bsdf;
 mod single_scattering;
+mod slope;
 
+pub use bsdf::{NoncentralBsdf, NoncentralMasking};
 pub use single_scattering::NoncentralMaterial;
+pub use slope::Noncentral;

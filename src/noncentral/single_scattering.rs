@@ -1,10 +1,11 @@
 //! The single-scattering BSDF of a material on a sheared microsurface (Dupuy 2015, eq. 2.9 with
 //! eqs. 3.2–3.4 and the separable G2).
 
+use super::slope::Noncentral;
 use crate::contract::{is_direction, is_uniform};
 use crate::material::{Conductor, Material};
 use crate::microsurface::WalkSample;
-use crate::slope::{MicrosurfaceSlope, Noncentral};
+use crate::slope::MicrosurfaceSlope;
 use crate::vector::normalize_fast;
 use glam::{Vec2, Vec3};
 

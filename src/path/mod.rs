@@ -5,8 +5,8 @@
 //! without shadowing, [`Material::vertex`]) and shadowing factors ([`Shadowing`]).
 //!
 //! This layer holds the vertex machinery and the one-vertex path, which is the
-//! single-scattering BSDF with full-spherical masking ([`crate::single_scattering`] is built on
-//! it); the multiple-bounce estimators (PT, BDPT) are [`crate::position_free`]'s.
+//! single-scattering BSDF with full-spherical masking (`single_scattering` is built on
+//! it); the multiple-bounce estimators (PT, BDPT) are the `position_free` module's.
 
 mod shadowing;
 
@@ -136,7 +136,6 @@ impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
         let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
         (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
     }
-
 
     /// The incident state for the macro direction ωi, or `None` on the horizon.
     ///

@@ -1,12 +1,12 @@
 //! The bidirectional estimator (Wang et al. 2022, §4.2, eqs. 27–29), with the exact
 //! per-strategy path densities and the balance heuristic.
 
-use crate::path::{VertexRole, inv_g1};
 use super::{BDPT_ROULETTE_FROM, PositionFree, Roulette};
-use crate::path::{Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PathModel};
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::microsurface::ScatteringOrder;
+use crate::path::{Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PathModel};
+use crate::path::{VertexRole, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::{DVec3, Vec3};
@@ -149,7 +149,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         order: ScatteringOrder,
         rng: &mut impl Rng,
     ) -> (Vec3, usize, usize) {
-        let (Some(start), Some(wo_side)) = (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) =
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        else {
             return (Vec3::ZERO, 0, 0);
         };
         let last = order.last() as usize;
@@ -211,7 +213,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     let area =
                         out.lambda.and_then(|lambda| known_area(out.side.frame(out.w).z, 1.0 + lambda));
                     let reverse = at.towards(out).reversed().with_incident_area(area);
-                    (contribution, f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse)))
+                    (
+                        contribution,
+                        f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse)),
+                    )
                 }
             };
             Connection { contribution, forward: 0.0, reverse }
@@ -229,7 +234,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             Connection {
                 contribution: phase.as_dvec3() * factor,
                 forward: f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &it)),
-                reverse: f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &it.reversed())),
+                reverse: f64::from(
+                    self.model.material.pdf_phase_unchecked(&self.model.slope, &it.reversed()),
+                ),
             }
         } else {
             let factor = self.model.shadowing_factor(at, k_at, out, VertexRole::Middle);
@@ -281,7 +288,8 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             let step = at.to(x, next.side).with_incident_area(known_area(at.in_frame().z, k_at));
             let pdf_forward = f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &step));
             let reverse = step.reversed().with_incident_area(known_area(-next.in_frame().z, 1.0 + k_next));
-            let pdf_reverse_prev = f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse));
+            let pdf_reverse_prev =
+                f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse));
             // the connection of the new vertex to ωo, the (s, 0) strategy's
             let connection = self.model.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
             let vertex = CameraVertex { next, k_next, connection, throughput, pdf_forward, pdf_reverse_prev };
@@ -312,7 +320,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             let b_area = b.lambda.and_then(|lambda| known_area(b_frame_z, 1.0 + lambda));
             let factor = self.model.shadowing_factor(a, k_in, b, role)
                 * f64::from(self.model.material.relative_eta_sq(a.side, b.side))
-                * f64::from(b_area.unwrap_or_else(|| self.model.slope.projected_area_unchecked(b.side.frame(b.w))))
+                * f64::from(
+                    b_area.unwrap_or_else(|| self.model.slope.projected_area_unchecked(b.side.frame(b.w))),
+                )
                 / f64::from(a.w.z.abs());
             throughput *= s.weight.as_dvec3() * factor;
             if throughput == DVec3::ZERO || !throughput.is_finite() {
@@ -328,8 +338,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             let step = a.to(b.w, b.side).with_incident_area(known_area(a_frame.z, k_in));
             let reverse = step.reversed().with_incident_area(b_area);
             let pdf_reverse = f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse));
-            let pdf_forward_out =
-                if i == 0 { 0.0 } else { f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &step)) };
+            let pdf_forward_out = if i == 0 {
+                0.0
+            } else {
+                f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &step))
+            };
             // −a can leave the surface where a points down in its frame, and then its Λ is
             // 1 + L̃ of a (Λ(−ω) = −1 − Λ(ω)): the exit data without another Λ
             let out_next = Exit { w: -a.w, side: a.side, lambda: (a_frame.z < 0.0).then_some(k_in) };

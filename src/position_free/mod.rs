@@ -14,7 +14,7 @@ mod roulette;
 
 use crate::contract::is_direction;
 use crate::material::Material;
-use crate::microsurface::WalkSample;
+use crate::microsurface::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 use crate::path::{Incident, PathModel, Shadowing, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
@@ -44,7 +44,8 @@ pub enum Estimator {
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Conductor, Estimator, Ggx, PositionFree, ScatteringOrder, Shadowing};
+/// use microsurface::{Conductor, Ggx};
+/// use microsurface::research::{Estimator, PositionFree, ScatteringOrder, Shadowing};
 /// use microsurface::glam::Vec3;
 /// use microsurface::rand::SeedableRng;
 ///
@@ -101,7 +102,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         wi: Vec3,
         wo: Vec3,
         estimator: Estimator,
-        order: crate::ScatteringOrder,
+        order: ScatteringOrder,
         rng: &mut impl Rng,
     ) -> Vec3 {
         match estimator {
@@ -130,15 +131,15 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The weight is f·|cos θo|/pdf exactly: the product of the sample weights (Fresnel for
     /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
     /// the material (on the horizon, or at the nadir of an opaque material, where no facet
-    /// faces it), or the walk reached [`crate::MAX_BOUNCES`].
+    /// faces it), or the walk reached [`crate::research::MAX_BOUNCES`].
     ///
     /// Nearly index-matched dielectrics at grazing incidence: a refraction through an
     /// interface with η ≈ 1 barely turns the ray, and this model's exit probability per vertex
     /// then falls to about 2^−Λ (it forgets the height a vertex was reached at, which the
     /// height-tracing walk keeps), so its paths grow as |η − 1| → 0: no path is lost to
-    /// [`crate::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk/cap.rs`), while within one or
+    /// [`crate::research::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk/cap.rs`), while within one or
     /// two f32 ulps of 1 nearly all grazing paths are (path lengths measured in DESIGN.md,
-    /// “The bounce cap”). η = 1 itself is transparent ([`crate::Material::is_transparent`]).
+    /// “The bounce cap”). η = 1 itself is transparent ([`crate::research::Material::is_transparent`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
@@ -154,7 +155,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             return None;
         }
         let mut weight = Vec3::ONE;
-        for bounces in 1..=crate::MAX_BOUNCES {
+        for bounces in 1..=MAX_BOUNCES {
             let s = self.model.material.sample_phase_unchecked(&self.model.slope, at.w, at.side, rng);
             weight *= s.weight;
             if weight == Vec3::ZERO {
@@ -226,7 +227,6 @@ mod tests {
     use super::*;
     use crate::material::{Conductor, Side};
     use crate::path::PDF_COSINE_SHARE;
-    use crate::microsurface::ScatteringOrder;
     use crate::sampling::cosine_hemisphere;
     use crate::slope::Beckmann;
     use rand::SeedableRng;

@@ -1,11 +1,11 @@
 //! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
 
-use crate::path::{VertexRole, inv_g1};
 use super::{PositionFree, ROULETTE_FROM_BOUNCE, Roulette};
-use crate::path::{Incident, PathModel};
 use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
+use crate::path::{Incident, PathModel};
+use crate::path::{VertexRole, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::{DVec3, Vec3};
@@ -23,7 +23,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// function's peak relative to this path's single-scattering term, keeps it unbiased and
     /// of finite variance and ends the paths lit from below a smooth surface (see
     /// `Roulette::survival`); the throughput is carried in f64. `order` selects all orders (no
-    /// truncation; [`crate::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
+    /// truncation; [`crate::research::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
@@ -42,7 +42,9 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         order: ScatteringOrder,
         rng: &mut impl Rng,
     ) -> (Vec3, u32) {
-        let (Some(mut at), Some(wo_side)) = (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo)) else {
+        let (Some(mut at), Some(wo_side)) =
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        else {
             return (Vec3::ZERO, 0);
         };
         let mut extensions = 0;

@@ -2,8 +2,8 @@
 //! probability and the quantities it compares.
 
 use super::PositionFree;
-use crate::path::{Incident, LAMBDA_RATIO_LOG_BELOW};
 use crate::material::{Material, Side};
+use crate::path::{Incident, LAMBDA_RATIO_LOG_BELOW};
 use crate::slope::MicrosurfaceSlope;
 use core::f64::consts::PI;
 use glam::{DVec3, Vec3};

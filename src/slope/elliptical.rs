@@ -69,12 +69,13 @@ impl AxisAlignedSlope for Beckmann {
 /// for an axis-aligned slope); `MicrofacetBsdf`'s smooth and walk-length limits compare
 /// [`MicrosurfaceSlope::alpha_max`] = max(α₁, α₂), the same for every φα, against their
 /// thresholds.
-/// It does not implement [`VCavitySlope`](crate::VCavitySlope), whose closed forms are written
+/// It does not implement [`VCavitySlope`](crate::vndf::VCavitySlope), whose closed forms are written
 /// in the stretched frame of an axis-aligned distribution.
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Beckmann, Elliptical, MicrosurfaceSlope};
+/// use microsurface::{Beckmann, Elliptical};
+/// use microsurface::slope::MicrosurfaceSlope;
 /// use microsurface::glam::Vec3;
 ///
 /// let slope = Elliptical::<Beckmann>::from_ellipse(0.5, 0.1, 0.3)?;

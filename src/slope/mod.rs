@@ -6,23 +6,12 @@
 
 mod beckmann;
 mod elliptical;
-mod extract;
 mod ggx;
-mod grid;
-mod noncentral;
 mod stretch;
-mod tabulated;
 
 pub use beckmann::Beckmann;
 pub use elliptical::{AxisAlignedSlope, Elliptical};
-pub use extract::{
-    BackscatterShadowing, Extraction, GridExtraction, extract_anisotropic, extract_anisotropic_fn,
-    extract_fresnel, extract_isotropic, extract_isotropic_fn,
-};
 pub use ggx::Ggx;
-pub use grid::GridSlope;
-pub use noncentral::Noncentral;
-pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
 
 pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};

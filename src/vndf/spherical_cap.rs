@@ -13,7 +13,8 @@ use glam::Vec3;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Ggx, GgxSphericalCap, VisibleNormalSampler};
+/// use microsurface::Ggx;
+/// use microsurface::vndf::{GgxSphericalCap, VisibleNormalSampler};
 /// use microsurface::glam::Vec3;
 /// let sampler = GgxSphericalCap(Ggx::isotropic(0.3)?);
 /// let wi = Vec3::new(0.6, 0.0, 0.8);

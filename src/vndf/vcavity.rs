@@ -6,7 +6,8 @@ use crate::constants::INV_SQRT_PI;
 use crate::contract::{are_uniform, is_direction, is_plane_normal};
 use crate::rng::cut_tails64;
 use crate::slope::{
-    Azimuth, Beckmann, Ggx, MicrosurfaceSlope, disk_frame, gaussian_slope, stretch, stretch64, visible_slope_x_above,
+    Azimuth, Beckmann, Ggx, MicrosurfaceSlope, disk_frame, gaussian_slope, stretch, stretch64,
+    visible_slope_x_above,
 };
 use crate::special::{erfc64, erfcx64, erfinv_from_both_ends, one_minus_scaled_erfcx};
 use glam::Vec3;

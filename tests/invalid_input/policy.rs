@@ -11,15 +11,21 @@
 //! directions, signed zeros, lengths within the tolerance) must pass the checks.
 
 use glam::{DVec3, Vec2, Vec3};
-use microsurface::{
-    Beckmann, BeckmannNewton, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Estimator,
-    GaussianHeight, Ggx, GgxDisk, GgxSphericalCap, HeightSample, Material, Microsurface,
-    MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PhaseSample, PositionFree, ScatteringOrder,
-    Shadowing, SmithVndf, UniformHeight, VCavity, VCavitySlope, VisibleNormalSampler, concentric_disk,
-    fresnel_conductor, fresnel_dielectric, fresnel_schlick, orthonormal_basis, sample_cosine_hemisphere,
+use microsurface::Elliptical;
+use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+use microsurface::leadr::Noncentral;
+use microsurface::research::{
+    Estimator, GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry,
+    MicrosurfaceHeight, PhaseSample, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
+    concentric_disk, orthonormal_basis, sample_cosine_hemisphere,
+};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
     smith_normalization,
 };
-use microsurface::{Elliptical, Interaction, Noncentral, Side};
+use microsurface::{Beckmann, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::fmt::Debug;

@@ -15,12 +15,13 @@
 use validation::par_map;
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Estimator, Ggx, Material, Microsurface,
-    MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample,
+use microsurface::research::{
+    Estimator, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample,
     sample_cosine_hemisphere,
 };
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};
 use rand::RngExt;
 use std::f64::consts::{PI, TAU};
 use validation::{Stats, TestRng, family_z, uniform64};
@@ -1149,7 +1150,7 @@ fn per_order_albedos_against_quadrature() {
 /// eval_bdpt(All) = eval_pt(All) there (PT has no cap) at two directions (two-sample).
 #[test]
 fn bdpt_subpath_cap_loses_negligible_energy() {
-    use microsurface::MAX_BOUNCES;
+    use microsurface::research::MAX_BOUNCES;
     const N_WALK: usize = 400_000;
     let cap = 2 * 48 + 1;
     let mut cases = Vec::new();

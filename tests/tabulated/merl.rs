@@ -2,10 +2,11 @@
 //! MERL's nearest-bin lookup, bad files, and the extraction (Dupuy 2015 §4.2) run on a file.
 
 use glam::Vec3;
-use microsurface::{
-    BackscatterShadowing, Conductor, Ggx, MerlBrdf, MerlError, Microsurface, TabulatedSlope, UniformHeight,
-    extract_isotropic_fn, half_diff_angles,
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::tabulated::{
+    BackscatterShadowing, MerlBrdf, MerlError, TabulatedSlope, extract_isotropic_fn, half_diff_angles,
 };
+use microsurface::{Conductor, Ggx};
 use std::f64::consts::{FRAC_PI_2, PI};
 use validation::{dir, rng, uniform64};
 

@@ -18,11 +18,11 @@
 //! absolute error (≤ bound × 1e-6) below.
 
 use glam::{DVec3, Vec3};
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Ggx, Material, MicrosurfaceGeometry, MicrosurfaceSlope,
-    UniformHeight, fresnel_conductor, fresnel_dielectric,
-};
-use microsurface::{Interaction, Side};
+use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric};
+use microsurface::research::{Interaction, Side};
+use microsurface::research::{Material, MicrosurfaceGeometry, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Ggx};
 use rand::SeedableRng;
 use statrs::function::erf::erfc;
 use statrs::function::gamma::ln_gamma;

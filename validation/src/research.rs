@@ -3,10 +3,11 @@
 //! (`examples/bsdf_calls.rs`) call them.
 
 use glam::Vec3;
-use microsurface::{
-    Material, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SingleScattering,
-    Technique, UniformHeight,
+use microsurface::Technique;
+use microsurface::research::{
+    Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, SingleScattering, UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
 use rand_pcg::Pcg64Mcg;
 
 /// The research-layer calls a technique wraps, in the adjoint orientation of the trait (the

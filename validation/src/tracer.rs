@@ -8,9 +8,10 @@
 //! their key, so a render is a pure function of its seed (identical for any thread count).
 
 use glam::{Vec2, Vec3};
+use microsurface::research::{Estimator, ScatteringOrder, Shadowing};
 use microsurface::{
-    Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor, Dielectric, Diffuse, Estimator,
-    Ggx, MicrofacetBsdf, ScatteringOrder, ShadingFrame, Shadowing, Technique,
+    Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor, Dielectric, Diffuse, Ggx,
+    MicrofacetBsdf, ShadingFrame, Technique,
 };
 use rand::Rng;
 use rand::RngExt;

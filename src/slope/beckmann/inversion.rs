@@ -7,11 +7,11 @@
 //! (`erf_min = −0.9999`). It is
 //! [`Beckmann`]'s `sample_d_wi` (and so [`SmithVndf`](super::SmithVndf)`<Beckmann>`).
 
-use crate::slope::stretch::{Azimuth, stretch64};
+use super::Beckmann;
 use crate::constants::SQRT_PI;
 use crate::rng::cut_tails64;
-use super::Beckmann;
 use crate::slope::MicrosurfaceSlope;
+use crate::slope::stretch::{Azimuth, stretch64};
 use crate::special::{
     NO_LOG_BELOW, PSI_SERIES_FROM, ROUNDING_MAGIC, erfc_inv_f32, erfcx64, erfinv_central, exp_nonpositive,
     gaussian_integral_and_half, one_minus_scaled_erfcx, tail_ratio,

@@ -8,8 +8,8 @@ use crate::special::{
 };
 mod inversion;
 
-pub(crate) use inversion::{gaussian_slope, sample_visible_normal, visible_slope_x_above, visible_slopes};
 use glam::{DVec3, Vec2, Vec3};
+pub(crate) use inversion::{gaussian_slope, sample_visible_normal, visible_slope_x_above, visible_slopes};
 
 /// 1/π.
 const INV_PI: f64 = core::f64::consts::FRAC_1_PI;
@@ -37,7 +37,8 @@ const LAMBDA32_VANISHES_FROM: f64 = 10.0;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Beckmann, MicrosurfaceSlope};
+/// use microsurface::Beckmann;
+/// use microsurface::slope::MicrosurfaceSlope;
 /// use microsurface::glam::Vec3;
 ///
 /// let beckmann = Beckmann::isotropic(0.5)?;

@@ -7,9 +7,9 @@ use super::{
 use crate::error::Error;
 mod visible;
 
-use visible::{sample_spherical_cap, sample_visible_hemisphere};
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
+use visible::{sample_spherical_cap, sample_visible_hemisphere};
 
 /// 1/(4π), the constant of the reflection density D(ωh)/(4 A(ωi)).
 const FRAC_1_4PI: f32 = 0.25 * FRAC_1_PI;
@@ -33,7 +33,8 @@ const MIN_SLOPE_COS: f32 = f32::MIN_POSITIVE;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Ggx, MicrosurfaceSlope};
+/// use microsurface::Ggx;
+/// use microsurface::slope::MicrosurfaceSlope;
 /// use microsurface::glam::Vec3;
 ///
 /// let ggx = Ggx::new(0.3, 0.1)?;

@@ -2,7 +2,7 @@
 //! LEADR (a MIP pyramid of averaged normals). Shared by `examples/leadr` and `tests/leadr.rs`.
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
-use microsurface::HeightMap;
+use microsurface::leadr::HeightMap;
 use rand::{RngExt, SeedableRng};
 use std::f64::consts::TAU;
 

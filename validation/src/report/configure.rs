@@ -2,10 +2,11 @@
 //! how much (the sample budget of a quick or a full run).
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, UniformHeight,
+use microsurface::research::{
+    Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use std::path::PathBuf;
 
 pub type Rng = rand_pcg::Pcg64Mcg;

@@ -8,7 +8,8 @@ use super::configure::{
 };
 use super::tables::{self, TableCurve};
 use glam::Vec3;
-use microsurface::{Material, MicrosurfaceSlope, ScatteringOrder};
+use microsurface::research::{Material, ScatteringOrder};
+use microsurface::slope::MicrosurfaceSlope;
 use rand::SeedableRng;
 use std::hint::black_box;
 use std::sync::Mutex;

@@ -12,10 +12,8 @@
 
 use crate::quadrature::{SlopeFamily, VisibleTolerance, integrate_visible};
 use glam::Vec3;
-use microsurface::{
-    AlbedoTable, Beckmann, Bsdf, Conductor, Dielectric, DielectricAlbedoTable, Ggx, MicrofacetBsdf,
-    Technique, Transport,
-};
+use microsurface::compensation::{AlbedoTable, DielectricAlbedoTable};
+use microsurface::{Beckmann, Bsdf, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique, Transport};
 
 /// The roughnesses of the curves: between the tables' nodes (r = √α on 32 or 16 nodes).
 pub const TABLE_ALPHAS: [f32; 4] = [0.03, 0.12, 0.4, 0.9];

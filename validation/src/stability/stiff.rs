@@ -11,11 +11,13 @@
 
 use crate::{Stats, TestRng};
 use glam::Vec3;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Estimator, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, UniformHeight, WalkSample, sample_cosine_hemisphere,
+use microsurface::research::{
+    Estimator, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample,
+    sample_cosine_hemisphere,
 };
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Ggx};
 use rand::RngExt;
 use std::f64::consts::PI;
 

@@ -1,12 +1,12 @@
 //! Energy-compensated dielectrics: the single-scattering microfacet BSDF (reflection and
 //! transmission) scaled so that a non-absorbing interface keeps the energy the single bounce
 //! loses (Turquin 2019), from this crate's dielectric albedo tables
-//! ([`crate::DielectricAlbedoTable`]).
+//! ([`crate::compensation::DielectricAlbedoTable`]).
 
-use super::compensated::{AlbedoTabulated, Tables, check_tabulated};
-use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction};
-use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricDirection, node_cell};
+use super::conductor::{AlbedoTabulated, Tables, check_tabulated};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction};
+use crate::bsdf::{MicrofacetBsdf, Technique};
+use crate::compensation::tables::{DIELECTRIC_TABLE_SIZE, DielectricDirection, node_cell};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::slope::MicrosurfaceSlope;
@@ -36,13 +36,13 @@ const LAST: f32 = (DIELECTRIC_TABLE_SIZE - 1) as f32;
 /// (the default) transmitted radiance carries the factor (η_wo/η_wi)² = 1/`eta`² of the
 /// sample, so the *flux* is conserved: the mean of weight × `eta`² is 1.
 ///
-/// **Tables.** [`crate::DielectricAlbedoTable`] of the slope family at α = √(αx αy) (anisotropic
+/// **Tables.** [`crate::compensation::DielectricAlbedoTable`] of the slope family at α = √(αx αy) (anisotropic
 /// surfaces are compensated as the isotropic surface of the same slope area), blended in (α, η)
 /// once at construction, the direction axis interpolated linearly at run time (one lookup
 /// per call). `pdf` and `sample` are those of single scattering: the density is exact and a
 /// sample's weight is the single-scattering weight divided by E(μo), i.e. f·|cos θi|/pdf.
 ///
-/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) and
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) and
 /// η = 1 are the Dirac lobes of the single-scattering BSDF, uncompensated (the loss vanishes
 /// with α). A view on the horizon (μo = 0) has no lobe. Near η = 1 at grazing views E(μo)
 /// approaches 0 (single scattering reflects almost nothing and masks every refraction at the
@@ -80,8 +80,8 @@ impl<S: AlbedoTabulated> CompensatedDielectric<S> {
     /// The compensated BSDF of a dielectric interface on the given slopes.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (`"alpha"`) or the
-    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA)] = [1/3, 3]
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::compensation::MAX_TABULATED_ALPHA) (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::compensation::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::compensation::MAX_TABULATED_ETA)] = [1/3, 3]
     /// (`"eta"`): the tables' range, beyond which there is no albedo to compensate with.
     pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
@@ -131,7 +131,7 @@ impl<S: MicrosurfaceSlope> CompensatedDielectric<S> {
     }
 
     /// E at |cos θo| = μ for a view on `side`: linear interpolation on the tables' direction
-    /// axis of the side's relative index (see [`crate::DielectricAlbedoTable`]).
+    /// axis of the side's relative index (see [`crate::compensation::DielectricAlbedoTable`]).
     #[inline(always)]
     fn albedo_at(&self, mu: f32, side: Side) -> f32 {
         let side = match side {

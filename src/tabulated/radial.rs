@@ -1,11 +1,10 @@
 //! A tabulated isotropic slope distribution (Dupuy 2015, thesis §4.2: data-driven
 //! microsurfaces), with exact visible-normal sampling on the whole sphere.
 
-use super::MicrosurfaceSlope;
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
+use crate::slope::{Azimuth, MicrosurfaceSlope};
 use crate::vector::ensure_visible;
-use super::stretch::Azimuth;
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -377,7 +376,7 @@ impl TabulatedSlope {
     }
 
     /// The normal angle θₖ = atan(s·tan θ′) of the centre of ring k (θ′ the stretched angle at
-    /// k + ½): where [`crate::extract_isotropic`] collocates the backscattering samples.
+    /// k + ½): where [`crate::tabulated::extract_isotropic`] collocates the backscattering samples.
     #[must_use]
     pub fn ring_centre_angle(scale: f32, rings: usize, k: usize) -> f64 {
         (f64::from(scale) * grid_angle(k as f64 + 0.5, rings).tan()).atan()

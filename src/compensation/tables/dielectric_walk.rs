@@ -2,7 +2,7 @@
 //! and transmission, and their interpolation.
 
 use super::axis::{node_cell, scale_invariant_direction};
-use super::dielectric_walk_data as data;
+use super::generated::dielectric_walk as data;
 use super::grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA, NODES, SideGrids};
 use super::table::MAX_TABULATED_ALPHA;
 
@@ -27,7 +27,7 @@ fn eta_coordinate(eta_at_least_one: f32) -> f32 {
 ///
 /// # Examples
 /// ```
-/// use microsurface::DielectricWalkTable;
+/// use microsurface::compensation::DielectricWalkTable;
 ///
 /// // rough glass (α = 1, η = 1.5) seen from outside at normal incidence
 /// let h = DielectricWalkTable::GGX.energy(1.0, 1.0, 1.5).expect("in range");
@@ -45,12 +45,12 @@ pub struct HigherOrders {
 /// energy of scattering orders ≥ 2, ΔR(μ, α, η) and ΔT(μ, α, η), of an isotropic dielectric
 /// microsurface (the model of [`crate::Dielectric`], importance transport: the walk's flux),
 /// for one slope family and both sides of the interface. The walk's order 1 is the
-/// single-scattering model of [`crate::DielectricAlbedoTable`], and the walk conserves
+/// single-scattering model of [`crate::compensation::DielectricAlbedoTable`], and the walk conserves
 /// energy, so R_ss + T_ss + ΔR + ΔT = 1 up to the tables' errors: the higher orders that a
 /// compensated lobe ([`crate::KullaContyDielectric`]) restores, with their split between the
 /// two sides.
 ///
-/// **Axes** (those of [`crate::DielectricAlbedoTable`]): relative index η ∈ [1, 3] seen from
+/// **Axes** (those of [`crate::compensation::DielectricAlbedoTable`]): relative index η ∈ [1, 3] seen from
 /// outside and 1/η from inside, on u = √((η − 1)/2); roughness r = √α; direction
 /// x = √(μ (1 + α)/(μ + α)); 16 equal steps each, η slowest, direction fastest, trilinear.
 /// Rows without walks: r = 0 is the smooth limit (0), u = 0 the index-matched limit (ΔR = 0,
@@ -63,7 +63,7 @@ pub struct HigherOrders {
 ///
 /// # Examples
 /// ```
-/// use microsurface::DielectricWalkTable;
+/// use microsurface::compensation::DielectricWalkTable;
 ///
 /// // rough glass seen from air: the higher orders mostly transmit
 /// let h = DielectricWalkTable::GGX.energy(0.5, 0.8, 1.5).expect("in range");

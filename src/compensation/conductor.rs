@@ -2,16 +2,14 @@
 //! higher orders restored from the single-scattering albedo tables ([`AlbedoTable`]), with a
 //! deterministic eval, an exact pdf and a sampler (Kulla and Conty 2017; Turquin 2019).
 
-mod shared;
-
-pub(crate) use shared::{ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
+pub(crate) use super::shared::{ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
 
 use super::lobe_profile::{
     DirectionAxis, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
-use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, valid_direction, valid_uniforms};
-use crate::albedo::{
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, valid_direction, valid_uniforms};
+use crate::bsdf::{MicrofacetBsdf, Technique};
+use crate::compensation::tables::{
     ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, ORDER_TABLES,
     ScatteringOrderTable, node_cell,
 };
@@ -158,7 +156,7 @@ pub enum Compensation {
 /// taken in its sampler's form F G2/G1 · pdf_ss (within 1e-5 of eval's, as its sampler's
 /// weight is). Turquin samples and has the density of the single-scattering lobe.
 ///
-/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
 /// the Dirac mirror of the single-scattering BSDF, uncompensated (the energy the single
 /// bounce loses vanishes with α). View directions below the horizon (a backfacing shading
 /// normal, which single scattering supports) have no tabulated albedo: the lobe is then the
@@ -235,7 +233,7 @@ impl<S: AlbedoTabulated> CompensatedConductor<S> {
     /// The compensated BRDF of a conductor on the given slopes.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (= 1), the
+    /// [`Error::InvalidParameter`] (`"alpha"`) if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::compensation::MAX_TABULATED_ALPHA) (= 1), the
     /// tables' range: there is no albedo to compensate with beyond it.
     pub fn new(slope: S, conductor: Conductor, scheme: Compensation) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();
@@ -651,7 +649,7 @@ fn fresnel_average(conductor: &Conductor) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ComplexIor;
+    use crate::fresnel::ComplexIor;
 
     /// The added lobe's branch of the sampler takes single scattering's f·cos θi and density
     /// in its sampler's form (`single_at`): the density is `pdf`'s, bit for bit, and f is

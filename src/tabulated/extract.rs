@@ -1,10 +1,10 @@
 //! Extraction of a tabulated slope distribution and of a Fresnel term from a BRDF (Dupuy 2015,
 //! thesis §4.2: the backscattering eigenproblem solved by power iteration, Algorithms 1–3).
 
-use super::MicrosurfaceSlope;
 use super::grid::{GridSlope, boundaries};
-use super::tabulated::{TabulatedSlope, check_ring_count, disk_area};
+use super::radial::{TabulatedSlope, check_ring_count, disk_area};
 use crate::error::Error;
+use crate::slope::MicrosurfaceSlope;
 use core::f64::consts::PI;
 use glam::{DVec3, Vec3};
 
@@ -55,7 +55,7 @@ pub struct Extraction {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] if `scale` is not finite and > 0, if N is 0 or above
-/// [`crate::MAX_RINGS`], if `iterations` is 0 (`name = "iterations"`), if a sample is NaN,
+/// [`crate::tabulated::MAX_RINGS`], if `iterations` is 0 (`name = "iterations"`), if a sample is NaN,
 /// infinite or negative (`name = "backscatter[i]"`), or if the iterate vanishes (all-zero
 /// data, `name = "total mass"`).
 pub fn extract_isotropic(
@@ -78,7 +78,7 @@ pub fn extract_isotropic(
         });
     }
     let radii: Vec<f64> = (0..=n)
-        .map(|k| if k == 0 { 0.0 } else { s * super::tabulated::grid_angle(k as f64, n).tan() })
+        .map(|k| if k == 0 { 0.0 } else { s * super::radial::grid_angle(k as f64, n).tan() })
         .collect();
     // the kernel, row-major
     let mut kernel = vec![0.0f64; n * n];

@@ -1,6 +1,6 @@
 //! The directional and average single-scattering albedo tables and their interpolation.
 
-use super::data;
+use super::generated::conductor as data;
 
 /// Nodes per axis of the tables: 32 × 32 for E(μ, α), 32 for E_avg(α).
 pub const ALBEDO_TABLE_SIZE: usize = 32;
@@ -32,7 +32,7 @@ const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
 ///
 /// # Examples
 /// ```
-/// use microsurface::AlbedoTable;
+/// use microsurface::compensation::AlbedoTable;
 ///
 /// let e = AlbedoTable::GGX.directional(1.0, 1.0).expect("in range");
 /// assert!((e - 0.3069).abs() < 1e-3); // GGX α = 1 at normal incidence

@@ -2,10 +2,10 @@
 //! sampling on the whole sphere (Dupuy 2015, thesis §4.2: the anisotropic data-driven
 //! microsurface).
 
-use super::MicrosurfaceSlope;
-use super::tabulated::{check_ring_count, grid_angle};
+use super::radial::{check_ring_count, grid_angle};
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
+use crate::slope::MicrosurfaceSlope;
 use crate::vector::{ensure_visible, normal_from_slopes};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -247,7 +247,7 @@ impl GridSlope {
     /// The backscattering direction of the centre of cell (column `i`, row `j`) of the grid of
     /// `half_cells` per half axis: the unit normal whose slopes are the cell centre (in the
     /// stretched angles, as the ring centres of [`super::TabulatedSlope`]), where
-    /// [`crate::extract_anisotropic`] collocates its samples. Cell k = j·2N + i.
+    /// [`crate::tabulated::extract_anisotropic`] collocates its samples. Cell k = j·2N + i.
     #[must_use]
     pub fn cell_centre_direction(scale_x: f32, scale_y: f32, half_cells: usize, i: usize, j: usize) -> Vec3 {
         let n = half_cells;

@@ -2,7 +2,7 @@
 //! and their interpolation.
 
 use super::axis::{DielectricDirection, log_sqrt_blend};
-use super::dielectric_data as data;
+use super::generated::dielectric as data;
 use super::grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA, SideGrids};
 use super::table::MAX_TABULATED_ALPHA;
 
@@ -92,7 +92,7 @@ pub struct DielectricAlbedo {
 /// μ with α ≈ μ; treat a lookup as uncertain by these maxima, the nodes by 1e-5.
 /// # Examples
 /// ```
-/// use microsurface::DielectricAlbedoTable;
+/// use microsurface::compensation::DielectricAlbedoTable;
 ///
 /// // glass (η = 1.5) seen from air at normal incidence, α = 0.25
 /// let v = DielectricAlbedoTable::GGX.albedo(1.0, 0.25, 1.5).expect("in range");

@@ -1,9 +1,11 @@
 //! Noncentral (sheared) microsurfaces: a slope distribution offset by a mean slope
 //! (Dupuy 2015, thesis §3.2).
 
-use super::{MicrosurfaceSlope, is_direction, is_direction64, is_uniform, normalize_fast};
+use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
+use crate::slope::MicrosurfaceSlope;
 use crate::vector::ensure_visible;
+use crate::vector::normalize_fast;
 use glam::{DVec3, Vec2, Vec3};
 
 /// A sheared microsurface (Dupuy 2015, thesis §3.2): the slopes of the central distribution `S`
@@ -35,11 +37,11 @@ use glam::{DVec3, Vec2, Vec3};
 /// be a central one in the frame of n with exits through that plane, not the base plane (no
 /// longer the noncentral BRDF of the thesis). This type therefore does not implement
 /// [`MicrosurfaceSlope`], so that the type system keeps it out of
-/// [`Microsurface`](crate::Microsurface), [`PositionFree`](crate::PositionFree) and
+/// [`Microsurface`](crate::research::Microsurface), [`PositionFree`](crate::research::PositionFree) and
 /// [`MicrofacetBsdf`](crate::MicrofacetBsdf); its single-scattering BRDF is
 /// [`Noncentral::eval_single_scattering`] (with [`Noncentral::sample_single_scattering`] and
 /// [`Noncentral::pdf_single_scattering`]), and renderers use it through
-/// [`NoncentralBsdf`](crate::NoncentralBsdf).
+/// [`NoncentralBsdf`](crate::leadr::NoncentralBsdf).
 ///
 /// # Single scattering: separable G2
 /// The thesis' correlated G2 (eq. 2.13), 1/G2 = 1/G1(ωi) + 1/G1(ωo) − 1, is not positive for
@@ -49,7 +51,8 @@ use glam::{DVec3, Vec2, Vec3};
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Beckmann, Elliptical, Noncentral};
+/// use microsurface::{Beckmann, Elliptical};
+/// use microsurface::leadr::Noncentral;
 /// use microsurface::glam::{Vec2, Vec3};
 ///
 /// let slope = Elliptical::<Beckmann>::from_bivariate(0.3, 0.2, 0.5)?;

@@ -1,11 +1,12 @@
 //! The renderer-facing single-scattering BSDF of a noncentral (sheared) microsurface: the lobe a
 //! renderer that filters its normal maps with LEADR evaluates per texel.
 
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
+use super::NoncentralMaterial;
+use super::slope::Noncentral;
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
 use crate::error::Error;
 use crate::material::Conductor;
-use crate::noncentral::NoncentralMaterial;
-use crate::slope::{MicrosurfaceSlope, Noncentral};
+use crate::slope::MicrosurfaceSlope;
 use glam::{Vec2, Vec3};
 
 /// The masking-shadowing of a [`NoncentralBsdf`]: the thesis' G1 (eq. 3.3), or that G1 clamped
@@ -27,7 +28,7 @@ pub enum NoncentralMasking {
 
 /// The single-scattering BSDF of a sheared microsurface [`Noncentral<S>`] with a conductor, for
 /// renderers (the [`Bsdf`] trait): the LEADR lobe of a filtered normal or displacement map
-/// (Dupuy 2015, thesis §3.3–3.4; [`LeadrLobe::bsdf`](crate::LeadrLobe::bsdf)).
+/// (Dupuy 2015, thesis §3.3–3.4; [`LeadrLobe::bsdf`](crate::leadr::LeadrLobe::bsdf)).
 ///
 /// * f(wo, wi) = F(⟨wi, ωh⟩) D(ωh) G1(wo) G1(wi) / (4 cos θo cos θi), ωh = (wo + wi)/‖·‖, with D
 ///   by eq. 3.2, G1 by eq. 3.3 and the separable G2 (see [`Noncentral`]) for wo and wi above
@@ -59,7 +60,8 @@ pub enum NoncentralMasking {
 /// # Examples
 /// ```
 /// use microsurface::glam::{Vec2, Vec3};
-/// use microsurface::{Beckmann, Bsdf, ComplexIor, Conductor, Elliptical, Noncentral, NoncentralBsdf};
+/// use microsurface::{Beckmann, Bsdf, ComplexIor, Conductor, Elliptical};
+/// use microsurface::leadr::{Noncentral, NoncentralBsdf};
 ///
 /// let slope = Elliptical::<Beckmann>::from_bivariate(0.3, 0.2, 0.5)?;
 /// let surface = Noncentral::new(slope, Vec2::new(0.4, -0.1))?;

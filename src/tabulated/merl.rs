@@ -1,6 +1,6 @@
 //! The MERL isotropic BRDF binary format (Matusik, Pfister, Brand and McMillan 2003, "A
 //! Data-Driven Reflectance Model"), in which most measured BRDFs ship: a reader, a writer and a
-//! nearest-bin lookup, so that [`crate::extract_isotropic`] can run on a measurement.
+//! nearest-bin lookup, so that [`crate::tabulated::extract_isotropic`] can run on a measurement.
 //!
 //! Layout (little-endian): three `i32` dimensions (90 θh bins, 90 θd bins, 180 φd bins), then
 //! 3 × 90·90·180 `f64` values, the red, green and blue blocks, each indexed by

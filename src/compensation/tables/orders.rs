@@ -1,7 +1,8 @@
 //! The per-order multiple-scattering energies of the F = 1 conductor, tabulated from the
 //! exact random walk, and their interpolation.
 
-use super::{ALBEDO_TABLE_SIZE, MAX_TABULATED_ALPHA, orders_data};
+use super::generated::orders as orders_data;
+use super::{ALBEDO_TABLE_SIZE, MAX_TABULATED_ALPHA};
 
 /// The last scattering order with a table of its own: orders 2 … 6 are tabulated one by one,
 /// the orders above 6 together (the tail).
@@ -21,7 +22,7 @@ const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{ScatteringOrderTable, TabulatedOrder};
+/// use microsurface::compensation::{ScatteringOrderTable, TabulatedOrder};
 ///
 /// assert_eq!(TabulatedOrder::Exactly(2).index(), Some(0));
 /// assert_eq!(TabulatedOrder::Exactly(1).index(), None); // single scattering: `AlbedoTable`
@@ -74,7 +75,7 @@ impl TabulatedOrder {
 ///
 /// # Examples
 /// ```
-/// use microsurface::{AlbedoTable, ScatteringOrderTable, TabulatedOrder};
+/// use microsurface::compensation::{AlbedoTable, ScatteringOrderTable, TabulatedOrder};
 ///
 /// let (mu, alpha) = (1.0, 1.0);
 /// let single = AlbedoTable::GGX.directional(mu, alpha).expect("in range");

@@ -14,8 +14,8 @@ pub const MAX_TABULATED_ETA: f32 = 3.0;
 /// arriving from the side of the lower index, external incidence) or the one of η ≤ 1 (from
 /// the side of the higher index, internal incidence, with total internal reflection beyond the
 /// critical angle). For an interface of index η ≥ 1 (glass in air) light from
-/// [`crate::Side::Outside`] reads [`EtaRange::AtLeastOne`] at η and light from
-/// [`crate::Side::Inside`] reads [`EtaRange::AtMostOne`] at 1/η; [`EtaRange::of`] selects by
+/// [`crate::research::Side::Outside`] reads [`EtaRange::AtLeastOne`] at η and light from
+/// [`crate::research::Side::Inside`] reads [`EtaRange::AtMostOne`] at 1/η; [`EtaRange::of`] selects by
 /// the relative index seen by the light.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EtaRange {
@@ -34,7 +34,6 @@ impl EtaRange {
         if eta >= 1.0 { Self::AtLeastOne } else { Self::AtMostOne }
     }
 }
-
 
 /// Nodes per grid.
 pub(crate) const NODES: usize = DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE * DIELECTRIC_TABLE_SIZE;

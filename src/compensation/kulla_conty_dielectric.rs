@@ -3,13 +3,13 @@
 //! higher orders' reflected and transmitted energy, from the walk's tables
 //! ([`DielectricWalkTable`]), in the manner of Kulla and Conty 2017.
 
-use super::compensated::{AlbedoTabulated, ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
+use super::conductor::{AlbedoTabulated, ONE_MINUS_ULP, Tables, check_tabulated, mixture_sample};
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
-use super::microfacet::{MicrofacetBsdf, Technique};
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
-use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
+use crate::bsdf::{MicrofacetBsdf, Technique};
+use crate::compensation::tables::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::single_scattering::SingleScattering;
@@ -105,7 +105,7 @@ struct SideLobes {
 /// view (32 cells, one multiply and one truncation to find one) the probabilities of the
 /// single-scattering sample, the reflection lobe and the transmission lobe are
 /// E_ss : ΔR_a : c_a ΔT_a at the cell's centre (E_ss = R_ss + T_ss from
-/// [`crate::DielectricAlbedoTable`], at least 1e-3 of the total), normalized at construction;
+/// [`crate::compensation::DielectricAlbedoTable`], at least 1e-3 of the total), normalized at construction;
 /// each lobe samples the profile g(μi) μi of its light factor on its hemisphere by cells of the
 /// uniform μ axis (a density continuous and linear in μi² on each cell, a cell by its mass with
 /// the alias method, φ uniform: no division, root or search to find a cell or its density).
@@ -167,8 +167,8 @@ impl<S: WalkTabulated> KullaContyDielectric<S> {
     /// transport).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::MAX_TABULATED_ALPHA) (`"alpha"`) or the
-    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::MAX_TABULATED_ETA)] = [1/3, 3]
+    /// [`Error::InvalidParameter`] if √(αx αy) > [`MAX_TABULATED_ALPHA`](crate::compensation::MAX_TABULATED_ALPHA) (`"alpha"`) or the
+    /// relative index η lies outside [1/[`MAX_TABULATED_ETA`](crate::compensation::MAX_TABULATED_ETA), [`MAX_TABULATED_ETA`](crate::compensation::MAX_TABULATED_ETA)] = [1/3, 3]
     /// (`"eta"`): the tables' range.
     pub fn new(slope: S, dielectric: Dielectric) -> Result<Self, Error> {
         let alpha = slope.albedo_alpha();

@@ -213,4 +213,3 @@ pub mod research {
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
-pub use noncentral::NoncentralMaterial;

@@ -350,7 +350,7 @@ fn out_of_range_gives_none() {
 // ---------------------------------------------------------------------------------------------
 
 /// The measured interpolation errors of R + T of the dielectric lookups (max over 256 random
-/// points against quadrature, `examples/tables --interpolation`; `DESIGN.md`), per family
+/// points against quadrature, `tools --bin tables -- --interpolation`; `DESIGN.md`), per family
 /// (GGX, Beckmann) and side (outside, inside).
 const STATED_DIELECTRIC_ERROR: [[f64; 2]; 2] = [
     [DIELECTRIC_ERROR_GGX_OUT, DIELECTRIC_ERROR_GGX_IN],

@@ -471,7 +471,7 @@ fn invalid_input_gives_nothing() {
 // ---------------------------------------------------------------------------------------------
 
 /// The dielectric tables' measured interpolation error of R + T (max at 256 random points,
-/// `cargo run --release --example tables -- --interpolation --only dielectric`), per family
+/// `cargo run --release -p tools --bin tables -- --interpolation --only dielectric`), per family
 /// (GGX, Beckmann) and side (outside, inside).
 const DIELECTRIC_TABLE_ERROR: [[f64; 2]; 2] = [[4.80e-2, 6.17e-2], [7.50e-2, 1.30e-1]];
 /// The error of E at a node: quadrature 1e-5 (checked by the generator) and the f32 rounding

@@ -48,7 +48,7 @@ fn range_of(above: bool) -> EtaRange {
     if above { EtaRange::AtLeastOne } else { EtaRange::AtMostOne }
 }
 
-/// (μ, α, η ≥ 1) of table node (i, j, l), as the generator places it (`examples/tables/walk_dielectric.rs`).
+/// (μ, α, η ≥ 1) of table node (i, j, l), as the generator places it (`tools/src/bin/tables/walk_dielectric.rs`).
 fn node(i: usize, j: usize, l: usize) -> (f32, f32, f32) {
     let r = j as f64 / 15.0;
     let alpha = r * r;

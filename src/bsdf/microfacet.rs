@@ -9,7 +9,9 @@ use crate::error::Error;
 use crate::height::UniformHeight;
 use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
+#[cfg(feature = "position-free")]
 use crate::path::Shadowing;
+#[cfg(feature = "position-free")]
 use crate::position_free::{Estimator, PositionFree};
 use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
@@ -72,6 +74,7 @@ pub enum Technique {
     /// vertex is a vertex reached from below (DESIGN.md); for Beckmann seen from so far below
     /// that Λ underflows f64 (|cot θo|/α ≳ 26.6) `sample` returns nothing and eval keeps only
     /// the first order.
+    #[cfg(feature = "position-free")]
     PositionFree {
         /// PT or BDPT.
         estimator: Estimator,
@@ -259,6 +262,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 
     /// The position-free model with the given shadowing over the same slope and material.
+    #[cfg(feature = "position-free")]
     #[inline(always)]
     fn position_free(&self, shadowing: Shadowing) -> PositionFree<S, M> {
         PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
@@ -323,6 +327,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         for _ in 0..walks {
             // the walk enters along the view direction
             let sample = match self.technique {
+                #[cfg(feature = "position-free")]
                 Technique::PositionFree { shadowing, .. } => self.position_free(shadowing).sample(wo, rng),
                 _ => self.surface.sample(wo, rng),
             };
@@ -344,6 +349,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         match self.technique {
             Technique::SingleScattering => self.single().eval_unchecked(walk_in, walk_out, rng),
             Technique::RandomWalk => self.surface.eval(walk_in, walk_out, self.order, rng),
+            #[cfg(feature = "position-free")]
             Technique::PositionFree { estimator, shadowing } => {
                 self.position_free(shadowing).eval(walk_in, walk_out, estimator, self.order, rng)
             }
@@ -512,6 +518,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
                 let mut rng = PrimedPcg::after_one_private(&uniforms, hash());
                 self.surface.sample(walk_in, &mut rng)
             }
+            #[cfg(feature = "position-free")]
             Technique::PositionFree { shadowing, .. } => {
                 // the estimators draw beyond the caller's uniforms from the first bounce on
                 let mut rng = PrimedPcg::new(&uniforms, hash());

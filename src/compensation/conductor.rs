@@ -133,7 +133,7 @@ pub enum Compensation {
 /// **Tables.** E(μ) is the slope family's [`AlbedoTable`] at α = √(αx αy) (anisotropic
 /// surfaces are compensated as the isotropic surface of the same slope area: an
 /// approximation that restores only about half of the missing energy, measured by
-/// `examples/compensation`: GGX F = 1, αx = 0.2, αy = 0.8 still lacks up to 0.20 of albedo,
+/// `lab --bin compensation`: GGX F = 1, αx = 0.2, αy = 0.8 still lacks up to 0.20 of albedo,
 /// against 0.40 for single scattering), interpolated as the table does: the two
 /// roughness rows are blended once at construction and the direction axis is interpolated
 /// linearly at run time. The lobe interpolates the complements 1 − E of the nodes (exact in
@@ -173,7 +173,7 @@ pub enum Compensation {
 /// per-order energies ([`ScatteringOrderTable`], standard error ≤ 1.95e-3 per node) instead of
 /// Kulla and Conty's series in E_avg: for F = 1 it is the Kulla–Conty lobe; for coloured metals
 /// it follows the walk where the series does not (GGX gold, copper, aluminium at α = 1: albedo
-/// within 0.5 % of the walk against 3–4 % for Kulla–Conty, `examples/compensation`), but its
+/// within 0.5 % of the walk against 3–4 % for Kulla–Conty, `lab --bin compensation`), but its
 /// F̄ = F_avg per bounce misses the grazing-facet Fresnel of the higher orders for grazing views
 /// at small α (gold at α = 0.1, μo = 0.1: 3 % low, as Kulla–Conty).
 ///

@@ -36,6 +36,7 @@ pub(crate) struct PathModel<S, M> {
     pub(crate) shadowing: Shadowing,
 }
 
+/// An outgoing direction of a vertex with what its shadowing factors need.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Exit {
     /// The direction.
@@ -74,14 +75,6 @@ impl Incident {
     }
 }
 
-impl Exit {
-    /// Whether the direction can leave the surface.
-    #[inline(always)]
-    pub(crate) fn can_exit(self) -> bool {
-        self.lambda.is_some()
-    }
-}
-
 impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
     /// The model of the given slope distribution, material and shadowing.
     #[inline]
@@ -99,27 +92,6 @@ impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
             return Vec3::ZERO;
         };
         self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
-    }
-
-    /// Samples the single-bounce term for a unit ωi (see `PositionFree::sample_single`).
-    #[inline]
-    pub(crate) fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
-        let at = Self::incident(wi)?;
-        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
-        let k_in = inv_g1(&self.slope, at.in_frame());
-        let last = self.relative_shadowing(at, k_in, self.exit(s.wo, s.side)).last;
-        let weight = s.weight * last as f32;
-        (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
-    }
-
-    /// The density of [`Self::sample_single`] for unit directions: the phase function's
-    /// sampling density (exact for conductors and dielectrics).
-    #[inline]
-    pub(crate) fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
-        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return 0.0;
-        };
-        self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side))
     }
 
     /// The approximate density of a multiple-bounce sample, for multiple importance sampling
@@ -235,14 +207,6 @@ impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
             _ => 0.0,
         };
         self.shadowing.relative(k_in, out.lambda, ratio, event)
-    }
-
-    /// Whether the incident state `at` with 1 + L̃ = `k_in` sees no microsurface: Λ(−ωin) = 0
-    /// exactly (straight from below), told apart from a Λ(−ωin) that only underflows f64
-    /// (Beckmann, |cot θ|/αᵢ > 26.6) by ln Λ (−∞ only in the first case).
-    #[inline]
-    pub(crate) fn sees_nothing(&self, at: Incident, k_in: f64) -> bool {
-        k_in == 0.0 && self.slope.ln_lambda(-at.in_frame()) == f64::NEG_INFINITY
     }
 
     /// The exit data of an outgoing direction: whether it points up in its side frame (can

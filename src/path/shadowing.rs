@@ -46,6 +46,8 @@ pub(crate) enum VertexRole {
     /// The path leaves through the outgoing direction.
     Last,
     /// The path continues along the outgoing direction.
+    /// (Only the multiple-bounce estimators continue a path.)
+    #[cfg_attr(not(feature = "position-free"), allow(dead_code))]
     Middle,
 }
 

@@ -15,7 +15,7 @@ mod roulette;
 use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::{MAX_BOUNCES, ScatteringOrder, WalkSample};
-use crate::path::{Incident, PathModel, Shadowing, inv_g1};
+use crate::path::{Exit, Incident, PathModel, Shadowing, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
@@ -65,8 +65,6 @@ pub struct PositionFree<S, M> {
     /// The scales of the phase function's peak for the camera paths' roulette.
     peaks: PeakScales,
 }
-
-/// An outgoing direction of a vertex with what its shadowing factors need.
 
 impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// A position-free BSDF with the given slope distribution, material and shadowing model.
@@ -195,7 +193,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// `None` (a debug assertion in debug builds).
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
         require!(is_direction(wi), None; wi);
-        self.model.sample_single(wi, rng)
+        let m = &self.model;
+        let at = PathModel::<S, M>::incident(wi)?;
+        let s = m.material.sample_phase_unchecked(&m.slope, at.w, at.side, rng);
+        let k_in = inv_g1(&m.slope, at.in_frame());
+        let last = m.relative_shadowing(at, k_in, m.exit(s.wo, s.side)).last;
+        let weight = s.weight * last as f32;
+        (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
     }
 
     /// The density of [`PositionFree::sample_single`]: the phase function's sampling density
@@ -205,7 +209,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        self.model.pdf_single(wi, wo)
+        let (Some(start), Some(wo_side)) =
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        else {
+            return 0.0;
+        };
+        self.model.material.pdf_phase_unchecked(&self.model.slope, &start.to(wo, wo_side))
     }
 
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
@@ -219,6 +228,24 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
         self.model.mis_pdf(wi, wo)
+    }
+}
+
+impl Exit {
+    /// Whether the direction can leave the surface.
+    #[inline(always)]
+    pub(crate) fn can_exit(self) -> bool {
+        self.lambda.is_some()
+    }
+}
+
+impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
+    /// Whether the incident state `at` with 1 + L̃ = `k_in` sees no microsurface: Λ(−ωin) = 0
+    /// exactly (straight from below), told apart from a Λ(−ωin) that only underflows f64
+    /// (Beckmann, |cot θ|/αᵢ > 26.6) by ln Λ (−∞ only in the first case).
+    #[inline]
+    pub(crate) fn sees_nothing(&self, at: Incident, k_in: f64) -> bool {
+        k_in == 0.0 && self.slope.ln_lambda(-at.in_frame()) == f64::NEG_INFINITY
     }
 }
 

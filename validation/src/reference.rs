@@ -1,7 +1,7 @@
 //! A test-only double-precision reference for the f32 crate and the accuracy map built on it.
 //!
 //! Used by `tests/special/accuracy_map.rs` (which asserts the bounds) and
-//! `examples/stability.rs` (which prints the map).
+//! `lab/src/bin/stability.rs` (which prints the map).
 //!
 //! The reference evaluates the definitions of the supplement (Heitz et al. 2016) in f64, on
 //! the *same* f32 inputs the crate receives (widened exactly), with `statrs` special functions.

@@ -1,6 +1,6 @@
 //! The research-layer calls that the renderer trait's techniques wrap, in the trait's
 //! orientation, as the BSDF benches (`benches/bsdf.rs`) and their instruction-count driver
-//! (`examples/bsdf_calls.rs`) call them.
+//! (`tools/src/bin/profile_bsdf.rs`) call them.
 
 use glam::Vec3;
 use microsurface::Technique;

@@ -71,7 +71,7 @@ impl TabulatedOrder {
 /// **Accuracy.** Every node is the mean of 2¹⁶ walks of its own seeded generator: standard
 /// error √(e (1 − e)/2¹⁶) ≤ [`ORDER_TABLE_MAX_STANDARD_ERROR`] per node (and per average
 /// node); the nodes of a cell are independent. Generated (bit for bit reproducibly) by
-/// `cargo run --release --example tables -- --only orders`.
+/// `cargo run --release -p tools --bin tables -- --only orders`.
 ///
 /// # Examples
 /// ```

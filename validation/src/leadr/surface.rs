@@ -1,5 +1,5 @@
 //! The procedural displacement map of the LEADR validation, and the naive alternative to
-//! LEADR (a MIP pyramid of averaged normals). Shared by `examples/leadr` and `tests/leadr.rs`.
+//! LEADR (a MIP pyramid of averaged normals). Shared by `lab/src/bin/leadr` and `tests/leadr.rs`.
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use microsurface::leadr::HeightMap;

@@ -9,7 +9,7 @@
 //! `sample-first` and `sample-last` run the sampler with the lobe-choice uniform fixed at 0 or
 //! 1⁻ (a mixture's single-scattering lobe, or its added lobe), to time the branches apart.
 //!
-//! Usage: `compensated_calls {gold|glass} {none|single|kulla-conty|turquin|per-order}
+//! Usage: `profile_compensated {gold|glass} {none|single|kulla-conty|turquin|per-order}
 //! {eval|pdf|sample|eval_with_pdf|sample-first|sample-last} calls`
 
 use microsurface::glam::{Vec2, Vec3};
@@ -110,7 +110,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let [_, material, technique, what, calls] = &args[..] else {
         panic!(
-            "usage: compensated_calls {{gold|glass}} {{none|single|kulla-conty|turquin|per-order}} {{eval|pdf|sample|eval_with_pdf|sample-first|sample-last}} calls"
+            "usage: profile_compensated {{gold|glass}} {{none|single|kulla-conty|turquin|per-order}} {{eval|pdf|sample|eval_with_pdf|sample-first|sample-last}} calls"
         )
     };
     let calls: usize = calls.parse().expect("a call count");

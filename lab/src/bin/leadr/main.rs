@@ -2,7 +2,7 @@
 //! normal-map MIP: an error table of single texels, and a picture of a displacement-mapped
 //! plane receding to the horizon.
 //!
-//! `cargo run --release --example leadr [-- --quick] [--out DIR]` (default `target/leadr`).
+//! `cargo run --release -p lab --bin leadr [-- --quick] [--out DIR]` (default `target/leadr`).
 //! Writes `leadr.png`: top row supersampled | LEADR | naive; bottom row the MIP level used per
 //! pixel (black 0, white the coarsest) | 2 × |LEADR − reference| | 2 × |naive − reference|
 //! (tone-mapped values).

@@ -10,10 +10,10 @@
 //! J = dωi/dωm = 4|ωo·ωm| of the reflection and J = (ωo·ωm + η ωi·ωm)² / (η²|ωi·ωm|) of the
 //! refraction (the inverses of Walter et al. 2007, eqs. 14 and 16).
 
-use crate::quadrature::{SlopeFamily, VisibleTolerance, integrate_visible};
 use glam::Vec3;
 use microsurface::compensation::{AlbedoTable, DielectricAlbedoTable};
 use microsurface::{Beckmann, Bsdf, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique, Transport};
+use validation::quadrature::{SlopeFamily, VisibleTolerance, integrate_visible};
 
 /// The roughnesses of the curves: between the tables' nodes (r = √α on 32 or 16 nodes).
 pub const TABLE_ALPHAS: [f32; 4] = [0.03, 0.12, 0.4, 0.9];

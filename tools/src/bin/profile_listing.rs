@@ -7,7 +7,7 @@
 //! `pt` and `bdpt` run the position-free estimators (correlated shadowing) on the same
 //! configuration instead; an optional last argument replaces α = 0.5.
 //!
-//! Usage: `listing_calls {conductor|diffuse|dielectric} {ggx|beckmann} {eval|sample|pt|bdpt} calls [α]`
+//! Usage: `profile_listing {conductor|diffuse|dielectric} {ggx|beckmann} {eval|sample|pt|bdpt} calls [α]`
 
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
@@ -59,7 +59,7 @@ fn main() {
         [_, m, s, w, c] => (m, s, w, c, 0.5),
         [_, m, s, w, c, a] => (m, s, w, c, a.parse().expect("a roughness")),
         _ => panic!(
-            "usage: listing_calls {{conductor|diffuse|dielectric}} {{ggx|beckmann}} {{eval|sample|pt|bdpt}} calls [α]"
+            "usage: profile_listing {{conductor|diffuse|dielectric}} {{ggx|beckmann}} {{eval|sample|pt|bdpt}} calls [α]"
         ),
     };
     let calls: u64 = calls.parse().expect("a call count");

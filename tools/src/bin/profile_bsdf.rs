@@ -7,9 +7,9 @@
 //! difference for the `loop` variant of the call (the rotation through the same inputs,
 //! behind the same `black_box`es, without the call).
 //!
-//! Usage: `bsdf_calls {gold|glass} {single|walk|pt|bdpt} {eval|pdf|eval_with_pdf|sample}
+//! Usage: `profile_bsdf {gold|glass} {single|walk|pt|bdpt} {eval|pdf|eval_with_pdf|sample}
 //! {research|research+pdf|static|dyn|loop|loop-research} calls`, and
-//! `bsdf_calls gold single sample {vndf|vndf-static|vndf-loop} calls` for the
+//! `profile_bsdf gold single sample {vndf|vndf-static|vndf-loop} calls` for the
 //! `gold/single/sample-vs-vndf` group (its own inputs). `loop` is the baseline of the trait's
 //! calls and of the research `eval`, `pdf` and `eval_with_pdf` (the same inputs read);
 //! `loop-research` that of the research `sample` (which reads only wo).
@@ -124,7 +124,7 @@ fn run<M: Material + SpecularLimit>(
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let [_, material, technique, call, variant, calls] = &args[..] else {
-        panic!("usage: bsdf_calls {{gold|glass}} {{single|walk|pt|bdpt}} call variant calls");
+        panic!("usage: profile_bsdf {{gold|glass}} {{single|walk|pt|bdpt}} call variant calls");
     };
     let calls: usize = calls.parse().expect("a call count");
     let technique = match technique.as_str() {

@@ -5,7 +5,7 @@
 //! the Beckmann guess table's one-time build, and leaves the sampler plus a few instructions of
 //! loop.
 //!
-//! Usage: `sampler_calls {beckmann|ggx} theta calls [α]` (α = 0.5 by default)
+//! Usage: `profile_sampler {beckmann|ggx} theta calls [α]` (α = 0.5 by default)
 
 use microsurface::glam::Vec3;
 use microsurface::slope::MicrosurfaceSlope;
@@ -51,7 +51,7 @@ fn main() {
     let (slope, theta, calls, alpha) = match &args[..] {
         [_, s, t, c] => (s, t, c, 0.5),
         [_, s, t, c, a] => (s, t, c, a.parse().expect("a roughness")),
-        _ => panic!("usage: sampler_calls {{beckmann|ggx}} theta calls [α]"),
+        _ => panic!("usage: profile_sampler {{beckmann|ggx}} theta calls [α]"),
     };
     let theta: f64 = theta.parse().expect("an angle");
     let calls: usize = calls.parse().expect("a call count");

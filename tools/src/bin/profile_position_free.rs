@@ -15,7 +15,7 @@
 //!   cycle through 1024 ωo drawn from the mixture of `PositionFree::pdf` (0.8 phase sampling,
 //!   0.2 cosine), as the albedo tests draw them.
 //!
-//! Usage: `position_free_calls <configuration> {pt|bdpt} calls`
+//! Usage: `profile_position_free <configuration> {pt|bdpt} calls`
 
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
@@ -104,7 +104,7 @@ fn run_config<S: MicrosurfaceSlope, M: Material>(
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let [_, config, what, calls] = &args[..] else {
-        panic!("usage: position_free_calls <configuration> {{pt|bdpt}} calls")
+        panic!("usage: profile_position_free <configuration> {{pt|bdpt}} calls")
     };
     let calls: u64 = calls.parse().expect("a call count");
     let parts: Vec<&str> = config.split('-').collect();

@@ -1,16 +1,16 @@
 //! The crate's main job: a report of every estimator's accuracy against run time, the lobes
 //! and energy per scattering order, and the cost of every model, measured on this machine.
 //!
-//! `cargo run --release --example report -- [--quick] [--out DIR]` writes CSV files, SVG
+//! `cargo run --release -p lab --bin report -- [--quick] [--out DIR]` writes CSV files, SVG
 //! figures, `summary.md` and the page `index.html` into DIR (default `target/report`) and
-//! prints the summary. The stages (`validation::report`), one file each: `configure` (what and how much), `measure`
+//! prints the summary. The stages (`lab::report`), one file each: `configure` (what and how much), `measure`
 //! (per-sample values, timings, references, energy, lobes, cost), `reduce` (errors against
 //! time, efficiency ratios with confidence intervals, lobe panels), `plot` (SVG figures) and
 //! `write` (CSV, Markdown, HTML); `pipeline` runs them in order.
 
-use validation::report::{configure, pipeline};
+use lab::report::{configure, pipeline};
 
-const USAGE: &str = "usage: cargo run --release --example report -- [--quick] [--out DIR]
+const USAGE: &str = "usage: cargo run --release -p lab --bin report -- [--quick] [--out DIR]
 
   --quick    a small run (seconds instead of minutes)
   --out DIR  output directory (default target/report)

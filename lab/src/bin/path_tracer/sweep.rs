@@ -10,12 +10,10 @@
 
 use crate::label::{Align, BLACK, Canvas, Fonts, Rgb8, WHITE, Weight, srgb8};
 use glam::Vec3;
+use lab::tracer::{Camera, Environment, Light, Lighting, Material, RenderStats, Scene, Sphere, render};
 use microsurface::{
     CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
     MicrofacetBsdf, Technique,
-};
-use validation::tracer::{
-    Camera, Environment, Light, Lighting, Material, RenderStats, Scene, Sphere, render,
 };
 
 /// The roughnesses of the columns.

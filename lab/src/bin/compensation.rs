@@ -22,8 +22,8 @@
 //! standard error. Writes `target/compensation/albedo.csv`, `lobes.csv` and `table.md`.
 //!
 //! ```sh
-//! cargo run --release --example compensation            # the published numbers
-//! cargo run --release --example compensation -- --quick # a smaller run (CI)
+//! cargo run --release -p lab --bin compensation            # the published numbers
+//! cargo run --release -p lab --bin compensation -- --quick # a smaller run (CI)
 //! ```
 
 use microsurface::glam::{Vec2, Vec3};

@@ -3,10 +3,10 @@
 //! the albedos add up), and every SVG and the HTML page parse and reference only files that
 //! exist.
 
+use lab::report::configure::{Config, Est, LOBE_MATERIALS, Options, RunSize};
+use lab::report::tables::{Family, Tabulated};
+use lab::report::{configure, pipeline};
 use std::path::Path;
-use validation::report::configure::{Config, Est, LOBE_MATERIALS, Options, RunSize};
-use validation::report::tables::{Family, Tabulated};
-use validation::report::{configure, pipeline};
 
 fn quick_report() -> (pipeline::Report, std::path::PathBuf) {
     let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));

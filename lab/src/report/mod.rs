@@ -1,6 +1,6 @@
 //! The crate's report: every estimator's accuracy against run time, the lobes and energy per
 //! scattering order, and the cost of every model, measured on this machine (run by
-//! `examples/report/main.rs` and, in its quick mode, by `tests/examples/report.rs`).
+//! `lab/src/bin/report.rs` and, in its quick mode, by `lab/tests/report.rs`).
 //!
 //! The stages, one file each: [`configure`] (what and how much), [`measure`] (per-sample
 //! values, timings, references, energy, lobes, cost), [`reduce`] (errors against time,

@@ -1,7 +1,7 @@
 //! A small CPU path tracer over the `microsurface` BSDFs: spheres, one spherical area light,
 //! an environment; next-event estimation, Russian roulette and multiple importance sampling
 //! (the classic unidirectional path tracer with MIS). Used by
-//! `examples/path_tracer/main.rs` and `tests/examples/path_tracer.rs`.
+//! `lab/src/bin/path_tracer/` and `lab/tests/path_tracer.rs`.
 //!
 //! The materials are a `Vec<Box<dyn Bsdf>>`: no enum, no dispatch macro. The BSDF samples
 //! are driven by the tracer's own uniforms; the stochastic BSDFs get the path's index as

@@ -380,7 +380,7 @@ fn csv_files(results: &Results) -> Vec<(&'static str, String)> {
 }
 
 /// The path tracer's sweep images with their captions: rendered by
-/// `cargo run --release --example path_tracer` and committed under `docs/`.
+/// `cargo run --release -p lab --bin path_tracer` and committed under `docs/`.
 const RENDERS: [(&str, &str); 2] = [
     (
         "sweep.png",
@@ -414,7 +414,7 @@ fn figure_html(f: &Figure, caption: &str) -> String {
 /// Copies the sweep images from `docs/` into `out_dir`; returns the (file, caption) of those
 /// that exist.
 fn copy_renders(out_dir: &std::path::Path, files: &mut Vec<PathBuf>) -> Vec<(&'static str, &'static str)> {
-    let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs");
     RENDERS
         .into_iter()
         .filter(|(name, _)| {
@@ -432,7 +432,7 @@ fn copy_renders(out_dir: &std::path::Path, files: &mut Vec<PathBuf>) -> Vec<(&'s
 fn renders_html(renders: &[(&str, &str)]) -> String {
     let mut h = String::from("<h2 id=\"render\">Rendered roughness sweep and its white furnace</h2>\n");
     if renders.is_empty() {
-        h.push_str("<p>No render found under docs/: <code>cargo run --release --example path_tracer</code> renders them.</p>\n");
+        h.push_str("<p>No render found under docs/: <code>cargo run --release -p lab --bin path_tracer</code> renders them.</p>\n");
     }
     for (file, caption) in renders {
         let _ = writeln!(

@@ -4,10 +4,10 @@
 //! any number of threads.
 
 use glam::Vec3;
-use microsurface::{Bsdf, ComplexIor, Conductor, Ggx, MicrofacetBsdf, ShadingFrame, Technique};
-use validation::tracer::{
+use lab::tracer::{
     self, Camera, Environment, Hit, Lighting, RenderStats, Scene, Sphere, render, showcase_scene,
 };
+use microsurface::{Bsdf, ComplexIor, Conductor, Ggx, MicrofacetBsdf, ShadingFrame, Technique};
 use validation::{Stats, family_z};
 
 /// Every BSDF call is a pure function of its arguments and the tracer's generators are

@@ -1,20 +1,20 @@
 //! A small multi-threaded CPU path tracer over the BSDFs of `microsurface`. By default it
 //! renders the GGX roughness sweep (gold and glass; single scattering, the exact walk and the
 //! compensated lobes) and its white-furnace version, labelled in the images:
-//! `cargo run --release --example path_tracer -- [--quick] [--spp N] [--out-dir DIR]`;
+//! `cargo run --release -p lab --bin path_tracer -- [--quick] [--spp N] [--out-dir DIR]`;
 //! `--showcase` renders one sphere per model instead.
 
 mod label;
 mod png;
 mod sweep;
 
+use lab::tracer::{Lighting, RenderStats, SHOWCASE_LABELS, render, showcase_scene};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 use sweep::{Layout, render_sweep};
-use validation::tracer::{Lighting, RenderStats, SHOWCASE_LABELS, render, showcase_scene};
 
-const USAGE: &str = "usage: cargo run --release --example path_tracer -- [--quick] [--spp N] [--out-dir DIR]
-       cargo run --release --example path_tracer -- --showcase [--width W] [--height H] [--spp N] [--out FILE.png] [--furnace]
+const USAGE: &str = "usage: cargo run --release -p lab --bin path_tracer -- [--quick] [--spp N] [--out-dir DIR]
+       cargo run --release -p lab --bin path_tracer -- --showcase [--width W] [--height H] [--spp N] [--out FILE.png] [--furnace]
 
   (default)      the GGX roughness sweep (α from 0.05 to 1; gold and glass; single scattering,
                  exact walk, Kulla–Conty and Turquin; glass Turquin) and its white furnace:

@@ -3,11 +3,11 @@
 //! the stiff-walk table (white-furnace albedo ± standard error and mean walk length of every
 //! estimator at α = 1e-3, α = 4, θi = 1.57 rad and near total internal reflection).
 //!
-//! `cargo run --release --example stability` prints both as markdown (`validation::stability`).
+//! `cargo run --release -p lab --bin stability` prints both as markdown (`validation::stability`).
 //! The same measurements are asserted by `tests/special/accuracy_map.rs` and
 //! `tests/walk/stiff.rs`.
 
-const USAGE: &str = "usage: cargo run --release --example stability
+const USAGE: &str = "usage: cargo run --release -p lab --bin stability
 
 Prints the accuracy map and the stiff-walk table as markdown. Takes no arguments other than
 --help.";

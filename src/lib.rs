@@ -122,6 +122,7 @@ mod constants;
 mod error;
 mod fresnel;
 mod height;
+mod invariance;
 mod leadr;
 mod material;
 mod merl;
@@ -156,6 +157,7 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 /// can name the crate's types.
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+pub use invariance::{FORCED_BOUNCES, Invariance, MIN_FIRST_RATE};
 pub use leadr::{
     CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, MomentLevel,
     SlopeMoments,

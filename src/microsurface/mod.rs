@@ -6,6 +6,7 @@ mod walk;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
 pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
+pub(crate) use walk::incident_area;
 
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;

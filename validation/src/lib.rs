@@ -17,7 +17,8 @@
 //! rectangles, the sphere, and the slope-space integrals of visible normals), one f64
 //! reference model ([`reference`](mod@reference)), one set of statistical assertions (seeded generators,
 //! Šidák-corrected z, mean within z·SE with SE small enough: the crate root), the pooling of
-//! low-expectation cells ([`chi2::pool`]), and the code of the examples that the tests also
+//! low-expectation cells ([`chi2::pool`]), the per-order albedos of the walk and the position-free
+//! models in closed form for GGX α = 1 ([`per_order`]), and the code of the examples that the tests also
 //! run: the report ([`report`]), the path tracer ([`tracer`]), the stability report
 //! ([`stability`]) and the LEADR validation ([`leadr`](mod@leadr)).
 //!
@@ -40,6 +41,7 @@ pub mod chi2;
 pub mod clock;
 pub mod inputs;
 pub mod leadr;
+pub mod per_order;
 pub mod quadrature;
 pub mod reference;
 pub mod report;

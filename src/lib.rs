@@ -157,7 +157,7 @@ pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_sch
 /// can name the crate's types.
 pub use glam;
 pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
-pub use invariance::{FORCED_BOUNCES, Invariance, MIN_FIRST_RATE};
+pub use invariance::{Invariance, MIN_FIRST_RATE};
 pub use leadr::{
     CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, MomentLevel,
     SlopeMoments,

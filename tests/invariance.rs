@@ -159,9 +159,10 @@ fn per_order_albedos_against_quadrature() {
 }
 
 /// Per-order albedos (orders 1–3 and all) of `eval` against the walk's bounce histogram,
-/// elsewhere than the quadrature's configuration: Beckmann α = 0.5 and GGX α = 0.3 (paths
-/// that go down again after going up, from order 3 on), anisotropic GGX (0.15, 0.9), Beckmann
-/// α = 2, a gold conductor (per RGB channel) and white diffuse facets. Two-sample z-test,
+/// elsewhere than the quadrature's configuration: Beckmann α = 0.5, GGX α = 0.3 at grazing
+/// incidence, anisotropic GGX (0.15, 0.9), Beckmann α = 2, gold conductors (per RGB channel)
+/// and white diffuse facets (whose paths, unlike a mirror's, can go down again after going
+/// up). Two-sample z-test,
 /// Šidák over every (configuration, order, channel); each combined SE ≤ 8e-3 asserted (order
 /// 4 carries 3e-4 of the albedo at Beckmann α = 0.5, too little for this N to resolve).
 #[test]

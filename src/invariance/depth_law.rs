@@ -2,9 +2,11 @@
 //! position-free state: the Laplace transform of its density, kept in a basis in which every
 //! update is a sum of positive terms.
 
-/// The segments kept inline before the state spills to the heap (a path with more than this
-/// many downward segments: none in 10⁶ GGX α = 1 paths; a few in 10⁴ at α = 10).
-const INLINE: usize = 16;
+/// The downward segments kept inline before the state spills to the heap. A conductor's path
+/// has one run of them, at its start (a mirror reflection only raises a ray: see the module
+/// documentation of `invariance`), so this is the rare long dive; diffuse facets can add
+/// segments after an upward one.
+const INLINE: usize = 8;
 
 /// Rescale the coefficients when their sum leaves [1e-150, 1e150] (they are kept
 /// unnormalized, see [`DepthLaw`]).

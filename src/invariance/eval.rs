@@ -10,23 +10,21 @@ use crate::slope::MicrosurfaceSlope;
 use glam::{DVec3, Vec3};
 use rand::Rng;
 
-/// The hit probability L of an upward segment is carried as a weight to the next-event term
-/// of the vertex it reaches; the path then continues past that vertex with probability L
-/// (Russian roulette with the walk's own law, the weight divided by L) — except past the
-/// first `FORCED_BOUNCES` vertices, where it always continues with L kept in the weight.
-pub const FORCED_BOUNCES: u32 = 2;
-
 impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
     /// Estimates f(ωi, ωo)·|cos θo| of the orders `order` (Cui et al. 2023; the estimator of
     /// the [module documentation](super)): unbiased, stochastic, per RGB channel.
     ///
     /// A path draws its directions from the phase function (exact visible-normal sampling)
-    /// and adds at every vertex j the next-event term (Π w)·L·p(d_{j−1} → ωo)·Ψ_j(Λ(ωo)),
-    /// Ψ_j(Λ(ωo)) the exact probability that ωo leaves vertex j unmasked given the directions
-    /// (order 1: the height-correlated single scattering, exactly). Paths end by Russian
-    /// roulette with the exact hit probability of their upward segments after
-    /// [`FORCED_BOUNCES`]; `order` truncates them (all orders: [`crate::MAX_BOUNCES`] is only
-    /// a guard). Precision: the depth law is in f64 with positive terms only (relative error
+    /// and adds at every vertex j the next-event term (Π w)·P·p(d_{j−1} → ωo)·Ψ_j(Λ(ωo)):
+    /// w the phase samples' weights (Fresnel), Ψ_j(Λ(ωo)) the exact probability that ωo
+    /// leaves vertex j unmasked given the directions (order 1: the height-correlated single
+    /// scattering, exactly), and P the exact probability that the segment d_{j−1} hits (1
+    /// going down). The path then goes on past vertex j with probability P (Russian roulette
+    /// with the walk's own law, the weight divided by P), so that its length is the walk's,
+    /// while the next-event term keeps P as a weight: where an upward d_{j−1} barely hits
+    /// (Λ → 0) the phase function p ∝ 1/A(−d_{j−1}) = 1/(Λ|cos|) is unbounded but P·p is not,
+    /// whereas the walk's next-event term after a sampled hit has unbounded variance there.
+    /// `order` truncates the paths (all orders: [`crate::MAX_BOUNCES`] is only a guard). Precision: the depth law is in f64 with positive terms only (relative error
     /// a few f64 ulps per bounce); Λ in f64.
     ///
     /// 0 for ωi or ωo on the horizon and for ωo below it. ωi below the horizon (a backfacing
@@ -46,10 +44,10 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
         if !(first_rate >= MIN_FIRST_RATE) {
             return self.walk().eval_from_below(wi, wo, order, rng);
         }
-        let mut law = DepthLaw::new(first_rate, slope.lambda64(wo));
+        let mut law = DepthLaw::new(first_rate, f64::from(slope.lambda_unchecked(wo)));
         let last = order.last();
         // the throughput: the phase samples' weights times the hit probability of the
-        // segment that reached the current vertex (and of earlier ones, while forced)
+        // segment that reached the current vertex
         let mut weight = DVec3::ONE;
         // the hit probability carried in `weight` that the roulette has not yet resolved
         let mut pending = 1.0;
@@ -68,7 +66,7 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
             if bounce == last {
                 break;
             }
-            if pending < 1.0 && bounce > FORCED_BOUNCES {
+            if pending < 1.0 {
                 // the roulette of the segment that reached this vertex, after its next-event
                 // term (which kept the hit probability as a weight: with p ∝ 1/A(−d) it stays
                 // bounded, where a sampled hit would give p alone, of unbounded variance)
@@ -80,19 +78,21 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
             let s = self.material.sample_phase_walk_unchecked(slope, incident, Side::Outside, rng);
             weight *= s.weight.as_dvec3();
             let d = s.wo;
-            let lambda = slope.lambda64(d);
+            // Λ in f32 as the walk takes it (relative error a few ulps; a Λ below f32's range
+            // ends an upward segment's path, whose hit probability it is)
+            let lambda = slope.lambda_unchecked(d);
             pending = 1.0;
             if d.z < 0.0 {
-                law.down(-lambda);
+                law.down(-f64::from(lambda));
             } else if d.z > 0.0 {
-                pending = law.up(lambda);
+                pending = law.up(f64::from(lambda));
                 weight *= pending;
             }
             // (a horizontal d meets the surface at once, at the same depth: the law is unchanged)
             if weight == DVec3::ZERO {
                 break;
             }
-            area = incident_area(d.z, lambda as f32);
+            area = incident_area(d.z, lambda);
             incident = -d;
         }
         sum.as_vec3()

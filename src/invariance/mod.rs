@@ -46,21 +46,26 @@
 //! (Φ(s) − Φ(b))/(b − s); and G = Φ_k(σ_k). Normalized by Φ_j(0), Ψ_j = Φ_j/Φ_j(0) is the
 //! depth's moment generating function: Ψ_j(Λ(ωo)) is the probability that ωo leaves vertex j
 //! unmasked given the path's directions (order 1: (1 + Λi)/(1 + Λi + Λo), the height-correlated
-//! G2/G1), and 1 − Ψ_j(b) the probability that an upward segment of rate b hits. For a path
-//! that goes down and then only up, G reduces to the paper's sum over interleavings of the two
-//! chains; in general (a segment down after one up) the suffix-product basis of `DepthLaw`
-//! keeps it exact.
+//! G2/G1), and 1 − Ψ_j(b) the probability that an upward segment of rate b hits.
+//!
+//! Per-order structure: on mirror facets a reflection only raises a ray (d′.z = d.z −
+//! 2(d·m)m.z > d.z for a facet it meets, d·m < 0, m.z > 0), so a conductor's path goes down
+//! for a while and then only up, and G is a sum over the interleavings of the two chains'
+//! depths, each interleaving a product of 1/(σ_down + σ_up) — the form of the paper's path
+//! shadowing-masking function and of its released implementation. Diffuse facets can send an
+//! upward ray down again; the suffix-product basis of `DepthLaw` is exact for those paths too
+//! (checked against the sum over all depth orderings in its tests).
 //!
 //! # The estimators
 //!
 //! * [`Invariance::eval`]: path tracing with next-event estimation towards ωo at every vertex,
 //!   directions drawn from the phase function (exact visible-normal sampling): the
-//!   contribution of order j + 1 is (Π w)·L·p(d_j → ωo)·Ψ_{j+1}(Λ(ωo)), w the sample weights
-//!   (Fresnel), L the probability that the walk reaches vertex j + 1 given the directions.
-//!   L is carried as a weight through the first [`FORCED_BOUNCES`] segments and sampled
-//!   after (Russian roulette with the exact hit probability, the walk's own law). Unbiased for
-//!   every order; the masking of ωo and of every upward segment is the exact conditional
-//!   expectation given the directions, where the walk draws heights (Rao–Blackwell).
+//!   contribution of order j + 1 is (Π w)·P·p(d_j → ωo)·Ψ_{j+1}(Λ(ωo)), w the sample weights
+//!   (Fresnel), P the probability that segment j hits given the directions (1 going down).
+//!   After that next-event term the path goes on with probability P (Russian roulette with
+//!   the walk's own law, deferred by one vertex: see [`Invariance::eval`]). Unbiased for every
+//!   order; the masking of ωo and the hits of the upward segments are exact conditional
+//!   expectations given the directions, where the walk draws heights (Rao–Blackwell).
 //! * [`Invariance::sample`]: the walk's law of exit directions with the depths integrated out:
 //!   an upward segment leaves with probability Ψ(b); the weight is the product of the phase
 //!   sample weights, f·|cos θo|/pdf exactly (1 for F = 1). Its density has no closed form (as
@@ -71,11 +76,6 @@
 //! handled the same way; where Λ(−ωi) < [`MIN_FIRST_RATE`] (Beckmann seen from so far below
 //! that it nears f64 underflow) both methods use the walk from below
 //! ([`Microsurface::eval_from_below`], the same model), which works in ln Λ.
-//!
-//! The released implementation that accompanies the paper accumulates G for a path that goes
-//! down and then up; for a segment down after an upward one (possible from order 3 on) it
-//! drops that segment's factor. This module derives G for every path and checks it against an
-//! independent closed form (the depth-ordering sum of `depth_law`'s tests).
 
 mod depth_law;
 mod eval;
@@ -86,8 +86,6 @@ use crate::height::UniformHeight;
 use crate::material::Material;
 use crate::microsurface::Microsurface;
 use crate::slope::MicrosurfaceSlope;
-
-pub use eval::FORCED_BOUNCES;
 
 /// Below this rate σ₀ = Λ(−ωi) of a view from below, the methods use the walk from below
 /// ([`Microsurface::eval_from_below`]): 1e-200 keeps every product of the state within f64.

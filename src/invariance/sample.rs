@@ -46,9 +46,9 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
             }
             let d = s.wo;
             if d.z < 0.0 {
-                law.down(-slope.lambda64(d));
+                law.down(-f64::from(slope.lambda_unchecked(d)));
             } else if d.z > 0.0 {
-                let hit = law.up(slope.lambda64(d));
+                let hit = law.up(f64::from(slope.lambda_unchecked(d)));
                 if !(f64::from(uniform(rng)) < hit) {
                     return Some(WalkSample { wo: d, weight, bounces });
                 }

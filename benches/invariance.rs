@@ -19,8 +19,8 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::{
-    Beckmann, ComplexIor, Conductor, Estimator, Ggx, Invariance, Microsurface, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, UniformHeight,
+    Beckmann, ComplexIor, Conductor, Estimator, Ggx, Invariance, Microsurface, MicrosurfaceSlope,
+    PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;

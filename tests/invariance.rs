@@ -12,9 +12,9 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use microsurface::{
-    Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Diffuse, Error, Ggx, Interaction, Invariance, Material,
-    Microsurface, MicrofacetBsdf, MicrosurfaceSlope, ScatteringOrder,
-    Side, Technique, UniformHeight, sample_cosine_hemisphere,
+    Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Diffuse, Error, Ggx, Interaction, Invariance,
+    Material, MicrofacetBsdf, Microsurface, MicrosurfaceSlope, ScatteringOrder, Side, Technique,
+    UniformHeight, sample_cosine_hemisphere,
 };
 use rand::RngExt;
 use std::f64::consts::PI;
@@ -39,7 +39,8 @@ fn mixture<S: MicrosurfaceSlope, M: Material>(slope: &S, m: &M, wi: Vec3, rng: &
     } else {
         sample_cosine_hemisphere(rng.random::<f32>(), rng.random::<f32>())
     };
-    let phase = if share > 0.0 { f64::from(m.pdf_phase(slope, &Interaction::reflection(wi, wo))) } else { 0.0 };
+    let phase =
+        if share > 0.0 { f64::from(m.pdf_phase(slope, &Interaction::reflection(wi, wo))) } else { 0.0 };
     let cosine = if wo.z > 0.0 { f64::from(wo.z) / PI } else { 0.0 };
     (wo, share * phase + (1.0 - share) * cosine)
 }
@@ -58,7 +59,11 @@ fn eval_albedos<S: MicrosurfaceSlope, M: Material>(
         let (wo, pdf) = mixture(inv.slope(), inv.material(), wi, rng);
         for (k, s) in st.iter_mut().enumerate() {
             let order = if k as u32 == orders { ScatteringOrder::All } else { only(k as u32 + 1) };
-            let v = if wo.z > 0.0 && pdf > 0.0 { inv.eval(wi, wo, order, rng).as_dvec3() / pdf } else { DVec3::ZERO };
+            let v = if wo.z > 0.0 && pdf > 0.0 {
+                inv.eval(wi, wo, order, rng).as_dvec3() / pdf
+            } else {
+                DVec3::ZERO
+            };
             for c in 0..3 {
                 s[c].push(v[c]);
             }
@@ -130,7 +135,7 @@ fn per_order_albedos_against_quadrature() {
     let z = family_z(0.01, jobs.len() * 3);
     for (&(t, by_sample), st) in jobs.iter().zip(&results) {
         let cos_i = thetas[t].cos();
-        for k in 0..3 {
+        for (k, st) in st.iter().enumerate() {
             let walk = quadrature(Reference::Walk, cos_i, k + 1, &rule);
             let correlated = quadrature(Reference::Correlated, cos_i, k + 1, &rule);
             let label = format!(
@@ -141,16 +146,16 @@ fn per_order_albedos_against_quadrature() {
             );
             println!(
                 "{label}: N = {}, mean {:.5}, SE {:.5}, z = {:.2} (walk quadrature {walk:.5}; correlated {correlated:.5})",
-                st[k].n,
-                st[k].mean(),
-                st[k].se(),
-                (st[k].mean() - walk) / st[k].se()
+                st.n,
+                st.mean(),
+                st.se(),
+                (st.mean() - walk) / st.se()
             );
-            assert_mean(&label, &st[k], walk, z, 2.5e-3, 0.0);
+            assert_mean(&label, st, walk, z, 2.5e-3, 0.0);
             if !by_sample && k > 0 && thetas[t] < 1.5 {
                 assert!((correlated - walk).abs() > 0.01, "{label}: the models do not differ");
                 assert!(
-                    (st[k].mean() - correlated).abs() > z * st[k].se(),
+                    (st.mean() - correlated).abs() > z * st.se(),
                     "{label}: indistinguishable from the correlated position-free model"
                 );
             }
@@ -247,7 +252,8 @@ fn reciprocity() {
         (dir(0.9, 1.0), dir(0.2, 5.0)),
     ];
     let configs = ["GGX α = 1 gold", "Beckmann α = 0.4 F = 1", "GGX (0.2, 0.7) gold"];
-    let jobs: Vec<(usize, usize)> = (0..configs.len()).flat_map(|c| (0..pairs.len()).map(move |p| (c, p))).collect();
+    let jobs: Vec<(usize, usize)> =
+        (0..configs.len()).flat_map(|c| (0..pairs.len()).map(move |p| (c, p))).collect();
     let results = par_map(&jobs, |i, &(c, p)| {
         let mut rng = validation::rng(0x3c1_0000 + i as u64);
         let (wi, wo) = pairs[p];
@@ -271,14 +277,18 @@ fn reciprocity() {
         let gold = Conductor::new(ComplexIor::GOLD);
         match c {
             0 => both(Invariance::new(Ggx::isotropic(1.0).unwrap(), gold).unwrap(), wi, wo, &mut rng),
-            1 => both(Invariance::new(Beckmann::isotropic(0.4).unwrap(), Conductor::perfect()).unwrap(), wi, wo, &mut rng),
+            1 => both(
+                Invariance::new(Beckmann::isotropic(0.4).unwrap(), Conductor::perfect()).unwrap(),
+                wi,
+                wo,
+                &mut rng,
+            ),
             _ => both(Invariance::new(Ggx::new(0.2, 0.7).unwrap(), gold).unwrap(), wi, wo, &mut rng),
         }
     });
     let z = family_z(0.01, jobs.len() * 3);
     for (&(c, p), st) in jobs.iter().zip(&results) {
-        for k in 0..3 {
-            let (a, b) = (&st[0][k], &st[1][k]);
+        for (k, (a, b)) in st[0].iter().zip(&st[1]).enumerate() {
             let l = format!("{} pair {p} channel {k}", configs[c]);
             let se = (a.se().powi(2) + b.se().powi(2)).sqrt();
             println!(
@@ -305,7 +315,9 @@ fn white_furnace() {
     const N: usize = 20_000;
     let jobs: Vec<(bool, f32, f64)> = [false, true]
         .into_iter()
-        .flat_map(|b| [0.2f32, 1.0, 3.0].into_iter().flat_map(move |a| [0.0, 1.2, 1.5].map(move |t| (b, a, t))))
+        .flat_map(|b| {
+            [0.2f32, 1.0, 3.0].into_iter().flat_map(move |a| [0.0, 1.2, 1.5].map(move |t| (b, a, t)))
+        })
         .collect();
     let results = par_map(&jobs, |i, &(beckmann, alpha, theta)| {
         let mut rng = validation::rng(0x4d2_0000 + i as u64);
@@ -329,7 +341,13 @@ fn white_furnace() {
     let z = family_z(0.01, jobs.len());
     for (&(beckmann, alpha, theta), st) in jobs.iter().zip(&results) {
         let l = format!("{} α = {alpha}, θi = {theta}", if beckmann { "Beckmann" } else { "GGX" });
-        println!("{l}: N = {}, albedo {:.5} ± {:.5}, z = {:.2}", st.n, st.mean(), st.se(), (st.mean() - 1.0) / st.se());
+        println!(
+            "{l}: N = {}, albedo {:.5} ± {:.5}, z = {:.2}",
+            st.n,
+            st.mean(),
+            st.se(),
+            (st.mean() - 1.0) / st.se()
+        );
         assert_mean(&l, st, 1.0, z, 0.012, 0.0);
     }
 }
@@ -348,22 +366,23 @@ fn renderer_technique_estimates_the_walks_bsdf() {
     let gold = MicrofacetBsdf::new(Ggx::isotropic(0.6).unwrap(), Conductor::new(ComplexIor::GOLD)).unwrap();
     let inv = gold.with_technique(Technique::Invariance);
     assert_eq!(inv.technique(), Technique::Invariance);
-    let pairs = [(dir(0.5, 0.0), dir(0.7, 3.0)), (dir(1.2, 0.0), dir(0.1, 1.0)), (dir(1.4, 0.2), dir(1.3, 1.5))];
+    let pairs =
+        [(dir(0.5, 0.0), dir(0.7, 3.0)), (dir(1.2, 0.0), dir(0.1, 1.0)), (dir(1.4, 0.2), dir(1.3, 1.5))];
     let z = family_z(0.01, 3 * 3 + 3);
     for (wo, wi) in pairs {
         let mut st: [[Stats; 3]; 2] = Default::default();
         for key in 0..N {
             for (b, s) in [&inv, &gold].into_iter().zip(st.iter_mut()) {
                 let f = b.eval_keyed(wo, wi, key).f.as_dvec3();
-                for k in 0..3 {
-                    s[k].push(f[k]);
+                for (k, channel) in s.iter_mut().enumerate() {
+                    channel.push(f[k]);
                 }
             }
         }
-        for k in 0..3 {
+        for (k, (a, b)) in st[0].iter().zip(&st[1]).enumerate() {
             let l = format!("wo = {wo}, wi = {wi}, channel {k}");
-            assert!(st[0][k].se() <= 0.02 * st[1][k].mean(), "{l}: not resolved");
-            assert_two_sample(&l, &st[0][k], &st[1][k], z, f64::INFINITY);
+            assert!(a.se() <= 0.02 * b.mean(), "{l}: not resolved");
+            assert_two_sample(&l, a, b, z, f64::INFINITY);
         }
     }
     let mut rng = validation::rng(77);
@@ -445,7 +464,8 @@ fn finite_over_the_fuzz_domain() {
                 }
             }
         }
-        let bsdf = MicrofacetBsdf::new(s, m).unwrap().without_smooth_limit().with_technique(Technique::Invariance);
+        let bsdf =
+            MicrofacetBsdf::new(s, m).unwrap().without_smooth_limit().with_technique(Technique::Invariance);
         assert_finite_at_edges(&bsdf, &dirs, label);
         assert_finite_on_sphere(&bsdf, 200, rng, label);
     }

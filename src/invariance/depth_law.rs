@@ -146,7 +146,7 @@ impl DepthLaw {
             exit_sum = (exit_sum + t) * s.at_exit;
         }
         let hit = rate * sum / self.norm;
-        if !(hit > 0.0) {
+        if hit.is_nan() || hit <= 0.0 {
             return 0.0;
         }
         self.norm = sum;

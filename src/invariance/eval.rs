@@ -1,7 +1,7 @@
 //! The path-tracing estimator of f·|cos θo| with next-event estimation at every vertex.
 
+use super::Invariance;
 use super::depth_law::DepthLaw;
-use super::{Invariance, MIN_FIRST_RATE};
 use crate::contract::is_direction;
 use crate::material::{Interaction, Material, Side};
 use crate::microsurface::{ScatteringOrder, incident_area};
@@ -12,7 +12,7 @@ use rand::Rng;
 
 impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
     /// Estimates f(ωi, ωo)·|cos θo| of the orders `order` (Cui et al. 2023; the estimator of
-    /// the [module documentation](super)): unbiased, stochastic, per RGB channel.
+    /// the derivation on [`Invariance`]): unbiased, stochastic, per RGB channel.
     ///
     /// A path draws its directions from the phase function (exact visible-normal sampling)
     /// and adds at every vertex j the next-event term (Π w)·P·p(d_{j−1} → ωo)·Ψ_j(Λ(ωo)):
@@ -28,22 +28,20 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
     /// a few f64 ulps per bounce); Λ in f64.
     ///
     /// 0 for ωi or ωo on the horizon and for ωo below it. ωi below the horizon (a backfacing
-    /// view) enters with σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`] the walk from
+    /// view) enters with σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`](crate::MIN_FIRST_RATE) the walk from
     /// below answers ([`crate::Microsurface::eval_from_below`], the same model).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        if !(wo.z > 0.0) || wi.z == 0.0 {
+        if wo.z <= 0.0 || wi.z == 0.0 {
             return Vec3::ZERO;
         }
         let slope = &self.slope;
-        // σ₀ = |Λ(−ωi)|: 1 + Λ(ωi) from above, Λ(−ωi) from below
-        let first_rate = slope.lambda64(-wi).abs();
-        if !(first_rate >= MIN_FIRST_RATE) {
+        let Some((first_rate, first_area)) = self.entry(wi) else {
             return self.walk().eval_from_below(wi, wo, order, rng);
-        }
+        };
         let mut law = DepthLaw::new(first_rate, f64::from(slope.lambda_unchecked(wo)));
         let last = order.last();
         // the throughput: the phase samples' weights times the hit probability of the
@@ -54,7 +52,7 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
         let mut sum = DVec3::ZERO;
         // the incident direction at the current vertex (−d of the segment that reached it)
         // and its projected area where known
-        let (mut incident, mut area) = (wi, None);
+        let (mut incident, mut area) = (wi, first_area);
         for bounce in 1..=last {
             if order.includes(bounce) {
                 let it = Interaction::reflection(incident, wo).with_incident_area(area);
@@ -70,7 +68,7 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
                 // the roulette of the segment that reached this vertex, after its next-event
                 // term (which kept the hit probability as a weight: with p ∝ 1/A(−d) it stays
                 // bounded, where a sampled hit would give p alone, of unbounded variance)
-                if !(f64::from(uniform(rng)) < pending) {
+                if f64::from(uniform(rng)) >= pending {
                     break;
                 }
                 weight /= pending;

@@ -1,7 +1,7 @@
 //! Sampling the exit direction with the depths integrated out.
 
+use super::Invariance;
 use super::depth_law::DepthLaw;
-use super::{Invariance, MIN_FIRST_RATE};
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::microsurface::{MAX_BOUNCES, WalkSample};
@@ -11,7 +11,7 @@ use glam::Vec3;
 use rand::Rng;
 
 impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
-    /// Samples an exit direction of the walk's BRDF (the [module documentation](super)):
+    /// Samples an exit direction of the walk's BRDF (the derivation on [`Invariance`]):
     /// directions from the phase function, and at every upward segment of rate b = Λ(d) an
     /// exit with the exact probability Ψ(b) that the walk's ray escapes given the directions
     /// so far (no height is drawn). The returned direction has the walk's exit density, and
@@ -20,7 +20,7 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
     ///
     /// `None` if ωi lies on the horizon, if the path was absorbed (a zero weight) or if it
     /// reached [`MAX_BOUNCES`]. ωi below the horizon (a backfacing view) enters with
-    /// σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`] the walk from below answers
+    /// σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`](crate::MIN_FIRST_RATE) the walk from below answers
     /// ([`crate::Microsurface::sample_from_below`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
@@ -31,10 +31,9 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
             return None;
         }
         let slope = &self.slope;
-        let first_rate = slope.lambda64(-wi).abs();
-        if !(first_rate >= MIN_FIRST_RATE) {
+        let Some((first_rate, _)) = self.entry(wi) else {
             return self.walk().sample_from_below(wi, rng);
-        }
+        };
         let mut law = DepthLaw::new(first_rate, 0.0);
         let mut weight = Vec3::ONE;
         let mut incident = wi;
@@ -49,7 +48,7 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
                 law.down(-f64::from(slope.lambda_unchecked(d)));
             } else if d.z > 0.0 {
                 let hit = law.up(f64::from(slope.lambda_unchecked(d)));
-                if !(f64::from(uniform(rng)) < hit) {
+                if f64::from(uniform(rng)) >= hit {
                     return Some(WalkSample { wo: d, weight, bounces });
                 }
             }

@@ -5,8 +5,8 @@ mod geometry;
 mod walk;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
-pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 pub(crate) use walk::incident_area;
+pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;

@@ -166,8 +166,7 @@ fn mean(lo: f64, hi: f64, rule: &[(f64, f64)], f: &mut dyn FnMut(f64) -> f64) ->
         }
         s
     };
-    let total =
-        if lo < 0.0 && hi > 0.0 { integral(lo, 0.0) + integral(0.0, hi) } else { integral(lo, hi) };
+    let total = if lo < 0.0 && hi > 0.0 { integral(lo, 0.0) + integral(0.0, hi) } else { integral(lo, hi) };
     total / (hi - lo)
 }
 

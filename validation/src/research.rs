@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 use microsurface::{
-    Invariance, Material, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SingleScattering,
-    Technique, UniformHeight,
+    Invariance, Material, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing,
+    SingleScattering, Technique, UniformHeight,
 };
 use rand_pcg::Pcg64Mcg;
 

@@ -121,6 +121,8 @@ mod bsdf;
 mod constants;
 mod error;
 mod height;
+#[cfg(feature = "invariance")]
+mod invariance;
 mod material;
 mod microsurface;
 #[cfg(feature = "leadr")]
@@ -198,6 +200,8 @@ pub mod research {
     pub use crate::basis::orthonormal_basis;
     pub use crate::bsdf::{EnergyByOrder, SpecularEvent, SpecularLimit};
     pub use crate::height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+    #[cfg(feature = "invariance")]
+    pub use crate::invariance::{Invariance, MIN_FIRST_RATE};
     pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
     pub use crate::microsurface::{
         HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,

@@ -7,6 +7,8 @@ use super::{
 };
 use crate::error::Error;
 use crate::height::UniformHeight;
+#[cfg(feature = "invariance")]
+use crate::invariance::Invariance;
 use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
 #[cfg(feature = "position-free")]
@@ -81,6 +83,14 @@ pub enum Technique {
         /// Height-correlated or uncorrelated shadowing.
         shadowing: Shadowing,
     },
+    /// The invariance-principle estimator of Cui et al. 2023 ([`Invariance`]): the random
+    /// walk's BSDF (the same model as [`Technique::RandomWalk`]) with the heights integrated
+    /// out, stochastic eval with less variance, exact sample weights, approximate pdf (the
+    /// position-free model's, as for the walk). Opaque materials only (conductors, diffuse
+    /// facets): [`MicrofacetBsdf::with_technique`] refuses it for a dielectric. Valid for
+    /// backfacing views, as the walk.
+    #[cfg(feature = "invariance")]
+    Invariance,
 }
 
 /// The share of a BSDF's albedo carried by each scattering order, estimated from sampled
@@ -218,7 +228,13 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 
     /// The same BSDF evaluated with another technique.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): [`Technique::Invariance`] for a material
+    /// that transmits (a dielectric, which that estimator does not cover) is a contract
+    /// violation: a debug assertion in debug builds, the BSDF unchanged in release builds.
     pub fn with_technique(self, technique: Technique) -> Self {
+        #[cfg(feature = "invariance")]
+        require!(!(M::TRANSMITS && technique == Technique::Invariance), self; technique);
         Self { technique, ..self }.with_derived()
     }
 
@@ -266,6 +282,14 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     #[inline(always)]
     fn position_free(&self, shadowing: Shadowing) -> PositionFree<S, M> {
         PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
+    }
+
+    /// The invariance-principle estimator over the same slope and material, `None` for a
+    /// material that transmits (which `with_technique` keeps from choosing it).
+    #[cfg(feature = "invariance")]
+    #[inline(always)]
+    fn invariance(&self) -> Option<Invariance<S, M>> {
+        Invariance::new(*self.surface.slope(), *self.surface.material()).ok()
     }
 
     /// The single-scattering BSDF over the same slope and material.
@@ -353,6 +377,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             Technique::PositionFree { estimator, shadowing } => {
                 self.position_free(shadowing).eval(walk_in, walk_out, estimator, self.order, rng)
             }
+            #[cfg(feature = "invariance")]
+            Technique::Invariance => match self.invariance() {
+                Some(invariance) => invariance.eval(walk_in, walk_out, self.order, rng),
+                None => self.surface.eval(walk_in, walk_out, self.order, rng),
+            },
         }
     }
 
@@ -523,6 +552,15 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
                 // the estimators draw beyond the caller's uniforms from the first bounce on
                 let mut rng = PrimedPcg::new(&uniforms, hash());
                 self.position_free(shadowing).sample(walk_in, &mut rng)
+            }
+            #[cfg(feature = "invariance")]
+            Technique::Invariance => {
+                // the first visible normal from (u.x, u.y), the first exit test from uc
+                let mut rng = PrimedPcg::new(&uniforms, hash());
+                match self.invariance() {
+                    Some(invariance) => invariance.sample(walk_in, &mut rng),
+                    None => self.surface.sample(walk_in, &mut rng),
+                }
             }
         };
         let s = s?;

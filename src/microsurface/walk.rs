@@ -494,7 +494,7 @@ struct Hit {
 /// materials then form the density in f64) and where Λ saturated at ±`f32::MAX`
 /// (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
 #[inline(always)]
-fn incident_area(z: f32, lambda: f32) -> Option<f32> {
+pub(crate) fn incident_area(z: f32, lambda: f32) -> Option<f32> {
     // Λ(ω) and ω.z have the same sign (Λ ≤ −1 below the horizon), so the product is ≥ 0
     let area = lambda * z;
     (area >= f32::MIN_POSITIVE && lambda.abs() < f32::MAX).then_some(area)

@@ -26,6 +26,7 @@ use microsurface::vndf::{
     smith_normalization,
 };
 use microsurface::{Beckmann, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Ggx};
+use microsurface::research::Invariance;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::fmt::Debug;
@@ -312,6 +313,7 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
     let mut rng = rng();
     let surface = Microsurface::new(UniformHeight, s, m);
     let pf = |shadowing| PositionFree::new(s, m, shadowing);
+    let invariance = Invariance::new(s, m).ok();
     let all = ScatteringOrder::All;
     for b in bad_directions() {
         for (wi, wo, slot) in [(b, good(), "ωi"), (good(), b, "ωo")] {
@@ -358,6 +360,9 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
                 || surface.eval(wi, wo, ScatteringOrder::only(1).unwrap(), &mut rng),
                 zero,
             );
+            if let Some(inv) = &invariance {
+                r.expect_nothing(&format!("{l}: Invariance::eval"), || inv.eval(wi, wo, all, &mut rng), zero);
+            }
             r.expect_nothing(
                 &format!("{l}: Microsurface::eval_phase"),
                 || surface.eval_phase(wi, wo, &mut rng),
@@ -401,6 +406,13 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
             || surface.sample(b, &mut rng),
             Option::is_none,
         );
+        if let Some(inv) = &invariance {
+            r.expect_nothing(
+                &format!("{l}: Invariance::sample"),
+                || inv.sample(b, &mut rng),
+                Option::is_none,
+            );
+        }
         r.expect_nothing(
             &format!("{l}: Microsurface::sample_phase"),
             || surface.sample_phase(b, &mut rng),

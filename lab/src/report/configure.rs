@@ -2,9 +2,7 @@
 //! how much (the sample budget of a quick or a full run).
 
 use glam::Vec3;
-use microsurface::research::{
-    Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
-};
+use microsurface::research::{ Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, };
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use std::path::PathBuf;

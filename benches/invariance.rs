@@ -18,9 +18,11 @@
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use microsurface::{Beckmann, ComplexIor, Conductor, Ggx};
-use microsurface::research::{Estimator, Invariance, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight};
+use microsurface::research::{
+    Estimator, Invariance, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
+};
 use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Ggx};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;

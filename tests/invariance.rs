@@ -11,9 +11,14 @@
 //! + ½ a cosine lobe (the cosine lobe alone for diffuse facets, whose `pdf_phase` is approximate). Accumulation is in f64; every generator is a fixed-seed PCG.
 
 use glam::{DVec3, Vec2, Vec3};
-use microsurface::{Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Diffuse, Error, Ggx, MicrofacetBsdf, Technique};
-use microsurface::research::{Interaction, Invariance, Material, Microsurface, sample_cosine_hemisphere, ScatteringOrder, Side, UniformHeight};
+use microsurface::research::{
+    Interaction, Invariance, Material, Microsurface, ScatteringOrder, Side, UniformHeight,
+    sample_cosine_hemisphere,
+};
 use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{
+    Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Diffuse, Error, Ggx, MicrofacetBsdf, Technique,
+};
 use rand::RngExt;
 use std::f64::consts::PI;
 use validation::per_order::{Model as Reference, albedo as quadrature, gauss_legendre};
@@ -436,7 +441,10 @@ fn finite_over_the_fuzz_domain() {
         Vec3::new(-0.6, 0.0, 0.8),
         Vec3::new(0.0, 0.6, -0.8),
     ]);
-    fn check<S: MicrosurfaceSlope + 'static, M: Material + microsurface::research::SpecularLimit + 'static>(
+    fn check<
+        S: MicrosurfaceSlope + 'static,
+        M: Material + microsurface::research::SpecularLimit + 'static,
+    >(
         s: S,
         m: M,
         label: &str,

@@ -10,7 +10,13 @@ use std::path::Path;
 
 fn quick_report() -> (pipeline::Report, std::path::PathBuf) {
     let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));
-    let opts = Options { size: RunSize::Quick, out_dir: out_dir.clone(), threads: 2, progress: false };
+    let opts = Options {
+        size: RunSize::Quick,
+        out_dir: out_dir.clone(),
+        threads: 2,
+        progress: false,
+        results_page: None,
+    };
     (pipeline::run(&opts).expect("the report runs"), out_dir)
 }
 

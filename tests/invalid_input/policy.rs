@@ -14,6 +14,7 @@ use glam::{DVec3, Vec2, Vec3};
 use microsurface::Elliptical;
 use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 use microsurface::leadr::Noncentral;
+use microsurface::research::Invariance;
 use microsurface::research::{
     Estimator, GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry,
     MicrosurfaceHeight, PhaseSample, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
@@ -26,7 +27,6 @@ use microsurface::vndf::{
     smith_normalization,
 };
 use microsurface::{Beckmann, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Ggx};
-use microsurface::research::Invariance;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::fmt::Debug;

@@ -15,7 +15,10 @@
 use validation::par_map;
 
 use glam::Vec3;
-use microsurface::research::{ Estimator, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample, sample_cosine_hemisphere, };
+use microsurface::research::{
+    Estimator, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample,
+    sample_cosine_hemisphere,
+};
 use microsurface::research::{Interaction, Side};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};

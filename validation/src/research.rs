@@ -5,7 +5,8 @@
 use glam::Vec3;
 use microsurface::Technique;
 use microsurface::research::{
-    Invariance, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, SingleScattering, UniformHeight,
+    Invariance, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, SingleScattering,
+    UniformHeight,
 };
 use microsurface::slope::MicrosurfaceSlope;
 use rand_pcg::Pcg64Mcg;

@@ -2,7 +2,9 @@
 //! how much (the sample budget of a quick or a full run).
 
 use glam::Vec3;
-use microsurface::research::{ Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, };
+use microsurface::research::{
+    Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
+};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use std::path::PathBuf;
@@ -20,6 +22,8 @@ pub struct Options {
     pub threads: usize,
     /// Print a progress bar on stderr (`main` sets it only when stderr is a terminal).
     pub progress: bool,
+    /// Where a full run writes the results page (`None`: `docs/results.md`).
+    pub results_page: Option<PathBuf>,
 }
 
 /// How much a run computes.

@@ -22,14 +22,16 @@
 use super::configure::{Budget, Case, Config, Options, Outgoing, Rng, SlopeKind, THETAS};
 use super::measure::{Estimate, TIMING_CHUNKS, Timing};
 use super::reduce::{mean_and_variance, rel2, variance_se};
-use validation::clock::thread_time;
 use glam::Vec3;
-use microsurface::{Beckmann, ComplexIor, Conductor, Diffuse, Ggx};
-use microsurface::research::{Estimator, Invariance, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight};
+use microsurface::research::{
+    Estimator, Invariance, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
+};
 use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Diffuse, Ggx};
 use rand::SeedableRng;
 use std::fmt::Write as _;
 use std::hint::black_box;
+use validation::clock::thread_time;
 
 /// The estimators of the table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -42,6 +42,9 @@ pub fn run(opts: &Options) -> std::io::Result<Report> {
     std::fs::write(&summary, &md)?;
     written.markdown.push('\n');
     written.markdown.push_str(&table);
+    if let Some(page) = super::results_page::write(opts, &written.markdown, start.elapsed().as_secs_f64())? {
+        written.files.push(page);
+    }
     Ok(Report {
         budget,
         results,

@@ -1,7 +1,7 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
 use super::{
-    MicrosurfaceSlope, check_roughness, is_direction, is_direction64, is_uniform, projected_roughness_sq,
+    MicrosurfaceSlope, check_roughness, is_direction, is_uniform, projected_roughness_sq,
     reflection_density64, smith_d_wi64,
 };
 use crate::error::Error;
@@ -149,12 +149,6 @@ impl MicrosurfaceSlope for Ggx {
     }
 
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        require!(is_direction64(wm), 0.0; wm);
-        self.d64_unchecked(wm)
-    }
-
-    #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
         if wm.z <= 0.0 {
             return 0.0;
@@ -218,12 +212,6 @@ impl MicrosurfaceSlope for Ggx {
     }
 
     #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.lambda_unchecked(w)
-    }
-
-    #[inline]
     fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         // Λ of the upper hemisphere at |cos θ|: z = −0 is the horizon seen from above, like +0
@@ -236,12 +224,6 @@ impl MicrosurfaceSlope for Ggx {
     /// equivalent αᵢ² sin²θ / (2(√(cos²θ + αᵢ² sin²θ) − cos θ)) below it, which has no
     /// cancellation there.
     #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.projected_area_unchecked(w)
-    }
-
-    #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         let root = (w.z * w.z + q).sqrt();
@@ -252,12 +234,6 @@ impl MicrosurfaceSlope for Ggx {
     /// spherical cap, unstretch (Dupuy and Benyoub 2023, with the cap z > −ωi.z, which is
     /// also valid for ωi.z < 0). The stretched ωi is not normalized: the cap is sampled at its
     /// scale (a square root, no division).
-    #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
-        self.sample_d_wi_unchecked(wi, u1, u2)
-    }
-
     #[inline(always)]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_spherical_cap(self, wi, u1, u2)

@@ -263,17 +263,18 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         u1: f32,
         u2: f32,
     ) -> Option<SingleSample> {
-        let s = material.sample_mirror_unchecked(slope, wi, u1, u2);
+        let (wm, area_s) = slope.sample_mirror_normal_unchecked(wi, u1, u2);
+        let s = material.mirror_reflection_unchecked(wi, wm);
         let exits = s.wo.z > 0.0;
         if !exits {
             return None;
         }
-        // G2/G1 = (1 + Λi)/(1 + Λi + Λo) with 1 + Λ = A/cos θ: Ai zo/(Ai zo + zi (Ao − zo))
+        // G2/G1 = (1 + Λi)/(1 + Λi + Λo) with 1 + Λ = A/cos θ: Ai zo/(Ai zo + zi (Ao − zo)),
+        // times As/Ai for a sampler of area As (f·cos/pdf = F G2 As/zi)
         let (zi, zo) = (wi.z, s.wo.z);
         let (area_i, area_o) = (slope.projected_area_unchecked(wi), slope.projected_area_unchecked(s.wo));
-        let front = area_i * zo;
-        let last = front / (front + zi * (area_o - zo));
-        let pdf = Self::mirror_density(slope, wi, s.wo);
+        let last = area_s * zo / (area_i * zo + zi * (area_o - zo));
+        let pdf = Self::mirror_density_over(slope, wi, s.wo, area_s);
         (last > 0.0 && pdf > 0.0).then(|| SingleSample { wo: s.wo, weight: s.weight * last, pdf })
     }
 
@@ -287,6 +288,12 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// rounding of −ωi, where the f32 directions' lengths decide the sign).
     #[inline(always)]
     pub(crate) fn mirror_density(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
+        Self::mirror_density_over(slope, wi, wo, slope.mirror_sampling_area_unchecked(wi))
+    }
+
+    /// [`Self::mirror_density`] with the sampler's area A_s(ωi) known (the sampler returns it).
+    #[inline(always)]
+    fn mirror_density_over(slope: &S, wi: Vec3, wo: Vec3, area_s: f32) -> f32 {
         // the f32 dot product of ωi with ωi + ωo (|ωi + ωo| ≤ 2) is within 4e-7 of the exact one
         let visible = wi.dot(wi + wo) > VISIBLE_SUM_MARGIN || {
             let w = wi.as_dvec3();
@@ -295,7 +302,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         if !visible {
             return 0.0;
         }
-        slope.reflection_density_unchecked(wi, wo)
+        slope.reflection_density_over_unchecked(wi, wo, area_s)
     }
 
     /// The phase-function density of ωo from the incident state `at`.

@@ -14,6 +14,7 @@
 
 mod beckmann_inversion;
 mod beckmann_newton;
+mod bounded_cap;
 mod disk_band;
 mod ggx_disk;
 mod smith;
@@ -23,6 +24,8 @@ mod vcavity;
 
 pub(crate) use beckmann_inversion::{sample_visible_normal, visible_slopes};
 pub use beckmann_newton::BeckmannNewton;
+pub use bounded_cap::GgxBoundedCap;
+pub(crate) use bounded_cap::{bounded_area, sample_bounded_cap};
 pub use ggx_disk::GgxDisk;
 pub use smith::SmithVndf;
 pub use spherical_cap::GgxSphericalCap;

@@ -7,7 +7,7 @@ use crate::rng::cut_tails;
 use crate::slope::{Ggx, MicrosurfaceSlope};
 use crate::special::sin_cos_turns;
 use crate::vector::{DIRECT_SCALE_RANGE, ensure_visible, normalize_fast, normalize_scaled};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 /// GGX visible normals by the spherical-cap method (Dupuy and Benyoub 2023): ωm is the
 /// normalized sum of the stretched ωi and a point uniform on the cap z > −ωi.z. Exact on the
@@ -49,6 +49,65 @@ impl VisibleNormalSampler for GgxSphericalCap {
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+    sample_stretched_cap(ggx, wi, CapBound::FULL, u1, u2)
+}
+
+/// The lower end of the cap of [`sample_visible_cap`], c.z ≥ −k v̂.z, given by κ = 1 + k ∈ (0, 2]
+/// (κ = 2: the whole visible cap c.z ≥ −v̂.z of Dupuy and Benyoub; κ < 2: the bounded caps of
+/// [`GgxBoundedCap`](super::GgxBoundedCap)). Only views above the horizon (v.z > 0) are
+/// bounded: below it the cap is always the whole visible one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CapBound {
+    /// κ = 1 + k.
+    pub(crate) kappa: f32,
+}
+
+impl CapBound {
+    /// The whole visible cap, k = 1.
+    pub(crate) const FULL: Self = Self { kappa: 2.0 };
+
+    /// The cap's height scaled by len, len (1 + k v̂.z) = len + k v.z, written without
+    /// cancellation: len + (κ − 1) v.z for κ ≥ 1 (κ − 1 exact), (len − v.z) + κ v.z with
+    /// len − v.z = |v_xy|²/(len + v.z) for κ < 1, and |v_xy|²/(len − v.z) (= len + v.z) for
+    /// the whole cap of a view below the horizon.
+    #[inline(always)]
+    pub(crate) fn top(self, v: Vec3, len: f32) -> f32 {
+        if v.z < 0.0 {
+            (v.x * v.x + v.y * v.y) / (len - v.z)
+        } else if self.kappa >= 1.0 {
+            len + (self.kappa - 1.0) * v.z
+        } else {
+            (v.x * v.x + v.y * v.y) / (len + v.z) + self.kappa * v.z
+        }
+    }
+
+    /// [`Self::top`] in double precision (len = |v| in f64).
+    #[inline(always)]
+    pub(crate) fn top64(self, v: DVec3, len: f64) -> f64 {
+        let kappa = f64::from(self.kappa);
+        if v.z < 0.0 {
+            (v.x * v.x + v.y * v.y) / (len - v.z)
+        } else if kappa >= 1.0 {
+            len + (kappa - 1.0) * v.z
+        } else {
+            (v.x * v.x + v.y * v.y) / (len + v.z) + kappa * v.z
+        }
+    }
+
+    /// The height of the cap's bottom above the plane of −v, len (v̂.z − b) = (1 − k) v.z =
+    /// (2 − κ) v.z ≥ 0: 0 for the whole cap (also below the horizon, where κ = 2).
+    #[inline(always)]
+    fn lift(self, v: Vec3) -> f32 {
+        (2.0 - self.kappa) * v.z
+    }
+}
+
+/// [`sample_spherical_cap`] with the cap bounded below by `bound`: stretch, sample the cap
+/// c.z ≥ −k v̂.z, unstretch. The same normalization as `sample_spherical_cap` (`bound` is
+/// relative to v̂, so it holds for the rescaled v of huge or tiny stretched views).
+#[must_use]
+#[inline(always)]
+pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
     let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
     let stretched = Vec3::new(alpha_x * wi.x, alpha_y * wi.y, wi.z);
     let len_sq = stretched.length_squared();
@@ -57,7 +116,7 @@ pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec
     } else {
         (normalize_scaled(stretched, Vec3::Z), 1.0)
     };
-    let h = sample_visible_hemisphere(v, len, u1, u2);
+    let h = sample_visible_cap(v, len, bound, u1, u2);
     ensure_visible(wi, normalize_fast(Vec3::new(alpha_x * h.x, alpha_y * h.y, h.z), Vec3::Z))
 }
 
@@ -83,14 +142,27 @@ pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
+    sample_visible_cap(v, len, CapBound::FULL, u1, u2)
+}
+
+/// [`sample_visible_hemisphere`] on the cap c.z ≥ −k v̂.z of `bound` (Eto and Tokuyoshi 2023):
+/// c.z uniform in [−k v̂.z, 1], i.e. len c.z = (1 − u1) top − k v.z with top = len + k v.z
+/// ([`CapBound`]'s cancellation-free form) and h.z = len c.z + v.z = (1 − u1) top + (1 − k) v.z;
+/// len − len c.z is still exactly u1 top. The normals are those of the whole cap whose c lies
+/// in the bounded one, each with the density max(0, v̂·m)/π scaled by (1 + v̂.z)/(1 + k v̂.z).
+/// For the whole cap (κ = 2) top is len + v.z (or its backfacing form) and the lift an exact
+/// 0: the map of Dupuy and Benyoub bit for bit.
+#[must_use]
+#[inline(always)]
+pub(crate) fn sample_visible_cap(v: Vec3, len: f32, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
     let u1 = cut_tails(u1);
     // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
     // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
     // len + v.z written as (v.x² + v.y²)/(len − v.z) below the horizon: for a backfacing ωi
     // of a low-roughness surface v̂ ≈ −z and the direct sum cancels (GGX α = 1e-4 at θ = 2.3:
     // it rounded to 0 and every sample became the fallback horizontal normal)
-    let top = if v.z >= 0.0 { len + v.z } else { (v.x * v.x + v.y * v.y) / (len - v.z) };
-    let h_z = (1.0 - u1) * top;
+    let top = bound.top(v, len);
+    let h_z = (1.0 - u1) * top + bound.lift(v);
     let z_scaled = h_z - v.z;
     let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
     let (sin_phi, cos_phi) = sin_cos_turns(u2);
@@ -99,7 +171,7 @@ pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> 
     if h_z >= NEAR_OPPOSITE * len || h.length_squared() >= NEAR_OPPOSITE * NEAR_OPPOSITE * (len * len) {
         return h;
     }
-    cap_near_opposite(v, u1, u2).unwrap_or(h)
+    cap_near_opposite(v, bound, u1, u2).unwrap_or(h)
 }
 
 /// |h| below this fraction of len is recomputed by [`cap_near_opposite`].
@@ -117,7 +189,7 @@ const NEAR_OPPOSITE: f32 = 1.0 / 64.0;
 /// (sin, cos)(π u2) and the half angle of φo by the angle-difference formulas (no library
 /// call). `None` for v along ±z (no cancellation there: v_xy = 0).
 #[inline(never)]
-fn cap_near_opposite(v: Vec3, u1: f32, u2: f32) -> Option<Vec3> {
+fn cap_near_opposite(v: Vec3, bound: CapBound, u1: f32, u2: f32) -> Option<Vec3> {
     let (vx, vy, vz, u1) = (f64::from(v.x), f64::from(v.y), f64::from(v.z), f64::from(u1));
     let s_sq = vx * vx + vy * vy;
     if s_sq == 0.0 {
@@ -126,8 +198,9 @@ fn cap_near_opposite(v: Vec3, u1: f32, u2: f32) -> Option<Vec3> {
     let s = s_sq.sqrt();
     let len = (s_sq + vz * vz).sqrt();
     // as in the f32 form: len + v.z = |v_xy|²/(len − v.z) below the horizon, without cancellation
-    let top = if vz >= 0.0 { len + vz } else { s_sq / (len - vz) };
-    let h_z = (1.0 - u1) * top;
+    // and bounded as in `CapBound::top` and `CapBound::lift`
+    let top = bound.top64(DVec3::new(vx, vy, vz), len);
+    let h_z = (1.0 - u1) * top + (2.0 - f64::from(bound.kappa)) * vz;
     let z = h_z - vz;
     let r = (u1 * top * (len + z)).max(0.0).sqrt();
     let s_sq_minus_r_sq = (z - vz) * h_z;
@@ -192,7 +265,7 @@ mod tests {
             if !(1.0 / 64.0..=0.5).contains(&ratio) {
                 continue;
             }
-            let Some(exact) = cap_near_opposite(v, u1, u2) else { continue };
+            let Some(exact) = cap_near_opposite(v, CapBound::FULL, u1, u2) else { continue };
             let gap = f64::from((direct.normalize() - exact.normalize()).length());
             worst = worst.max(gap);
             compared += 1;

@@ -1,5 +1,6 @@
 //! All visible-normal samplers side by side on the same inputs (Tokuyoshi's comparison):
-//! GGX by spherical caps (the crate's default), Heitz's 2018 disk and the V-cavity model;
+//! GGX by spherical caps (the crate's default), the bounded caps of Eto and Tokuyoshi 2023
+//! (reflections; target at most 1.15× the spherical cap), Heitz's 2018 disk and the V-cavity model;
 //! Beckmann by the safeguarded log-space inversion (default), the erf-domain Newton method and
 //! the V-cavity model. One call per iteration on 1024 pre-generated (direction, uniforms)
 //! pairs from a fixed seed, rotated behind `black_box`.
@@ -12,7 +13,7 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::{
-    AxisAlignedSlope, Beckmann, BeckmannNewton, Elliptical, Ggx, GgxDisk, GgxSphericalCap, MicrosurfaceSlope,
+    AxisAlignedSlope, Beckmann, BeckmannNewton, Elliptical, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, MicrosurfaceSlope,
     SmithVndf, VCavity, VisibleNormalSampler,
 };
 use rand::{RngExt, SeedableRng};
@@ -61,6 +62,7 @@ fn samplers(c: &mut Criterion) {
     let ggx = |a: f32| Ggx::isotropic(a).expect("valid α");
     let beckmann = |a: f32| Beckmann::isotropic(a).expect("valid α");
     bench_sampler(c, "ggx_spherical_cap", |a| GgxSphericalCap(ggx(a)));
+    bench_sampler(c, "ggx_bounded_cap", |a| GgxBoundedCap(ggx(a)));
     bench_sampler(c, "ggx_disk", |a| GgxDisk(ggx(a)));
     bench_sampler(c, "ggx_vcavity", |a| VCavity(ggx(a)));
     bench_sampler(c, "beckmann_safeguarded", |a| SmithVndf(beckmann(a)));

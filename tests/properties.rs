@@ -16,7 +16,7 @@
 use glam::{Vec2, Vec3};
 use microsurface::{
     Beckmann, BeckmannNewton, Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor,
-    Dielectric, Diffuse, Estimator, GaussianHeight, GgxDisk, GgxSphericalCap, HeightSample, Material,
+    Dielectric, Diffuse, Estimator, GaussianHeight, GgxBoundedCap, GgxDisk, GgxSphericalCap, HeightSample, Material,
     MicrofacetBsdf, Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PositionFree,
     ScatteringOrder, Shadowing, SmithVndf, SpecularLimit, Technique, Transport, UniformHeight, VCavity,
     VCavitySlope, VisibleNormalSampler, beta, erf, erfc, erfinv, fresnel_conductor, fresnel_dielectric,
@@ -501,6 +501,7 @@ proptest! {
             let s = Ggx::new(ax, ay).unwrap();
             vcavity_props(s, wi, m, u)?;
             sampler_props(GgxSphericalCap(s), wi, m, u)?;
+            sampler_props(GgxBoundedCap(s), wi, m, u)?;
             sampler_props(GgxDisk(s), wi, m, u)?;
         }
     }

@@ -107,6 +107,10 @@ impl VisibleNormalSampler for GgxBoundedCap {
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         let ggx = &self.0;
+        if !(wi.z > 0.0) {
+            // the whole visible cap: the spherical cap's density
+            return ggx.d_wi(wi, wm);
+        }
         let cos_im = wi.as_dvec3().dot(wm.as_dvec3());
         if cos_im <= 0.0 || wm.z <= 0.0 {
             return 0.0;

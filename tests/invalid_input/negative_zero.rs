@@ -14,7 +14,7 @@
 
 use glam::{Vec2, Vec3};
 use microsurface::{
-    Beckmann, BeckmannNewton, Conductor, Dielectric, Diffuse, Ggx, GgxDisk, GgxSphericalCap, Material,
+    Beckmann, BeckmannNewton, Conductor, Dielectric, Diffuse, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, Material,
     MicrosurfaceGeometry, MicrosurfaceSlope, SmithVndf, UniformHeight, VCavity, VCavitySlope,
     VisibleNormalSampler, orthonormal_basis, smith_normalization,
 };
@@ -304,6 +304,7 @@ fn named_samplers_treat_negative_zero_like_positive_zero() {
                 c.vector1("GgxSphericalCap.sample", w, |w| {
                     GgxSphericalCap(ggx).sample(w, u).to_array().to_vec()
                 });
+                c.vector1("GgxBoundedCap.sample", w, |w| GgxBoundedCap(ggx).sample(w, u).to_array().to_vec());
                 c.vector1("GgxDisk.sample", w, |w| GgxDisk(ggx).sample(w, u).to_array().to_vec());
                 c.vector1("BeckmannNewton.sample", w, |w| {
                     BeckmannNewton(beckmann).sample(w, u).to_array().to_vec()
@@ -311,6 +312,7 @@ fn named_samplers_treat_negative_zero_like_positive_zero() {
             }
             for wm in directions() {
                 c.scalar2("GgxSphericalCap.pdf", w, wm, |a, b| GgxSphericalCap(ggx).pdf(a, b));
+                c.scalar2("GgxBoundedCap.pdf", w, wm, |a, b| GgxBoundedCap(ggx).pdf(a, b));
                 c.scalar2("GgxDisk.pdf", w, wm, |a, b| GgxDisk(ggx).pdf(a, b));
                 c.scalar2("BeckmannNewton.pdf", w, wm, |a, b| BeckmannNewton(beckmann).pdf(a, b));
             }

@@ -13,7 +13,7 @@
 use glam::{DVec3, Vec2, Vec3};
 use microsurface::{
     Beckmann, BeckmannNewton, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Estimator,
-    GaussianHeight, Ggx, GgxDisk, GgxSphericalCap, HeightSample, Material, Microsurface,
+    GaussianHeight, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, HeightSample, Material, Microsurface,
     MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PhaseSample, PositionFree, ScatteringOrder,
     Shadowing, SmithVndf, UniformHeight, VCavity, VCavitySlope, VisibleNormalSampler, concentric_disk,
     fresnel_conductor, fresnel_dielectric, fresnel_schlick, orthonormal_basis, sample_cosine_hemisphere,
@@ -567,6 +567,7 @@ fn visible_normal_samplers() {
     check_sampler(&mut r, "SmithVndf<GGX>", SmithVndf(ggx));
     check_sampler(&mut r, "SmithVndf<Beckmann>", SmithVndf(beckmann));
     check_sampler(&mut r, "GgxSphericalCap", GgxSphericalCap(ggx));
+    check_sampler(&mut r, "GgxBoundedCap", GgxBoundedCap(ggx));
     check_sampler(&mut r, "GgxDisk", GgxDisk(ggx));
     check_sampler(&mut r, "BeckmannNewton", BeckmannNewton(beckmann));
     check_sampler(&mut r, "VCavity<GGX>", VCavity(ggx));

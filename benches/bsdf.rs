@@ -16,7 +16,7 @@
 //! direction, what the trait's sample computes),
 //! `{material}/single/eval_with_pdf/{research|static|dyn}` (the research call is
 //! `SingleScattering::eval_with_pdf`; its `sample` returns the density too), and
-//! `gold/single/sample-vs-vndf/{sample_d_wi|static}`.
+//! `gold/single/sample-vs-vndf/{sample_d_wi|bounded_cap|static}`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use microsurface::{

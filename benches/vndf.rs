@@ -14,8 +14,8 @@ use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::{
-    AxisAlignedSlope, Beckmann, BeckmannNewton, Elliptical, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, MicrosurfaceSlope,
-    SmithVndf, VCavity, VisibleNormalSampler,
+    AxisAlignedSlope, Beckmann, BeckmannNewton, Elliptical, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap,
+    MicrosurfaceSlope, SmithVndf, VCavity, VisibleNormalSampler,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;

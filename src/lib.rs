@@ -177,8 +177,8 @@ pub use slope::{
 };
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
 pub use vndf::{
-    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
+    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope,
+    VisibleNormalSampler, smith_normalization,
 };
 
 /// The README's code blocks, compiled and run as doctests.

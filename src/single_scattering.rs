@@ -110,10 +110,13 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     }
 
     /// The density with which [`SingleScattering::sample`] draws ωo: the material's phase-function
-    /// density (exact for conductors and dielectrics). For a conductor with ωi and ωo above
-    /// the horizon, D(ωh)/(4 A(ωi)): GGX evaluates it in f32 from the unnormalized half
-    /// vector (relative error below 4e-6 for every α and pair of directions), other slopes in
-    /// f64 (a few f32 ulps); `sample` and `eval_with_pdf` return the same bits.
+    /// density (exact for conductors and dielectrics), except for a conductor with ωi and ωo
+    /// above the horizon: D(ωh)/(4 A_s(ωi)) with A_s the area of the slope's reflection sampler
+    /// (`sample_mirror_front`): the projected area A, or for GGX the bounded cap's
+    /// A_b = (L + k cos θi)/2 ≤ A (Eto and Tokuyoshi 2023, eq. 8, see
+    /// [`GgxBoundedCap`](crate::GgxBoundedCap)). GGX evaluates it in f32 from the unnormalized
+    /// half vector (relative error below 4e-6 for every α and pair of directions), other
+    /// slopes in f64 (a few f32 ulps); `sample` and `eval_with_pdf` return the same bits.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
@@ -245,8 +248,11 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
 
     /// [`SingleScattering::sample`] of mirror facets ([`Material::MIRROR_FACETS`]: conductors)
     /// seen from above the horizon (ωi.z > 0, unit), from the two uniforms of the visible
-    /// normal: ωm ~ D_ωi, ωo = reflect(ωi, ωm), the weight F·G2/G1 with G2/G1 = (1 + Λi)/(1 +
-    /// Λi + Λo) from the f32 projected areas A = (1 + Λ) cos θ, as Ai zo/(Ai zo + zi (Ao − zo))
+    /// normal: ωm from the slope's reflection sampler
+    /// ([`MicrosurfaceSlope::sample_mirror_normal_unchecked`]: D_ωi, or GGX's bounded cap of
+    /// area A_s = A_b, which leaves out only normals that reflect below the horizon),
+    /// ωo = reflect(ωi, ωm), the weight F·G2 A_s/zi = F·(G2/G1)·(A_s/Ai) with G2/G1 = (1 + Λi)/(1 +
+    /// Λi + Λo) from the f32 projected areas A = (1 + Λ) cos θ, as As zo/(Ai zo + zi (Ao − zo))
     /// (z = cos θ; one division, and Ai is the density's): the rounding of Ao − zo = Λo zo,
     /// which cancels where Λo is small, is at most ε Ao, and relative to the denominator (at
     /// least zi zo max(1, Λo)) that is at most 3ε, so the ratio keeps a few f32 ulps; and
@@ -279,8 +285,9 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     }
 
     /// The density of a reflection of mirror facets ([`Material::MIRROR_FACETS`]) between ωi
-    /// and ωo strictly above the horizon: D(ωh)/(4 A(ωi)) from the slope
-    /// ([`MicrosurfaceSlope::reflection_density_unchecked`]; for GGX in f32, relative error
+    /// and ωo strictly above the horizon as `sample_mirror_front` draws it: D(ωh)/(4 A_s(ωi))
+    /// from the slope ([`MicrosurfaceSlope::mirror_sampling_area_unchecked`] and
+    /// [`MicrosurfaceSlope::reflection_density_over_unchecked`]; for GGX in f32, relative error
     /// below 4e-6), the one function `pdf`, `eval_with_pdf` and `sample` share, so that their
     /// densities agree bit for bit.
     /// 0 where the half vector is not a facet normal ωi can see (ωi·(ωi + ωo) ≤ 0, in f64 as

@@ -16,11 +16,11 @@
 use glam::{Vec2, Vec3};
 use microsurface::{
     Beckmann, BeckmannNewton, Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor,
-    Dielectric, Diffuse, Estimator, GaussianHeight, GgxBoundedCap, GgxDisk, GgxSphericalCap, HeightSample, Material,
-    MicrofacetBsdf, Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, SmithVndf, SpecularLimit, Technique, Transport, UniformHeight, VCavity,
-    VCavitySlope, VisibleNormalSampler, beta, erf, erfc, erfinv, fresnel_conductor, fresnel_dielectric,
-    fresnel_schlick, ln_beta, ln_gamma, smith_normalization,
+    Dielectric, Diffuse, Estimator, GaussianHeight, GgxBoundedCap, GgxDisk, GgxSphericalCap, HeightSample,
+    Material, MicrofacetBsdf, Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope,
+    PositionFree, ScatteringOrder, Shadowing, SmithVndf, SpecularLimit, Technique, Transport, UniformHeight,
+    VCavity, VCavitySlope, VisibleNormalSampler, beta, erf, erfc, erfinv, fresnel_conductor,
+    fresnel_dielectric, fresnel_schlick, ln_beta, ln_gamma, smith_normalization,
 };
 use microsurface::{Ggx, MAX_BOUNCES};
 use microsurface::{Interaction, Side};

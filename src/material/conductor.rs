@@ -32,7 +32,8 @@ const FRESNEL_AT_HALF_VECTOR_BELOW: f32 = 0.05;
 ///   f32 ωi and ωo, as the evaluations do, so that weight = F·(the phase density ratio) holds
 ///   to f32 precision;
 /// - single scattering F(ωi·ωh) D(ωh) G2(ωi, ωo)/(4 cos θi) (the Cook–Torrance BRDF times
-///   cos θo).
+///   cos θo), sampled for views above the horizon from the slope's reflection sampler (GGX:
+///   the bounded cap of Eto and Tokuyoshi 2023, [`GgxBoundedCap`](crate::GgxBoundedCap)).
 ///
 /// # Examples
 /// ```

@@ -2,7 +2,7 @@
 
 use super::{
     MicrosurfaceSlope, check_roughness, is_direction, is_direction64, is_uniform, projected_roughness_sq,
-    smith_d_wi64,
+    reflection_density64_over, smith_d_wi64,
 };
 use crate::error::Error;
 use crate::vndf::{bounded_area, sample_bounded_cap, sample_spherical_cap, sample_visible_hemisphere};
@@ -310,7 +310,7 @@ impl Ggx {
         if len_sq >= F32_DENSITY_MIN_SUM && t >= F32_DENSITY_MIN_SUM && density.is_normal() {
             density
         } else {
-            self.reflection_density_of_sum_unchecked(wi.as_dvec3() + wo.as_dvec3(), area)
+            reflection_density64_over(self, wi, wo, area)
         }
     }
 }

@@ -331,7 +331,12 @@ pub(crate) fn reflection_density64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo
 
 /// [`reflection_density64`] with the area given: 0.25 D(ωh)/`area` in f64 rounded once.
 #[inline(always)]
-pub(crate) fn reflection_density64_over<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3, area: f32) -> f32 {
+pub(crate) fn reflection_density64_over<S: MicrosurfaceSlope>(
+    slope: &S,
+    wi: Vec3,
+    wo: Vec3,
+    area: f32,
+) -> f32 {
     let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
     let area = f64::from(area);
     if area <= 0.0 { 0.0 } else { (0.25 * slope.d64_unchecked(wh) / area) as f32 }

@@ -229,7 +229,11 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
         let wo = dir(1.4 * uniform64(&mut rng), 2.0 * PI * uniform64(&mut rng));
         let u = Vec2::new(grid(uniform32(&mut rng)), grid(uniform32(&mut rng)));
         let uc = grid(uniform32(&mut rng));
-        let m_gold = microsurface::VisibleNormalSampler::sample(&microsurface::GgxBoundedCap(slope), wo, [u.x, u.y, 0.0]);
+        let m_gold = microsurface::VisibleNormalSampler::sample(
+            &microsurface::GgxBoundedCap(slope),
+            wo,
+            [u.x, u.y, 0.0],
+        );
         let mirror_gold = 2.0 * wo.dot(m_gold) * m_gold - wo;
         if let Some(s) = gold_b.sample(wo, uc, u) {
             assert!(

@@ -14,8 +14,8 @@
 
 use glam::{Vec2, Vec3};
 use microsurface::{
-    Beckmann, BeckmannNewton, Conductor, Dielectric, Diffuse, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, Material,
-    MicrosurfaceGeometry, MicrosurfaceSlope, SmithVndf, UniformHeight, VCavity, VCavitySlope,
+    Beckmann, BeckmannNewton, Conductor, Dielectric, Diffuse, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap,
+    Material, MicrosurfaceGeometry, MicrosurfaceSlope, SmithVndf, UniformHeight, VCavity, VCavitySlope,
     VisibleNormalSampler, orthonormal_basis, smith_normalization,
 };
 use microsurface::{Interaction, Side};

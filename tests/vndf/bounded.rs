@@ -14,6 +14,7 @@
 
 use glam::{DVec3, Vec3};
 use microsurface::{Ggx, GgxBoundedCap, GgxSphericalCap, MicrosurfaceSlope, VisibleNormalSampler};
+use std::f64::consts::FRAC_PI_2;
 use validation::{rng, uniform32};
 
 /// The roughness pairs of the fuzz domain: α from 1e-4 to 10, anisotropy to 1e4.
@@ -132,7 +133,11 @@ fn the_bound_is_eq5_and_tight() {
                     continue;
                 }
                 let p = bounded.pdf(wi, wm);
-                assert_eq!(p > 0.0, margin > 0.0, "α = {alpha}, θ = {theta}, ωm = {wm}: c.z + b = {margin:e}, pdf {p}");
+                assert_eq!(
+                    p > 0.0,
+                    margin > 0.0,
+                    "α = {alpha}, θ = {theta}, ωm = {wm}: c.z + b = {margin:e}, pdf {p}"
+                );
                 if margin > 0.0 {
                     kept += 1;
                     // A/A_b = (1 + v̂.z)/(1 + b) on the kept normals
@@ -166,7 +171,11 @@ fn views_below_the_horizon_keep_the_spherical_cap() {
             let u = [uniform32(&mut r), uniform32(&mut r), 0.0];
             let wm = bounded.sample(wi, u);
             assert_eq!(wm, cap.sample(wi, u), "α = ({ax}, {ay}), wi = {wi}, u = {u:?}");
-            assert_eq!(bounded.pdf(wi, wm).to_bits(), cap.pdf(wi, wm).to_bits(), "α = ({ax}, {ay}), wi = {wi}, ωm = {wm}");
+            assert_eq!(
+                bounded.pdf(wi, wm).to_bits(),
+                cap.pdf(wi, wm).to_bits(),
+                "α = ({ax}, {ay}), wi = {wi}, ωm = {wm}"
+            );
         }
     }
 }
@@ -187,7 +196,7 @@ fn extreme_uniforms_and_the_fuzz_domain() {
     for (ax, ay) in FUZZ_ALPHAS {
         let ggx = Ggx::new(ax, ay).unwrap();
         let sampler = GgxBoundedCap(ggx);
-        for theta in [0.0f64, 0.3, 1.0, 1.45, 1.5707, 1.570_796, 1.7, 2.8] {
+        for theta in [0.0f64, 0.3, 1.0, 1.45, FRAC_PI_2 - 1e-4, FRAC_PI_2 - 1e-7, 1.7, 2.8] {
             for phi in [0.0f64, 0.7, 2.0] {
                 let wi = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()).as_vec3();
                 for u1 in us {
@@ -195,7 +204,8 @@ fn extreme_uniforms_and_the_fuzz_domain() {
                         let wm = sampler.sample(wi, [u1, u2, 0.5]);
                         let p = sampler.pdf(wi, wm);
                         checked += 1;
-                        let tag = format!("α = ({ax}, {ay}), θ = {theta}, φ = {phi}, u = ({u1}, {u2}): ωm = {wm}");
+                        let tag =
+                            format!("α = ({ax}, {ay}), θ = {theta}, φ = {phi}, u = ({u1}, {u2}): ωm = {wm}");
                         if !(wm.is_finite() && (wm.length() - 1.0).abs() < 1e-5 && wm.z >= 0.0) {
                             failures.push(format!("{tag}: not a unit upper normal"));
                             continue;
@@ -203,18 +213,19 @@ fn extreme_uniforms_and_the_fuzz_domain() {
                         if !(p > 0.0 && p.is_finite()) {
                             failures.push(format!("{tag}: density {p:e}"));
                         }
-                        if !(wi.z > 0.0) || !(u1 == 0.0 || u1 == U_MAX) {
+                        if wi.z <= 0.0 || !(u1 == 0.0 || u1 == U_MAX) {
                             continue;
                         }
                         let (axd, ayd) = (f64::from(ax), f64::from(ay));
                         let (v, c) = cap_point(axd, ayd, wi.as_dvec3(), wm.as_dvec3());
                         let b = reference_k(axd, ayd, wi.as_dvec3()) * v.z;
-                        let n = DVec3::new(f64::from(wm.x) / axd, f64::from(wm.y) / ayd, f64::from(wm.z)).normalize();
+                        let n = DVec3::new(f64::from(wm.x) / axd, f64::from(wm.y) / ayd, f64::from(wm.z))
+                            .normalize();
                         // 1 − c.z and c.z + b, the first without cancellation
                         if u1 == 0.0 {
                             let tail = (c.x * c.x + c.y * c.y) / (1.0 + c.z) / (1.0 + b);
                             smallest = smallest.min(tail);
-                            if !(tail >= MIN_TAIL) {
+                            if tail.is_nan() || tail < MIN_TAIL {
                                 failures.push(format!("{tag}: tail above the sample {tail:.3e} < 2⁻²⁶"));
                             }
                         } else if v.dot(n) >= 1e-5 {
@@ -224,7 +235,7 @@ fn extreme_uniforms_and_the_fuzz_domain() {
                             // 2⁻²⁰ of the cap below the bound (the pdf's tolerance)
                             let depth = (c.z + b) / (1.0 + b);
                             lowest = lowest.min(depth);
-                            if !(depth >= -BOUND_TOLERANCE) {
+                            if depth.is_nan() || depth < -BOUND_TOLERANCE {
                                 failures.push(format!("{tag}: {depth:.3e} of the cap below the bound"));
                             }
                         }

@@ -20,8 +20,8 @@
 
 use glam::{DVec3, Vec3};
 use microsurface::{
-    Beckmann, BeckmannNewton, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
-    smith_normalization,
+    Beckmann, BeckmannNewton, Ggx, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity,
+    VisibleNormalSampler, smith_normalization,
 };
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -166,7 +166,13 @@ const CHI2_QUAD_DEPTH: u32 = 5;
 /// the support: the coarse quadrature of a cap grid's outside cell can miss the thin part of
 /// the support beyond the cap (observed: 12 of 500 000 samples in an outside cell whose
 /// quadrature gave 0, GGX α = 1, θi = 0.5).
-fn grid_for(sampler: &dyn Sampler, tails: SlopeTails, wi: Vec3, seed: u64, hard_edge: bool) -> (Chi2Grid, String) {
+fn grid_for(
+    sampler: &dyn Sampler,
+    tails: SlopeTails,
+    wi: Vec3,
+    seed: u64,
+    hard_edge: bool,
+) -> (Chi2Grid, String) {
     let (mut grid, label) = if wi.z < 0.0 && tails == SlopeTails::Gaussian {
         (Chi2Grid { pole: wi.normalize(), ..Chi2Grid::sphere(16, 32) }, "sphere 16×32 around ωi".to_string())
     } else if wi.z < 0.0 {
@@ -212,7 +218,8 @@ fn chi2_config(
     let sampler = make(kind, alpha);
     let wi = dir(theta, PHI);
     let hard_edge = kind == Kind::GgxBoundedCap;
-    let (grid, grid_label) = grid_for(sampler.as_ref(), kind.tails(), wi, seed ^ 0x9E37_79B9_7F4A_7C15, hard_edge);
+    let (grid, grid_label) =
+        grid_for(sampler.as_ref(), kind.tails(), wi, seed ^ 0x9E37_79B9_7F4A_7C15, hard_edge);
     let label = format!(
         "{kind:?} α = {alpha:?}, θi = {theta}, φi = {PHI}, wi = {wi:.5}, N = {N_CHI2}, seed = {seed}, {grid_label}"
     );

@@ -547,7 +547,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
 /// 1 − E at the direction nodes for roughness α: the table's two roughness rows around
 /// r = √α blended linearly (as its bilinear interpolation does), from the complements of the
 /// f32 nodes (exact in f32 for E ≥ 1/2, and every E node is above 0.2).
-fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZE] {
+pub(crate) fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZE] {
     let nodes = table.directional_nodes();
     let t = alpha.sqrt() * LAST;
     let j = (t as usize).min(ALBEDO_TABLE_SIZE - 2);

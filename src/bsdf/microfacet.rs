@@ -1,6 +1,7 @@
 //! The renderer-facing BSDF of a microsurface, with a choice of technique.
 
 use super::seed::{Hasher, PrimedPcg, PrimedRng};
+use super::walk_density::WalkDensity;
 use super::specular::SpecularLimit;
 use super::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
@@ -160,6 +161,8 @@ pub struct MicrofacetBsdf<S, M> {
     /// the sample of a view from above is the exact reflection off a visible normal drawn
     /// from the caller's uniforms (the one flag the trait's fast path tests).
     exact_mirror: bool,
+    /// The stochastic techniques' MIS density of a tabulated conductor (`None` otherwise).
+    walk_density: Option<WalkDensity>,
 }
 
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
@@ -190,6 +193,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             seed: 0,
             specular,
             exact_mirror: false,
+            walk_density: if M::MIRROR_FACETS {
+                slope.conductor_albedo().and_then(|(table, alpha)| WalkDensity::new(&table, alpha))
+            } else {
+                None
+            },
         }
         .with_derived())
     }
@@ -355,7 +363,13 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn research_pdf_out(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
         match self.technique {
             Technique::SingleScattering => self.single().pdf_unchecked(walk_in, walk_out),
-            _ => self.position_free(Shadowing::Correlated).pdf_unchecked(walk_in, walk_out),
+            _ => match &self.walk_density {
+                // a tabulated conductor seen and lit from above: the F = 1 Kulla–Conty density
+                Some(density) if M::MIRROR_FACETS && walk_in.z > 0.0 && walk_out.z > 0.0 => {
+                    density.pdf(self.surface.slope(), walk_in, walk_out)
+                }
+                _ => self.position_free(Shadowing::Correlated).pdf_unchecked(walk_in, walk_out),
+            },
         }
     }
 

@@ -27,6 +27,7 @@ mod microfacet;
 mod noncentral;
 mod seed;
 mod specular;
+mod walk_density;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use compensated::{AlbedoTabulated, CompensatedConductor, Compensation};

@@ -184,6 +184,11 @@ impl crate::sealed::Sealed for Beckmann {}
 
 impl MicrosurfaceSlope for Beckmann {
     #[inline]
+    fn conductor_albedo(&self) -> Option<(crate::albedo::AlbedoTable, f32)> {
+        Some((crate::albedo::AlbedoTable::BECKMANN, (self.alpha_x() * self.alpha_y()).sqrt()))
+    }
+
+    #[inline]
     fn alpha_x(&self) -> f32 {
         self.alpha_x
     }

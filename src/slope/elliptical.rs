@@ -395,6 +395,12 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         (ensure_visible(wi, self.to_tangent(wm)), area)
     }
 
+    /// `S`'s table at √(α₁ α₂), rotation invariant.
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(AlbedoTable, f32)> {
+        self.axis_aligned.conductor_albedo()
+    }
+
     #[inline]
     fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
         self.axis_aligned.mirror_sampling_area_unchecked(self.to_ellipse(wi))

@@ -291,6 +291,11 @@ impl MicrosurfaceSlope for Ggx {
     fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
         bounded_area(self, wi)
     }
+
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(crate::albedo::AlbedoTable, f32)> {
+        Some((crate::albedo::AlbedoTable::GGX, (self.alpha_x * self.alpha_y).sqrt()))
+    }
 }
 
 impl Ggx {

@@ -301,6 +301,15 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         (self.sample_d_wi_unchecked(wi, u1, u2), self.projected_area_unchecked(wi))
     }
 
+    /// The F = 1 conductor albedo table of the slope's family and the roughness to read it at
+    /// (√(αx αy); for an [`Elliptical`] slope √(α₁ α₂)), for the stochastic techniques' MIS
+    /// density of conductors; `None` for untabulated families (the default).
+    #[doc(hidden)]
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(crate::albedo::AlbedoTable, f32)> {
+        None
+    }
+
     /// The area A_s(ωi) of [`Self::sample_mirror_normal_unchecked`] (the same bits): A(ωi) by
     /// default, GGX's bounded A_b. No argument check (crate-internal hot path).
     #[doc(hidden)]

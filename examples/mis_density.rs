@@ -20,8 +20,8 @@
 
 use glam::{Vec2, Vec3};
 use microsurface::{
-    Bsdf, CompensatedConductor, Compensation, Conductor, Dielectric, Ggx, KullaContyDielectric, MicrofacetBsdf,
-    PositionFree, Shadowing,
+    Bsdf, CompensatedConductor, Compensation, Conductor, Dielectric, Ggx, KullaContyDielectric,
+    MicrofacetBsdf, PositionFree, Shadowing,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -87,7 +87,14 @@ fn histogram(walk: &dyn Bsdf, wo: Vec3, n: usize, seed: u64) -> (Vec<f64>, usize
     (h.iter().map(|x| x / got.max(1) as f64).collect(), got)
 }
 
-fn report(label: &str, walk: &dyn Bsdf, wo: Vec3, n: usize, seed: u64, candidates: &[(&str, &dyn Fn(Vec3) -> f64)]) {
+fn report(
+    label: &str,
+    walk: &dyn Bsdf,
+    wo: Vec3,
+    n: usize,
+    seed: u64,
+    candidates: &[(&str, &dyn Fn(Vec3) -> f64)],
+) {
     let (p, got) = histogram(walk, wo, n, seed);
     let occupied = p.iter().filter(|&&x| x > 0.0).count();
     print!("| {label} | {:.1e} |", (occupied.max(1) - 1) as f64 / got as f64);
@@ -108,7 +115,9 @@ fn main() {
         }
     }
     let thetas = [0.0f32, 45.0, 75.0];
-    println!("χ² distance / KL of each density from the walk's sampled directions ({n} samples, 16 × 32 cells)");
+    println!(
+        "χ² distance / KL of each density from the walk's sampled directions ({n} samples, 16 × 32 cells)"
+    );
     println!();
     println!("| conductor F = 1 | noise floor | phase+cos | Bsdf::pdf | kulla-conty | per-order | mixture |");
     println!("|---|---|---|---|---|---|---|");
@@ -116,7 +125,8 @@ fn main() {
     for alpha in [0.2f32, 0.5, 1.0] {
         let ggx = Ggx::isotropic(alpha).expect("valid α");
         let walk = MicrofacetBsdf::new(ggx, Conductor::perfect()).expect("α ≤ 10");
-        let kc = CompensatedConductor::new(ggx, Conductor::perfect(), Compensation::KullaConty).expect("α ≤ 1");
+        let kc =
+            CompensatedConductor::new(ggx, Conductor::perfect(), Compensation::KullaConty).expect("α ≤ 1");
         let po = CompensatedConductor::new(ggx, Conductor::perfect(), Compensation::PerOrder).expect("α ≤ 1");
         let research = PositionFree::new(ggx, Conductor::perfect(), Shadowing::Correlated);
         for t in thetas {
@@ -134,7 +144,13 @@ fn main() {
                 wo,
                 n,
                 seed,
-                &[("phase+cos", &old), ("Bsdf::pdf", &today), ("kulla-conty", &kc_f), ("per-order", &po_f), ("mixture", &mix)],
+                &[
+                    ("phase+cos", &old),
+                    ("Bsdf::pdf", &today),
+                    ("kulla-conty", &kc_f),
+                    ("per-order", &po_f),
+                    ("mixture", &mix),
+                ],
             );
         }
     }

@@ -1,8 +1,8 @@
 //! The renderer-facing BSDF of a microsurface, with a choice of technique.
 
 use super::seed::{Hasher, PrimedPcg, PrimedRng};
-use super::walk_density::WalkDensity;
 use super::specular::SpecularLimit;
+use super::walk_density::WalkDensity;
 use super::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
 };
@@ -60,7 +60,11 @@ pub enum Technique {
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
-    /// weights, approximate pdf. Valid for backfacing views of opaque materials (normal
+    /// weights, approximate pdf (the MIS density of the stochastic techniques: for a conductor
+    /// of a tabulated slope family, √(αx αy) ≤ 1, seen and lit from above, the F = 1
+    /// Kulla–Conty BRDF × cos, near the walk's own distribution of directions, see
+    /// `src/bsdf/walk_density.rs`; otherwise [`PositionFree::pdf`](crate::PositionFree::pdf)'s
+    /// 0.8 × phase density + 0.2 × cosine lobe). Valid for backfacing views of opaque materials (normal
     /// mapping): the walk starts with the full-spherical first intersection
     /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there, except
     /// for smooth Beckmann surfaces seen from well below (|cot θo|/α ≳ 9.6), where the walk's
@@ -68,7 +72,7 @@ pub enum Technique {
     #[default]
     RandomWalk,
     /// The position-free estimators of Wang et al. 2022: stochastic eval, exact sample
-    /// weights, approximate pdf. Valid for backfacing views of opaque materials, whose first
+    /// weights, approximate pdf (that of [`Technique::RandomWalk`]). Valid for backfacing views of opaque materials, whose first
     /// vertex is a vertex reached from below (DESIGN.md); for Beckmann seen from so far below
     /// that Λ underflows f64 (|cot θo|/α ≳ 26.6) `sample` returns nothing and eval keeps only
     /// the first order.

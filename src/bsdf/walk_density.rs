@@ -55,9 +55,11 @@ impl WalkDensity {
     #[inline(always)]
     pub(crate) fn pdf<S: MicrosurfaceSlope>(&self, slope: &S, walk_in: Vec3, walk_out: Vec3) -> f32 {
         let (zi, zo) = (walk_in.z, walk_out.z);
-        let (area_in, area_out) = (slope.projected_area_unchecked(walk_in), slope.projected_area_unchecked(walk_out));
+        let (area_in, area_out) =
+            (slope.projected_area_unchecked(walk_in), slope.projected_area_unchecked(walk_out));
         let front = area_in * zo;
-        let single = slope.reflection_density_unchecked(walk_in, walk_out) * front / (front + zi * (area_out - zo));
+        let single =
+            slope.reflection_density_unchecked(walk_in, walk_out) * front / (front + zi * (area_out - zo));
         let (cell_in, cell_out) = self.axis.cells(zi, zo);
         single + row_at(&self.h, cell_in) * row_at(&self.h, cell_out) * zo
     }

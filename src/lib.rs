@@ -154,8 +154,9 @@ pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Sidedness, Technique, Transport,
+    BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking,
+    ClassicNdf, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Sidedness,
+    Technique, Transport,
 };
 #[cfg(feature = "mint")]
 pub use bsdf::{MintBsdf, MintSample};

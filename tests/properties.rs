@@ -776,13 +776,40 @@ fn flags_agree_with_every_call() {
         let beckmann = Beckmann::new(ax, ay).unwrap();
         for t in techniques {
             let l = format!("α ({ax}, {ay}) η {eta} {t:?}");
-            run(&mut r, &format!("GGX gold {l}"), &MicrofacetBsdf::new(ggx, gold).unwrap().with_technique(t), &mut rng);
-            run(&mut r, &format!("Beckmann gold {l}"), &MicrofacetBsdf::new(beckmann, gold).unwrap().with_technique(t), &mut rng);
-            run(&mut r, &format!("GGX glass {l}"), &MicrofacetBsdf::new(ggx, dielectric).unwrap().with_technique(t), &mut rng);
-            run(&mut r, &format!("Beckmann glass {l}"), &MicrofacetBsdf::new(beckmann, dielectric).unwrap().with_technique(t), &mut rng);
-            run(&mut r, &format!("GGX diffuse {l}"), &MicrofacetBsdf::new(ggx, diffuse).unwrap().with_technique(t), &mut rng);
+            run(
+                &mut r,
+                &format!("GGX gold {l}"),
+                &MicrofacetBsdf::new(ggx, gold).unwrap().with_technique(t),
+                &mut rng,
+            );
+            run(
+                &mut r,
+                &format!("Beckmann gold {l}"),
+                &MicrofacetBsdf::new(beckmann, gold).unwrap().with_technique(t),
+                &mut rng,
+            );
+            run(
+                &mut r,
+                &format!("GGX glass {l}"),
+                &MicrofacetBsdf::new(ggx, dielectric).unwrap().with_technique(t),
+                &mut rng,
+            );
+            run(
+                &mut r,
+                &format!("Beckmann glass {l}"),
+                &MicrofacetBsdf::new(beckmann, dielectric).unwrap().with_technique(t),
+                &mut rng,
+            );
+            run(
+                &mut r,
+                &format!("GGX diffuse {l}"),
+                &MicrofacetBsdf::new(ggx, diffuse).unwrap().with_technique(t),
+                &mut rng,
+            );
         }
-        let classic = ClassicBrdf::new(Vec3::splat(0.3), Vec3::splat(0.5), ClassicNdf::Ggx(ax), ClassicMasking::Exact).unwrap();
+        let classic =
+            ClassicBrdf::new(Vec3::splat(0.3), Vec3::splat(0.5), ClassicNdf::Ggx(ax), ClassicMasking::Exact)
+                .unwrap();
         run(&mut r, &format!("classic α {ax}"), &classic, &mut rng);
         for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
             if let Ok(b) = CompensatedConductor::new(ggx, gold, scheme) {
@@ -804,7 +831,12 @@ fn flags_agree_with_every_call() {
         }
     }
     println!("flags: {} cases, {} samples, {} violations", r.cases, r.samples, r.failures.len());
-    assert!(r.cases >= CONFIGS * CASES * 20 && r.samples > r.cases / 4, "{} cases, {} samples", r.cases, r.samples);
+    assert!(
+        r.cases >= CONFIGS * CASES * 20 && r.samples > r.cases / 4,
+        "{} cases, {} samples",
+        r.cases,
+        r.samples
+    );
     assert!(
         r.failures.is_empty(),
         "{} of {} cases broke the flags contract; the first:\n{}",

@@ -4,7 +4,8 @@ use super::seed::{Hasher, PrimedPcg, PrimedRng};
 use super::sidedness::{Facing, Sidedness, mirror_z};
 use super::specular::SpecularLimit;
 use super::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, renormalized, unit_direction, unit_uniforms,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, renormalized, unit_direction,
+    unit_uniforms,
 };
 use crate::error::Error;
 use crate::height::UniformHeight;

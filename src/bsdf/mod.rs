@@ -29,10 +29,10 @@ mod specular;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use frame::ShadingFrame;
+pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
 #[cfg(feature = "mint")]
 pub use mint::{MintBsdf, MintSample};
 pub use sidedness::Sidedness;
-pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
 pub use specular::{SpecularEvent, SpecularLimit};
 
 use glam::{Vec2, Vec3};

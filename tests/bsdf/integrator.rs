@@ -123,7 +123,10 @@ fn the_specular_limit_below_smooth_alpha() {
         // samples are flagged specular (pdf 1), and eval and pdf stay 0, as the flags say
         let from_below = b.sample(-wo, 0.5, Vec2::splat(0.5)).expect("the backfacing lobe reflects");
         assert!(from_below.flags.specular && from_below.pdf == 1.0, "{tname}: {from_below:?}");
-        assert!(from_below.weight.max_element() > 0.0 && from_below.flags.reflection, "{tname}: {from_below:?}");
+        assert!(
+            from_below.weight.max_element() > 0.0 && from_below.flags.reflection,
+            "{tname}: {from_below:?}"
+        );
         assert_eq!(b.eval(-wo, from_below.wi).f, Vec3::ZERO, "{tname}");
         assert_eq!(b.pdf(-wo, from_below.wi), 0.0, "{tname}");
         // dielectric: reflection with probability F, refraction (Snell) otherwise

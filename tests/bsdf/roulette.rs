@@ -26,7 +26,13 @@ enum Roulette {
 
 /// One path's radiance estimate and whether it reached `MAX_EVENTS`; the survival
 /// probability of its first roulette decision goes to `first`.
-fn trace(b: &dyn Bsdf, wo_top: Vec3, roulette: Roulette, rng: &mut TestRng, first: &mut Stats) -> (f64, bool) {
+fn trace(
+    b: &dyn Bsdf,
+    wo_top: Vec3,
+    roulette: Roulette,
+    rng: &mut TestRng,
+    first: &mut Stats,
+) -> (f64, bool) {
     let mut decided = false;
     let mut d = -wo_top;
     let mut inside = false;
@@ -90,7 +96,13 @@ fn roulette_as_documented_tracks_the_energy_in_a_glass_furnace() {
             truncated += usize::from(cut);
         }
         let dev = (est.mean() - L_ENV).abs();
-        println!("{label}: N {N}, mean {:.5} ± {:.1e}, first survival {:.4} ({} paths entered)", est.mean(), est.se(), q.mean(), q.n);
+        println!(
+            "{label}: N {N}, mean {:.5} ± {:.1e}, first survival {:.4} ({} paths entered)",
+            est.mean(),
+            est.se(),
+            q.mean(),
+            q.n
+        );
         assert!(truncated <= N / 1000, "{label}: {truncated} paths reached {MAX_EVENTS} events");
         assert!(q.n > N as u64 / 2, "{label}: only {} paths entered the glass", q.n);
         if rule == Roulette::TimesEtaSq {
@@ -100,7 +112,11 @@ fn roulette_as_documented_tracks_the_energy_in_a_glass_furnace() {
             assert!(dev <= 1e-3, "{label}: mean {} ≠ 1", est.mean());
         } else {
             let expected = 1.0 / 1.5f64.powi(4);
-            assert!((q.mean() - expected).abs() <= 1e-5, "{label}: first survival {} ≠ 1/η⁴ = {expected}", q.mean());
+            assert!(
+                (q.mean() - expected).abs() <= 1e-5,
+                "{label}: first survival {} ≠ 1/η⁴ = {expected}",
+                q.mean()
+            );
             assert!(est.se() <= 0.02, "{label}: SE {} too large to test the mean", est.se());
             assert!(dev <= z * est.se(), "{label}: mean {} ± {} ≠ 1 (z = {z})", est.mean(), est.se());
         }
@@ -136,5 +152,11 @@ fn roulette_as_documented_is_unbiased_for_lossy_glass() {
     // the lossy glass kills some paths, and keeps most (the energy lost per event is small)
     assert!(stats[1].1.n > N as u64 / 2 && q_on < 1.0 && q_on > 0.5, "survival {q_on}");
     let [(a, _), (b_, _)] = &mut stats;
-    assert_two_sample("single-scattering glass furnace: roulette against none", a, b_, family_z(0.01, 1), 0.01);
+    assert_two_sample(
+        "single-scattering glass furnace: roulette against none",
+        a,
+        b_,
+        family_z(0.01, 1),
+        0.01,
+    );
 }

@@ -86,7 +86,10 @@ fn shading_frame_from_normal_and_tangent() {
         let sin = along.length() / t64.length();
         let projected = along.normalize().as_vec3();
         let tol = 1e-6 + 2e-7 / sin as f32;
-        assert!((x - projected).length() <= tol, "{n} {t}: tangent {x}, expected {projected} (tolerance {tol})");
+        assert!(
+            (x - projected).length() <= tol,
+            "{n} {t}: tangent {x}, expected {projected} (tolerance {tol})"
+        );
         assert!((f.to_world(Vec3::X) - x).length() <= 1e-6 && (f.to_local(x) - Vec3::X).length() <= 1e-6);
     }
     let n = Vec3::new(0.3, -0.4, 0.8);
@@ -127,5 +130,8 @@ fn the_tangent_orients_anisotropic_roughness() {
             }
         }
     }
-    assert!(compared > 1000 && max_wrong > 2.0, "{compared} pairs, largest ratio of the wrong orientation {max_wrong}");
+    assert!(
+        compared > 1000 && max_wrong > 2.0,
+        "{compared} pairs, largest ratio of the wrong orientation {max_wrong}"
+    );
 }

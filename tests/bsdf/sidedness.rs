@@ -19,9 +19,17 @@ fn check_sides(label: &str, base: &dyn Bsdf, two: &dyn Bsdf, black: &dyn Bsdf, r
         let (uc, u) = (uniform32(rng), Vec2::new(uniform32(rng), uniform32(rng)));
         if wo.z < 0.0 {
             let (m_o, m_i) = (mirror(wo), mirror(wi));
-            assert_eq!(two.eval_keyed(wo, wi, key), base.eval_keyed(m_o, m_i, key), "{label}: eval {wo} {wi}");
+            assert_eq!(
+                two.eval_keyed(wo, wi, key),
+                base.eval_keyed(m_o, m_i, key),
+                "{label}: eval {wo} {wi}"
+            );
             assert_eq!(two.pdf(wo, wi), base.pdf(m_o, m_i), "{label}: pdf {wo} {wi}");
-            assert_eq!(two.eval_with_pdf_keyed(wo, wi, key), base.eval_with_pdf_keyed(m_o, m_i, key), "{label}");
+            assert_eq!(
+                two.eval_with_pdf_keyed(wo, wi, key),
+                base.eval_with_pdf_keyed(m_o, m_i, key),
+                "{label}"
+            );
             let s = two.sample_keyed(wo, uc, u, key);
             let expected = base.sample_keyed(m_o, uc, u, key).map(|s| BsdfSample { wi: mirror(s.wi), ..s });
             assert_eq!(s, expected, "{label}: sample {wo}");

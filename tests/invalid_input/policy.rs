@@ -109,7 +109,12 @@ impl Report {
 
     /// Checks one call with valid input: it must not panic (in either mode) and its result must
     /// satisfy `ok`.
-    pub(super) fn expect_valid<T: Debug>(&mut self, label: &str, f: impl FnOnce() -> T, ok: impl Fn(&T) -> bool) {
+    pub(super) fn expect_valid<T: Debug>(
+        &mut self,
+        label: &str,
+        f: impl FnOnce() -> T,
+        ok: impl Fn(&T) -> bool,
+    ) {
         self.checked += 1;
         match catch_unwind(AssertUnwindSafe(f)) {
             Ok(v) if ok(&v) => {}

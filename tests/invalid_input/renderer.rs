@@ -13,8 +13,8 @@ use microsurface::leadr::{Noncentral, NoncentralBsdf};
 use microsurface::research::{Estimator, Shadowing};
 use microsurface::{
     BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Diffuse, Ggx,
-    KullaContyDielectric, MicrofacetBsdf, Technique,
+    CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Diffuse,
+    Ggx, KullaContyDielectric, MicrofacetBsdf, Technique,
 };
 
 /// 1 − 2⁻²⁴, what a uniform of 1 stands for.
@@ -34,16 +34,33 @@ fn models() -> Vec<(String, Box<dyn Bsdf>, bool)> {
         ("pt", Technique::PositionFree { estimator: Estimator::Pt, shadowing: Shadowing::Correlated }),
         ("bdpt", Technique::PositionFree { estimator: Estimator::Bdpt, shadowing: Shadowing::Uncorrelated }),
     ] {
-        v.push((format!("gold {t}"), Box::new(MicrofacetBsdf::new(ggx, gold).unwrap().with_technique(technique)), true));
-        v.push((format!("glass {t}"), Box::new(MicrofacetBsdf::new(ggx, glass).unwrap().with_technique(technique)), true));
-        v.push((format!("diffuse {t}"), Box::new(MicrofacetBsdf::new(ggx, diffuse).unwrap().with_technique(technique)), true));
+        v.push((
+            format!("gold {t}"),
+            Box::new(MicrofacetBsdf::new(ggx, gold).unwrap().with_technique(technique)),
+            true,
+        ));
+        v.push((
+            format!("glass {t}"),
+            Box::new(MicrofacetBsdf::new(ggx, glass).unwrap().with_technique(technique)),
+            true,
+        ));
+        v.push((
+            format!("diffuse {t}"),
+            Box::new(MicrofacetBsdf::new(ggx, diffuse).unwrap().with_technique(technique)),
+            true,
+        ));
     }
-    let classic = ClassicBrdf::new(Vec3::splat(0.3), Vec3::splat(0.5), ClassicNdf::Ggx(0.3), ClassicMasking::Exact);
+    let classic =
+        ClassicBrdf::new(Vec3::splat(0.3), Vec3::splat(0.5), ClassicNdf::Ggx(0.3), ClassicMasking::Exact);
     v.push(("classic".into(), Box::new(classic.unwrap()), true));
     let noncentral = NoncentralBsdf::new(Noncentral::new(ggx, Vec2::new(0.2, -0.1)).unwrap(), gold).unwrap();
     v.push(("noncentral".into(), Box::new(noncentral), true));
     for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
-        v.push((format!("compensated gold {scheme:?}"), Box::new(CompensatedConductor::new(ggx, gold, scheme).unwrap()), false));
+        v.push((
+            format!("compensated gold {scheme:?}"),
+            Box::new(CompensatedConductor::new(ggx, gold, scheme).unwrap()),
+            false,
+        ));
     }
     v.push(("Turquin glass".into(), Box::new(CompensatedDielectric::new(ggx, glass).unwrap()), false));
     v.push(("Kulla-Conty glass".into(), Box::new(KullaContyDielectric::new(ggx, glass).unwrap()), false));
@@ -79,35 +96,61 @@ fn drifted_directions_are_renormalized_and_beyond_the_tolerance_rejected() {
         let f = b.eval_keyed(wo, wi, key).f;
         let pdf = b.pdf(wo, wi);
         let s = b.sample_keyed(wo, uc, u, key);
-        assert!(f.max_element() > 0.0 && pdf > 0.0 && s.is_some(), "{label}: the unit directions have no value");
+        assert!(
+            f.max_element() > 0.0 && pdf > 0.0 && s.is_some(),
+            "{label}: the unit directions have no value"
+        );
         for k in inside {
             let (d_o, d_i) = (k * wo, k * wi);
             let l = format!("{label}: |ω| = {k}");
             if exact {
                 let (r_o, r_i) = (renormalized(d_o), renormalized(d_i));
                 let e = b.eval_keyed(r_o, r_i, key);
-                r.expect_valid(&format!("{l}: eval(wo)"), || b.eval_keyed(d_o, r_i, key), |v| *v == e && v.f.max_element() > 0.0);
+                r.expect_valid(
+                    &format!("{l}: eval(wo)"),
+                    || b.eval_keyed(d_o, r_i, key),
+                    |v| *v == e && v.f.max_element() > 0.0,
+                );
                 r.expect_valid(&format!("{l}: eval(wi)"), || b.eval_keyed(r_o, d_i, key), |v| *v == e);
                 let p = b.pdf(r_o, r_i);
                 r.expect_valid(&format!("{l}: pdf"), || b.pdf(d_o, d_i), |x| *x == p && p > 0.0);
                 let ep = b.eval_with_pdf_keyed(r_o, r_i, key);
-                r.expect_valid(&format!("{l}: eval_with_pdf"), || b.eval_with_pdf_keyed(d_o, d_i, key), |x| *x == ep);
+                r.expect_valid(
+                    &format!("{l}: eval_with_pdf"),
+                    || b.eval_with_pdf_keyed(d_o, d_i, key),
+                    |x| *x == ep,
+                );
                 let s = b.sample_keyed(r_o, uc, u, key);
-                r.expect_valid(&format!("{l}: sample"), || b.sample_keyed(d_o, uc, u, key), |x| *x == s && s.is_some());
+                r.expect_valid(
+                    &format!("{l}: sample"),
+                    || b.sample_keyed(d_o, uc, u, key),
+                    |x| *x == s && s.is_some(),
+                );
             } else {
                 // the added lobes read their tables at the caller's cosines (within 1e-2 of the
                 // unit ones): within 2 % of the unit answer
-                r.expect_valid(&format!("{l}: eval"), || b.eval_keyed(d_o, d_i, key), |v: &BsdfValue| close(v.f, f, 2e-2));
+                r.expect_valid(
+                    &format!("{l}: eval"),
+                    || b.eval_keyed(d_o, d_i, key),
+                    |v: &BsdfValue| close(v.f, f, 2e-2),
+                );
                 r.expect_valid(&format!("{l}: pdf"), || b.pdf(d_o, d_i), |p| (p - pdf).abs() <= 2e-2 * pdf);
-                r.expect_valid(&format!("{l}: sample"), || b.sample_keyed(d_o, uc, u, key), |s: &Option<BsdfSample>| {
-                    s.is_some_and(|s| s.weight.is_finite() && s.pdf > 0.0 && (s.wi.length() - 1.0).abs() < 1e-5)
-                });
+                r.expect_valid(
+                    &format!("{l}: sample"),
+                    || b.sample_keyed(d_o, uc, u, key),
+                    |s: &Option<BsdfSample>| {
+                        s.is_some_and(|s| {
+                            s.weight.is_finite() && s.pdf > 0.0 && (s.wi.length() - 1.0).abs() < 1e-5
+                        })
+                    },
+                );
             }
         }
         for k in outside {
             let (d_o, d_i) = (k * wo, k * wi);
             let l = format!("{label}: |ω| = {k}");
-            let says = |name: &str| [format!("`{name}` = Vec3("), format!("is not a unit direction (|{name}| = ")];
+            let says =
+                |name: &str| [format!("`{name}` = Vec3("), format!("is not a unit direction (|{name}| = ")];
             let (so, si) = (says("wo"), says("wi"));
             let (so, si) = ([so[0].as_str(), so[1].as_str()], [si[0].as_str(), si[1].as_str()]);
             let zero = |v: &BsdfValue| v.f == Vec3::ZERO;
@@ -121,12 +164,22 @@ fn drifted_directions_are_renormalized_and_beyond_the_tolerance_rejected() {
                 |(v, p)| v.f == Vec3::ZERO && *p == 0.0,
                 &si,
             );
-            r.expect_nothing_saying(&format!("{l}: sample(wo)"), || b.sample_keyed(d_o, uc, u, key), Option::is_none, &so);
+            r.expect_nothing_saying(
+                &format!("{l}: sample(wo)"),
+                || b.sample_keyed(d_o, uc, u, key),
+                Option::is_none,
+                &so,
+            );
         }
         for bad in [Vec3::NAN, Vec3::new(0.0, f32::INFINITY, 1.0), Vec3::ZERO] {
             let l = format!("{label}: wo = {bad}");
             let needle = format!("`wo` = {bad:?}");
-            r.expect_nothing_saying(&l, || b.sample_keyed(bad, uc, u, key), Option::is_none, &[needle.as_str()]);
+            r.expect_nothing_saying(
+                &l,
+                || b.sample_keyed(bad, uc, u, key),
+                Option::is_none,
+                &[needle.as_str()],
+            );
         }
     }
     r.finish("drifted_directions_are_renormalized_and_beyond_the_tolerance_rejected", 800);
@@ -154,20 +207,34 @@ fn uniforms_of_one_are_the_largest_below_one() {
                     let expected = b.sample_keyed(wo, uc1, u1, 5);
                     r.expect_valid(&l, || b.sample_keyed(wo, uc, u, 5), |s| *s == expected);
                 } else {
-                    r.expect_valid(&l, || b.sample_keyed(wo, uc, u, 5), |s: &Option<BsdfSample>| {
-                        s.is_none_or(|s| s.weight.is_finite() && s.pdf > 0.0 && s.wi.is_finite())
-                    });
+                    r.expect_valid(
+                        &l,
+                        || b.sample_keyed(wo, uc, u, 5),
+                        |s: &Option<BsdfSample>| {
+                            s.is_none_or(|s| s.weight.is_finite() && s.pdf > 0.0 && s.wi.is_finite())
+                        },
+                    );
                 }
             }
             let above = 1.0 + f32::EPSILON;
             for bad in [above, -1e-7, -1.0, f32::NAN, f32::INFINITY] {
                 let needle = format!("`uc` = {bad:?} is not a uniform");
                 let l = format!("{label}: sample(uc = {bad})");
-                r.expect_nothing_saying(&l, || b.sample_keyed(wo, bad, Vec2::splat(0.5), 5), Option::is_none, &[needle.as_str()]);
+                r.expect_nothing_saying(
+                    &l,
+                    || b.sample_keyed(wo, bad, Vec2::splat(0.5), 5),
+                    Option::is_none,
+                    &[needle.as_str()],
+                );
                 let u = Vec2::new(0.5, bad);
                 let needle = format!("`u` = {u:?}");
                 let l = format!("{label}: sample(u = {u})");
-                r.expect_nothing_saying(&l, || b.sample_keyed(wo, 0.5, u, 5), Option::is_none, &[needle.as_str()]);
+                r.expect_nothing_saying(
+                    &l,
+                    || b.sample_keyed(wo, 0.5, u, 5),
+                    Option::is_none,
+                    &[needle.as_str()],
+                );
             }
         }
     }

@@ -725,7 +725,7 @@ fn check_flags(r: &mut FlagsReport, label: &str, b: &dyn Bsdf, rng: &mut Rng) {
             if !flags.has_non_specular() {
                 fail(format!("a non-specular sample {s:?} for wo {wo}, flags without such a lobe"));
             }
-            if !(p_at > 0.0) {
+            if p_at.is_nan() || p_at <= 0.0 {
                 fail(format!("non-specular sample {s:?} for wo {wo}: pdf {p_at} at its direction"));
             }
         }

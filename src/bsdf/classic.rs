@@ -3,7 +3,7 @@
 //! masking and Schlick's Fresnel (Cook and Torrance 1982; Walter et al. 2007; Schlick 1994).
 
 use super::sidedness::{Facing, Sidedness, mirror_z};
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, unit_direction, unit_uniforms};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, unit_directions, unit_view};
 use crate::error::Error;
 use crate::fresnel::fresnel_schlick;
 use crate::rng::cut_tails;
@@ -238,8 +238,7 @@ impl Bsdf for ClassicBrdf {
 
     /// `uc` chooses the lobe, `u` the direction within it (exact: no other random number).
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, _key: u64) -> Option<BsdfSample> {
-        let wo = unit_direction("wo", wo)?;
-        let (uc, u) = unit_uniforms(uc, u)?;
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, 0));
         if self.mirrored(wo)? {
             let s = self.sample_above(mirror_z(wo), uc, u)?;
             return Some(BsdfSample { wi: mirror_z(s.wi), ..s });
@@ -254,9 +253,7 @@ impl Bsdf for ClassicBrdf {
 
     /// One half vector and one D for both.
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> (BsdfValue, f32) {
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return (BsdfValue::ZERO, 0.0);
-        };
+        unit_directions!(wo, wi, (BsdfValue::ZERO, 0.0), self.eval_with_pdf_keyed(wo, wi, 0));
         let (wo, wi) = match self.mirrored(wo) {
             Some(false) => (wo, wi),
             Some(true) => (mirror_z(wo), mirror_z(wi)),

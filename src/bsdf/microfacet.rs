@@ -4,8 +4,7 @@ use super::seed::{Hasher, PrimedPcg, PrimedRng};
 use super::sidedness::{Facing, Sidedness, mirror_z};
 use super::specular::SpecularLimit;
 use super::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, renormalized, unit_direction,
-    unit_uniforms,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, renormalized, unit_directions, unit_view,
 };
 use crate::error::Error;
 use crate::height::UniformHeight;
@@ -628,16 +627,13 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return BsdfValue { f: Vec3::ZERO, exact: self.exact_eval() };
-        };
+        unit_directions!(wo, wi, BsdfValue { f: Vec3::ZERO, exact: self.exact_eval() }, self.eval_keyed(wo, wi, key));
         self.eval_unit(wo, wi, key)
     }
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
-        let wo = unit_direction("wo", wo)?;
-        let (uc, u) = unit_uniforms(uc, u)?;
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, key));
         if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
             // a conductor seen from above: the caller's (u.x, u.y) are the visible normal's
             // uniforms, taken as they are (no generator, no hash); the research sample's
@@ -660,9 +656,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
         let exact = self.exact_eval();
         let nothing = (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return nothing;
-        };
+        unit_directions!(wo, wi, nothing, self.eval_with_pdf_keyed(wo, wi, key));
         let (wo, wi) = match self.facing(wo) {
             Facing::AsGiven => (wo, wi),
             Facing::Mirrored => (mirror_z(wo), mirror_z(wi)),
@@ -691,9 +685,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return 0.0;
-        };
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
         let pdf = if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
             // the exact reflection density (the single-scattering density of a view from
             // above: 0 for a light below the horizon), without the Dirac, sidedness and

@@ -265,16 +265,69 @@ const LENGTH_SQ_RANGE: core::ops::RangeInclusive<f32> = {
 /// 1 − 2⁻²⁴, the largest f32 below 1: what a uniform of exactly 1 is taken as.
 pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Whether `w` is unit by the research layer's bound (the fast path of [`unit_direction`]).
+/// Whether `w` is unit by the research layer's bound: the fast path of the entry checks.
 pub(crate) use crate::contract::is_direction;
 
-/// The unit direction of a direction argument named `name`: `w` itself if it is unit to
-/// [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE) (one comparison), `w/‖w‖` within
-/// [`BSDF_DIRECTION_TOLERANCE`], otherwise `None` with a debug assertion naming the argument.
-/// The trait's entry-point check of a direction.
+/// `unit_directions!(wo, wi, nothing, retry)`, at the top of a [`Bsdf`] method: if `wo` or
+/// `wi` is not unit to [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE) (one comparison
+/// each, the whole cost for unit input), returns `retry` evaluated with both renormalized
+/// (rebound under their names) if they lie within [`BSDF_DIRECTION_TOLERANCE`], and
+/// `nothing` otherwise, after a debug assertion naming the argument and its value.
+macro_rules! unit_directions {
+    ($wo:ident, $wi:ident, $nothing:expr, $retry:expr) => {
+        if !$crate::bsdf::is_direction($wo) || !$crate::bsdf::is_direction($wi) {
+            return match $crate::bsdf::renormalize_pair($wo, $wi) {
+                Some(($wo, $wi)) => $retry,
+                None => $nothing,
+            };
+        }
+    };
+}
+pub(crate) use unit_directions;
+
+/// `unit_view!(wo, uc, u, nothing, retry)`, at the top of a `sample` method: as
+/// [`unit_directions!`] for the view `wo`, and uniforms of exactly 1 taken as 1 − 2⁻²⁴
+/// (`nothing` for a NaN, negative or above 1).
+macro_rules! unit_view {
+    ($wo:ident, $uc:ident, $u:ident, $nothing:expr, $retry:expr) => {
+        if !$crate::bsdf::is_direction($wo) || !$crate::bsdf::are_unit_uniforms($uc, $u) {
+            return match $crate::bsdf::renormalize_view($wo, $uc, $u) {
+                Some(($wo, $uc, $u)) => $retry,
+                None => $nothing,
+            };
+        }
+    };
+}
+pub(crate) use unit_view;
+
+/// The slow path of [`unit_directions!`]: both directions renormalized, or `None` (with the
+/// debug assertion) if one is beyond [`BSDF_DIRECTION_TOLERANCE`].
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn renormalize_pair(wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
+    Some((unit_or_report("wo", wo)?, unit_or_report("wi", wi)?))
+}
+
+/// The slow path of [`unit_view!`].
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn renormalize_view(wo: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32, Vec2)> {
+    let wo = unit_or_report("wo", wo)?;
+    let r = clamp_ones(uc, u);
+    if r.is_none() {
+        report_uniforms(uc, u);
+    }
+    let (uc, u) = r?;
+    Some((wo, uc, u))
+}
+
+/// The unit direction of the argument `name`: `w` if unit, renormalized within
+/// [`BSDF_DIRECTION_TOLERANCE`], otherwise `None` after the debug assertion.
 #[inline(always)]
 #[track_caller]
-pub(crate) fn unit_direction(name: &'static str, w: Vec3) -> Option<Vec3> {
+fn unit_or_report(name: &str, w: Vec3) -> Option<Vec3> {
     if is_direction(w) {
         return Some(w);
     }
@@ -297,7 +350,7 @@ fn report_direction(name: &str, w: Vec3) {
 }
 
 /// `w/‖w‖` for a length within [`BSDF_DIRECTION_TOLERANCE`] of 1, `None` beyond (NaN, ±∞
-/// and zero included). Out of line: drifted directions are the exception.
+/// and zero included).
 #[cold]
 #[inline(never)]
 fn renormalize_drifted(w: Vec3) -> Option<Vec3> {
@@ -320,20 +373,11 @@ pub(crate) fn valid_direction(w: Vec3) -> bool {
     is_direction(w) || renormalize_drifted(w).is_some()
 }
 
-/// The caller's uniforms with 1 taken as 1 − 2⁻²⁴: themselves if all lie in [0, 1) (one
-/// test), otherwise `None` with a debug assertion naming the argument if one is NaN, negative
-/// or above 1.
+/// Whether the caller's uniforms all lie in [0, 1) (NaN fails): the fast path of
+/// [`unit_view!`].
 #[inline(always)]
-#[track_caller]
-pub(crate) fn unit_uniforms(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
-    if in_unit_interval(uc) & in_unit_interval(u.x) & in_unit_interval(u.y) {
-        return Some((uc, u));
-    }
-    let r = clamp_ones(uc, u);
-    if r.is_none() {
-        report_uniforms(uc, u);
-    }
-    r
+pub(crate) fn are_unit_uniforms(uc: f32, u: Vec2) -> bool {
+    in_unit_interval(uc) & in_unit_interval(u.x) & in_unit_interval(u.y)
 }
 
 /// The debug assertion of invalid uniforms, naming the first bad argument.
@@ -355,8 +399,7 @@ fn in_unit_interval(x: f32) -> bool {
 }
 
 /// The uniforms with every 1 replaced by 1 − 2⁻²⁴ if all lie in [0, 1], `None` otherwise.
-#[cold]
-#[inline(never)]
+#[inline(always)]
 fn clamp_ones(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
     let all = [uc, u.x, u.y];
     all.iter().all(|x| (0.0..=1.0).contains(x)).then(|| {
@@ -369,5 +412,5 @@ fn clamp_ones(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
 /// wrappers that hand invalid input on to an inner lobe, whose own check reports it.
 #[inline(always)]
 pub(crate) fn valid_uniforms(uc: f32, u: Vec2) -> bool {
-    (in_unit_interval(uc) & in_unit_interval(u.x) & in_unit_interval(u.y)) || clamp_ones(uc, u).is_some()
+    are_unit_uniforms(uc, u) || clamp_ones(uc, u).is_some()
 }

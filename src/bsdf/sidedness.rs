@@ -70,13 +70,13 @@ impl Sidedness {
     /// [`Sidedness::BackfacingLobe`].
     #[inline(always)]
     pub(crate) fn facing(self, wo: Vec3) -> Facing {
-        if wo.z >= 0.0 || wo.z.is_nan() {
-            return Facing::AsGiven;
-        }
-        match self {
-            Sidedness::BackfacingLobe => Facing::AsGiven,
-            Sidedness::TwoSided => Facing::Mirrored,
-            Sidedness::Black => Facing::Nothing,
+        // the default first: one test of the field for every view
+        if self == Sidedness::BackfacingLobe || wo.z >= 0.0 || wo.z.is_nan() {
+            Facing::AsGiven
+        } else if self == Sidedness::TwoSided {
+            Facing::Mirrored
+        } else {
+            Facing::Nothing
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use super::NoncentralMaterial;
 use super::slope::Noncentral;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, unit_direction, unit_uniforms};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, unit_directions, unit_view};
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::slope::MicrosurfaceSlope;
@@ -171,16 +171,13 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> Bsdf for NoncentralBsdf<S, M> 
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> BsdfValue {
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return BsdfValue::ZERO;
-        };
+        unit_directions!(wo, wi, BsdfValue::ZERO, self.eval_keyed(wo, wi, 0));
         BsdfValue { f: self.f_checked(wo, wi), exact: true }
     }
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, _key: u64) -> Option<BsdfSample> {
-        let wo = unit_direction("wo", wo)?;
-        let (_, u) = unit_uniforms(uc, u)?;
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, 0));
         if wo.z <= 0.0 {
             return None;
         }
@@ -208,17 +205,13 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> Bsdf for NoncentralBsdf<S, M> 
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return 0.0;
-        };
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
         self.pdf_checked(wo, wi)
     }
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> (BsdfValue, f32) {
-        let (Some(wo), Some(wi)) = (unit_direction("wo", wo), unit_direction("wi", wi)) else {
-            return (BsdfValue::ZERO, 0.0);
-        };
+        unit_directions!(wo, wi, (BsdfValue::ZERO, 0.0), self.eval_with_pdf_keyed(wo, wi, 0));
         (BsdfValue { f: self.f_checked(wo, wi), exact: true }, self.pdf_checked(wo, wi))
     }
 }

@@ -61,7 +61,11 @@ pub enum Technique {
     /// closed form and `eval` returns an unbiased one-sample estimate (one visible normal drawn
     /// from a hash of the arguments and the key; `BsdfValue::exact` is false, and so is the
     /// samples' `exact_pdf`: the density is the documented approximation of
-    /// [`Diffuse`](crate::Diffuse)'s phase function). Valid for backfacing view directions (normal mapping): the
+    /// [`Diffuse`](crate::Diffuse)'s phase function). A fixed quadrature over the visible
+    /// normals is no substitute at a comparable cost: ⟨ωo, ωm⟩⁺ has a kink across the visible
+    /// normals, and a 4 × 4 midpoint rule in the sampler's uniforms (16 visible normals, 16×
+    /// the estimate's) is off by up to 63 % of the value for GGX α = 0.5 and 100 % at α = 1
+    /// (8 × 8: 2.4 % and 41 %). Valid for backfacing view directions (normal mapping): the
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
     /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term or GGX's f32

@@ -35,7 +35,7 @@ pub struct MintSample {
 /// same way):
 ///
 /// ```
-/// use microsurface::{ComplexIor, Conductor, Ggx, MicrofacetBsdf, MintBsdf};
+/// use microsurface::{ComplexIor, Conductor, Ggx, MicrofacetBsdf, MintBsdf, Technique};
 ///
 /// #[derive(Debug, Clone, Copy)]
 /// struct V3 { x: f32, y: f32, z: f32 }
@@ -46,13 +46,15 @@ pub struct MintSample {
 ///     fn from(v: mint::Vector3<f32>) -> Self { V3 { x: v.x, y: v.y, z: v.z } }
 /// }
 ///
-/// let gold = MicrofacetBsdf::new(Ggx::isotropic(0.3)?, Conductor::new(ComplexIor::GOLD))?;
+/// let gold = MicrofacetBsdf::new(Ggx::isotropic(0.3)?, Conductor::new(ComplexIor::GOLD))?
+///     .with_technique(Technique::SingleScattering);
 /// let wo = V3 { x: 0.6, y: 0.0, z: 0.8 };
 /// let s = gold.sample_mint(wo, 0.5, [0.3, 0.7], 0).expect("gold reflects");
 /// let wi: V3 = s.wi.into();
 /// let (f, pdf) = gold.eval_with_pdf_mint(wo, wi, 0);
 /// let f: V3 = f.into();
 /// assert!(f.x > 0.0 && pdf > 0.0);
+/// // single scattering is exact: the weight is f·cos θi/pdf
 /// assert!((f.x * wi.z / pdf - s.weight.x).abs() < 1e-4 * s.weight.x);
 /// # Ok::<(), microsurface::Error>(())
 /// ```

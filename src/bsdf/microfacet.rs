@@ -631,7 +631,12 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        unit_directions!(wo, wi, BsdfValue { f: Vec3::ZERO, exact: self.exact_eval() }, self.eval_keyed(wo, wi, key));
+        unit_directions!(
+            wo,
+            wi,
+            BsdfValue { f: Vec3::ZERO, exact: self.exact_eval() },
+            self.eval_keyed(wo, wi, key)
+        );
         self.eval_unit(wo, wi, key)
     }
 

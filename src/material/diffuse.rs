@@ -175,7 +175,8 @@ impl Material for Diffuse {
             return Vec3::ZERO;
         }
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * positive_part(it.wo().dot(wm)) * slope.projected_area_unchecked(wi) / wi.z.abs())
+        self.albedo
+            * (FRAC_1_PI * positive_part(it.wo().dot(wm)) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
     #[inline]

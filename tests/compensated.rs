@@ -462,7 +462,9 @@ fn invalid_input_gives_nothing() {
         }
         // (a uniform of exactly 1 is valid: tests/invalid_input/renderer.rs)
         let above_one = 1.0 + f32::EPSILON;
-        for (uc, u) in [(above_one, Vec2::splat(0.5)), (0.5, Vec2::new(f32::NAN, 0.2)), (-0.1, Vec2::splat(0.5))] {
+        for (uc, u) in
+            [(above_one, Vec2::splat(0.5)), (0.5, Vec2::new(f32::NAN, 0.2)), (-0.1, Vec2::splat(0.5))]
+        {
             check("sample(uniforms)", &|| b.sample(ok, uc, u).is_none());
         }
     }

@@ -38,7 +38,7 @@ const MESSAGE: &str = "invalid input";
 
 /// Silences the panics of contract violations (they are expected by the thousand in debug
 /// builds); every other panic is reported by the default hook.
-fn quiet_violations() {
+pub(super) fn quiet_violations() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         let default = std::panic::take_hook();
@@ -58,7 +58,7 @@ fn quiet_violations() {
 
 /// The failures collected by a test, reported together at its end.
 #[derive(Default)]
-struct Report {
+pub(super) struct Report {
     checked: usize,
     failures: Vec<String>,
 }
@@ -67,11 +67,23 @@ impl Report {
     /// Checks one call with invalid input: in a debug build it must panic with the
     /// contract-violation message, in a release build it must return a value `is_nothing`
     /// accepts.
-    fn expect_nothing<T: Debug>(
+    pub(super) fn expect_nothing<T: Debug>(
         &mut self,
         label: &str,
         f: impl FnOnce() -> T,
         is_nothing: impl Fn(&T) -> bool,
+    ) {
+        self.expect_nothing_saying(label, f, is_nothing, &[]);
+    }
+
+    /// [`Report::expect_nothing`], and in a debug build the panic message must contain each of
+    /// `needles` (the argument's name and value).
+    pub(super) fn expect_nothing_saying<T: Debug>(
+        &mut self,
+        label: &str,
+        f: impl FnOnce() -> T,
+        is_nothing: impl Fn(&T) -> bool,
+        needles: &[&str],
     ) {
         self.checked += 1;
         if cfg!(debug_assertions) {
@@ -83,7 +95,7 @@ impl Report {
                         .cloned()
                         .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
                         .unwrap_or_default();
-                    if !text.starts_with(MESSAGE) {
+                    if !text.starts_with(MESSAGE) || !needles.iter().all(|n| text.contains(n)) {
                         self.failures.push(format!("{label}: panicked with an unexpected message: {text}"));
                     }
                 }
@@ -98,7 +110,12 @@ impl Report {
 
     /// Checks one call with valid input: it must not panic (in either mode) and its result must
     /// satisfy `ok`.
-    fn expect_valid<T: Debug>(&mut self, label: &str, f: impl FnOnce() -> T, ok: impl Fn(&T) -> bool) {
+    pub(super) fn expect_valid<T: Debug>(
+        &mut self,
+        label: &str,
+        f: impl FnOnce() -> T,
+        ok: impl Fn(&T) -> bool,
+    ) {
         self.checked += 1;
         match catch_unwind(AssertUnwindSafe(f)) {
             Ok(v) if ok(&v) => {}
@@ -107,7 +124,7 @@ impl Report {
         }
     }
 
-    fn finish(self, name: &str, at_least: usize) {
+    pub(super) fn finish(self, name: &str, at_least: usize) {
         println!("{name}: {} calls checked", self.checked);
         assert!(self.checked >= at_least, "{name}: only {} calls checked", self.checked);
         assert!(

@@ -2,10 +2,10 @@
 # Runs the Heitz 2016 supplement's listing timing (../shared/bench/heitz2016-listing/run.sh,
 # g++ -O2) and the crate's `listing/` bench group (the same fixed directions) back to back, and
 # prints listing ns / crate ns per configuration (the GGX dielectric's eval with omega_o inside,
-# the listing's wo_sph=2.54 line, as `eval_inside`) and their geometric mean. Both sides measure wall time (the listing's
-# driver uses steady_clock; set MICROSURFACE_BENCH_CLOCK=cpu to give criterion the thread's CPU
-# time instead, which flatters the crate on a loaded machine); MEASUREMENT_TIME (seconds,
-# default 2) sets criterion's measurement time.
+# the listing's wo_sph=2.54 line, as `eval_inside`) and their geometric mean. Both sides measure
+# wall time (the listing's driver uses steady_clock; set MICROSURFACE_BENCH_CLOCK=cpu to give
+# criterion the thread's CPU time instead, which flatters the crate on a loaded machine);
+# MEASUREMENT_TIME (seconds, default 2) sets criterion's measurement time.
 # Usage: benches/compare-listing.sh [path/to/heitz2016-listing]
 set -e
 cd "$(dirname "$0")/.."

@@ -134,7 +134,7 @@ fn spherical(theta: f64, phi: f64) -> Vec3 {
 /// ωo of the listing's timing: θ = 0.8, φ = 3.5 (a reflection).
 const LISTING_WO: (f64, f64) = (0.8, 3.5);
 /// ωo of the listing's dielectric transmission timing: θ = π − 0.6, φ = 3.5 (seen from inside).
-const LISTING_WO_INSIDE: (f64, f64) = (2.541_592_653_589_793_1, 3.5);
+const LISTING_WO_INSIDE: (f64, f64) = (2.541_592_653_589_793, 3.5);
 
 /// The configuration of `../shared/bench/heitz2016-listing` exactly: uniform heights, α = 0.5,
 /// ωi at θ = 0.5 (φ = 0), ωo at `wo` (θ, φ), both fixed; one call per iteration. `sample`

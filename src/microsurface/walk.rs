@@ -263,11 +263,15 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         let (mut wr, mut side, mut at) = (wr, side, first);
         let mut bounce = 1;
         loop {
-            let Some(s) = estimator.vertex(self, bounce, &at, wr, side, rng) else {
+            let Some((s, other_side)) = estimator.vertex(self, bounce, &at, wr, side, rng) else {
                 return estimator.end();
             };
             let next_side = Self::side_after(s.side);
-            let depth = if next_side != side { at.depth.crossed(self, rng) } else { at.depth };
+            let depth = if next_side != side {
+                other_side.unwrap_or_else(|| D::other_side(&at, self, rng))
+            } else {
+                at.depth
+            };
             wr = s.wo;
             side = next_side;
             if !estimator.carry(s.weight) {
@@ -293,7 +297,9 @@ trait Estimator<D: Heights> {
     type Output;
 
     /// The phase-function work at bounce `bounce`, the vertex `at` reached by the ray `wr` on
-    /// `side`: the sample of the next direction, or `None` to end the walk there.
+    /// `side`: the sample of the next direction and, where the estimator formed it, the
+    /// vertex's point seen from the other side of the interface ([`Heights::other_side`],
+    /// which a crossing reuses); or `None` to end the walk there.
     fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         &mut self,
         surface: &Microsurface<H, S, M>,
@@ -302,7 +308,7 @@ trait Estimator<D: Heights> {
         wr: Vec3,
         side: Side,
         rng: &mut impl Rng,
-    ) -> Option<PhaseSample>;
+    ) -> Option<(PhaseSample, Option<D>)>;
 
     /// Multiplies the path's weight by a phase sample's; false once it is zero (absorbed).
     fn carry(&mut self, weight: Vec3) -> bool;
@@ -343,7 +349,9 @@ impl<D: Heights> Estimator<D> for Evaluation<D> {
     type Output = Vec3;
 
     /// The next-event term (where `order` counts the bounce) and the next direction in one
-    /// material call; at the last bounce the term alone.
+    /// material call; at the last bounce the term alone. Where ωo lies across the interface
+    /// (a dielectric), the masking takes the vertex's point seen from ωo's side, which is
+    /// returned for a crossing of the sampled direction: one ln(1 − C¹) per vertex.
     #[inline(always)]
     fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         &mut self,
@@ -353,29 +361,33 @@ impl<D: Heights> Estimator<D> for Evaluation<D> {
         wr: Vec3,
         side: Side,
         rng: &mut impl Rng,
-    ) -> Option<PhaseSample> {
+    ) -> Option<(PhaseSample, Option<D>)> {
         let (slope, material) = (surface.geometry.slope(), &surface.material);
         let it = Interaction::new(-wr, self.wo, side, self.wo_side).with_incident_area(at.incident_area);
         let includes = self.order.includes(bounce);
+        let same_side = side == self.wo_side;
         if bounce == self.last {
             if includes {
                 let phase = material.eval_phase_unchecked(slope, &it, rng);
                 if phase != Vec3::ZERO {
-                    let masking = D::masking(surface, at, bounce, side == self.wo_side, self.masking_wo);
+                    let seen = if same_side { at.depth } else { D::other_side(at, surface, rng) };
+                    let masking = D::masking(surface, at, bounce, seen, same_side, self.masking_wo);
                     self.sum += self.throughput * phase * masking;
                 }
             }
             return None;
         }
         if !includes {
-            return Some(material.sample_phase_walk_unchecked(slope, -wr, side, rng));
+            return Some((material.sample_phase_walk_unchecked(slope, -wr, side, rng), None));
         }
         let (phase, s) = material.eval_and_sample_phase_unchecked(slope, &it, rng);
+        let other_side = (!same_side).then(|| D::other_side(at, surface, rng));
         if phase != Vec3::ZERO {
-            let masking = D::masking(surface, at, bounce, side == self.wo_side, self.masking_wo);
+            let seen = other_side.unwrap_or(at.depth);
+            let masking = D::masking(surface, at, bounce, seen, same_side, self.masking_wo);
             self.sum += self.throughput * phase * masking;
         }
-        Some(s)
+        Some((s, other_side))
     }
 
     #[inline(always)]
@@ -419,8 +431,8 @@ impl<D: Heights> Estimator<D> for Sampling {
         wr: Vec3,
         side: Side,
         rng: &mut impl Rng,
-    ) -> Option<PhaseSample> {
-        Some(surface.material.sample_phase_walk_unchecked(surface.geometry.slope(), -wr, side, rng))
+    ) -> Option<(PhaseSample, Option<D>)> {
+        Some((surface.material.sample_phase_walk_unchecked(surface.geometry.slope(), -wr, side, rng), None))
     }
 
     #[inline(always)]
@@ -463,20 +475,22 @@ trait Heights: Copy {
         rng: &mut impl Rng,
     ) -> Option<Vertex<Self>>;
 
-    /// The same point seen from the other side of a dielectric interface.
-    fn crossed<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
-        self,
+    /// The point of the vertex `at` seen from the other side of a dielectric interface.
+    fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        at: &Vertex<Self>,
         surface: &Microsurface<H, S, M>,
         rng: &mut impl Rng,
     ) -> Self;
 
-    /// The masking of ωo at the vertex `at` of bounce `bounce`: the probability that a ray from
-    /// there escapes along ωo (through the interface where ωo lies on the other side:
-    /// `same_side` false), or its conditional expectation where that is known in closed form.
+    /// The masking of ωo at the vertex `at` of bounce `bounce`, whose point seen from ωo's
+    /// side is `seen` (`at.depth`, or [`Heights::other_side`] where ωo lies across the
+    /// interface: `same_side` false): the probability that a ray from there escapes along ωo,
+    /// or its conditional expectation where that is known in closed form.
     fn masking<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         surface: &Microsurface<H, S, M>,
         at: &Vertex<Self>,
         bounce: u32,
+        seen: Self,
         same_side: bool,
         wo: Self::Wo,
     ) -> f32;
@@ -528,12 +542,12 @@ impl Heights for Depth {
 
     /// ln(1 − C¹) ([`flip_ln_c1`]), the depth drawn first if it was not.
     #[inline(always)]
-    fn crossed<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
-        self,
+    fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        at: &Vertex<Self>,
         _surface: &Microsurface<H, S, M>,
         rng: &mut impl Rng,
     ) -> Self {
-        Depth::at(flip_ln_c1(Microsurface::<H, S, M>::drawn(self, rng)))
+        Depth::at(flip_ln_c1(Microsurface::<H, S, M>::drawn(at.depth, rng)))
     }
 
     /// [`masking`], in closed form at an undrawn depth, and at a dielectric's first hit on
@@ -543,6 +557,7 @@ impl Heights for Depth {
         _surface: &Microsurface<H, S, M>,
         at: &Vertex<Self>,
         bounce: u32,
+        seen: Self,
         same_side: bool,
         lambda_o: f32,
     ) -> f32 {
@@ -551,7 +566,7 @@ impl Heights for Depth {
             None if !Microsurface::<H, S, M>::LAZY => (bounce == 1 && same_side).then_some(-at.lambda),
             None => None,
         };
-        masking(closed, at.depth, lambda_o, same_side)
+        masking(closed, seen, lambda_o)
     }
 }
 
@@ -573,24 +588,25 @@ impl Heights for ScaledDepth {
 
     /// Never called: the walks from below are those of opaque materials, which no ray crosses.
     #[inline(always)]
-    fn crossed<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
-        self,
+    fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        at: &Vertex<Self>,
         _surface: &Microsurface<H, S, M>,
         _rng: &mut impl Rng,
     ) -> Self {
-        self
+        at.depth
     }
 
     /// C¹^Λ(ωo) ([`ScaledDepth::escape_probability`]), rounded to f32.
     #[inline(always)]
     fn masking<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         _surface: &Microsurface<H, S, M>,
-        at: &Vertex<Self>,
+        _at: &Vertex<Self>,
         _bounce: u32,
+        seen: Self,
         _same_side: bool,
         ln_lambda_o: f64,
     ) -> f32 {
-        at.depth.escape_probability(ln_lambda_o) as f32
+        seen.escape_probability(ln_lambda_o) as f32
     }
 }
 
@@ -651,10 +667,10 @@ impl Depth {
     }
 }
 
-/// The masking factor of the next-event estimate at a hit at `depth` (in the frame of the
-/// walk's side), for ωo with Λ(ωo) = `lambda_o` seen from its own side: C¹^Λ(ωo), the
-/// probability that a ray from there escapes along ωo (supplement §3.1; through the other
-/// side, ln(1 − C¹), for a dielectric's ωo across the interface).
+/// The masking factor of the next-event estimate at a hit at `depth`, seen from ωo's side
+/// (ln(1 − C¹) for a dielectric's ωo across the interface), for ωo with Λ(ωo) = `lambda_o`
+/// seen from its own side: C¹^Λ(ωo), the probability that a ray from there escapes along ωo
+/// (supplement §3.1).
 ///
 /// Where `closed` holds a rate a, the conditional expectation a/(a + Λ(ωo)) instead: at an
 /// undrawn depth (see [`Depth`]) and at the first hit of a ray from above on ωo's side (a =
@@ -663,17 +679,14 @@ impl Depth {
 /// depend on the height, so the estimate stays unbiased (Rao–Blackwell) and its variance drops.
 /// In f64 (no overflow where Λ saturates at grazing angles), rounded once.
 #[inline(always)]
-fn masking(closed: Option<f32>, depth: Depth, lambda_o: f32, same_side: bool) -> f32 {
-    match (closed, depth) {
-        (Some(rate), _) => {
+fn masking(closed: Option<f32>, depth: Depth, lambda_o: f32) -> f32 {
+    match closed {
+        Some(rate) => {
             let rate = f64::from(rate);
             (rate / (rate + f64::from(lambda_o))) as f32
         }
-        (None, depth) => {
-            // `closed` holds the rate of every undrawn depth, so this is ln C¹ ≤ 0
-            let ln_c1 = depth.0.min(0.0);
-            exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) })
-        }
+        // `closed` holds the rate of every undrawn depth, so this is ln C¹ ≤ 0
+        None => exp_f32(lambda_o * depth.0.min(0.0)),
     }
 }
 

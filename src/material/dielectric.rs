@@ -361,10 +361,14 @@ impl Material for Dielectric {
         self.sample_at_facet(slope, wi, side, u1, u2, rng)
     }
 
-    /// The walk's next direction and its next-event phase function in one call (no uniform
-    /// for the latter): the sample as [`Material::sample_phase_walk_unchecked`] draws it, then
-    /// the phase function at `it`, the two calls of the default in that order and with the
-    /// same results; one call instead of two saves the walk's spills around the second.
+    /// The walk's next-event phase function and next direction in one call, with the results
+    /// of the default's two calls (the phase function draws no uniform): the visible normal's
+    /// uniforms are drawn first, as [`Material::sample_phase_walk_unchecked`] draws them, then
+    /// the phase function at `it` is formed, then the sample. The phase function's long f64
+    /// chain (Fresnel, density) so starts ahead of the sampler's instead of after its call
+    /// returns: measured −5 % (GGX, ωo above) and −10 % (ωo inside) per walk `eval`; the
+    /// conductor, whose next-event density is short, keeps the two calls (its phase function
+    /// first measured +19 %).
     #[inline(never)]
     fn eval_and_sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,

@@ -18,6 +18,16 @@ pub enum Error {
         /// The range the parameter must lie in, in words (`"finite and > 0"`).
         expected: &'static str,
     },
+    /// A slice of a batch call is not as long as the batch's first slice (the batch API,
+    /// [`BatchBsdf`](crate::BatchBsdf)): nothing was computed.
+    LengthMismatch {
+        /// Name of the slice (`"wi.x"`, `"pdf"`…).
+        name: &'static str,
+        /// The batch's length (that of its first direction slice).
+        expected: usize,
+        /// The slice's length.
+        found: usize,
+    },
 }
 
 impl Error {
@@ -54,6 +64,9 @@ impl fmt::Display for Error {
         match self {
             Error::InvalidParameter { name, value, expected } => {
                 write!(f, "invalid parameter `{name}` = {value}: expected {expected}")
+            }
+            Error::LengthMismatch { name, expected, found } => {
+                write!(f, "batch slice `{name}` has {found} elements: expected {expected}")
             }
         }
     }

@@ -105,7 +105,9 @@
 //! without a neutral value (Λ, G1, projected areas, Fresnel terms, heights). Grazing, exactly
 //! horizontal and below-horizon unit directions are valid input.
 
-#![forbid(unsafe_code)]
+// No unsafe code, except the runtime dispatch of the batch loops to their AVX2 build
+// (`lanes::dispatch`: a call of a `#[target_feature]` function after the CPU check).
+#![deny(unsafe_code)]
 #![deny(missing_docs)]
 // One allowance for the fitted coefficient tables of src/special (the erfcx pieces, the
 // Gaussian-quantile fits, the azimuth polynomials) and their reference values: they are written
@@ -121,6 +123,7 @@ mod bsdf;
 mod constants;
 mod error;
 mod height;
+mod lanes;
 mod material;
 mod microsurface;
 #[cfg(feature = "leadr")]
@@ -146,8 +149,9 @@ pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, MAX_WALK_ALPHA,
-    MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Technique, Transport,
+    BatchBsdf, Bsdf, BsdfFlags, BsdfSample, BsdfValue, Channels, ClassicBrdf, ClassicMasking, ClassicNdf,
+    Directions, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, SampleOutputs, ShadingFrame,
+    Technique, Transport,
 };
 pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
 pub use contract::DIRECTION_TOLERANCE;

@@ -3,7 +3,7 @@
 //! that returns the sample with its density.
 
 use crate::contract::is_direction;
-use crate::material::{Material, Side};
+use crate::material::{Material, Side, g2_over_g1_of};
 use crate::path::{Incident, PathModel, Shadowing, VertexRole};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
@@ -12,7 +12,7 @@ use rand::Rng;
 
 /// An f32 value of ωi·(ωi + ωo) above this is positive in exact arithmetic (its rounding error
 /// is below 3 ulps of 2, 4e-7).
-const VISIBLE_SUM_MARGIN: f32 = 1e-6;
+pub(crate) const VISIBLE_SUM_MARGIN: f32 = 1e-6;
 
 /// An outgoing direction sampled from the single-scattering BSDF, with its weight and density.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -274,8 +274,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         // G2/G1 = (1 + Λi)/(1 + Λi + Λo) with 1 + Λ = A/cos θ: Ai zo/(Ai zo + zi (Ao − zo))
         let (zi, zo) = (wi.z, s.wo.z);
         let (area_i, area_o) = (slope.projected_area_unchecked(wi), slope.projected_area_unchecked(s.wo));
-        let front = area_i * zo;
-        let last = front / (front + zi * (area_o - zo));
+        let last = g2_over_g1_of(area_i, area_o, zi, zo);
         let pdf = Self::mirror_density(slope, wi, s.wo);
         (last > 0.0 && pdf > 0.0).then(|| SingleSample { wo: s.wo, weight: s.weight * last, pdf })
     }

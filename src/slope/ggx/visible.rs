@@ -3,10 +3,13 @@
 //! exact on the whole sphere of incident directions.
 
 use super::Ggx;
-use crate::rng::cut_tails;
+use crate::lanes::{Lanes, V3};
+use crate::rng::{TAIL_CUT, cut_tails};
 use crate::slope::MicrosurfaceSlope;
-use crate::special::sin_cos_turns;
-use crate::vector::{DIRECT_SCALE_RANGE, ensure_visible, normalize_fast, normalize_scaled};
+use crate::special::{sin_cos_turns, sin_cos_turns_of};
+use crate::vector::{
+    DIRECT_SCALE_RANGE, VISIBLE_DOT_MARGIN, ensure_visible, normalize_fast, normalize_scaled,
+};
 use glam::Vec3;
 
 /// A GGX visible normal for a unit ωi, exact for every ωi: stretch ωi to α = 1, sample the
@@ -18,15 +21,50 @@ use glam::Vec3;
 #[inline(always)]
 pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
     let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
-    let stretched = Vec3::new(alpha_x * wi.x, alpha_y * wi.y, wi.z);
+    let stretched = stretch_of(alpha_x, alpha_y, V3::of(wi)).vec3();
     let len_sq = stretched.length_squared();
-    let (v, len) = if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {
+    let (v, len) = if in_direct_range(len_sq) {
         (stretched, len_sq.sqrt())
     } else {
         (normalize_scaled(stretched, Vec3::Z), 1.0)
     };
     let h = sample_visible_hemisphere(v, len, u1, u2);
-    ensure_visible(wi, normalize_fast(Vec3::new(alpha_x * h.x, alpha_y * h.y, h.z), Vec3::Z))
+    ensure_visible(wi, normalize_fast(stretch_of(alpha_x, alpha_y, V3::of(h)).vec3(), Vec3::Z))
+}
+
+/// (αx x, αy y, z): the stretch of ωi to the α = 1 configuration, and the unstretch of a
+/// sampled (unnormalized) normal back to (αx, αy).
+#[inline(always)]
+pub(crate) fn stretch_of<L: Lanes>(alpha_x: L, alpha_y: L, w: V3<L>) -> V3<L> {
+    V3::new(alpha_x * w.x, alpha_y * w.y, w.z)
+}
+
+/// Whether a squared length is normalized directly (`DIRECT_SCALE_RANGE`).
+#[inline(always)]
+pub(crate) fn in_direct_range<L: Lanes>(len_sq: L) -> L::Mask {
+    len_sq.gt(L::lit(DIRECT_SCALE_RANGE.0)) & len_sq.lt(L::lit(DIRECT_SCALE_RANGE.1))
+}
+
+/// The GGX visible normal of [`sample_spherical_cap`] for every lane type, on its common path:
+/// the stretched ωi normalized directly, the cap point away from −v̂, the unstretched normal
+/// normalized directly and clearly visible. Returns the normal and the mask of the lanes where
+/// that path is [`sample_spherical_cap`]'s, bit for bit; the others need the scalar sampler.
+#[inline(always)]
+pub(crate) fn sample_spherical_cap_of<L: Lanes>(
+    alpha_x: L,
+    alpha_y: L,
+    wi: V3<L>,
+    u1: L,
+    u2: L,
+) -> (V3<L>, L::Mask) {
+    let stretched = stretch_of(alpha_x, alpha_y, wi);
+    let len_sq = stretched.length_squared();
+    let (h, away) = cap_direct(stretched, len_sq.sqrt(), u1, u2);
+    let m = stretch_of(alpha_x, alpha_y, h);
+    let m_len_sq = m.length_squared();
+    let m = m.scale(L::lit(1.0) / m_len_sq.sqrt());
+    let visible = wi.dot(m).gt(L::lit(VISIBLE_DOT_MARGIN));
+    (m, in_direct_range(len_sq) & away & in_direct_range(m_len_sq) & visible)
 }
 
 /// Samples the normals of the unit upper hemisphere visible from the direction `v` of length
@@ -51,23 +89,35 @@ pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
-    let u1 = cut_tails(u1);
+    debug_assert!((0.0..=1.0).contains(&u2), "u2 = {u2} outside [0, 1]");
+    let (h, away) = cap_direct(V3::of(v), len, u1, u2);
+    if away {
+        return h.vec3();
+    }
+    cap_near_opposite(v, cut_tails(u1), u2).unwrap_or(h.vec3())
+}
+
+/// The cap point h of [`sample_visible_hemisphere`] in its direct form, for every lane type,
+/// with the mask of the lanes where it is away from −v̂ (|h| ≥ len/64: kept; the others are
+/// recomputed by [`cap_near_opposite`]).
+#[inline(always)]
+pub(crate) fn cap_direct<L: Lanes>(v: V3<L>, len: L, u1: L, u2: L) -> (V3<L>, L::Mask) {
+    let u1 = u1.clamp(L::lit(TAIL_CUT), L::lit(1.0 - TAIL_CUT));
     // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
     // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
     // len + v.z written as (v.x² + v.y²)/(len − v.z) below the horizon: for a backfacing ωi
     // of a low-roughness surface v̂ ≈ −z and the direct sum cancels (GGX α = 1e-4 at θ = 2.3:
     // it rounded to 0 and every sample became the fallback horizontal normal)
-    let top = if v.z >= 0.0 { len + v.z } else { (v.x * v.x + v.y * v.y) / (len - v.z) };
-    let h_z = (1.0 - u1) * top;
+    let top = L::choose(v.z.ge(L::lit(0.0)), || len + v.z, || (v.x * v.x + v.y * v.y) / (len - v.z));
+    let h_z = (L::lit(1.0) - u1) * top;
     let z_scaled = h_z - v.z;
-    let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = sin_cos_turns(u2);
-    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
+    let r = (u1 * top * (len + z_scaled)).max(L::lit(0.0)).sqrt();
+    let (sin_phi, cos_phi) = sin_cos_turns_of(u2);
+    let h = V3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
     // |h| ≥ h.z: the height alone clears the test for all but the bottom of the cap
-    if h_z >= NEAR_OPPOSITE * len || h.length_squared() >= NEAR_OPPOSITE * NEAR_OPPOSITE * (len * len) {
-        return h;
-    }
-    cap_near_opposite(v, u1, u2).unwrap_or(h)
+    let near = L::lit(NEAR_OPPOSITE);
+    let away = h_z.ge(near * len) | h.length_squared().ge(near * near * (len * len));
+    (h, away)
 }
 
 /// |h| below this fraction of len is recomputed by [`cap_near_opposite`].

@@ -426,18 +426,24 @@ impl Lanes for F32x8 {
     }
     #[inline(always)]
     fn quadrant(self) -> (Self, M32x8, M32x8) {
-        let mut q = [0i32; WIDTH];
-        for i in 0..WIDTH {
-            // x + ½ ∈ [0, 5): the conversion is exact and needs no saturation
-            q[i] = (self.0[i] + 0.5) as i32;
-        }
-        let (mut f, mut b0, mut b1) = ([0.0; WIDTH], [0; WIDTH], [0; WIDTH]);
-        for i in 0..WIDTH {
-            f[i] = q[i] as f32;
-            b0[i] = -(q[i] & 1);
-            b1[i] = -((q[i] >> 1) & 1);
-        }
-        (Self(f), M32x8(b0), M32x8(b1))
+        // x + ½ ∈ [0, 5): its floor is the truncation of the scalar form, and the bits of the
+        // small integer q come from the floors of q/2 and q/4 (all exact), in float
+        // instructions that vectorize (a float-to-int conversion with Rust's saturation does
+        // not)
+        let q = (self + Self::lit(0.5)).map(f32::floor);
+        let half = q * Self::lit(0.5);
+        let odd = half.ne_floor();
+        let quarter = q * Self::lit(0.25);
+        let high = (quarter - quarter.map(f32::floor)).ge(Self::lit(0.5));
+        (q, odd, high)
+    }
+}
+
+impl F32x8 {
+    /// The lanes whose value is not an integer.
+    #[inline(always)]
+    fn ne_floor(self) -> M32x8 {
+        self.cmp(self.map(f32::floor), |a, b| a != b)
     }
 }
 

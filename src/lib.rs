@@ -135,6 +135,7 @@ mod rng;
 mod sampling;
 mod sealed;
 mod single_scattering;
+mod soa;
 mod vector;
 
 pub mod compensation;
@@ -149,9 +150,9 @@ pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    BatchBsdf, Bsdf, BsdfFlags, BsdfSample, BsdfValue, Channels, ClassicBrdf, ClassicMasking, ClassicNdf,
-    Directions, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, SampleOutputs, ShadingFrame,
-    Technique, Transport,
+    BatchBsdf, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
+    MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, SampleOutputs, ShadingFrame, Technique,
+    Transport,
 };
 pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
 pub use contract::DIRECTION_TOLERANCE;
@@ -159,6 +160,7 @@ pub use error::Error;
 pub use fresnel::ComplexIor;
 pub use material::{Conductor, Dielectric, Diffuse};
 pub use slope::{Beckmann, Elliptical, Ggx};
+pub use soa::{Channels, Directions};
 
 /// The vector library of the public API, re-exported so that users on another `glam` version
 /// can name the crate's types.
@@ -204,7 +206,8 @@ pub mod research {
     pub use crate::height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
     pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
     pub use crate::microsurface::{
-        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
+        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkOutputs,
+        WalkSample,
     };
     pub use crate::path::Shadowing;
     #[cfg(feature = "position-free")]

@@ -39,102 +39,8 @@ use crate::slope::{
     F32_DENSITY_MIN_SUM, MicrosurfaceSlope, d_of_sum, lambda_and_area_of, reflection_density_of,
     sample_spherical_cap_of,
 };
+use crate::soa::{Channels, Directions, check_len};
 use glam::{Vec2, Vec3, Vec3A};
-
-/// Directions in structure-of-arrays layout: the x, y and z coordinates of query i are
-/// `x[i]`, `y[i]` and `z[i]`.
-///
-/// # Examples
-/// ```
-/// use microsurface::Directions;
-///
-/// let (x, y, z) = ([0.0, 0.6], [0.0, 0.0], [1.0, 0.8]);
-/// let w = Directions::new(&x, &y, &z)?;
-/// assert_eq!(w.len(), 2);
-/// assert!(Directions::new(&x, &y, &z[..1]).is_err());
-/// # Ok::<(), microsurface::Error>(())
-/// ```
-#[derive(Debug, Clone, Copy)]
-pub struct Directions<'a> {
-    x: &'a [f32],
-    y: &'a [f32],
-    z: &'a [f32],
-}
-
-impl<'a> Directions<'a> {
-    /// The directions of three coordinate slices of equal length.
-    ///
-    /// # Errors
-    /// [`Error::LengthMismatch`] if `y` or `z` is not as long as `x`.
-    pub fn new(x: &'a [f32], y: &'a [f32], z: &'a [f32]) -> Result<Self, Error> {
-        check_len("y", x.len(), y.len())?;
-        check_len("z", x.len(), z.len())?;
-        Ok(Self { x, y, z })
-    }
-
-    /// The number of directions.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.x.len()
-    }
-
-    /// Whether there is none.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.x.is_empty()
-    }
-
-    /// Direction `i`.
-    #[inline(always)]
-    fn get(&self, i: usize) -> Vec3 {
-        Vec3::new(self.x[i], self.y[i], self.z[i])
-    }
-
-    /// The eight directions from `i` on, as lanes.
-    #[inline(always)]
-    fn lanes(&self, i: usize) -> V3<F32x8> {
-        V3::new(F32x8::load(&self.x[i..]), F32x8::load(&self.y[i..]), F32x8::load(&self.z[i..]))
-    }
-}
-
-/// Mutable RGB or xyz outputs in structure-of-arrays layout (three slices of equal length).
-#[derive(Debug)]
-pub struct Channels<'a> {
-    /// The first channel (red, or x).
-    pub a: &'a mut [f32],
-    /// The second channel (green, or y).
-    pub b: &'a mut [f32],
-    /// The third channel (blue, or z).
-    pub c: &'a mut [f32],
-}
-
-impl<'a> Channels<'a> {
-    /// The outputs of three slices.
-    pub fn new(a: &'a mut [f32], b: &'a mut [f32], c: &'a mut [f32]) -> Self {
-        Self { a, b, c }
-    }
-
-    /// Checks that every slice has `n` elements.
-    fn check(&self, name: &'static str, n: usize) -> Result<(), Error> {
-        check_len(name, n, self.a.len())?;
-        check_len(name, n, self.b.len())?;
-        check_len(name, n, self.c.len())
-    }
-
-    #[inline(always)]
-    fn set(&mut self, i: usize, v: Vec3) {
-        self.a[i] = v.x;
-        self.b[i] = v.y;
-        self.c[i] = v.z;
-    }
-
-    #[inline(always)]
-    fn store(&mut self, i: usize, v: [F32x8; 3]) {
-        v[0].store(&mut self.a[i..]);
-        v[1].store(&mut self.b[i..]);
-        v[2].store(&mut self.c[i..]);
-    }
-}
 
 /// The outputs of [`BatchBsdf::sample_batch`], one element per query: the sampled direction,
 /// the weight f·|cos θi|/pdf, the density and the relative index η_wi/η_wo. A query with no
@@ -178,10 +84,6 @@ impl SampleOutputs<'_> {
             }
         }
     }
-}
-
-fn check_len(name: &'static str, expected: usize, found: usize) -> Result<(), Error> {
-    if expected == found { Ok(()) } else { Err(Error::LengthMismatch { name, expected, found }) }
 }
 
 /// [`Bsdf`]'s calls over many queries at once: query i of each method is the plain call
@@ -417,7 +319,8 @@ fn front_reflection(ax: F32x8, ay: F32x8, wo: V3<F32x8>, wi: V3<F32x8>) -> (F32x
 /// The evaluation lanes of a chunk (renderer orientation), `None` in `done` where the scalar
 /// call must answer.
 #[inline(always)]
-fn evaluate(kernel: Kernel, wo: V3<F32x8>, wi: V3<F32x8>) -> Evaluated {
+fn evaluate<const WANT: u8>(kernel: Kernel, wo: V3<F32x8>, wi: V3<F32x8>) -> Evaluated {
+    let want_f = WANT & Want::EVAL != 0;
     let valid = is_direction(wo) & is_direction(wi);
     let zero = splat(0.0);
     let front = valid & wo.z.gt(zero);
@@ -428,9 +331,13 @@ fn evaluate(kernel: Kernel, wo: V3<F32x8>, wi: V3<F32x8>) -> Evaluated {
             // a light at or below the horizon of a view from above: no reflection, f = pdf = 0
             let below = front & wi.z.le(zero);
             let (density, g2_over_g1, cos, ok) = front_reflection(ax, ay, wo, wi);
-            let w = conductor_fresnel(fresnel, cos);
-            let scale = density * g2_over_g1 / wi.z;
-            let f = w.map(|w| F32x8::select(above, w * scale, zero));
+            let f = if want_f {
+                let w = conductor_fresnel(fresnel, cos);
+                let scale = density * g2_over_g1 / wi.z;
+                w.map(|w| F32x8::select(above, w * scale, zero))
+            } else {
+                [zero; 3]
+            };
             let done = (above & ok) | below;
             Evaluated { f, pdf: F32x8::select(above, density, zero), done_f: done, done_pdf: done }
         }
@@ -537,34 +444,35 @@ fn sample_conductor(
 /// (`Conductor`'s `FRESNEL_AT_HALF_VECTOR_BELOW`): the scalar sampler serves those lanes.
 const FRESNEL_AT_HALF_VECTOR_BELOW: f32 = 0.05;
 
-/// What a batch loop computes per query.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Want {
-    Eval,
-    Pdf,
-    Both,
+/// What a batch loop computes per query (a const parameter of the loop, so that a density-only
+/// loop carries no Fresnel term).
+struct Want;
+
+impl Want {
+    const EVAL: u8 = 1;
+    const PDF: u8 = 2;
+    const BOTH: u8 = 3;
 }
 
 /// The evaluation loop over chunks of eight queries.
-struct EvalLoop<'s, 'a, 'b, B> {
+struct EvalLoop<'s, 'a, 'b, B, const WANT: u8> {
     bsdf: &'s B,
     kernel: Kernel,
-    want: Want,
     wo: &'s Directions<'a>,
     wi: &'s Directions<'a>,
     f: Option<&'s mut Channels<'b>>,
     pdf: Option<&'s mut [f32]>,
 }
 
-impl<B: Bsdf> EvalLoop<'_, '_, '_, B> {
+impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
     /// The scalar call for query `i`.
     #[inline(never)]
     fn scalar(&mut self, i: usize) {
         let (wo, wi) = (self.wo.get(i), self.wi.get(i));
-        match self.want {
-            Want::Eval => self.f.as_mut().map_or((), |f| f.set(i, self.bsdf.eval(wo, wi).f)),
-            Want::Pdf => self.pdf.as_mut().map_or((), |p| p[i] = self.bsdf.pdf(wo, wi)),
-            Want::Both => {
+        match WANT {
+            Want::EVAL => self.f.as_mut().map_or((), |f| f.set(i, self.bsdf.eval(wo, wi).f)),
+            Want::PDF => self.pdf.as_mut().map_or((), |p| p[i] = self.bsdf.pdf(wo, wi)),
+            _ => {
                 let (v, p) = self.bsdf.eval_with_pdf(wo, wi);
                 if let Some(f) = self.f.as_mut() {
                     f.set(i, v.f);
@@ -583,7 +491,7 @@ fn finite_or_zero(x: F32x8) -> F32x8 {
     F32x8::select(x.abs().lt(splat(f32::INFINITY)), x, splat(0.0))
 }
 
-impl<B: Bsdf> LaneLoop for EvalLoop<'_, '_, '_, B> {
+impl<B: Bsdf, const WANT: u8> LaneLoop for EvalLoop<'_, '_, '_, B, WANT> {
     #[inline(always)]
     fn run(&mut self) {
         let n = self.wo.len();
@@ -591,17 +499,17 @@ impl<B: Bsdf> LaneLoop for EvalLoop<'_, '_, '_, B> {
         let mut i = 0;
         while i < chunks {
             let (wo, wi) = (self.wo.lanes(i), self.wi.lanes(i));
-            let e = evaluate(self.kernel, wo, wi);
+            let e = evaluate::<WANT>(self.kernel, wo, wi);
             if let Some(f) = self.f.as_mut() {
                 f.store(i, e.f.map(finite_or_zero));
             }
             if let Some(pdf) = self.pdf.as_mut() {
                 finite_or_zero(e.pdf).store(&mut pdf[i..]);
             }
-            let done = match self.want {
-                Want::Eval => e.done_f,
-                Want::Pdf => e.done_pdf,
-                Want::Both => e.done_f & e.done_pdf,
+            let done = match WANT {
+                Want::EVAL => e.done_f,
+                Want::PDF => e.done_pdf,
+                _ => e.done_f & e.done_pdf,
             };
             let mut rest = !done.bits() & 0xff;
             while rest != 0 {
@@ -669,16 +577,15 @@ impl<B: Bsdf> LaneLoop for SampleLoop<'_, '_, '_, B> {
 
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     /// The evaluation loop of a batch call in lanes, or `None` for the scalar one.
-    fn eval_loop<'s, 'a, 'b>(
+    fn eval_loop<'s, 'a, 'b, const WANT: u8>(
         &'s self,
-        want: Want,
         wo: &'s Directions<'a>,
         wi: &'s Directions<'a>,
         f: Option<&'s mut Channels<'b>>,
         pdf: Option<&'s mut [f32]>,
     ) -> bool {
         let Some(kernel) = self.kernel() else { return false };
-        dispatch(&mut EvalLoop { bsdf: self, kernel, want, wo, wi, f, pdf });
+        dispatch(&mut EvalLoop::<Self, WANT> { bsdf: self, kernel, wo, wi, f, pdf });
         true
     }
 }
@@ -703,7 +610,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         let n = wo.len();
         check_len("wi", n, wi.len())?;
         f.check("f", n)?;
-        if !self.eval_loop(Want::Eval, wo, wi, Some(f), None) {
+        if !self.eval_loop::<{ Want::EVAL }>(wo, wi, Some(f), None) {
             for i in 0..n {
                 f.set(i, self.eval(wo.get(i), wi.get(i)).f);
             }
@@ -715,7 +622,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         let n = wo.len();
         check_len("wi", n, wi.len())?;
         check_len("pdf", n, pdf.len())?;
-        if !self.eval_loop(Want::Pdf, wo, wi, None, Some(pdf)) {
+        if !self.eval_loop::<{ Want::PDF }>(wo, wi, None, Some(pdf)) {
             for i in 0..n {
                 pdf[i] = self.pdf(wo.get(i), wi.get(i));
             }
@@ -734,7 +641,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         check_len("wi", n, wi.len())?;
         f.check("f", n)?;
         check_len("pdf", n, pdf.len())?;
-        if !self.eval_loop(Want::Both, wo, wi, Some(f), Some(pdf)) {
+        if !self.eval_loop::<{ Want::BOTH }>(wo, wi, Some(f), Some(pdf)) {
             for i in 0..n {
                 let (v, p) = self.eval_with_pdf(wo.get(i), wi.get(i));
                 f.set(i, v.f);

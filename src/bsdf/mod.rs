@@ -24,7 +24,7 @@ mod microfacet;
 mod seed;
 mod specular;
 
-pub use batch::{BatchBsdf, Channels, Directions, SampleOutputs};
+pub use batch::{BatchBsdf, SampleOutputs};
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};

@@ -3,9 +3,11 @@
 
 mod geometry;
 mod walk;
+mod walk_lanes;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
 pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
+pub use walk_lanes::WalkOutputs;
 
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;

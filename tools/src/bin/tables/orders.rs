@@ -10,11 +10,10 @@
 
 use super::quadrature::Family;
 use super::{N, alpha_of_node, mu_of, par_map};
-use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::research::{Microsurface, UniformHeight, WalkOutputs};
 use microsurface::slope::MicrosurfaceSlope;
-use microsurface::{Beckmann, Conductor, Ggx};
+use microsurface::{Beckmann, Channels, Conductor, Directions, Ggx};
 use std::fmt::Write as _;
 
 /// Walks per cell: 2¹⁶, so that every cell's standard error is at most 0.5/256 < 2e-3.
@@ -52,7 +51,9 @@ fn generator(seed: u64, family: Family, cell: usize) -> Pcg {
 }
 
 /// Counts of walks leaving after k = 2 … K bounces and after more, for `walks` walks with the
-/// incident cosine drawn by `mu` (fixed, or cosine-weighted).
+/// incident cosine drawn by `mu` (fixed, or cosine-weighted), walked in lanes
+/// ([`Microsurface::sample_batch`]: GGX in eight f32 lanes, Beckmann by the scalar walk) from a
+/// seed drawn after the cosines.
 fn count<S: MicrosurfaceSlope>(
     slope: S,
     walks: usize,
@@ -60,19 +61,27 @@ fn count<S: MicrosurfaceSlope>(
     mut mu: impl FnMut(&mut Pcg) -> f32,
 ) -> [u64; TABLES] {
     let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
+    // a grazing ray sees only the top of the surface: single scattering takes it all
+    let cosines: Vec<f32> = (0..walks).map(|_| mu(rng)).filter(|&m| m > 0.0).collect();
+    let x: Vec<f32> = cosines.iter().map(|&m| (1.0 - m * m).max(0.0).sqrt()).collect();
+    let y = vec![0.0f32; cosines.len()];
+    let seed = microsurface::rand::Rng::next_u64(rng);
+    let n = cosines.len();
+    let (mut wx, mut wy, mut wz) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
+    let (mut r, mut g, mut b) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
+    let mut bounces = vec![0u32; n];
+    let mut out = WalkOutputs {
+        wo: Channels::new(&mut wx, &mut wy, &mut wz),
+        weight: Channels::new(&mut r, &mut g, &mut b),
+        bounces: &mut bounces,
+    };
+    let wi = Directions::new(&x, &y, &cosines).expect("equal lengths");
+    surface.sample_batch(&wi, seed, &mut out).expect("equal lengths");
     let mut counts = [0u64; TABLES];
-    for _ in 0..walks {
-        let m = mu(rng);
-        if m <= 0.0 {
-            // a grazing ray sees only the top of the surface: single scattering takes it all
-            continue;
-        }
-        let wi = Vec3::new((1.0 - m * m).max(0.0).sqrt(), 0.0, m);
-        if let Some(s) = surface.sample(wi, rng) {
-            let k = s.bounces as usize;
-            if k >= 2 {
-                counts[(k - 2).min(TABLES - 1)] += 1;
-            }
+    for &k in &bounces {
+        let k = k as usize;
+        if k >= 2 {
+            counts[(k - 2).min(TABLES - 1)] += 1;
         }
     }
     counts

@@ -54,6 +54,13 @@ impl<'a> Directions<'a> {
         Vec3::new(self.x[i], self.y[i], self.z[i])
     }
 
+    /// The three coordinate slices.
+    #[inline(always)]
+    pub(crate) fn slices(&self) -> (&'a [f32], &'a [f32], &'a [f32]) {
+        let n = self.x.len();
+        (self.x, &self.y[..n], &self.z[..n])
+    }
+
     /// The eight directions from `i` on, as lanes.
     #[inline(always)]
     pub(crate) fn lanes(&self, i: usize) -> V3<F32x8> {
@@ -76,6 +83,13 @@ impl<'a> Channels<'a> {
     /// The outputs of three slices.
     pub fn new(a: &'a mut [f32], b: &'a mut [f32], c: &'a mut [f32]) -> Self {
         Self { a, b, c }
+    }
+
+    /// The three slices, of equal length.
+    #[inline(always)]
+    pub(crate) fn slices(&mut self) -> (&mut [f32], &mut [f32], &mut [f32]) {
+        let n = self.a.len();
+        (&mut *self.a, &mut self.b[..n], &mut self.c[..n])
     }
 
     /// Checks that every slice has `n` elements.

@@ -32,7 +32,7 @@
 use super::{Bsdf, MicrofacetBsdf, SpecularLimit, Technique};
 use crate::error::Error;
 use crate::fresnel::{fresnel_dielectric_cosines_of, reflectance_of};
-use crate::lanes::{F32x8, LaneLoop, Lanes, M32x8, V3, WIDTH, dispatch};
+use crate::lanes::{LaneLoop, Lanes, V3, dispatch};
 use crate::material::{LaneMaterial, Material, g2_over_g1_of};
 use crate::single_scattering::VISIBLE_SUM_MARGIN;
 use crate::slope::{
@@ -242,45 +242,28 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 /// so the f32 refraction half vector keeps 2⁻²⁴/0.05 of relative precision.
 const DIELECTRIC_LANES_MIN_CONTRAST: f32 = 0.05;
 
-/// The mask of unit directions (`contract::is_direction` in each lane).
+/// Whether a direction is unit (`contract::is_direction`, every lane type).
 #[inline(always)]
-fn is_direction(w: V3<F32x8>) -> M32x8 {
-    (w.length_squared() - F32x8::lit(1.0)).abs().le(F32x8::lit(crate::contract::DIRECTION_TOLERANCE))
-}
-
-/// The per-lane results of an evaluation: f per channel and the density, with the mask of the
-/// lanes they hold (the others take the scalar call).
-struct Evaluated {
-    f: [F32x8; 3],
-    pdf: F32x8,
-    /// The lanes whose f is held.
-    done_f: M32x8,
-    /// The lanes whose density is held.
-    done_pdf: M32x8,
+fn is_direction<L: Lanes>(w: V3<L>) -> L::Mask {
+    (w.length_squared() - L::lit(1.0)).abs().le(L::lit(crate::contract::DIRECTION_TOLERANCE))
 }
 
 /// A density is one the lanes return where it is a normal f32 (the scalar form's test).
 #[inline(always)]
-fn normal(x: F32x8) -> M32x8 {
-    x.ge(F32x8::lit(f32::MIN_POSITIVE)) & x.lt(F32x8::lit(f32::INFINITY))
+fn normal<L: Lanes>(x: L) -> L::Mask {
+    x.ge(L::lit(f32::MIN_POSITIVE)) & x.lt(L::lit(f32::INFINITY))
 }
 
-/// f32 lanes of a scalar.
+/// The conductor's Fresnel term per channel at cos θ (`conductor_reflectance`).
 #[inline(always)]
-fn splat(x: f32) -> F32x8 {
-    F32x8::lit(x)
-}
-
-/// The conductor's Fresnel term per channel at cos θ ∈ (0, 1] (`conductor_reflectance`).
-#[inline(always)]
-fn conductor_fresnel(fresnel: Option<(Vec3A, Vec3A)>, cos: F32x8) -> [F32x8; 3] {
+fn conductor_fresnel<L: Lanes>(fresnel: Option<(Vec3A, Vec3A)>, cos: L) -> [L; 3] {
     match fresnel {
-        None => [splat(1.0); 3],
+        None => [L::lit(1.0); 3],
         Some((t0, m)) => {
-            let c = cos.abs().min(splat(1.0));
-            let grazing = c.eq(splat(0.0));
+            let c = cos.abs().min(L::lit(1.0));
+            let grazing = c.eq(L::lit(0.0));
             let channel =
-                |t: f32, k: f32| F32x8::select(grazing, splat(1.0), reflectance_of(c, splat(t), splat(k)));
+                |t: f32, k: f32| L::select(grazing, L::lit(1.0), reflectance_of(c, L::lit(t), L::lit(k)));
             [channel(t0.x, m.x), channel(t0.y, m.y), channel(t0.z, m.z)]
         }
     }
@@ -289,74 +272,32 @@ fn conductor_fresnel(fresnel: Option<(Vec3A, Vec3A)>, cos: F32x8) -> [F32x8; 3] 
 /// The dielectric's Fresnel reflectance at cos θ = `c` ∈ [0, 1] with index η
 /// (`dielectric_reflectance`, in f32).
 #[inline(always)]
-fn dielectric_fresnel(eta: F32x8, c: F32x8) -> F32x8 {
-    let c = c.abs().min(splat(1.0));
-    let eta2_cos2_t = c * c + (eta - splat(1.0)) * (eta + splat(1.0));
-    let total = eta2_cos2_t.le(splat(0.0));
-    let t = eta2_cos2_t.max(splat(0.0)).sqrt() / eta;
-    F32x8::select(total, splat(1.0), fresnel_dielectric_cosines_of(c, t, eta))
+fn dielectric_fresnel<L: Lanes>(eta: L, c: L) -> L {
+    let one = L::lit(1.0);
+    let c = c.abs().min(one);
+    let eta2_cos2_t = c * c + (eta - one) * (eta + one);
+    let total = eta2_cos2_t.le(L::lit(0.0));
+    let t = eta2_cos2_t.max(L::lit(0.0)).sqrt() / eta;
+    L::select(total, one, fresnel_dielectric_cosines_of(c, t, eta))
 }
 
 /// Single scattering of a front-facing reflection (ωo, ωi both above the horizon, renderer
 /// orientation: the walk enters along ωo): the density D(ωh)/(4 A(ωo)) from the unnormalized
 /// h = ωo + ωi, G2/G1(ωo) from the projected areas and the cosine ωo·ωh. f = w·pdf·(G2/G1)/cos θi
-/// with w the facet's weight (Fresnel). `ok`: the lanes where the density is the scalar f32
-/// form's and ωh is clearly visible.
+/// with w the facet's weight (Fresnel). `ok`: where the density is the scalar f32 form's and
+/// ωh is clearly visible.
 #[inline(always)]
-fn front_reflection(ax: F32x8, ay: F32x8, wo: V3<F32x8>, wi: V3<F32x8>) -> (F32x8, F32x8, F32x8, M32x8) {
+fn front_reflection<L: Lanes>(ax: L, ay: L, wo: V3<L>, wi: V3<L>) -> (L, L, L, L::Mask) {
     let h = wo.add(wi);
-    let visible = wo.dot(h).gt(splat(VISIBLE_SUM_MARGIN));
+    let wo_h = wo.dot(h);
+    let visible = wo_h.gt(L::lit(VISIBLE_SUM_MARGIN));
     let (_, area_o) = lambda_and_area_of(ax, ay, wo);
     let (_, area_i) = lambda_and_area_of(ax, ay, wi);
     let (density, len_sq, t) = reflection_density_of(ax, ay, h, area_o);
-    let min = splat(F32_DENSITY_MIN_SUM);
+    let min = L::lit(F32_DENSITY_MIN_SUM);
     let ok = visible & len_sq.ge(min) & t.ge(min) & normal(density);
     let g2_over_g1 = g2_over_g1_of(area_o, area_i, wo.z, wi.z);
-    let cos = wo.dot(h) / len_sq.sqrt();
-    (density, g2_over_g1, cos, ok)
-}
-
-/// The evaluation lanes of a chunk (renderer orientation), `None` in `done` where the scalar
-/// call must answer.
-#[inline(always)]
-fn evaluate<const WANT: u8>(kernel: Kernel, wo: V3<F32x8>, wi: V3<F32x8>) -> Evaluated {
-    let want_f = WANT & Want::EVAL != 0;
-    let valid = is_direction(wo) & is_direction(wi);
-    let zero = splat(0.0);
-    let front = valid & wo.z.gt(zero);
-    match kernel {
-        Kernel::Conductor { ax, ay, fresnel } => {
-            let (ax, ay) = (splat(ax), splat(ay));
-            let above = front & wi.z.gt(zero);
-            // a light at or below the horizon of a view from above: no reflection, f = pdf = 0
-            let below = front & wi.z.le(zero);
-            let (density, g2_over_g1, cos, ok) = front_reflection(ax, ay, wo, wi);
-            let f = if want_f {
-                let w = conductor_fresnel(fresnel, cos);
-                let scale = density * g2_over_g1 / wi.z;
-                w.map(|w| F32x8::select(above, w * scale, zero))
-            } else {
-                [zero; 3]
-            };
-            let done = (above & ok) | below;
-            Evaluated { f, pdf: F32x8::select(above, density, zero), done_f: done, done_pdf: done }
-        }
-        Kernel::Dielectric { ax, ay, eta } => {
-            let (ax, ay, eta_l) = (splat(ax), splat(ay), splat(eta));
-            let above = front & wi.z.gt(zero);
-            let (density, g2_over_g1, cos, ok) = front_reflection(ax, ay, wo, wi);
-            let fr = dielectric_fresnel(eta_l, cos);
-            let f_reflect = fr * density * g2_over_g1 / wi.z;
-            let pdf_reflect = fr * density;
-            // transmission from above: the density of the refraction ωo → ωi
-            let below = front & wi.z.lt(zero);
-            let (pdf_transmit, ok_t) = transmission_density(ax, ay, eta_l, wo, wi);
-            let pdf = F32x8::select(above, pdf_reflect, pdf_transmit);
-            let f = F32x8::select(above, f_reflect, zero);
-            // a transmission's f (its G2 is a beta function) is the scalar call's
-            Evaluated { f: [f; 3], pdf, done_f: above & ok, done_pdf: (above & ok) | (below & ok_t) }
-        }
-    }
+    (density, g2_over_g1, wo_h / len_sq.sqrt(), ok)
 }
 
 /// Below these cosines (relative to |ωo + η ωi|) a refraction is left to the scalar f64 form:
@@ -366,83 +307,34 @@ const REFRACTION_MARGIN: f32 = 1e-4;
 /// The density of a refraction from ωo (above) to ωi (below) through a GGX dielectric of
 /// index η (the phase function of `Dielectric`, Heitz et al. 2016, supplement §3.4):
 /// η² (1 − F) D_ωo(ωh) |ωi·ωh|/(ωo·ωh + η ωi·ωh)², with ωh ∝ −(ωo + η ωi) turned up, D from
-/// the unnormalized sum ([`d_of_sum`]). `ok`: the lanes where the half vector's validity tests
-/// (ωh.z > 0, ωo·ωh > 0 > ωi·ωh) hold with a margin; 0 where they clearly fail.
+/// the unnormalized sum ([`d_of_sum`]). `ok`: where the half vector's validity tests
+/// (ωh.z > 0, ωo·ωh > 0 > ωi·ωh) hold or fail with a margin (0 where they fail).
 #[inline(always)]
-fn transmission_density(ax: F32x8, ay: F32x8, eta: F32x8, wo: V3<F32x8>, wi: V3<F32x8>) -> (F32x8, M32x8) {
-    let zero = splat(0.0);
+fn transmission_density<L: Lanes>(ax: L, ay: L, eta: L, wo: V3<L>, wi: V3<L>) -> (L, L::Mask) {
+    let zero = L::lit(0.0);
     let sum = wo.add(wi.scale(eta));
     let up = sum.z.gt(zero);
     let h = V3::select(up, sum, V3::new(-sum.x, -sum.y, -sum.z));
     let len_sq = h.length_squared();
     let len = len_sq.sqrt();
     let (cos_ih, cos_oh) = (wo.dot(h) / len, wi.dot(h) / len);
-    let margin = splat(REFRACTION_MARGIN);
+    let margin = L::lit(REFRACTION_MARGIN);
     let valid = h.z.gt(margin * len) & cos_ih.gt(margin) & cos_oh.lt(-margin);
     let invalid = h.z.lt(-margin * len) | cos_ih.lt(-margin) | cos_oh.gt(margin);
-    let d = d_of_sum(ax, ay, h, splat(core::f32::consts::FRAC_1_PI));
+    let d = d_of_sum(ax, ay, h, L::lit(core::f32::consts::FRAC_1_PI));
     let (_, area) = lambda_and_area_of(ax, ay, wo);
-    let transmittance = splat(1.0) - fresnel_dielectric_cosines_of(cos_ih, -cos_oh, eta);
+    let transmittance = L::lit(1.0) - fresnel_dielectric_cosines_of(cos_ih, -cos_oh, eta);
     let d_wi = cos_ih * d / area;
     let pdf = eta * eta * transmittance * d_wi * (-cos_oh) / len_sq;
-    let sane = len.gt(splat(DIELECTRIC_LANES_MIN_CONTRAST)) & len_sq.ge(splat(F32_DENSITY_MIN_SUM));
-    (F32x8::select(valid, pdf, zero), sane & (valid | invalid))
+    let sane = len.gt(L::lit(DIELECTRIC_LANES_MIN_CONTRAST)) & len_sq.ge(L::lit(F32_DENSITY_MIN_SUM));
+    (L::select(valid, pdf, zero), sane & (valid | invalid))
 }
 
-/// The sample lanes of a GGX conductor seen from above (`SingleScattering::sample_mirror_front`
-/// in lanes, renderer orientation): wi, weight, pdf and the lanes they hold; a lane whose
-/// sample does not exist (it points into the surface) is held with pdf 0.
+/// f as the trait returns it: 0 where not finite.
 #[inline(always)]
-fn sample_conductor(
-    ax: f32,
-    ay: f32,
-    fresnel: Option<(Vec3A, Vec3A)>,
-    wo: V3<F32x8>,
-    uc: F32x8,
-    u1: F32x8,
-    u2: F32x8,
-) -> (V3<F32x8>, [F32x8; 3], F32x8, M32x8) {
-    let (zero, one) = (splat(0.0), splat(1.0));
-    let (axl, ayl) = (splat(ax), splat(ay));
-    let uniform = |u: F32x8| u.ge(zero) & u.lt(one);
-    let valid = is_direction(wo) & wo.z.gt(zero) & uniform(uc) & uniform(u1) & uniform(u2);
-    let (m, cap_ok) = sample_spherical_cap_of(axl, ayl, wo, u1, u2);
-    let c = wo.dot(m);
-    // the reflection, renormalized by one Newton step (`renormalize`'s common path)
-    let k = splat(2.0) * c;
-    let r = V3::new(k * m.x - wo.x, k * m.y - wo.y, k * m.z - wo.z);
-    let r_len_sq = r.length_squared();
-    let nearly_unit = (r_len_sq - one).abs().le(splat(1.0 / 4096.0));
-    let wi = r.scale(splat(1.5) - splat(0.5) * r_len_sq);
-    let exits = wi.z.gt(zero);
-    let weight = conductor_fresnel(fresnel, c);
-    let (_, area_o) = lambda_and_area_of(axl, ayl, wo);
-    let (_, area_i) = lambda_and_area_of(axl, ayl, wi);
-    let last = g2_over_g1_of(area_o, area_i, wo.z, wi.z);
-    let h = wo.add(wi);
-    let visible = wo.dot(h).gt(splat(VISIBLE_SUM_MARGIN));
-    let (density, len_sq, t) = reflection_density_of(axl, ayl, h, area_o);
-    let min = splat(F32_DENSITY_MIN_SUM);
-    let density_ok = visible & len_sq.ge(min) & t.ge(min) & normal(density);
-    let weight = weight.map(|w| w * last);
-    let w_max = weight[0].max(weight[1]).max(weight[2]);
-    // the sample's f = weight·pdf/cos θi is clearly a normal f32 (the scalar test in f64 is
-    // weight·pdf ≥ f32::MIN_POSITIVE·cos θi)
-    let usable = last.gt(zero) & (w_max * density).ge(splat(1e-30)) & w_max.lt(splat(f32::INFINITY));
-    // a Fresnel cosine below 0.05 is taken from the half vector in f64 by the scalar path
-    let common = cap_ok
-        & (c.ge(splat(FRESNEL_AT_HALF_VECTOR_BELOW))
-            | splat(f32::from(u8::from(fresnel.is_none()))).gt(zero))
-        & nearly_unit;
-    let some = exits & usable;
-    let done = valid & common & (!exits | (density_ok & usable));
-    let keep = |x: F32x8| F32x8::select(some, x, zero);
-    (V3::new(keep(wi.x), keep(wi.y), keep(wi.z)), weight.map(keep), keep(density), done)
+fn finite_or_zero<L: Lanes>(x: L) -> L {
+    L::select(x.abs().lt(L::lit(f32::INFINITY)), x, L::lit(0.0))
 }
-
-/// Below this ωo·ωm a conductor's sampled Fresnel weight takes the half vector's cosine in f64
-/// (`Conductor`'s `FRESNEL_AT_HALF_VECTOR_BELOW`): the scalar sampler serves those lanes.
-const FRESNEL_AT_HALF_VECTOR_BELOW: f32 = 0.05;
 
 /// What a batch loop computes per query (a const parameter of the loop, so that a density-only
 /// loop carries no Fresnel term).
@@ -454,7 +346,116 @@ impl Want {
     const BOTH: u8 = 3;
 }
 
-/// The evaluation loop over chunks of eight queries.
+/// The evaluation of one query of a GGX conductor (renderer orientation) in the common path of
+/// the kernels: f, the density, and whether they are the answer (else the scalar call gives it).
+#[inline(always)]
+fn evaluate_conductor<L: Lanes, const WANT: u8>(
+    ax: f32,
+    ay: f32,
+    fresnel: Option<(Vec3A, Vec3A)>,
+    wo: V3<L>,
+    wi: V3<L>,
+) -> ([L; 3], L, L::Mask) {
+    let zero = L::lit(0.0);
+    let front = is_direction(wo) & is_direction(wi) & wo.z.gt(zero);
+    let above = front & wi.z.gt(zero);
+    // a light at or below the horizon of a view from above: no reflection, f = pdf = 0
+    let below = front & wi.z.le(zero);
+    let (density, g2_over_g1, cos, ok) = front_reflection(L::lit(ax), L::lit(ay), wo, wi);
+    let f = if WANT & Want::EVAL != 0 {
+        let w = conductor_fresnel(fresnel, cos);
+        let scale = density * g2_over_g1 / wi.z;
+        w.map(|w| finite_or_zero(L::select(above, w * scale, zero)))
+    } else {
+        [zero; 3]
+    };
+    (f, L::select(above, density, zero), (above & ok) | below)
+}
+
+/// [`evaluate_conductor`] for a GGX dielectric of index η: reflections from above, and the
+/// density of transmissions from above (their f, with the height-correlated G2 a beta
+/// function, is the scalar call's).
+#[inline(always)]
+fn evaluate_dielectric<L: Lanes, const WANT: u8>(
+    ax: f32,
+    ay: f32,
+    eta: f32,
+    wo: V3<L>,
+    wi: V3<L>,
+) -> ([L; 3], L, L::Mask) {
+    let zero = L::lit(0.0);
+    let front = is_direction(wo) & is_direction(wi) & wo.z.gt(zero);
+    let above = front & wi.z.gt(zero);
+    let (ax, ay, eta) = (L::lit(ax), L::lit(ay), L::lit(eta));
+    let (density, g2_over_g1, cos, ok) = front_reflection(ax, ay, wo, wi);
+    let fr = dielectric_fresnel(eta, cos);
+    let f = finite_or_zero(L::select(above, fr * density * g2_over_g1 / wi.z, zero));
+    if WANT == Want::PDF {
+        let below = front & wi.z.lt(zero);
+        let (pdf_transmit, ok_t) = transmission_density(ax, ay, eta, wo, wi);
+        let pdf = L::select(above, fr * density, pdf_transmit);
+        ([f; 3], pdf, (above & ok) | (below & ok_t))
+    } else {
+        ([f; 3], fr * density, above & ok)
+    }
+}
+
+/// The sample of a GGX conductor seen from above (`SingleScattering::sample_mirror_front` and
+/// `exact_reflection`, renderer orientation): wi, weight, pdf (0: no sample) and whether they
+/// are the answer (else the scalar call gives it).
+#[inline(always)]
+fn sample_conductor<L: Lanes>(
+    ax: f32,
+    ay: f32,
+    fresnel: Option<(Vec3A, Vec3A)>,
+    wo: V3<L>,
+    uc: L,
+    u1: L,
+    u2: L,
+) -> (V3<L>, [L; 3], L, L::Mask) {
+    let (zero, one) = (L::lit(0.0), L::lit(1.0));
+    let (axl, ayl) = (L::lit(ax), L::lit(ay));
+    let uniform = |u: L| u.ge(zero) & u.lt(one);
+    let valid = is_direction(wo) & wo.z.gt(zero) & uniform(uc) & uniform(u1) & uniform(u2);
+    let (m, cap_ok) = sample_spherical_cap_of(axl, ayl, wo, u1, u2);
+    let c = wo.dot(m);
+    // the reflection, renormalized by one Newton step (`renormalize`'s common path)
+    let k = L::lit(2.0) * c;
+    let r = V3::new(k * m.x - wo.x, k * m.y - wo.y, k * m.z - wo.z);
+    let r_len_sq = r.length_squared();
+    let nearly_unit = (r_len_sq - one).abs().le(L::lit(1.0 / 4096.0));
+    let wi = r.scale(L::lit(1.5) - L::lit(0.5) * r_len_sq);
+    let exits = wi.z.gt(zero);
+    let (_, area_o) = lambda_and_area_of(axl, ayl, wo);
+    let (_, area_i) = lambda_and_area_of(axl, ayl, wi);
+    let last = g2_over_g1_of(area_o, area_i, wo.z, wi.z);
+    let h = wo.add(wi);
+    let visible = wo.dot(h).gt(L::lit(VISIBLE_SUM_MARGIN));
+    let (density, len_sq, t) = reflection_density_of(axl, ayl, h, area_o);
+    let min = L::lit(F32_DENSITY_MIN_SUM);
+    let density_ok = visible & len_sq.ge(min) & t.ge(min) & normal(density);
+    let weight = conductor_fresnel(fresnel, c).map(|w| w * last);
+    let w_max = weight[0].max(weight[1]).max(weight[2]);
+    // the sample's f = weight·pdf/cos θi is clearly a normal f32 (the scalar test in f64 is
+    // weight·pdf ≥ f32::MIN_POSITIVE·cos θi)
+    let usable = last.gt(zero) & (w_max * density).ge(L::lit(1e-30)) & w_max.lt(L::lit(f32::INFINITY));
+    // a Fresnel cosine below 0.05 is taken from the half vector in f64 by the scalar path
+    let fresnel_common =
+        if fresnel.is_some() { c.ge(L::lit(FRESNEL_AT_HALF_VECTOR_BELOW)) } else { zero.le(zero) };
+    let common = cap_ok & fresnel_common & nearly_unit;
+    let some = exits & usable;
+    let done = valid & common & (!exits | (density_ok & usable));
+    let keep = |x: L| L::select(some, x, zero);
+    (V3::new(keep(wi.x), keep(wi.y), keep(wi.z)), weight.map(keep), keep(density), done)
+}
+
+/// Below this ωo·ωm a conductor's sampled Fresnel weight takes the half vector's cosine in f64
+/// (`Conductor`'s `FRESNEL_AT_HALF_VECTOR_BELOW`): the scalar sampler serves those lanes.
+const FRESNEL_AT_HALF_VECTOR_BELOW: f32 = 0.05;
+
+/// The evaluation loop: one pass of the f32 kernels over every query (a loop the compiler
+/// vectorizes, eight queries per AVX2 instruction), which marks the queries off the kernels'
+/// common path with a NaN (no answer of the kernels is NaN), then the scalar call for those.
 struct EvalLoop<'s, 'a, 'b, B, const WANT: u8> {
     bsdf: &'s B,
     kernel: Kernel,
@@ -485,47 +486,121 @@ impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
     }
 }
 
-/// f as the trait returns it: 0 where not finite.
-#[inline(always)]
-fn finite_or_zero(x: F32x8) -> F32x8 {
-    F32x8::select(x.abs().lt(splat(f32::INFINITY)), x, splat(0.0))
+impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
+    /// The pass of one kernel over every query (a loop without a branch on the kernel, which
+    /// the compiler vectorizes), then the scalar call for the marked queries.
+    #[inline(always)]
+    fn pass<K: QueryKernel<WANT>>(&mut self, kernel: K) {
+        let n = self.wo.len();
+        let (wo, wi) = (self.wo.slices(), self.wi.slices());
+        let mark = |done: bool, x: f32| if done { x } else { f32::NAN };
+        match (self.f.as_mut(), self.pdf.as_mut()) {
+            (Some(f), Some(pdf)) => {
+                let (fa, fb, fc) = f.slices();
+                let pdf = &mut pdf[..n];
+                for i in 0..n {
+                    let (v, p, done) = kernel.eval(at(wo, i), at(wi, i));
+                    (fa[i], fb[i], fc[i], pdf[i]) = (v[0], v[1], v[2], mark(done, p));
+                }
+            }
+            (Some(f), None) => {
+                let (fa, fb, fc) = f.slices();
+                for i in 0..n {
+                    let (v, _, done) = kernel.eval(at(wo, i), at(wi, i));
+                    (fa[i], fb[i], fc[i]) = (mark(done, v[0]), v[1], v[2]);
+                }
+            }
+            (None, Some(pdf)) => {
+                let pdf = &mut pdf[..n];
+                for i in 0..n {
+                    let (_, p, done) = kernel.eval(at(wo, i), at(wi, i));
+                    pdf[i] = mark(done, p);
+                }
+            }
+            (None, None) => {}
+        }
+        for i in 0..n {
+            let marked = match (&self.f, &self.pdf) {
+                (_, Some(pdf)) => pdf[i].is_nan(),
+                (Some(f), None) => f.a[i].is_nan(),
+                (None, None) => false,
+            };
+            if marked {
+                self.scalar(i);
+            }
+        }
+    }
 }
 
 impl<B: Bsdf, const WANT: u8> LaneLoop for EvalLoop<'_, '_, '_, B, WANT> {
     #[inline(always)]
     fn run(&mut self) {
-        let n = self.wo.len();
-        let chunks = n / WIDTH * WIDTH;
-        let mut i = 0;
-        while i < chunks {
-            let (wo, wi) = (self.wo.lanes(i), self.wi.lanes(i));
-            let e = evaluate::<WANT>(self.kernel, wo, wi);
-            if let Some(f) = self.f.as_mut() {
-                f.store(i, e.f.map(finite_or_zero));
+        // one loop per kernel and Fresnel term, each free of branches on them
+        match self.kernel {
+            Kernel::Conductor { ax, ay, fresnel: None } => self.pass(MirrorQuery { ax, ay }),
+            Kernel::Conductor { ax, ay, fresnel: Some(fresnel) } => {
+                self.pass(ConductorQuery { ax, ay, fresnel })
             }
-            if let Some(pdf) = self.pdf.as_mut() {
-                finite_or_zero(e.pdf).store(&mut pdf[i..]);
-            }
-            let done = match WANT {
-                Want::EVAL => e.done_f,
-                Want::PDF => e.done_pdf,
-                _ => e.done_f & e.done_pdf,
-            };
-            let mut rest = !done.bits() & 0xff;
-            while rest != 0 {
-                let lane = rest.trailing_zeros() as usize;
-                self.scalar(i + lane);
-                rest &= rest - 1;
-            }
-            i += WIDTH;
-        }
-        for k in chunks..n {
-            self.scalar(k);
+            Kernel::Dielectric { ax, ay, eta } => self.pass(DielectricQuery { ax, ay, eta }),
         }
     }
 }
 
-/// The sampling loop over chunks of eight queries (GGX conductors).
+/// A kernel evaluated query by query in a batch pass (`#[inline(always)]`, so that the pass
+/// compiles it into its own vectorized loop).
+trait QueryKernel<const WANT: u8> {
+    fn eval(&self, wo: V3<f32>, wi: V3<f32>) -> ([f32; 3], f32, bool);
+}
+
+/// A GGX perfect mirror.
+struct MirrorQuery {
+    ax: f32,
+    ay: f32,
+}
+
+/// A GGX conductor with its Fresnel constants.
+struct ConductorQuery {
+    ax: f32,
+    ay: f32,
+    fresnel: (Vec3A, Vec3A),
+}
+
+/// A GGX dielectric.
+struct DielectricQuery {
+    ax: f32,
+    ay: f32,
+    eta: f32,
+}
+
+impl<const WANT: u8> QueryKernel<WANT> for MirrorQuery {
+    #[inline(always)]
+    fn eval(&self, wo: V3<f32>, wi: V3<f32>) -> ([f32; 3], f32, bool) {
+        evaluate_conductor::<f32, WANT>(self.ax, self.ay, None, wo, wi)
+    }
+}
+
+impl<const WANT: u8> QueryKernel<WANT> for ConductorQuery {
+    #[inline(always)]
+    fn eval(&self, wo: V3<f32>, wi: V3<f32>) -> ([f32; 3], f32, bool) {
+        evaluate_conductor::<f32, WANT>(self.ax, self.ay, Some(self.fresnel), wo, wi)
+    }
+}
+
+impl<const WANT: u8> QueryKernel<WANT> for DielectricQuery {
+    #[inline(always)]
+    fn eval(&self, wo: V3<f32>, wi: V3<f32>) -> ([f32; 3], f32, bool) {
+        evaluate_dielectric::<f32, WANT>(self.ax, self.ay, self.eta, wo, wi)
+    }
+}
+
+/// Query i of structure-of-arrays slices.
+#[inline(always)]
+fn at(w: (&[f32], &[f32], &[f32]), i: usize) -> V3<f32> {
+    V3::new(w.0[i], w.1[i], w.2[i])
+}
+
+/// The sampling loop (GGX conductors), as [`EvalLoop`]: the kernels over every query, then the
+/// scalar call for the queries marked with a NaN density.
 struct SampleLoop<'s, 'a, 'b, B> {
     bsdf: &'s B,
     ax: f32,
@@ -539,38 +614,41 @@ struct SampleLoop<'s, 'a, 'b, B> {
 }
 
 impl<B: Bsdf> SampleLoop<'_, '_, '_, B> {
-    #[inline(never)]
-    fn scalar(&mut self, i: usize) {
-        let s = self.bsdf.sample(self.wo.get(i), self.uc[i], Vec2::new(self.u1[i], self.u2[i]));
-        self.out.set(i, s);
+    /// The pass of the kernel with the Fresnel term `fresnel` (fixed, so that the loop has no
+    /// branch on it) over every query, then the scalar call for the marked queries.
+    #[inline(always)]
+    fn pass(&mut self, fresnel: Option<(Vec3A, Vec3A)>) {
+        let n = self.wo.len();
+        let wo = self.wo.slices();
+        let (uc, u1, u2) = (&self.uc[..n], &self.u1[..n], &self.u2[..n]);
+        {
+            let (wx, wy, wz) = self.out.wi.slices();
+            let (ra, rb, rc) = self.out.weight.slices();
+            let (pdf, eta) = (&mut self.out.pdf[..n], &mut self.out.eta[..n]);
+            for i in 0..n {
+                let (w, weight, p, done) =
+                    sample_conductor::<f32>(self.ax, self.ay, fresnel, at(wo, i), uc[i], u1[i], u2[i]);
+                (wx[i], wy[i], wz[i]) = (w.x, w.y, w.z);
+                (ra[i], rb[i], rc[i]) = (weight[0], weight[1], weight[2]);
+                pdf[i] = if done { p } else { f32::NAN };
+                eta[i] = 1.0;
+            }
+        }
+        for i in 0..n {
+            if self.out.pdf[i].is_nan() {
+                let s = self.bsdf.sample(self.wo.get(i), uc[i], Vec2::new(u1[i], u2[i]));
+                self.out.set(i, s);
+            }
+        }
     }
 }
 
 impl<B: Bsdf> LaneLoop for SampleLoop<'_, '_, '_, B> {
     #[inline(always)]
     fn run(&mut self) {
-        let n = self.wo.len();
-        let chunks = n / WIDTH * WIDTH;
-        let mut i = 0;
-        while i < chunks {
-            let wo = self.wo.lanes(i);
-            let (uc, u1, u2) =
-                (F32x8::load(&self.uc[i..]), F32x8::load(&self.u1[i..]), F32x8::load(&self.u2[i..]));
-            let (wi, weight, pdf, done) = sample_conductor(self.ax, self.ay, self.fresnel, wo, uc, u1, u2);
-            self.out.wi.store(i, [wi.x, wi.y, wi.z]);
-            self.out.weight.store(i, weight);
-            pdf.store(&mut self.out.pdf[i..]);
-            splat(1.0).store(&mut self.out.eta[i..]);
-            let mut rest = !done.bits() & 0xff;
-            while rest != 0 {
-                let lane = rest.trailing_zeros() as usize;
-                self.scalar(i + lane);
-                rest &= rest - 1;
-            }
-            i += WIDTH;
-        }
-        for k in chunks..n {
-            self.scalar(k);
+        match self.fresnel {
+            None => self.pass(None),
+            Some(fr) => self.pass(Some(fr)),
         }
     }
 }

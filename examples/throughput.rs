@@ -169,6 +169,32 @@ fn rows<B: BatchBsdf>(material: &str, bsdf: &B, sphere: bool, seed: u64) {
     }
 }
 
+/// The random walk (GGX α = 0.5, views uniform on the upper hemisphere): the walks in lanes
+/// (`Microsurface::sample_batch`) against the scalar walk, per query.
+fn walk_rows<M: microsurface::research::Material>(name: &str, material: M, seed: u64) {
+    use microsurface::research::{Microsurface, UniformHeight, WalkOutputs};
+    let n = 1usize << (LOG2_N - 2);
+    let surface = Microsurface::new(UniformHeight, Ggx::isotropic(0.5).expect("valid"), material);
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let wi: Vec<Vec3> = (0..n).map(|_| direction(&mut rng, false)).collect();
+    let si = Soa::of(&wi);
+    let (mut wo, mut weight, mut bounces) = (Soa::zeros(n), Soa::zeros(n), vec![0u32; n]);
+    let mut batch_seed = 0;
+    let lanes = ns_per_query(n, || {
+        batch_seed += 1;
+        let mut out = WalkOutputs { wo: wo.channels(), weight: weight.channels(), bounces: &mut bounces };
+        surface.sample_batch(&si.dirs(), batch_seed, &mut out).expect("lengths");
+    });
+    let mut acc = 0u32;
+    let scalar = ns_per_query(n, || {
+        for w in &wi {
+            acc += black_box(&surface).sample(*w, &mut rng).map_or(0, |s| s.bounces);
+        }
+    });
+    black_box(acc);
+    println!("| {name} | walk sample | {lanes:.2} | {scalar:.1} | {:.1} |", scalar / lanes);
+}
+
 fn load() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(", "))
@@ -194,6 +220,8 @@ fn main() -> Result<(), microsurface::Error> {
         MicrofacetBsdf::new(slope, Dielectric::new(1.5)?)?.with_technique(Technique::SingleScattering);
     rows("gold", &gold, false, 3);
     rows("glass", &glass, true, 4);
+    walk_rows("gold", Conductor::new(ComplexIor::GOLD), 5);
+    walk_rows("mirror", Conductor::perfect(), 6);
     println!("load average after: {}", load());
     Ok(())
 }

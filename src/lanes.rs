@@ -1,14 +1,14 @@
 //! Lanes: the number types the crate's formula kernels are written over, so that one formula
-//! serves the scalar calls (one lane: `f32` or `f64`), the three colour channels of a Fresnel
-//! term (`glam::Vec3A`) and the batch calls (eight f32 lanes, [`F32x8`]).
+//! serves the scalar f32 calls, the f64 forms of the scalar paths (one lane each) and the three
+//! colour channels of a Fresnel term (`glam::Vec3A`, one SSE register).
 //!
 //! Every operation of a lane type is the same IEEE operation applied to each lane, in the same
-//! order (no fused multiply-add, no reassociation): a kernel instantiated with [`F32x8`] returns,
-//! lane by lane, the very bits it returns when instantiated with `f32`. [`F32x8`] is a plain
-//! `[f32; 8]` whose operations are loops over the eight lanes; LLVM turns each loop into one
-//! 256-bit instruction inside a function compiled for AVX2 ([`dispatch`]), and into two 128-bit
-//! ones elsewhere. Branches of a formula become [`Lanes::choose`]: a branch for one lane, both
-//! sides blended for several (each side skipped when no lane needs it).
+//! order (no fused multiply-add, no reassociation). The batch calls run the f32 instances in
+//! loops over their queries, which LLVM vectorizes (eight queries per AVX2 instruction inside
+//! [`dispatch`]'s AVX2 build, four per SSE2 instruction otherwise), so a batch answer is, query
+//! by query, the very bits of the f32 kernel. Branches of a formula are [`Lanes::choose`] (a
+//! branch for one lane, both sides blended for several) or [`Lanes::select`] (both sides
+//! computed: what a vectorized loop does with a branch anyway).
 
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 use glam::{BVec3A, Vec3, Vec3A};
@@ -222,231 +222,6 @@ impl Lanes for Vec3A {
     }
 }
 
-/// The number of lanes of [`F32x8`].
-pub(crate) const WIDTH: usize = 8;
-
-/// Eight f32 lanes (one AVX register), each operation a loop over the lanes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(32))]
-pub(crate) struct F32x8(pub(crate) [f32; WIDTH]);
-
-/// Eight lane masks, all bits set or clear (the layout of an AVX compare's result).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(C, align(32))]
-pub(crate) struct M32x8(pub(crate) [i32; WIDTH]);
-
-impl F32x8 {
-    /// The lanes of a slice of exactly [`WIDTH`] values.
-    #[inline(always)]
-    pub(crate) fn load(s: &[f32]) -> Self {
-        let mut out = [0.0; WIDTH];
-        out.copy_from_slice(&s[..WIDTH]);
-        Self(out)
-    }
-
-    /// Writes the lanes to a slice of at least [`WIDTH`] values.
-    #[inline(always)]
-    pub(crate) fn store(self, s: &mut [f32]) {
-        s[..WIDTH].copy_from_slice(&self.0);
-    }
-
-    /// Lane-wise map (for the integer steps of a kernel).
-    #[inline(always)]
-    fn map(self, f: impl Fn(f32) -> f32) -> Self {
-        Self(self.0.map(f))
-    }
-
-    /// Lane-wise combination of two operands.
-    #[inline(always)]
-    fn zip(self, other: Self, f: impl Fn(f32, f32) -> f32) -> Self {
-        let mut out = [0.0; WIDTH];
-        for i in 0..WIDTH {
-            out[i] = f(self.0[i], other.0[i]);
-        }
-        Self(out)
-    }
-
-    /// Lane-wise comparison.
-    #[inline(always)]
-    fn cmp(self, other: Self, f: impl Fn(f32, f32) -> bool) -> M32x8 {
-        let mut out = [0; WIDTH];
-        for i in 0..WIDTH {
-            out[i] = -i32::from(f(self.0[i], other.0[i]));
-        }
-        M32x8(out)
-    }
-}
-
-impl M32x8 {
-    /// The lanes as bits of an integer (lane i at bit i).
-    #[inline(always)]
-    pub(crate) fn bits(self) -> u32 {
-        let mut b = 0;
-        for i in 0..WIDTH {
-            b |= u32::from(self.0[i] != 0) << i;
-        }
-        b
-    }
-}
-
-impl Mask for M32x8 {
-    #[inline(always)]
-    fn all(self) -> bool {
-        self.0.iter().fold(-1, |a, &m| a & m) != 0
-    }
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0.iter().fold(0, |a, &m| a | m) != 0
-    }
-}
-
-impl BitAnd for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitand(self, o: Self) -> Self {
-        let mut out = self.0;
-        for i in 0..WIDTH {
-            out[i] &= o.0[i];
-        }
-        Self(out)
-    }
-}
-
-impl BitOr for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitor(self, o: Self) -> Self {
-        let mut out = self.0;
-        for i in 0..WIDTH {
-            out[i] |= o.0[i];
-        }
-        Self(out)
-    }
-}
-
-impl Not for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn not(self) -> Self {
-        Self(self.0.map(|m| !m))
-    }
-}
-
-macro_rules! lane_op {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for F32x8 {
-            type Output = Self;
-            #[inline(always)]
-            fn $f(self, o: Self) -> Self {
-                self.zip(o, |a, b| a $op b)
-            }
-        }
-    };
-}
-
-lane_op!(Add, add, +);
-lane_op!(Sub, sub, -);
-lane_op!(Mul, mul, *);
-lane_op!(Div, div, /);
-
-impl Neg for F32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self.map(|a| -a)
-    }
-}
-
-impl Lanes for F32x8 {
-    type Mask = M32x8;
-    #[inline(always)]
-    fn lit(x: f32) -> Self {
-        Self([x; WIDTH])
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        self.map(f32::sqrt)
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        self.map(f32::abs)
-    }
-    #[inline(always)]
-    fn min(self, other: Self) -> Self {
-        self.zip(other, f32::min)
-    }
-    #[inline(always)]
-    fn max(self, other: Self) -> Self {
-        self.zip(other, f32::max)
-    }
-    #[inline(always)]
-    fn clamp(self, lo: Self, hi: Self) -> Self {
-        let mut out = [0.0; WIDTH];
-        for i in 0..WIDTH {
-            // f32::clamp without its assertion lo ≤ hi (the kernels pass ordered bounds)
-            let mut x = self.0[i];
-            if x < lo.0[i] {
-                x = lo.0[i];
-            }
-            if x > hi.0[i] {
-                x = hi.0[i];
-            }
-            out[i] = x;
-        }
-        Self(out)
-    }
-    #[inline(always)]
-    fn lt(self, other: Self) -> M32x8 {
-        self.cmp(other, |a, b| a < b)
-    }
-    #[inline(always)]
-    fn le(self, other: Self) -> M32x8 {
-        self.cmp(other, |a, b| a <= b)
-    }
-    #[inline(always)]
-    fn gt(self, other: Self) -> M32x8 {
-        self.cmp(other, |a, b| a > b)
-    }
-    #[inline(always)]
-    fn ge(self, other: Self) -> M32x8 {
-        self.cmp(other, |a, b| a >= b)
-    }
-    #[inline(always)]
-    fn eq(self, other: Self) -> M32x8 {
-        self.cmp(other, |a, b| a == b)
-    }
-    #[inline(always)]
-    fn select(mask: M32x8, a: Self, b: Self) -> Self {
-        let mut out = [0.0; WIDTH];
-        for i in 0..WIDTH {
-            let bits = (a.0[i].to_bits() & mask.0[i] as u32) | (b.0[i].to_bits() & !mask.0[i] as u32);
-            out[i] = f32::from_bits(bits);
-        }
-        Self(out)
-    }
-    #[inline(always)]
-    fn quadrant(self) -> (Self, M32x8, M32x8) {
-        // x + ½ ∈ [0, 5): its floor is the truncation of the scalar form, and the bits of the
-        // small integer q come from the floors of q/2 and q/4 (all exact), in float
-        // instructions that vectorize (a float-to-int conversion with Rust's saturation does
-        // not)
-        let q = (self + Self::lit(0.5)).map(f32::floor);
-        let half = q * Self::lit(0.5);
-        let odd = half.ne_floor();
-        let quarter = q * Self::lit(0.25);
-        let high = (quarter - quarter.map(f32::floor)).ge(Self::lit(0.5));
-        (q, odd, high)
-    }
-}
-
-impl F32x8 {
-    /// The lanes whose value is not an integer.
-    #[inline(always)]
-    fn ne_floor(self) -> M32x8 {
-        self.cmp(self.map(f32::floor), |a, b| a != b)
-    }
-}
-
 /// A direction or vector of lanes: three coordinates, each a lane type.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct V3<L> {
@@ -558,33 +333,33 @@ fn run_avx2<Op: LaneLoop>(op: &mut Op) {
 mod tests {
     use super::*;
 
-    /// Each lane of every F32x8 operation is the f32 operation, NaN and signed zeros included.
+    /// Each lane of the three-channel type is the f32 operation, NaN and signed zeros included
+    /// (min and max on non-NaN operands, as the kernels use them), and the quadrant is the
+    /// scalar one.
     #[test]
-    fn lanes_are_the_scalar_operations() {
+    fn channel_lanes_are_the_scalar_operations() {
         let xs = [0.0f32, -0.0, 1.5, -2.25, f32::NAN, f32::INFINITY, 1e-40, 3.0];
         let ys = [-0.0f32, 0.0, f32::NAN, 7.0, 1.0, -1.0, 1e-40, 3.0];
-        let (a, b) = (F32x8(xs), F32x8(ys));
-        let same = |l: F32x8, f: &dyn Fn(f32, f32) -> f32| {
-            for i in 0..WIDTH {
-                assert_eq!(l.0[i].to_bits(), f(xs[i], ys[i]).to_bits(), "lane {i}");
-            }
-        };
-        same(a + b, &|x, y| x + y);
-        same(a - b, &|x, y| x - y);
-        same(a * b, &|x, y| x * y);
-        same(a / b, &|x, y| x / y);
-        same(a.min(b), &f32::min);
-        same(a.max(b), &f32::max);
-        same(a.sqrt(), &|x, _| x.sqrt());
-        same(-a, &|x, _| -x);
-        let m = a.lt(b);
-        for i in 0..WIDTH {
-            assert_eq!(m.bits() >> i & 1 == 1, xs[i] < ys[i]);
+        for k in 0..xs.len() - 2 {
+            let (a, b) = (Vec3A::from_slice(&xs[k..]), Vec3A::from_slice(&ys[k..]));
+            let same = |l: Vec3A, f: &dyn Fn(f32, f32) -> f32| {
+                for i in 0..3 {
+                    assert_eq!(l[i].to_bits(), f(xs[k + i], ys[k + i]).to_bits(), "lane {i} of {k}");
+                }
+            };
+            same(a + b, &|x, y| x + y);
+            same(a - b, &|x, y| x - y);
+            same(a * b, &|x, y| x * y);
+            same(a / b, &|x, y| x / y);
+            same(Lanes::sqrt(a), &|x, _| x.sqrt());
+            same(-a, &|x, _| -x);
+            let m = Lanes::lt(a, b);
+            same(<Vec3A as Lanes>::select(m, a, b), &|x, y| if x < y { x } else { y });
         }
-        same(F32x8::select(m, a, b), &|x, y| if x < y { x } else { y });
-        let (q, b0, b1) = F32x8([0.0, 0.3, 0.6, 1.2, 2.0, 2.7, 3.4, 4.2]).quadrant();
-        assert_eq!(q.0, [0.0, 0.0, 1.0, 1.0, 2.0, 3.0, 3.0, 4.0]);
-        assert_eq!(b0.bits(), 0b0110_0110);
-        assert_eq!(b1.bits(), 0b0111_0000);
+        for x in [0.0f32, 0.3, 0.6, 1.2, 2.0, 2.7, 3.4, 4.2] {
+            let (q, odd, high) = Lanes::quadrant(x);
+            let (q3, odd3, high3) = Lanes::quadrant(Vec3A::splat(x));
+            assert_eq!((q3.x, odd3.all(), high3.all()), (q, odd, high), "{x}");
+        }
     }
 }

@@ -2,7 +2,6 @@
 //! three `f32` slices each (the layout of SIMD lanes, see [`BatchBsdf`](crate::BatchBsdf)).
 
 use crate::error::Error;
-use crate::lanes::{F32x8, V3};
 use glam::Vec3;
 
 /// Directions in structure-of-arrays layout: the x, y and z coordinates of query i are
@@ -60,12 +59,6 @@ impl<'a> Directions<'a> {
         let n = self.x.len();
         (self.x, &self.y[..n], &self.z[..n])
     }
-
-    /// The eight directions from `i` on, as lanes.
-    #[inline(always)]
-    pub(crate) fn lanes(&self, i: usize) -> V3<F32x8> {
-        V3::new(F32x8::load(&self.x[i..]), F32x8::load(&self.y[i..]), F32x8::load(&self.z[i..]))
-    }
 }
 
 /// Mutable RGB or xyz outputs in structure-of-arrays layout (three slices of equal length).
@@ -104,13 +97,6 @@ impl<'a> Channels<'a> {
         self.a[i] = v.x;
         self.b[i] = v.y;
         self.c[i] = v.z;
-    }
-
-    #[inline(always)]
-    pub(crate) fn store(&mut self, i: usize, v: [F32x8; 3]) {
-        v[0].store(&mut self.a[i..]);
-        v[1].store(&mut self.b[i..]);
-        v[2].store(&mut self.c[i..]);
     }
 }
 

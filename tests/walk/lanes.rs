@@ -12,8 +12,10 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use validation::{Stats, assert_two_sample, family_z};
 
-/// Walks per sample and configuration.
-const N: usize = 40_000;
+/// Walks per sample and configuration: enough that a 10 % error in the closed-form escape
+/// probability of the lanes' walk (a/(a + 1.1Λ)) fails the order-1 share of gold at α = 0.5
+/// (|Δ| = 8.5e-3 against z·SE = 6.9e-3).
+const N: usize = 200_000;
 /// Orders compared one by one; longer walks are pooled.
 const ORDERS: usize = 5;
 /// Configurations × directions × (orders + tail) × quantities (share, weight, ωo.z, ωo.x).
@@ -103,7 +105,7 @@ fn compare<S: MicrosurfaceSlope, M: Material>(
                     k + 1,
                     if k == ORDERS { "+" } else { "" }
                 );
-                assert_two_sample(&l, &scalar[k][q], &lanes[k][q], z, 8e-3);
+                assert_two_sample(&l, &scalar[k][q], &lanes[k][q], z, 4e-3);
             }
         }
     }
@@ -114,8 +116,8 @@ fn lanes_walk_has_the_scalar_walks_distribution_per_order() {
     let gold = Conductor::new(ComplexIor::GOLD);
     compare("gold GGX 0.5", Microsurface::new(UniformHeight, Ggx::isotropic(0.5).expect("α"), gold), 11);
     compare(
-        "mirror GGX (1, 0.3)",
-        Microsurface::new(UniformHeight, Ggx::new(1.0, 0.3).expect("α"), Conductor::perfect()),
+        "mirror GGX (1.5, 0.5)",
+        Microsurface::new(UniformHeight, Ggx::new(1.5, 0.5).expect("α"), Conductor::perfect()),
         12,
     );
     compare("gold GGX 0.1", Microsurface::new(UniformHeight, Ggx::isotropic(0.1).expect("α"), gold), 13);

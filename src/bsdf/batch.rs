@@ -144,8 +144,8 @@ pub trait BatchBsdf: Bsdf {
         let n = wo.len();
         check_len("wi", n, wi.len())?;
         check_len("pdf", n, pdf.len())?;
-        for i in 0..n {
-            pdf[i] = self.pdf(wo.get(i), wi.get(i));
+        for (i, p) in pdf.iter_mut().enumerate() {
+            *p = self.pdf(wo.get(i), wi.get(i));
         }
         Ok(())
     }
@@ -166,10 +166,10 @@ pub trait BatchBsdf: Bsdf {
         check_len("wi", n, wi.len())?;
         f.check("f", n)?;
         check_len("pdf", n, pdf.len())?;
-        for i in 0..n {
+        for (i, slot) in pdf.iter_mut().enumerate() {
             let (v, p) = self.eval_with_pdf(wo.get(i), wi.get(i));
             f.set(i, v.f);
-            pdf[i] = p;
+            *slot = p;
         }
         Ok(())
     }
@@ -512,9 +512,9 @@ impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
             }
             (None, Some(pdf)) => {
                 let pdf = &mut pdf[..n];
-                for i in 0..n {
+                for (i, slot) in pdf.iter_mut().enumerate() {
                     let (_, p, done) = kernel.eval(at(wo, i), at(wi, i));
-                    pdf[i] = mark(done, p);
+                    *slot = mark(done, p);
                 }
             }
             (None, None) => {}
@@ -701,8 +701,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         check_len("wi", n, wi.len())?;
         check_len("pdf", n, pdf.len())?;
         if !self.eval_loop::<{ Want::PDF }>(wo, wi, None, Some(pdf)) {
-            for i in 0..n {
-                pdf[i] = self.pdf(wo.get(i), wi.get(i));
+            for (i, p) in pdf.iter_mut().enumerate() {
+                *p = self.pdf(wo.get(i), wi.get(i));
             }
         }
         Ok(())
@@ -720,10 +720,10 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         f.check("f", n)?;
         check_len("pdf", n, pdf.len())?;
         if !self.eval_loop::<{ Want::BOTH }>(wo, wi, Some(f), Some(pdf)) {
-            for i in 0..n {
+            for (i, slot) in pdf.iter_mut().enumerate() {
                 let (v, p) = self.eval_with_pdf(wo.get(i), wi.get(i));
                 f.set(i, v.f);
-                pdf[i] = p;
+                *slot = p;
             }
         }
         Ok(())

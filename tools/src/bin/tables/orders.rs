@@ -61,30 +61,53 @@ fn count<S: MicrosurfaceSlope>(
     mut mu: impl FnMut(&mut Pcg) -> f32,
 ) -> [u64; TABLES] {
     let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
-    // a grazing ray sees only the top of the surface: single scattering takes it all
-    let cosines: Vec<f32> = (0..walks).map(|_| mu(rng)).filter(|&m| m > 0.0).collect();
-    let x: Vec<f32> = cosines.iter().map(|&m| (1.0 - m * m).max(0.0).sqrt()).collect();
-    let y = vec![0.0f32; cosines.len()];
-    let seed = microsurface::rand::Rng::next_u64(rng);
-    let n = cosines.len();
-    let (mut wx, mut wy, mut wz) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
-    let (mut r, mut g, mut b) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
-    let mut bounces = vec![0u32; n];
-    let mut out = WalkOutputs {
-        wo: Channels::new(&mut wx, &mut wy, &mut wz),
-        weight: Channels::new(&mut r, &mut g, &mut b),
-        bounces: &mut bounces,
-    };
-    let wi = Directions::new(&x, &y, &cosines).expect("equal lengths");
-    surface.sample_batch(&wi, seed, &mut out).expect("equal lengths");
-    let mut counts = [0u64; TABLES];
-    for &k in &bounces {
-        let k = k as usize;
-        if k >= 2 {
-            counts[(k - 2).min(TABLES - 1)] += 1;
+    BUFFERS.with_borrow_mut(|b| {
+        // a grazing ray sees only the top of the surface: single scattering takes it all
+        b.z.clear();
+        b.z.extend((0..walks).map(|_| mu(rng)).filter(|&m| m > 0.0));
+        let n = b.z.len();
+        b.x.clear();
+        b.x.extend(b.z.iter().map(|&m| (1.0 - m * m).max(0.0).sqrt()));
+        for v in [&mut b.y, &mut b.wx, &mut b.wy, &mut b.wz, &mut b.r, &mut b.g, &mut b.b] {
+            v.resize(n, 0.0);
         }
-    }
-    counts
+        b.bounces.resize(n, 0);
+        let seed = microsurface::rand::Rng::next_u64(rng);
+        let mut out = WalkOutputs {
+            wo: Channels::new(&mut b.wx, &mut b.wy, &mut b.wz),
+            weight: Channels::new(&mut b.r, &mut b.g, &mut b.b),
+            bounces: &mut b.bounces,
+        };
+        let wi = Directions::new(&b.x, &b.y, &b.z).expect("equal lengths");
+        surface.sample_batch(&wi, seed, &mut out).expect("equal lengths");
+        let mut counts = [0u64; TABLES];
+        for &k in &b.bounces {
+            let k = k as usize;
+            if k >= 2 {
+                counts[(k - 2).min(TABLES - 1)] += 1;
+            }
+        }
+        counts
+    })
+}
+
+/// The walks' inputs and outputs, kept per thread across cells.
+#[derive(Default)]
+struct Buffers {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    wx: Vec<f32>,
+    wy: Vec<f32>,
+    wz: Vec<f32>,
+    r: Vec<f32>,
+    g: Vec<f32>,
+    b: Vec<f32>,
+    bounces: Vec<u32>,
+}
+
+thread_local! {
+    static BUFFERS: std::cell::RefCell<Buffers> = std::cell::RefCell::new(Buffers::default());
 }
 
 /// The counts of one cell (direction cell or average cell) with `walks` walks from `seed`.

@@ -44,7 +44,7 @@
 //! ```
 //!
 //! [`Technique`] chooses single scattering (exact, cheapest: the research layer's
-//! [`SingleScattering`], whose sampler returns its density), the random walk, or the
+//! [`SingleScattering`](research::SingleScattering), whose sampler returns its density), the random walk, or the
 //! position-free PT and BDPT estimators; [`ClassicBrdf`] is the classic Lambert plus
 //! Cook–Torrance BRDF. Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes
 //! (`flags().specular`).
@@ -58,7 +58,7 @@
 //! * **Renderer layer** ([`Bsdf`], pbrt's convention): `eval(wo, wi)` with `wo` towards the
 //!   viewer and `wi` towards the light returns **f** (no cosine); a sample's weight is
 //!   f·|cos θi|/pdf.
-//! * **Research layer** ([`Microsurface`], [`PositionFree`], [`Material`], the papers'
+//! * **Research layer** ([`Microsurface`](research::Microsurface), [`PositionFree`](research::PositionFree), [`Material`](research::Material), the papers'
 //!   convention): `eval(wi, wo)` with `wi` the direction light arrives from and `wo` the one it
 //!   leaves along returns **f·|cos θo|**, stochastic evaluations take `&mut impl Rng`, and a
 //!   walk sample's weight is f·|cos θo|/pdf.
@@ -170,17 +170,17 @@ pub use rand;
 
 /// The research layer: the papers' models with the papers' interfaces.
 ///
-/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`]: heights,
+/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`](crate::research::Microsurface): heights,
 /// slopes and a material, evaluated and sampled by tracing a ray through the microsurface),
-/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`]), the
-/// position-free estimators of Wang et al. 2022 ([`PositionFree`], feature `position-free`),
-/// the height distributions, the materials' phase functions ([`Material`]) and the geometry
-/// queries of the microsurface ([`MicrosurfaceGeometry`]).
+/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`](crate::research::SingleScattering)), the
+/// position-free estimators of Wang et al. 2022 ([`PositionFree`](crate::research::PositionFree), feature `position-free`),
+/// the height distributions, the materials' phase functions ([`Material`](crate::research::Material)) and the geometry
+/// queries of the microsurface ([`MicrosurfaceGeometry`](crate::research::MicrosurfaceGeometry)).
 ///
 /// Conventions (the papers'): `eval(wi, wo)` with `wi` towards the light and `wo` towards the
 /// viewer returns f·|cos θo| per RGB channel; stochastic evaluations take `&mut impl Rng` and
 /// are unbiased estimates; a walk sample's weight is f·|cos θo|/pdf. The renderer layer
-/// ([`Bsdf`](crate::Bsdf)) is built on these types.
+/// ([`Bsdf`]) is built on these types.
 ///
 /// # Examples
 ///

@@ -149,7 +149,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// the Fresnel term taken at the sampled normal, see [`Conductor`](crate::Conductor)).
     /// `None` if ωi cannot light the material (on the horizon, or at the nadir of an opaque
     /// material) or the sampled direction cannot leave the surface. Resolution limit of
-    /// backfacing Beckmann views below α ≈ 1e-3: see [`PositionFree::sample_single`].
+    /// backfacing Beckmann views below α ≈ 1e-3: see [`PositionFree::sample_single`](crate::research::PositionFree::sample_single).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).

@@ -156,7 +156,7 @@ pub enum Compensation {
 /// taken in its sampler's form F G2/G1 · pdf_ss (within 1e-5 of eval's, as its sampler's
 /// weight is). Turquin samples and has the density of the single-scattering lobe.
 ///
-/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`SMOOTH_ALPHA`](crate::SMOOTH_ALPHA)) are
 /// the Dirac mirror of the single-scattering BSDF, uncompensated (the energy the single
 /// bounce loses vanishes with α). View directions below the horizon (a backfacing shading
 /// normal, which single scattering supports) have no tabulated albedo: the lobe is then the

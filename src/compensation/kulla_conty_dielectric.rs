@@ -123,7 +123,7 @@ struct SideLobes {
 /// BSDF above.
 ///
 /// **Special cases.** Effectively smooth surfaces (largest principal roughness below
-/// [`super::SMOOTH_ALPHA`]) and η = 1 are the Dirac lobes of the single-scattering BSDF,
+/// [`SMOOTH_ALPHA`](crate::SMOOTH_ALPHA)) and η = 1 are the Dirac lobes of the single-scattering BSDF,
 /// uncompensated. A view or light on the horizon has no added lobe.
 ///
 /// # Examples

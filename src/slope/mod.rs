@@ -32,9 +32,9 @@ use glam::{DVec3, Vec3};
 /// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
 ///
 /// Sealed: implemented by the crate's distributions only ([`Ggx`], [`Beckmann`],
-/// `&`[`TabulatedSlope`], [`StretchedTabulated`], `&`[`GridSlope`]). A distribution of one's
-/// own goes through [`TabulatedSlope`] (isotropic: from P²² or D values on rings, or a radial
-/// function) or [`GridSlope`] (anisotropic: from a grid of slope densities), which check their
+/// `&`[`TabulatedSlope`](crate::tabulated::TabulatedSlope), [`StretchedTabulated`](crate::tabulated::StretchedTabulated), `&`[`GridSlope`](crate::tabulated::GridSlope)). A distribution of one's
+/// own goes through [`TabulatedSlope`](crate::tabulated::TabulatedSlope) (isotropic: from P²² or D values on rings, or a radial
+/// function) or [`GridSlope`](crate::tabulated::GridSlope) (anisotropic: from a grid of slope densities), which check their
 /// input, derive Λ, the projected area and D_ωi from it and sample it exactly, so that the
 /// random walks, the position-free estimators and the samplers are valid for it unchanged.
 /// Sealing lets the crate rely on the contract below (which its test suite checks for every

@@ -344,7 +344,7 @@ impl Material for Dielectric {
 
     // out of line: the walk instantiated with the renderer layer's primed generator inlined
     // it and ran 25 % slower than with the research layer's generator, which does not
-    // (DESIGN.md, “renderer trait speed, session 6”)
+    // (DESIGN.md, “Speed against the research calls”)
     #[inline(never)]
     fn sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
@@ -359,8 +359,8 @@ impl Material for Dielectric {
 
     /// The visible normal's two uniforms from one 64-bit draw (the walks' stream). Out of
     /// line: inlined with the GGX visible normal into the walk's loop, the listing's GGX
-    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Integration,
-    /// session 6”).
+    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Speed against
+    /// the research calls”).
     #[inline(never)]
     fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
         &self,

@@ -325,7 +325,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 /// (ωo close to −ωi, c small) this dominates: from below a smooth surface (Beckmann α = 0.02
 /// at θi = 120°, c ≈ 1e-4) the plain sum lost the sign of ωi·ωh for about 1 % of the sampled
 /// directions (eval and pdf 0 where the sampler put mass) and was off by a median 5 %
-/// elsewhere (DESIGN.md, “BDPT from below at a = 28.9”).
+/// elsewhere (DESIGN.md, “Paths from below”).
 ///
 /// So where either direction is below the horizon, ωh is that of the directions the vectors
 /// represent, ωh ∝ ω̂i + ω̂o ∝ ωi + (|ωi|/|ωo|)ωo in f64: its direction is exact to 1e-16/c rad

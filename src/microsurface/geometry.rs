@@ -242,7 +242,7 @@ pub(crate) fn step_ln_c1<L: Lanes>(z: L, lambda: L, ln_c1: L, ln_1mu: L) -> (L, 
 /// single-scattering term the full-spherical height-correlated one, E[C^{Λ(ωo)}] =
 /// Λ(−ωi)/(Λ(−ωi) + Λ(ωo)), i.e. G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17), and the
 /// first vertex the position-free model's vertex reached from below (see DESIGN.md,
-/// “Multiple scattering for views below the macrosurface”).
+/// “Views from below in the walk”).
 ///
 /// The result lies in [−f32::MAX, −f32::MIN_POSITIVE]. ln(1 − u)/Λ overflows only for
 /// Λ(−ωi) < 5e-38 (GGX: ωi within ~1e-19 rad of the nadir; Beckmann: a denormal Λ, smooth

@@ -172,7 +172,7 @@ pub use sampling::{concentric_disk, sample_cosine_hemisphere};
 pub use single_scattering::{SingleSample, SingleScattering};
 pub use slope::{
     AxisAlignedSlope, BackscatterShadowing, Beckmann, Elliptical, Extraction, Ggx, GridExtraction, GridSlope,
-    MAX_RINGS, MicrosurfaceSlope, Noncentral, StretchedTabulated, TabulatedSlope, extract_anisotropic,
+    MAX_RINGS, MicrosurfaceSlope, Noncentral, StretchedTabulated, TabulatedSlope, Tail, extract_anisotropic,
     extract_anisotropic_fn, extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
 pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};

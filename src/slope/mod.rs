@@ -10,7 +10,9 @@ mod extract;
 mod ggx;
 mod grid;
 mod noncentral;
+mod rings;
 mod tabulated;
+mod tabulated_vndf;
 
 pub use beckmann::Beckmann;
 pub use elliptical::{AxisAlignedSlope, Elliptical};
@@ -21,7 +23,7 @@ pub use extract::{
 pub use ggx::Ggx;
 pub use grid::GridSlope;
 pub use noncentral::Noncentral;
-pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope};
+pub use tabulated::{MAX_RINGS, StretchedTabulated, TabulatedSlope, Tail};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;

@@ -27,7 +27,6 @@ pub use ggx_disk::GgxDisk;
 pub use smith::SmithVndf;
 pub use spherical_cap::GgxSphericalCap;
 pub(crate) use spherical_cap::{sample_spherical_cap, sample_visible_hemisphere};
-pub(crate) use stretch::Azimuth;
 pub use vcavity::{VCavity, VCavitySlope};
 
 use crate::contract::is_direction;

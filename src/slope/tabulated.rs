@@ -4,11 +4,13 @@
 //! built at construction.
 
 use super::MicrosurfaceSlope;
+use super::ggx::Ggx;
 use super::rings::{RingGrid, RingLookup, back_area};
-use super::tabulated_vndf::VisibleSampler;
+use super::tabulated_vndf::{Visible, VisibleSampler};
 use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
 use crate::vector::ensure_visible;
+use crate::vndf::{sample_spherical_cap, sample_visible_hemisphere};
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -33,7 +35,8 @@ const GL8: [(f64, f64); 8] = [
 const BACKFACE_NODES: usize = 2048;
 /// Groups of rings of the back-face factor at most (larger tables group several rings).
 const MAX_GROUPS: usize = 256;
-/// The outermost rings whose back-face area is summed exactly rather than interpolated.
+/// The outermost rings whose back-face area is summed exactly rather than interpolated: 16, or
+/// a quarter of the rings if fewer (a coarse table interpolates its inner rings too).
 const EXACT_OUTER_RINGS: usize = 16;
 
 /// The model of a [`TabulatedSlope`] beyond its last ring, R > R_N.
@@ -90,8 +93,9 @@ pub enum Tail {
 /// sum ([`TabulatedSlope::projected_area_exact`]). The trait's `lambda` and `projected_area`
 /// multiply the closed-form back-face area of GGX(s), s²h²/(2(√(z² + s²h²) + |z|)), by a
 /// factor ρ = B/B_GGX(s) tabulated at construction (two nodes per ring, linear in
-/// c² = z²/h² between them, found by the constant-time ring lookup), except when the
-/// visibility line cuts only the 16 outermost rings (near the poles), where the sum is exact.
+/// c = |z|/h between them, found by the constant-time ring lookup), except when the
+/// visibility line cuts only the 16 outermost rings (a quarter of the rings if fewer; near the
+/// poles), where the sum is exact.
 /// ρ is a weighted mean of the factors fₖ of the rings beyond the visibility line: exactly 1
 /// for GGX(s), smooth otherwise. Λ = B/cos θ above the horizon and −1 − B/|cos θ| below, so
 /// Λ(−ω) = −1 − Λ(ω) holds exactly.
@@ -152,6 +156,8 @@ pub struct TabulatedSlope {
     input_mass: f64,
     /// The model beyond R_N.
     tail: Tail,
+    /// GGX of roughness s (whose visible normals the directions that see only the tail see).
+    lobe: Ggx,
 }
 
 impl core::fmt::Debug for TabulatedSlope {
@@ -305,9 +311,10 @@ impl TabulatedSlope {
                 expected: "finite and > 0 (a table with some mass)",
             });
         }
+        let lobe = Ggx::isotropic(grid.scale as f32)?;
         let mut factors: Vec<f64> = masses.iter().zip(&grid.ggx_mass).map(|(m, g)| m / total / g).collect();
         factors.push(0.0);
-        Ok(Self::build(grid, factors, Tail::Truncated, input_mass.unwrap_or(total)))
+        Ok(Self::build(grid, factors, Tail::Truncated, input_mass.unwrap_or(total), lobe))
     }
 
     /// The same rings with the model `tail` beyond R_N (the factors rescaled so that the whole
@@ -324,11 +331,11 @@ impl TabulatedSlope {
         for f in &mut factors {
             *f /= total;
         }
-        Self::build(self.grid, factors, tail, self.input_mass)
+        Self::build(self.grid, factors, tail, self.input_mass, self.lobe)
     }
 
     /// The derived tables of normalized factors.
-    fn build(grid: RingGrid, factors: Vec<f64>, tail: Tail, input_mass: f64) -> Self {
+    fn build(grid: RingGrid, factors: Vec<f64>, tail: Tail, input_mass: f64, lobe: Ggx) -> Self {
         let n = grid.rings;
         let s = grid.scale;
         let d_coef = factors.iter().map(|f| f * s * s / PI).collect();
@@ -338,7 +345,7 @@ impl TabulatedSlope {
         let lookup = RingLookup::new(&grid.radii_sq);
         let sampler = VisibleSampler::new(&grid, &factors);
         let step = n.div_ceil(MAX_GROUPS).max(1);
-        let exact_from = n.saturating_sub(EXACT_OUTER_RINGS) / step * step;
+        let exact_from = n.saturating_sub(EXACT_OUTER_RINGS.min(n.div_ceil(4))) / step * step;
         let sub = (BACKFACE_NODES / (exact_from / step).max(1)).max(2);
         let mut table = Self {
             grid,
@@ -351,6 +358,7 @@ impl TabulatedSlope {
             alpha: 0.0,
             input_mass,
             tail,
+            lobe,
         };
         let mut nodes = Vec::with_capacity(exact_from / step * sub + 1);
         for g in 0..exact_from / step {
@@ -543,12 +551,25 @@ impl TabulatedSlope {
         self.d_coef[k] * q * q
     }
 
+    /// The ring holding the visibility line c = |z|/h of a direction of horizontal length `h`
+    /// and height `z` (N beyond the last ring, and for h = 0).
+    #[inline(always)]
+    fn visibility_ring(&self, h: f64, z: f64) -> usize {
+        let c = z / h;
+        self.lookup.ring(c * c, &self.grid.radii_sq)
+    }
+
     /// An exactly sampled visible normal for a unit `wi` (f64 inside); +z if ωi sees nothing.
     fn sample_normal(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let (x, y, z) = (f64::from(wi.x), f64::from(wi.y), f64::from(wi.z));
         let h = (x * x + y * y).sqrt();
         let s = self.grid.scale;
-        let Some(m) = self.sampler.sample(s * h, z, u1, u2) else { return Vec3::Z };
+        let m = match self.sampler.sample(s * h, z, self.visibility_ring(h, z), u1, u2) {
+            Visible::Normal(m) => m,
+            // the directions that see only the tail see GGX(s): its exact sampler
+            Visible::TailOnly => return sample_spherical_cap(&self.lobe, wi, u1, u2),
+            Visible::Nothing => return Vec3::Z,
+        };
         // unstretch (the slopes scale by s) and rotate to the azimuth (x, y)/h of ωi, all
         // times h (no division): h·(s R m_xy, m.z), R the rotation
         let n = if h > 0.0 {
@@ -567,7 +588,7 @@ impl TabulatedSlope {
     pub fn sampler_acceptance(&self, w: Vec3) -> f64 {
         let w = w.as_dvec3();
         let h = (w.x * w.x + w.y * w.y).sqrt();
-        match self.sampler.proposal_mass(self.grid.scale * h, w.z) {
+        match self.sampler.proposal_mass(self.grid.scale * h, w.z, self.visibility_ring(h, w.z)) {
             Some(q) if q > 0.0 => self.projected_area_exact(w.as_vec3()) / (2.0 * q),
             _ => 1.0,
         }
@@ -623,9 +644,20 @@ impl TabulatedSlope {
     #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
         let (a, s) = (f64::from(self.alpha), self.grid.scale);
-        let Some(m) = self.sampler.sample(s * f64::from(sin_theta) / a, f64::from(cos_theta), u1, u2) else {
-            return Vec2::ZERO;
+        let (h, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));
+        let m = match self.sampler.sample(s * h, z, self.visibility_ring(h, z), u1, u2) {
+            Visible::Normal(m) => m,
+            Visible::TailOnly => {
+                // the unit GGX lobe's visible normals from the stretched direction (s h, 0, z)
+                let len = (s * h).hypot(z);
+                let v = Vec3::new((s * h / len) as f32, 0.0, (z / len) as f32);
+                sample_visible_hemisphere(v, 1.0, u1, u2).as_dvec3()
+            }
+            Visible::Nothing => return Vec2::ZERO,
         };
+        if m.z <= 0.0 {
+            return Vec2::ZERO;
+        }
         // slopes −s m.x/m.z, −s m.y/m.z, finite (a horizontal normal has the largest f32 slope)
         let slope = |v: f64| (-s * v / (m.z * a)).clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32;
         Vec2::new(slope(m.x), slope(m.y))
@@ -765,6 +797,15 @@ impl StretchedTabulated<'_> {
     }
 }
 
+impl StretchedTabulated<'_> {
+    /// The table's back-face area at the stretched direction (sx ω.x, sy ω.y, ω.z).
+    #[inline]
+    fn backface_area(&self, w: Vec3) -> f64 {
+        let (x, y) = (f64::from(self.sx) * f64::from(w.x), f64::from(self.sy) * f64::from(w.y));
+        self.table.backface_area((x * x + y * y).sqrt(), f64::from(w.z))
+    }
+}
+
 impl crate::sealed::Sealed for StretchedTabulated<'_> {}
 
 impl MicrosurfaceSlope for StretchedTabulated<'_> {
@@ -808,18 +849,35 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
         d_table * ratio.powi(4) / (sx * sy)
     }
 
+    /// The table's Λ at the stretched direction (the table's back-face area is homogeneous of
+    /// degree 1, so it is evaluated at (sx ω.x, sy ω.y, ω.z) directly, in f64); saturates to
+    /// ±`f32::MAX` at ±0. Invalid input ([policy](crate#invalid-input)): NaN.
     #[inline]
     fn lambda(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
-        let (s, _) = self.stretch(w);
-        (&self.table).lambda(s)
+        let lambda = (self.backface_area(w) / f64::from(w.z).abs()).min(f64::from(f32::MAX)) as f32;
+        if w.z >= 0.0 { lambda } else { -1.0 - lambda }
     }
 
+    /// Λ in f64, unsaturated.
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
+        let l = self.backface_area(w) / f64::from(w.z).abs();
+        if w.z >= 0.0 { l } else { -1.0 - l }
+    }
+
+    /// cos θ + B above the horizon, B below, B the table's back-face area at the stretched
+    /// direction. Invalid input ([policy](crate#invalid-input)): NaN.
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
         require!(is_direction(w), f32::NAN; w);
-        let (s, len) = self.stretch(w);
-        (len * f64::from((&self.table).projected_area(s))) as f32
+        self.projected_area64(w) as f32
+    }
+
+    /// The projected area in f64.
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        f64::from(w.z).max(0.0) + self.backface_area(w)
     }
 
     /// Exact for every ωi: the table's visible slopes from ω_s/‖ω_s‖, scaled by (sx, sy); +z
@@ -833,6 +891,10 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
             return Vec3::Z;
         }
         let m = (&self.table).sample_d_wi(s, u1, u2);
+        if m == Vec3::Z && wi.z <= 0.0 {
+            // the table sees nothing from the stretched ωi (as +z is not visible from ωi)
+            return Vec3::Z;
+        }
         // the table's normal m ∝ (−u, −v, 1): the slopes scale by (sx, sy)
         let stretched = Vec3::new(m.x * self.sx, m.y * self.sy, m.z);
         ensure_visible(wi, crate::vector::normalize_scaled(stretched, Vec3::Z))

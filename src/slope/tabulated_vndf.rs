@@ -33,14 +33,13 @@
 //! are hashed from the bits of the two (splitmix64). The measured acceptance rate is printed
 //! by `tests/tabulated/tabulated.rs` (0.9 or more above the horizon); after 128 rejections
 //! the last proposal is returned (probability below 1e-19 at the worst acceptance measured).
-//! Directions nearer the nadir than the last node see the tail zone only: there the visible
-//! normals are those of the unit GGX lobe, sampled exactly by the spherical cap
-//! ([`crate::vndf::sample_visible_hemisphere`]), or nothing for a truncated table.
+//! Directions nearer the nadir than the last node see the tail zone only: there the table is
+//! GGX(s) times the tail's factor, and its visible normals are those of GGX(s), which the
+//! caller samples exactly by the spherical cap; a truncated table sees nothing there.
 
 use super::rings::RingGrid;
-use crate::vndf::sample_visible_hemisphere;
 use core::f64::consts::{FRAC_PI_2, PI};
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 
 /// Zones wider than this (radians of the stretched angle) are split into cells.
 const MAX_CELL_ANGLE: f64 = 0.05;
@@ -58,12 +57,14 @@ const OCTANT_BINS: usize = 4;
 /// Bins of the half circle φ ∈ [0, π].
 const BINS: usize = 4 * OCTANT_BINS;
 /// Proposals before the last one is returned unchecked.
-const MAX_TRIALS: u64 = 128;
+const MAX_TRIALS: u64 = 160;
 /// The largest f64 below 1.
 const ONE_BELOW: f64 = 1.0 - f64::EPSILON / 2.0;
 /// The crate's tail cut (2⁻²⁴) of the z coordinate in the tail zone, whose lower end z = 0 is
 /// the horizon (a normal there has no density).
 const TAIL_CUT: f64 = 1.0 / 16_777_216.0;
+/// The relative margin in z kept from an end of a cell beyond which the model has no density.
+const GUARD: f64 = 1.0 / 1_048_576.0;
 
 /// tan(π/8) = √2 − 1: the half-angle tangent at the end of an octant.
 const TAN_PI_8: f64 = 0.414_213_562_373_095_05;
@@ -106,6 +107,71 @@ impl Bins {
     }
 }
 
+/// The outcome of [`VisibleSampler::sample`].
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Visible {
+    /// A positive multiple of the stretched normal, in the direction's azimuth frame.
+    Normal(DVec3),
+    /// The direction sees only the tail zone (where the table is the unit GGX lobe).
+    TailOnly,
+    /// The direction sees nothing.
+    Nothing,
+}
+
+/// The last ring L of positive density of a table without a tail (the table is empty beyond
+/// it), seen alone from near the nadir: cot θ′_L, below which tan ε′ (ε′ the stretched
+/// direction's angle from the nadir) sees only this ring; its lower end z = cos θ′_{L+1},
+/// ρ = sin θ′_{L+1}; its density D′ = f_L/π.
+#[derive(Debug, Clone, Copy)]
+struct LastRing {
+    cot_inner: f64,
+    z_low: f64,
+    rho_low: f64,
+    density: f64,
+}
+
+impl LastRing {
+    /// For the unit stretched direction (b, 0, a) from below: the largest ⟨ν, m⟩ on the ring's
+    /// visible part (at z_low, φ = 0), the highest visible z (sin ε′ = b) and the widest
+    /// visible azimuth φ₀ (at z_low); `None` if nothing is visible.
+    fn rectangle(&self, b: f64, a: f64) -> Option<(f64, f64, f64)> {
+        let top = a * self.z_low + b * self.rho_low;
+        if b <= self.z_low || top <= 0.0 {
+            return None;
+        }
+        Some((top, b, (-a * self.z_low / (b * self.rho_low)).clamp(-1.0, 1.0).acos()))
+    }
+}
+
+/// The top cell of the region visible from below and its proposal: the rectangle
+/// z ∈ [z_lo, z_top], |φ| ≤ φ₀ (uniform in solid angle) holding the cell's visible part, with
+/// ⟨ν̂, m⟩ ≤ `top` (its value at (z_lo, 0)); ν̂ = (b, 0, a) the unit direction.
+#[derive(Debug, Clone, Copy)]
+struct Frontier {
+    cell: usize,
+    b: f64,
+    a: f64,
+    top: f64,
+    z_top: f64,
+    phi0: f64,
+    mass: f64,
+}
+
+/// The proposal of one direction (see [`VisibleSampler::proposal`]).
+struct Proposal<'a> {
+    na: &'a Node,
+    nb: &'a Node,
+    lambda: f64,
+    mu: f64,
+    frontier: Option<Frontier>,
+    skip_a: f64,
+    skip_b: f64,
+    pa: f64,
+    pb: f64,
+    rect: f64,
+    total: f64,
+}
+
 /// A cell: its z = cos θ′ and ρ = sin θ′ ranges and its weight fₖ Δz/π.
 #[derive(Debug, Clone, Copy)]
 struct Cell {
@@ -114,6 +180,10 @@ struct Cell {
     rho_lo: f64,
     rho_hi: f64,
     weight: f64,
+    /// The fractions of the cell's z-range kept clear at its ends where the model has no
+    /// density beyond them (a truncated end or a zero ring; 2⁻²⁰ of z relative, so that the f32
+    /// normal stays on the dense side, or the tail cut at the horizon), else 0.
+    guard: (f64, f64),
 }
 
 /// A node: a stretched direction and the cumulative majorant masses of the cells it sees.
@@ -132,8 +202,9 @@ struct Node {
     guide_at: usize,
     /// The last cell of positive mass (relative to `first`).
     last: usize,
-    /// The total majorant mass Q.
+    /// The total majorant mass Q, and 1/Q (0 if Q = 0).
     total: f64,
+    inv_total: f64,
 }
 
 /// The sampler's tables (see the module documentation).
@@ -141,6 +212,9 @@ struct Node {
 pub(super) struct VisibleSampler {
     /// The cells, from the zenith down.
     cells: Vec<Cell>,
+    /// The first cell of each zone (N + 2 entries: zone k's cells are
+    /// `zone_start[k]..zone_start[k + 1]`; none for a truncated tail).
+    zone_start: Vec<u32>,
     nodes: Vec<Node>,
     /// 1/(νₙ × νₙ₊₁) per interval between nodes.
     inv_det: Vec<f64>,
@@ -150,6 +224,8 @@ pub(super) struct VisibleSampler {
     e_min: f64,
     /// Whether the tail zone has mass (then the directions below `e_min` see it).
     tail: bool,
+    /// Without a tail: the last ring of positive density (see [`LastRing`]).
+    last_ring: LastRing,
 }
 
 impl VisibleSampler {
@@ -162,8 +238,10 @@ impl VisibleSampler {
             FRAC_PI_2 * v * v
         };
         let mut cells = Vec::new();
+        let mut zone_start = Vec::with_capacity(n + 2);
         let tail = factors[n] > 0.0;
         for (k, &f) in factors.iter().enumerate().take(if tail { n + 1 } else { n }) {
+            zone_start.push(cells.len() as u32);
             // the zone [θ′ₖ, θ′ₖ₊₁] in complements γ (γ_{N+1} = 0: the horizon)
             let (g0, g1) = (gamma(k as f64), if k == n { 0.0 } else { gamma(k as f64 + 1.0) });
             // cells from γ₀ down: at most MAX_CELL_ANGLE wide, and at most a ratio
@@ -182,17 +260,51 @@ impl VisibleSampler {
                 let (zh, rl) = if l == 0 { (grid.cos[k], grid.sin[k]) } else { pair[0].sin_cos() };
                 let (zl, rh) =
                     if pair[1] == g1 { (grid.cos[k + 1], grid.sin[k + 1]) } else { pair[1].sin_cos() };
-                cells.push(Cell { z_lo: zl, z_hi: zh, rho_lo: rl, rho_hi: rh, weight: f * (zh - zl) / PI });
+                // a cell at the zone's lower (upper) end next to a ring of no density keeps 2⁻²⁰ of
+                // z clear: the f32 normal's slope radius is within 2⁻²² of the f64 one
+                let empty_below = pair[1] == g1 && (k == n || factors[k + 1] <= 0.0);
+                let empty_above = l == 0 && k > 0 && factors[k - 1] <= 0.0;
+                let clear = |z: f64| (GUARD * z / (zh - zl)).min(0.25);
+                let guard = (
+                    if zl == 0.0 {
+                        TAIL_CUT
+                    } else if empty_below {
+                        clear(zl)
+                    } else {
+                        0.0
+                    },
+                    if empty_above { clear(zh) } else { 0.0 },
+                );
+                cells.push(Cell {
+                    z_lo: zl,
+                    z_hi: zh,
+                    rho_lo: rl,
+                    rho_hi: rh,
+                    weight: f * (zh - zl) / PI,
+                    guard,
+                });
             }
         }
+        zone_start.resize(n + 2, cells.len() as u32);
         let mut sampler = Self {
             cells,
+            zone_start,
             nodes: Vec::new(),
             inv_det: Vec::new(),
             cdf: Vec::new(),
             guide: Vec::new(),
             e_min: 0.0,
             tail,
+            last_ring: {
+                // the last ring of positive density (beyond it the table is empty)
+                let last = factors[..n].iter().rposition(|f| *f > 0.0).unwrap_or(0);
+                LastRing {
+                    cot_inner: grid.cos[last] / grid.sin[last].max(f64::MIN_POSITIVE),
+                    z_low: grid.cos[last + 1],
+                    rho_low: grid.sin[last + 1],
+                    density: factors[last] / PI,
+                }
+            },
         };
         // below e_min only the tail zone is visible: sin ε′ ≤ cos θ′_N, tan ε′ = cot θ′_N
         let cot_last = grid.cos[n] / grid.sin[n];
@@ -259,7 +371,8 @@ impl VisibleSampler {
             }
             self.guide.push(k as u32);
         }
-        self.nodes.push(Node { b, a, first, len, at, guide_at, last, total });
+        let inv_total = if total > 0.0 { 1.0 / total } else { 0.0 };
+        self.nodes.push(Node { b, a, first, len, at, guide_at, last, total, inv_total });
     }
 
     /// The majorant mass of `cell` at `node` (0 if the node does not see it).
@@ -272,22 +385,76 @@ impl VisibleSampler {
         self.cdf[k + 1] - self.cdf[k]
     }
 
-    /// The cell of `node` holding the fraction `u` ∈ [0, 1) of its mass, and the residual
-    /// uniform in it.
+    /// The proposal for the direction (b, a) in node interval `n` (visibility line in `ring`):
+    /// the two nodes and their weights λ, μ, the frontier's rectangle from below, the nodes'
+    /// masses without the frontier cell, and the total.
     #[inline(always)]
-    fn pick(&self, node: &Node, u: f64) -> (usize, f64) {
+    fn proposal(&self, n: usize, b: f64, a: f64, ring: usize) -> Proposal<'_> {
+        let (na, nb) = (&self.nodes[n], &self.nodes[n + 1]);
+        let inv = self.inv_det[n];
+        let lambda = ((b * nb.a - a * nb.b) * inv).max(0.0);
+        let mu = ((na.b * a - na.a * b) * inv).max(0.0);
+        // from below, the cells above the top of the visible region are excluded, and its top
+        // cell has its own proposal (the nodes', which see more of it, would lose most of their
+        // mass where its visible part is a sliver)
+        let (frontier, skip_a, skip_b) = if a < 0.0 {
+            let (cell, frontier) = self.frontier(b, a, ring);
+            (frontier, self.mass_before(na, cell + 1), self.mass_before(nb, cell + 1))
+        } else {
+            (None, 0.0, 0.0)
+        };
+        let (pa, pb) = (lambda * (na.total - skip_a), mu * (nb.total - skip_b));
+        let rect = frontier.map_or(0.0, |f| f.mass);
+        Proposal { na, nb, lambda, mu, frontier, skip_a, skip_b, pa, pb, rect, total: pa + pb + rect }
+    }
+
+    /// The cell of `node` at the cumulative mass `target` + `shift` (the mass of the excluded
+    /// cells before the first one proposed), and the residual uniform in it.
+    #[inline(always)]
+    fn pick(&self, node: &Node, target: f64, shift: f64) -> (usize, f64) {
         let cdf = &self.cdf[node.at..=node.at + node.len];
-        let target = u * node.total;
-        let mut k = self.guide[node.guide_at + ((u * node.len as f64) as usize).min(node.len - 1)] as usize;
+        let target = target + shift;
+        let guess = ((target * node.inv_total * node.len as f64) as usize).min(node.len - 1);
+        let mut k = self.guide[node.guide_at + guess] as usize;
         while k + 1 < node.len && cdf[k + 1] <= target {
             k += 1;
         }
         if cdf[k + 1] <= target {
-            // u·Q rounded up to Q: the last cell of positive mass, at its top
+            // the target rounded up to Q: the last cell of positive mass, at its top
             return (node.first + node.last, ONE_BELOW);
         }
         let rest = ((target - cdf[k]) / (cdf[k + 1] - cdf[k])).clamp(0.0, ONE_BELOW);
         (node.first + k, rest)
+    }
+
+    /// The mass of the cells before `end` at `node` (0 if none).
+    #[inline(always)]
+    fn mass_before(&self, node: &Node, end: usize) -> f64 {
+        self.cdf[node.at + end.saturating_sub(node.first).min(node.len)]
+    }
+
+    /// For a direction from below (a < 0) whose visibility line lies in ring `ring`: the cell
+    /// holding the top of its visible region, z_vis = sin ε′ = b/|ν| (the cells before it are
+    /// not visible), and the rectangle that holds its visible part if it has mass
+    /// ([`Frontier`]).
+    #[inline]
+    fn frontier(&self, b: f64, a: f64, ring: usize) -> (usize, Option<Frontier>) {
+        let len = b.hypot(a);
+        let (b, a) = (b / len, a / len);
+        let z_vis = b;
+        let (start, end) = (self.zone_start[ring] as usize, self.zone_start[ring + 1] as usize);
+        let Some(cell) = (start..end).find(|&k| self.cells[k].z_lo < z_vis) else { return (end, None) };
+        let c = &self.cells[cell];
+        // ρ at the cell's lower end is rho_hi (cells are ordered by θ′)
+        let top = a * c.z_lo + b * c.rho_hi;
+        if top <= 0.0 || c.weight <= 0.0 {
+            return (cell, None);
+        }
+        let z_top = z_vis.min(c.z_hi);
+        let phi0 = (-a * c.z_lo / (b * c.rho_hi)).clamp(-1.0, 1.0).acos();
+        // the rectangle's mass in the nodes' units: |ν| · D′ · top · Δz · φ₀ (half the circle)
+        let mass = len * c.weight / (c.z_hi - c.z_lo) * top * (z_top - c.z_lo) * phi0;
+        (cell, Some(Frontier { cell, b, a, top, z_top, phi0, mass }))
     }
 
     /// The interval between nodes holding the stretched direction (b, a) (b ≥ 0, any length);
@@ -309,18 +476,26 @@ impl VisibleSampler {
     }
 
     /// A visible normal of the stretched hemisphere seen from the stretched direction
-    /// (b, 0, a) (b ≥ 0; any positive length), in that direction's azimuth frame: exact, from
-    /// the uniforms `u1`, `u2` (module documentation). `None` if the direction sees nothing.
-    pub(super) fn sample(&self, b: f64, a: f64, u1: f32, u2: f32) -> Option<DVec3> {
-        let Some(n) = self.interval(b, a) else { return self.near_nadir(b, a, u1, u2) };
-        let (na, nb) = (&self.nodes[n], &self.nodes[n + 1]);
-        let inv = self.inv_det[n];
-        let lambda = ((b * nb.a - a * nb.b) * inv).max(0.0);
-        let mu = ((na.b * a - na.a * b) * inv).max(0.0);
-        let (pa, pb) = (lambda * na.total, mu * nb.total);
-        let total = pa + pb;
+    /// (b, 0, a) (b ≥ 0; any positive length), in that direction's azimuth frame and as a
+    /// positive multiple of the unit normal: exact, from the uniforms `u1`, `u2` (module
+    /// documentation). [`Visible::TailOnly`] for the directions nearer the nadir than the last
+    /// node when the table has a tail (they see only the tail zone, where the table is the unit
+    /// GGX lobe: the caller samples it), [`Visible::Nothing`] if the direction sees nothing.
+    pub(super) fn sample(&self, b: f64, a: f64, ring: usize, u1: f32, u2: f32) -> Visible {
+        if !self.tail && a < 0.0 && b < -a * self.last_ring.cot_inner {
+            return if self.last_ring.density > 0.0 {
+                self.last_ring_only(b, a, u1, u2)
+            } else {
+                Visible::Nothing
+            };
+        }
+        let Some(n) = self.interval(b, a) else {
+            return if self.tail { Visible::TailOnly } else { Visible::Nothing };
+        };
+        let p = self.proposal(n, b, a, ring);
+        let Proposal { na, nb, lambda, mu, frontier, skip_a, skip_b, pa, pb, rect, total } = p;
         if !(total > 0.0 && total < f64::INFINITY) {
-            return None;
+            return Visible::Nothing;
         }
         let key = (u64::from(u1.to_bits()) << 32) | u64::from(u2.to_bits());
         let (mut v1, mut v2) = (f64::from(u1), f64::from(u2));
@@ -331,11 +506,31 @@ impl VisibleSampler {
                 v2 = unit(mix(key, 3 * trial + 1));
             }
             let x = v1 * total;
-            let (node, rest) = if x < pa { (na, x / pa) } else { (nb, ((x - pa) / pb).min(ONE_BELOW)) };
-            if node.len == 0 {
+            let (cell, r1) = if x < pa {
+                self.pick(na, x / lambda, skip_a)
+            } else if x < pa + pb {
+                self.pick(nb, ((x - pa) / mu).min((nb.total - skip_b) * ONE_BELOW), skip_b)
+            } else if let Some(f) = frontier {
+                // the frontier's rectangle: z uniform, the coin and |φ| uniform, accepted with
+                // ⟨ν̂, m⟩/top
+                let r = ((x - pa - pb) / rect).clamp(0.0, ONE_BELOW);
+                let c = &self.cells[f.cell];
+                let z = c.z_lo + r.clamp(c.guard.0, 1.0 - c.guard.1) * (f.z_top - c.z_lo);
+                let (flip, v) = if v2 < 0.5 { (false, 2.0 * v2) } else { (true, 2.0 * v2 - 1.0) };
+                let (sin_phi, cos_phi) = (v * f.phi0).sin_cos();
+                let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
+                let w = f.a * z + f.b * rho * cos_phi;
+                if w > 0.0 {
+                    let m = DVec3::new(rho * cos_phi, if flip { -rho * sin_phi } else { rho * sin_phi }, z);
+                    last = Some(m);
+                    if unit(mix(key, 3 * trial + 2)) * f.top < w {
+                        return Visible::Normal(m);
+                    }
+                }
                 continue;
-            }
-            let (cell, r1) = self.pick(node, rest);
+            } else {
+                continue;
+            };
             let c = &self.cells[cell];
             let (weights, octants) = majorants(c, a, b);
             let sum = (octants[0] + octants[1]) + (octants[2] + octants[3]);
@@ -368,7 +563,7 @@ impl VisibleSampler {
             // the point: z uniform in the cell, τ uniform in the bin; (cos φ, sin φ) =
             // (1 − τ², 2τ)/d, d = 1 + τ², kept unnormalized (everything below is homogeneous)
             let (zl, zh) = (c.z_lo, c.z_hi);
-            let r1 = if zl == 0.0 { r1.max(TAIL_CUT) } else { r1 };
+            let r1 = r1.clamp(c.guard.0, 1.0 - c.guard.1);
             let z = zl + r1 * (zh - zl);
             let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
             let tau = AZIMUTH_BINS.tau_lo[bin] + r2 * BIN_STEP;
@@ -383,43 +578,71 @@ impl VisibleSampler {
             };
             // d times the stretched normal m
             let m = DVec3::new(rho * cos_phi, if flip { -rho * sin_phi } else { rho * sin_phi }, d * z);
-            last = Some(m);
             // accept with probability [⟨ν, m⟩(1 + τ_lo²)/((1 + τ²) w̄)]·[weight·Σ/mixture], the
             // first factor the point's against the bin's bound, the second the cell's own
             // majorant against the nodes' mixture (both ≤ 1, by convexity for the second);
             // ⟨ν, m⟩ = (a·dz + b·ρ cos φ̃)/d: the test multiplied through, without a division
             let dot = a * m.z + b * rho * cos_phi;
             let numerator = dot * AZIMUTH_BINS.lo_factor[bin] * c.weight * sum;
-            if numerator > 0.0 && unit(mix(key, 3 * trial + 2)) * (d * d * bar * mixture) < numerator {
-                return Some(m);
+            if numerator > 0.0 {
+                last = Some(m);
+                if unit(mix(key, 3 * trial + 2)) * (d * d * bar * mixture) < numerator {
+                    return Visible::Normal(m);
+                }
+            }
+        }
+        last.map_or(Visible::Nothing, Visible::Normal)
+    }
+
+    /// A table without a tail seen from so near the nadir that only its last ring L of positive
+    /// density is visible (tan ε′ = b/|a| < cot θ′_L): a sliver above the ring's lower end
+    /// z_low = cos θ′_{L+1}, where the cells' majorants lose most of their mass as the sliver
+    /// shrinks. There D′ is constant, and the visible normals are drawn exactly by rejection
+    /// from the rectangle z ∈ [z_low, z_vis], |φ| ≤ φ₀ in (z, φ) (uniform in solid angle) that
+    /// holds them: z_vis = sin ε′ the highest visible z, cos φ₀ = |a| z_low/(b ρ_low) the
+    /// widest visible azimuth (at z_low), and ⟨ν, m⟩ ≤ its value at (z_low, 0). The acceptance
+    /// rate tends to 4/15 as the sliver vanishes (its scaled shape is ζ + ψ² < 1 with weight
+    /// 1 − ζ − ψ²) and is larger before.
+    fn last_ring_only(&self, b: f64, a: f64, u1: f32, u2: f32) -> Visible {
+        let len = b.hypot(a);
+        let (b, a) = (b / len, a / len);
+        let Some((top, z_vis, phi0)) = self.last_ring.rectangle(b, a) else { return Visible::Nothing };
+        let z_low = self.last_ring.z_low;
+        let key = (u64::from(u1.to_bits()) << 32) | u64::from(u2.to_bits());
+        let (mut v1, mut v2) = (f64::from(u1), f64::from(u2));
+        let mut last = Visible::Nothing;
+        for trial in 0..MAX_TRIALS {
+            if trial > 0 {
+                v1 = unit(mix(key, 3 * trial));
+                v2 = unit(mix(key, 3 * trial + 1));
+            }
+            let z = z_low + v1.max((GUARD * z_low / (z_vis - z_low)).min(0.25)) * (z_vis - z_low);
+            let (sin_phi, cos_phi) = ((2.0 * v2 - 1.0) * phi0).sin_cos();
+            let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
+            let m = DVec3::new(rho * cos_phi, rho * sin_phi, z);
+            let w = a * z + b * rho * cos_phi;
+            if w > 0.0 {
+                last = Visible::Normal(m);
+                if unit(mix(key, 3 * trial + 2)) * top < w {
+                    return last;
+                }
             }
         }
         last
     }
 
-    /// Directions nearer the nadir than the last node: with a tail, every normal they see is in
-    /// the tail zone, where the table is the unit GGX lobe (D′ constant), sampled exactly by
-    /// the spherical cap; without one they see nothing.
-    fn near_nadir(&self, b: f64, a: f64, u1: f32, u2: f32) -> Option<DVec3> {
-        if !self.tail {
-            return None;
+    /// The total proposal mass for the stretched direction (b, a) (b ≥ 0, any length; the
+    /// visibility line in ring `ring`), in units where the exact visible mass is half the
+    /// projected area |ν|·A′(ν̂) (the bins cover half the circle): the acceptance rate is
+    /// A/(2·this). `None` where no rejection is used (the tail alone).
+    pub(super) fn proposal_mass(&self, b: f64, a: f64, ring: usize) -> Option<f64> {
+        if !self.tail && a < 0.0 && b < -a * self.last_ring.cot_inner {
+            let len = b.hypot(a);
+            let (top, z_vis, phi0) = self.last_ring.rectangle(b / len, a / len)?;
+            return Some(len * self.last_ring.density * top * (z_vis - self.last_ring.z_low) * phi0);
         }
-        let len = b.hypot(a);
-        let v = Vec3::new((b / len) as f32, 0.0, (a / len) as f32);
-        sample_visible_hemisphere(v, 1.0, u1, u2).as_dvec3().try_normalize()
-    }
-
-    /// The total proposal mass λQₐ + μQ_b for the stretched direction (b, a) (b ≥ 0, any
-    /// length), in units where the exact visible mass is half the projected area |ν|·A′(ν̂)
-    /// (the bins cover half the circle): the acceptance rate is A/(2·this). `None` below the
-    /// last node (sampled exactly without rejection).
-    pub(super) fn proposal_mass(&self, b: f64, a: f64) -> Option<f64> {
         let n = self.interval(b, a)?;
-        let (na, nb) = (&self.nodes[n], &self.nodes[n + 1]);
-        let inv = self.inv_det[n];
-        let lambda = ((b * nb.a - a * nb.b) * inv).max(0.0);
-        let mu = ((na.b * a - na.a * b) * inv).max(0.0);
-        Some(lambda * na.total + mu * nb.total)
+        Some(self.proposal(n, b, a, ring).total)
     }
 
     /// Heap bytes of the tables.

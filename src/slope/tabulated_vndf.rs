@@ -13,8 +13,8 @@
 //!   ⟨ν, m⟩ = a z + b ρ cos φ (ν = (b, 0, a), z = cos θ′, ρ = sin θ′) is bounded by
 //!   w̄ = (a·z_ext + b·cos φ_max·ρ_ext)₊ with each term at its extreme, a positively
 //!   homogeneous convex function of ν.
-//! * **Nodes.** 25 directions uniform in the stretched octahedral coordinate
-//!   t = a/(b + |a|) from the zenith to e = 1 + t = ½, then two per halving of e − e_min down
+//! * **Nodes.** 31 directions uniform in the stretched octahedral coordinate
+//!   t = a/(b + |a|) from the zenith to e = 1 + t = ⅛, then two per halving of e − e_min down
 //!   to 1e-3 e_min, and e_min, the direction below which only the tail zone is visible (about
 //!   60 in all at N = 256). Each node stores the cumulative majorant masses of the cells it
 //!   sees (f64) and a guide table. A direction between nodes νₐ and ν_b is ν = λνₐ + μν_b with
@@ -57,12 +57,10 @@ const MAX_CELL_ANGLE: f64 = 0.05;
 /// Zones whose ends' angles from the horizon differ by more than this ratio are split too.
 const MAX_CELL_RATIO: f64 = 1.25;
 /// Intervals uniform in the octahedral coordinate t = a/(b + |a|), from the zenith (t = 1) to
-/// t = −½ (e = 1 + t = ½).
-const REGULAR_INTERVALS: usize = 24;
-/// Where the geometric nodes take over: e = ½.
-const E_REGULAR: f64 = 0.5;
-/// Geometric nodes per halving of e − e_min, down to 1e-3 e_min.
-const GEOMETRIC_PER_OCTAVE: f64 = 2.0;
+/// t = −⅞ (e = 1 + t = ⅛).
+const REGULAR_INTERVALS: usize = 30;
+/// Where the geometric nodes take over: e = ⅛.
+const E_REGULAR: f64 = 0.125;
 /// Bins per octant of the azimuth, uniform in τ ∈ [0, tan(π/8)].
 const OCTANT_BINS: usize = 4;
 /// Bins of the half circle φ ∈ [0, π].
@@ -118,6 +116,14 @@ impl Bins {
     }
 }
 
+/// The outcome of one proposal.
+enum Trial {
+    /// Accepted: the normal (a positive multiple).
+    Accepted(DVec3),
+    /// Rejected, with the proposal if it was visible.
+    Rejected(Option<DVec3>),
+}
+
 /// The outcome of [`VisibleSampler::sample`].
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Visible {
@@ -168,6 +174,7 @@ struct Frontier {
 }
 
 /// The proposal of one direction (see [`VisibleSampler::proposal`]).
+#[derive(Clone, Copy)]
 struct Proposal<'a> {
     na: &'a Node,
     nb: &'a Node,
@@ -190,6 +197,8 @@ struct Cell {
     rho_lo: f64,
     rho_hi: f64,
     weight: f64,
+    /// D′ = fₖ/π, the density of normals in the cell.
+    density: f64,
     /// The fractions of the cell's z-range kept clear at its ends where the model has no
     /// density beyond them (a truncated end or a zero ring; 2⁻²⁰ of z relative, so that the f32
     /// normal stays on the dense side, or the tail cut at the horizon), else 0.
@@ -291,6 +300,7 @@ impl VisibleSampler {
                     rho_lo: rl,
                     rho_hi: rh,
                     weight: f * (zh - zl) / PI,
+                    density: f / PI,
                     guard,
                 });
             }
@@ -325,18 +335,19 @@ impl VisibleSampler {
                 (1.0 - t.abs(), t)
             })
             .collect();
-        // then e = e_min + (½ − e_min)·2^(−j/2), down to 1e-3 e_min, and e_min itself
+        // then e = e_min + d with d = (⅛ − e_min)·2^(−j/2) (two per halving), down to
+        // 1e-3 e_min, and e_min itself
         let span = E_REGULAR - sampler.e_min;
-        let mut j = 1.0;
+        let mut j = 1;
         loop {
-            let d = span * (-j / GEOMETRIC_PER_OCTAVE).exp2();
+            let d = span * half_octaves(j);
             if d <= 1e-3 * sampler.e_min {
                 directions.push((sampler.e_min, sampler.e_min - 1.0));
                 break;
             }
             let e = sampler.e_min + d;
             directions.push((e, e - 1.0));
-            j += 1.0;
+            j += 1;
         }
         for (b, a) in directions {
             let len = b.hypot(a);
@@ -454,18 +465,18 @@ impl VisibleSampler {
         let Some(cell) = (start..end).find(|&k| self.cells[k].z_lo < z_vis) else { return (end, None) };
         let c = &self.cells[cell];
         // ρ at the cell's lower end is rho_hi (cells are ordered by θ′); ⟨ν, m⟩ is largest
-        // there at φ = 0, and the visible azimuths are widest: cos φ₀ = κ = −a z_lo/(b ρ_lo),
+        // there at φ = 0, and the visible azimuths are widest: cos φ₀ = κ = −a z_lo/(b ρ),
         // tan(φ₀/2) = √((1 − κ)/(1 + κ))
         let top = a * c.z_lo + b * c.rho_hi;
         if top <= 0.0 || c.weight <= 0.0 {
             return (cell, None);
         }
         let z_top = z_vis.min(c.z_hi);
-        let kappa = (-a * c.z_lo / (b * c.rho_hi)).clamp(0.0, 1.0);
-        let tau0 = ((1.0 - kappa) / (1.0 + kappa)).sqrt();
+        // (1 − κ)/(1 + κ) = (bρ + a z_lo)/(bρ − a z_lo) = top/(bρ − a z_lo)
+        let tau0 = (top / (b * c.rho_hi - a * c.z_lo)).min(1.0).sqrt();
         // the proposal's mass in the nodes' units: D′ · top · Δz · 2τ₀ (half the circle, the
         // φ-measure 2dτ/(1 + τ²) bounded by 2dτ)
-        let mass = c.weight / (c.z_hi - c.z_lo) * top * (z_top - c.z_lo) * 2.0 * tau0;
+        let mass = c.density * top * (z_top - c.z_lo) * 2.0 * tau0;
         (cell, Some(Frontier { cell, top, z_top, tau0, mass }))
     }
 
@@ -483,8 +494,7 @@ impl VisibleSampler {
         if d.is_nan() || d < 0.0 {
             return None;
         }
-        let j = (GEOMETRIC_PER_OCTAVE * ((E_REGULAR - self.e_min) / d).log2()) as usize;
-        Some((REGULAR_INTERVALS + j).min(self.nodes.len() - 2))
+        Some((REGULAR_INTERVALS + half_octave_index((E_REGULAR - self.e_min) / d)).min(self.nodes.len() - 2))
     }
 
     /// A visible normal of the stretched hemisphere seen from the stretched direction
@@ -505,110 +515,131 @@ impl VisibleSampler {
             return if self.tail { Visible::TailOnly } else { Visible::Nothing };
         };
         let p = self.proposal(n, b, a, ring);
-        let Proposal { na, nb, lambda, mu, frontier, skip_a, skip_b, pa, pb, rect, total } = p;
-        if !(total > 0.0 && total < f64::INFINITY) {
+        if !(p.total > 0.0 && p.total < f64::INFINITY) {
             return Visible::Nothing;
         }
         let key = (u64::from(u1.to_bits()) << 32) | u64::from(u2.to_bits());
-        let (mut v1, mut v2) = (f64::from(u1), f64::from(u2));
-        let mut last = None;
-        for trial in 0..MAX_TRIALS {
-            if trial > 0 {
-                v1 = unit(mix(key, 3 * trial));
-                v2 = unit(mix(key, 3 * trial + 1));
-            }
-            let x = v1 * total;
-            let (cell, r1) = if x < pa {
-                self.pick(na, x / lambda, skip_a)
-            } else if x < pa + pb {
-                self.pick(nb, ((x - pa) / mu).min((nb.total - skip_b) * ONE_BELOW), skip_b)
-            } else if let Some(f) = frontier {
-                // the frontier's proposal: z uniform, the coin and τ uniform; accepted with
-                // ⟨ν, m⟩/top times the Jacobian's 1/(1 + τ²), multiplied through by d = 1 + τ²
-                let r = ((x - pa - pb) / rect).clamp(0.0, ONE_BELOW);
-                let c = &self.cells[f.cell];
-                let z = c.z_lo + r.clamp(c.guard.0, 1.0 - c.guard.1) * (f.z_top - c.z_lo);
-                let (flip, v) = if v2 < 0.5 { (false, 2.0 * v2) } else { (true, 2.0 * v2 - 1.0) };
-                let tau = v * f.tau0;
-                let tau2 = tau * tau;
-                let d = 1.0 + tau2;
-                let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
-                let (cos_phi, sin_phi) = (1.0 - tau2, 2.0 * tau);
-                let dot = a * z * d + b * rho * cos_phi;
-                if dot > 0.0 {
-                    // d times the normal
-                    let m =
-                        DVec3::new(rho * cos_phi, if flip { -rho * sin_phi } else { rho * sin_phi }, d * z);
-                    last = Some(m);
-                    if unit(mix(key, 3 * trial + 2)) * f.top * d * d < dot {
-                        return Visible::Normal(m);
-                    }
-                }
-                continue;
-            } else {
-                continue;
-            };
-            let c = &self.cells[cell];
-            let (weights, octants) = majorants(c, a, b);
-            let sum = (octants[0] + octants[1]) + (octants[2] + octants[3]);
-            let mixture = lambda * self.mass(na, cell) + mu * self.mass(nb, cell);
-            if !(sum > 0.0 && mixture > 0.0) {
-                continue;
-            }
-            // the coin, then the octant and the bin (the first whose cumulative mass exceeds
-            // the target), and τ from the second uniform
-            let (flip, v) = if v2 < 0.5 { (false, 2.0 * v2) } else { (true, 2.0 * v2 - 1.0) };
-            let target = v * sum;
-            let mut acc = 0.0;
-            let mut octant = 0;
-            while octant < 3 && target >= acc + octants[octant] {
-                acc += octants[octant];
-                octant += 1;
-            }
-            let mut bin = octant * OCTANT_BINS;
-            while bin + 1 < (octant + 1) * OCTANT_BINS && target >= acc + weights[bin] {
-                acc += weights[bin];
-                bin += 1;
-            }
-            if weights[bin] <= 0.0 {
-                // rounding put the target past the last bin of positive mass: that bin, at its top
-                bin = weights.iter().rposition(|w| *w > 0.0).unwrap_or(0);
-                acc = target - weights[bin];
-            }
-            let r2 = ((target - acc) / weights[bin]).clamp(0.0, ONE_BELOW);
-            let bar = bound(c, a, b, bin);
-            // the point: z uniform in the cell, τ uniform in the bin; (cos φ, sin φ) =
-            // (1 − τ², 2τ)/d, d = 1 + τ², kept unnormalized (everything below is homogeneous)
-            let (zl, zh) = (c.z_lo, c.z_hi);
-            let r1 = r1.clamp(c.guard.0, 1.0 - c.guard.1);
-            let z = zl + r1 * (zh - zl);
-            let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
-            let tau = AZIMUTH_BINS.tau_lo[bin] + r2 * BIN_STEP;
-            let tau2 = tau * tau;
-            let d = 1.0 + tau2;
-            let (ch, sh) = (1.0 - tau2, 2.0 * tau);
-            let (cos_phi, sin_phi) = match bin / OCTANT_BINS {
-                0 => (ch, sh),
-                1 => (sh, ch),
-                2 => (-sh, ch),
-                _ => (-ch, sh),
-            };
-            // d times the stretched normal m
-            let m = DVec3::new(rho * cos_phi, if flip { -rho * sin_phi } else { rho * sin_phi }, d * z);
-            // accept with probability [⟨ν, m⟩(1 + τ_lo²)/((1 + τ²) w̄)]·[weight·Σ/mixture], the
-            // first factor the point's against the bin's bound, the second the cell's own
-            // majorant against the nodes' mixture (both ≤ 1, by convexity for the second);
-            // ⟨ν, m⟩ = (a·dz + b·ρ cos φ̃)/d: the test multiplied through, without a division
-            let dot = a * m.z + b * rho * cos_phi;
-            let numerator = dot * AZIMUTH_BINS.lo_factor[bin] * c.weight * sum;
-            if numerator > 0.0 {
-                last = Some(m);
-                if unit(mix(key, 3 * trial + 2)) * (d * d * bar * mixture) < numerator {
-                    return Visible::Normal(m);
-                }
+        // the first proposal inverts the uniforms; the rare further ones are out of line
+        match self.trial(&p, b, a, f64::from(u1), f64::from(u2), key, 0) {
+            Trial::Accepted(m) => Visible::Normal(m),
+            Trial::Rejected(last) => self.retry(&p, b, a, key, last),
+        }
+    }
+
+    /// The proposals after the first rejection (uniforms hashed from `key`), up to
+    /// [`MAX_TRIALS`]; the last visible proposal if none is accepted.
+    #[cold]
+    #[inline(never)]
+    fn retry(&self, p: &Proposal<'_>, b: f64, a: f64, key: u64, mut last: Option<DVec3>) -> Visible {
+        for trial in 1..MAX_TRIALS {
+            let (v1, v2) = (unit(mix(key, 3 * trial)), unit(mix(key, 3 * trial + 1)));
+            match self.trial(p, b, a, v1, v2, key, trial) {
+                Trial::Accepted(m) => return Visible::Normal(m),
+                Trial::Rejected(m) => last = m.or(last),
             }
         }
         last.map_or(Visible::Nothing, Visible::Normal)
+    }
+
+    /// One proposal from the uniforms `v1`, `v2` and its acceptance test (uniform hashed from
+    /// `key` and `trial`); a rejected proposal is returned if visible.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn trial(&self, p: &Proposal<'_>, b: f64, a: f64, v1: f64, v2: f64, key: u64, trial: u64) -> Trial {
+        let Proposal { na, nb, lambda, mu, frontier, skip_a, skip_b, pa, pb, rect, total } = *p;
+        let x = v1 * total;
+        let (cell, r1) = if x < pa + pb {
+            // node a or b, selected without a branch
+            let use_a = x < pa;
+            let node = if use_a { na } else { nb };
+            let (num, den, shift) = if use_a { (x, lambda, skip_a) } else { (x - pa, mu, skip_b) };
+            self.pick(node, (num / den).min((node.total - shift) * ONE_BELOW), shift)
+        } else if let Some(f) = frontier {
+            // the frontier's proposal: z uniform, the coin and τ uniform; accepted with
+            // ⟨ν, m⟩/top times the Jacobian's 1/(1 + τ²), multiplied through by d = 1 + τ²
+            let r = ((x - pa - pb) / rect).clamp(0.0, ONE_BELOW);
+            let c = &self.cells[f.cell];
+            let z = c.z_lo + r.clamp(c.guard.0, 1.0 - c.guard.1) * (f.z_top - c.z_lo);
+            let (flip, v) = if v2 < 0.5 { (false, 2.0 * v2) } else { (true, 2.0 * v2 - 1.0) };
+            let tau = v * f.tau0;
+            let tau2 = tau * tau;
+            let d = 1.0 + tau2;
+            let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
+            let (cos_phi, sin_phi) = (1.0 - tau2, 2.0 * tau);
+            let dot = a * z * d + b * rho * cos_phi;
+            if dot > 0.0 {
+                // d times the normal
+                let m = DVec3::new(rho * cos_phi, if flip { -rho * sin_phi } else { rho * sin_phi }, d * z);
+                if unit(mix(key, 3 * trial + 2)) * f.top * d * d < dot {
+                    return Trial::Accepted(m);
+                }
+                return Trial::Rejected(Some(m));
+            }
+            return Trial::Rejected(None);
+        } else {
+            return Trial::Rejected(None);
+        };
+        let c = &self.cells[cell];
+        let (weights, octants) = majorants(c, a, b);
+        let sum = (octants[0] + octants[1]) + (octants[2] + octants[3]);
+        let mixture = lambda * self.mass(na, cell) + mu * self.mass(nb, cell);
+        if !(sum > 0.0 && mixture > 0.0) {
+            return Trial::Rejected(None);
+        }
+        // the coin, then the octant and the bin (the first whose cumulative mass exceeds
+        // the target), and τ from the second uniform
+        let (flip, v) = if v2 < 0.5 { (false, 2.0 * v2) } else { (true, 2.0 * v2 - 1.0) };
+        let target = v * sum;
+        // branch-free: the octant, then the bin, counted by comparisons with the cumulative
+        // masses
+        let (c1, c2) = (octants[0], octants[0] + octants[1]);
+        let c3 = c2 + octants[2];
+        let octant = usize::from(target >= c1) + usize::from(target >= c2) + usize::from(target >= c3);
+        let base = [0.0, c1, c2, c3][octant];
+        let q = &weights[octant * OCTANT_BINS..(octant + 1) * OCTANT_BINS];
+        let (b1, b2) = (base + q[0], base + q[0] + q[1]);
+        let b3 = b2 + q[2];
+        let within = usize::from(target >= b1) + usize::from(target >= b2) + usize::from(target >= b3);
+        let mut bin = octant * OCTANT_BINS + within;
+        let mut acc = [base, b1, b2, b3][within];
+        if weights[bin] <= 0.0 {
+            // rounding put the target past the last bin of positive mass: that bin, at its top
+            bin = weights.iter().rposition(|w| *w > 0.0).unwrap_or(0);
+            acc = target - weights[bin];
+        }
+        let r2 = ((target - acc) / weights[bin]).clamp(0.0, ONE_BELOW);
+        let bar = bound(c, a, b, bin);
+        // the point: z uniform in the cell, τ uniform in the bin; (cos φ, sin φ) =
+        // (1 − τ², 2τ)/d, d = 1 + τ², kept unnormalized (everything below is homogeneous)
+        let (zl, zh) = (c.z_lo, c.z_hi);
+        let r1 = r1.clamp(c.guard.0, 1.0 - c.guard.1);
+        let z = zl + r1 * (zh - zl);
+        let rho = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
+        let tau = AZIMUTH_BINS.tau_lo[bin] + r2 * BIN_STEP;
+        let tau2 = tau * tau;
+        let d = 1.0 + tau2;
+        let (ch, sh) = (1.0 - tau2, 2.0 * tau);
+        let (cos_phi, sin_phi) = match bin / OCTANT_BINS {
+            0 => (ch, sh),
+            1 => (sh, ch),
+            2 => (-sh, ch),
+            _ => (-ch, sh),
+        };
+        // d times the stretched normal m
+        let m = DVec3::new(rho * cos_phi, if flip { -rho * sin_phi } else { rho * sin_phi }, d * z);
+        // accept with probability [⟨ν, m⟩(1 + τ_lo²)/((1 + τ²) w̄)]·[weight·Σ/mixture], the
+        // first factor the point's against the bin's bound, the second the cell's own
+        // majorant against the nodes' mixture (both ≤ 1, by convexity for the second);
+        // ⟨ν, m⟩ = (a·dz + b·ρ cos φ̃)/d: the test multiplied through, without a division
+        let dot = a * m.z + b * rho * cos_phi;
+        let numerator = dot * AZIMUTH_BINS.lo_factor[bin] * c.weight * sum;
+        if numerator > 0.0 {
+            if unit(mix(key, 3 * trial + 2)) * (d * d * bar * mixture) < numerator {
+                return Trial::Accepted(m);
+            }
+            return Trial::Rejected(Some(m));
+        }
+        Trial::Rejected(None)
     }
 
     /// A table without a tail seen from so near the nadir that only its last ring L of positive
@@ -700,6 +731,30 @@ fn bound(cell: &Cell, a: f64, b: f64, bin: usize) -> f64 {
     let head = a * if a >= 0.0 { cell.z_hi } else { cell.z_lo };
     let rho = if bin < BINS / 2 { cell.rho_hi } else { cell.rho_lo };
     (head + AZIMUTH_BINS.cos_max[bin] * b * rho).max(0.0)
+}
+
+/// 2^(−j/2) exactly as the geometric nodes are placed: 2^(−⌊j/2⌋), divided by √2 for odd j.
+fn half_octaves(j: u32) -> f64 {
+    let whole = (-f64::from(j / 2)).exp2();
+    if j % 2 == 1 { whole * core::f64::consts::FRAC_1_SQRT_2 } else { whole }
+}
+
+/// ⌊2 log₂ x⌋ for x ≥ 1 (0 below), from the float's exponent and a comparison of its
+/// mantissa with √2: the j with 2^(j/2) ≤ x < 2^((j+1)/2), consistent with [`half_octaves`]
+/// up to the rounding of √2 (a direction within an ulp of a node may fall in the neighbouring
+/// interval, where λ or μ is then −0 and clamped).
+#[inline(always)]
+fn half_octave_index(x: f64) -> usize {
+    if x.is_nan() || x < 1.0 {
+        return 0;
+    }
+    if x.is_infinite() {
+        return usize::MAX / 2;
+    }
+    let bits = x.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as usize - 1023;
+    let mantissa = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
+    2 * exponent + usize::from(mantissa >= core::f64::consts::SQRT_2)
 }
 
 /// splitmix64 of `key` advanced `index` + 1 times (Steele, Lea and Flood 2014): a stream of

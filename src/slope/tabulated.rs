@@ -855,14 +855,11 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
             return 0.0;
         }
         let (sx, sy) = (f64::from(self.sx), f64::from(self.sy));
-        // the stretched normal (m.x/sx, m.y/sy, m.z) has the stretched slopes; D transforms
-        // with cos⁴: D(m) = D_table(m′) (cos θm′/cos θm)⁴ /(sx sy) for unit m, m′
-        let m = DVec3::new(wm.x / sx, wm.y / sy, wm.z);
-        let (lm, lw) = (m.length(), wm.length());
-        let h2 = m.x * m.x + m.y * m.y;
-        let d_table = self.table.d_of(h2, m.z, h2 + m.z * m.z);
-        let ratio = (m.z / lm) / (wm.z / lw);
-        d_table * ratio.powi(4) / (sx * sy)
+        // the stretched normal m′ = (m.x/sx, m.y/sy, m.z) has the stretched slopes, and D
+        // transforms with cos⁴: D(m) = D_table(m′)(cos θm′/cos θm)⁴/(sx sy) =
+        // fₖ s²/π·(|m|²/(s² m.z² + |m′_xy|²))²/(sx sy), the table's form with |m|² for |m′|²
+        let (x, y) = (wm.x / sx, wm.y / sy);
+        self.table.d_of(x * x + y * y, wm.z, wm.length_squared()) / (sx * sy)
     }
 
     /// The table's Λ at the stretched direction (the table's back-face area is homogeneous of

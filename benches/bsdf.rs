@@ -19,10 +19,11 @@
 //! `gold/single/sample-vs-vndf/{sample_d_wi|static}`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use microsurface::research::{Estimator, Material, Microsurface, Shadowing, SpecularLimit, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric,
-    Estimator, Ggx, KullaContyDielectric, Material, MicrofacetBsdf, Microsurface, MicrosurfaceSlope,
-    Shadowing, SpecularLimit, Technique, UniformHeight,
+    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
+    KullaContyDielectric, MicrofacetBsdf, Technique,
 };
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;

@@ -16,10 +16,10 @@
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use microsurface::{
-    Beckmann, GaussianHeight, Ggx, GridSlope, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope,
-    TabulatedSlope, UniformHeight,
-};
+use microsurface::research::{GaussianHeight, MicrosurfaceGeometry, MicrosurfaceHeight, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::tabulated::{GridSlope, TabulatedSlope};
+use microsurface::{Beckmann, Ggx};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;

@@ -11,10 +11,11 @@
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use microsurface::{
-    AxisAlignedSlope, Beckmann, BeckmannNewton, Elliptical, Ggx, GgxDisk, GgxSphericalCap, MicrosurfaceSlope,
-    SmithVndf, VCavity, VisibleNormalSampler,
+use microsurface::slope::{AxisAlignedSlope, MicrosurfaceSlope};
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
 };
+use microsurface::{Beckmann, Elliptical, Ggx};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;

@@ -19,10 +19,9 @@
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope,
-    ScatteringOrder, UniformHeight,
-};
+use microsurface::research::{Material, Microsurface, ScatteringOrder, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;

@@ -4,10 +4,9 @@
 //! Run with `cargo run --release --example tour`.
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceHeight,
-    MicrosurfaceSlope, ScatteringOrder, UniformHeight,
-};
+use microsurface::research::{Material, Microsurface, MicrosurfaceHeight, ScatteringOrder, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
 
 type Rng = rand_pcg::Pcg64Mcg;

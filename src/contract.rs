@@ -20,7 +20,7 @@
 //! material methods once or more per bounce with directions they produced themselves (unit up
 //! to rounding), the crate calls their `*_unchecked` forms and the unchecked Fresnel and frame
 //! helpers: a walk pays for the check of its own arguments once per call, never per bounce.
-//! Each check is written once: the sealed [`Material`](crate::Material) trait's public
+//! Each check is written once: the sealed [`Material`](crate::research::Material) trait's public
 //! methods are provided ones that validate and call the required unchecked body; the slope
 //! traits' hidden `*_unchecked` methods default to the checked ones, which the crate's slopes
 //! override with the unchecked bodies.

@@ -1,18 +1,31 @@
 //! # microsurface
 //!
-//! Physically based microfacet BSDFs on Smith microsurfaces, **with multiple scattering**:
-//! the random-walk BSDFs of Heitz, Hanika, d'Eon and Dachsbacher 2016 (“Multiple-Scattering
-//! Microfacet BSDFs with the Smith Model”) and the position-free estimators of Wang et al.
-//! 2022 on conductor, diffuse and dielectric microfacets, built on exact visible-normal
-//! sampling, behind a small renderer-facing trait.
+//! Physically based microfacet BSDFs on Smith microsurfaces, **with multiple scattering**: the
+//! random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016, the position-free estimators of
+//! Wang et al. 2022 and the invariance-principle estimator of Cui et al. 2023 on conductor,
+//! diffuse and dielectric microfacets, energy-compensated lobes built from tables of the exact
+//! model, and exact visible-normal sampling on the whole sphere — behind one renderer-facing
+//! trait.
 //!
-//! ## For a renderer: [`Bsdf`]
+//! The documentation is grouped by use:
 //!
-//! Build a material once, then evaluate, sample and query the density in the local shading
-//! frame of each hit ([`ShadingFrame`]). `sample` takes the renderer's own uniforms (a 1D
-//! and a 2D sample, like pbrt's `Sample_f(wo, uc, u)`); every call is a pure function of its
-//! arguments, so renders are reproducible for any thread count, and `Vec<Box<dyn Bsdf>>`
-//! holds mixed materials.
+//! | you want | start at |
+//! |---|---|
+//! | a BSDF in a renderer | [`Bsdf`], [`MicrofacetBsdf`], [`ShadingFrame`] (this page) |
+//! | energy-conserving lobes at single-scattering cost | [`CompensatedConductor`], [`KullaContyDielectric`], [`compensation`] |
+//! | the papers' models for references and experiments | [`research`] |
+//! | slope distributions and visible normals | [`slope`], [`vndf`] |
+//! | measured materials, data-driven slopes | [`tabulated`] (feature `data-driven`) |
+//! | filtered displacement and normal maps | [`leadr`] (feature `leadr`) |
+//! | Fresnel terms, special functions | [`fresnel`], [`special`] |
+//!
+//! ## A BSDF in a renderer
+//!
+//! Build a material (cheap: per hit from textured parameters, or once), then evaluate, sample
+//! and query the density in the local shading frame of each hit ([`ShadingFrame`]). `sample`
+//! takes the renderer's own uniforms (a 1D and a 2D sample, like pbrt's `Sample_f(wo, uc, u)`);
+//! every call is a pure function of its arguments, so renders are reproducible for any thread
+//! count, and `Vec<Box<dyn Bsdf>>` holds mixed materials.
 //!
 //! ```
 //! use microsurface::glam::{Vec2, Vec3};
@@ -43,9 +56,10 @@
 //! # Ok::<(), microsurface::Error>(())
 //! ```
 //!
-//! [`Technique`] chooses single scattering (exact, cheapest: the research layer's
-//! [`SingleScattering`], whose sampler returns its density), the random walk, or the
-//! position-free PT and BDPT estimators; [`ClassicBrdf`] is the classic Lambert plus
+//! [`Technique`] chooses single scattering (exact, cheapest; it loses the energy of the higher
+//! orders), the random walk (the exact model, stochastic), the invariance-principle estimator of
+//! the same model, or the position-free PT and BDPT estimators; the compensated lobes restore the
+//! lost energy deterministically from tables. [`ClassicBrdf`] is the classic Lambert plus
 //! Cook–Torrance BRDF. Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes
 //! (`flags().specular`).
 //!
@@ -58,38 +72,15 @@
 //! * **Renderer layer** ([`Bsdf`], pbrt's convention): `eval(wo, wi)` with `wo` towards the
 //!   viewer and `wi` towards the light returns **f** (no cosine); a sample's weight is
 //!   f·|cos θi|/pdf.
-//! * **Research layer** ([`Microsurface`], [`PositionFree`], [`Material`], the papers'
-//!   convention): `eval(wi, wo)` with `wi` the direction light arrives from and `wo` the one it
-//!   leaves along returns **f·|cos θo|**, stochastic evaluations take `&mut impl Rng`, and a
-//!   walk sample's weight is f·|cos θo|/pdf.
+//! * **Research layer** ([`research`], the papers' convention): `eval(wi, wo)` with `wi` the
+//!   direction light arrives from and `wo` the one it leaves along returns **f·|cos θo|**,
+//!   stochastic evaluations take `&mut impl Rng`, and a walk sample's weight is f·|cos θo|/pdf.
 //!
 //! A zero component of a direction may have either sign: −0 is treated exactly like +0
 //! (ω.z = −0 is the horizon seen from above). Samplers take uniforms in [0, 1) and cut the
 //! tails of every quantile they invert at 2⁻²⁴, the spacing of 24-bit uniforms (u is used as
 //! clamp(u, 2⁻²⁴, 1 − 2⁻²⁴)): no sample lies beyond the last 2⁻²⁴ of its distribution, so the
 //! extreme uniforms never put a point mass where the model has almost nothing.
-//!
-//! See the README for the model table, the validation suite and the report.
-//!
-//! ## For research: the random walks themselves
-//!
-//! ```
-//! use microsurface::{Conductor, Ggx, Microsurface, ScatteringOrder, UniformHeight};
-//! use glam::Vec3;
-//! use rand::SeedableRng;
-//!
-//! let surface = Microsurface::new(UniformHeight, Ggx::isotropic(0.5)?, Conductor::perfect());
-//! let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
-//! let (wi, wo) = (Vec3::new(0.3, 0.0, 0.954).normalize(), Vec3::Z);
-//! let n = 10_000;
-//! // f·|cos θo| (the research layer's convention), averaged over independent walks
-//! let f_cos: f32 = (0..n).map(|_| surface.eval(wi, wo, ScatteringOrder::All, &mut rng).x).sum::<f32>() / n as f32;
-//! let single = surface.eval_single_scattering(wi, wo, &mut rng).x;
-//! assert!(f_cos > single); // multiple scattering adds energy
-//! let s = surface.sample(wi, &mut rng).expect("a walk from above always exits");
-//! assert!(s.bounces >= 1 && s.weight == Vec3::ONE);
-//! # Ok::<(), microsurface::Error>(())
-//! ```
 //!
 //! # Invalid input
 //!
@@ -103,6 +94,13 @@
 //! and a NaN direction (with a zero weight) from those that do not; NaN for quantities
 //! without a neutral value (Λ, G1, projected areas, Fresnel terms, heights). Grazing, exactly
 //! horizontal and below-horizon unit directions are valid input.
+//!
+//! # Features
+//!
+//! All on by default: `position-free` ([`research::PositionFree`], `Technique::PositionFree`),
+//! `invariance` ([`research::Invariance`], `Technique::Invariance`), `leadr` ([`leadr`]) and
+//! `data-driven` ([`tabulated`]). A renderer that needs only this page's types, the compensated
+//! lobes and the walk builds with `default-features = false`.
 
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -115,71 +113,102 @@
 
 #[macro_use]
 mod contract;
-mod albedo;
 mod basis;
 mod bsdf;
 mod constants;
 mod error;
-mod fresnel;
 mod height;
-mod leadr;
+#[cfg(feature = "invariance")]
+mod invariance;
 mod material;
-mod merl;
 mod microsurface;
+#[cfg(feature = "leadr")]
+mod noncentral;
+mod path;
+#[cfg(feature = "position-free")]
 mod position_free;
 mod rng;
 mod sampling;
 mod sealed;
 mod single_scattering;
-mod slope;
-mod special;
 mod vector;
-mod vndf;
 
-pub use albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
-    DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
-    MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable,
-    TabulatedOrder, WALK_BATCH,
-};
-pub use basis::orthonormal_basis;
+pub mod compensation;
+pub mod fresnel;
+#[cfg(feature = "leadr")]
+pub mod leadr;
+pub mod slope;
+pub mod special;
+#[cfg(feature = "data-driven")]
+pub mod tabulated;
+pub mod vndf;
+
+// The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    AlbedoTabulated, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    CompensatedConductor, CompensatedDielectric, Compensation, EnergyByOrder, KullaContyDielectric,
-    MAX_WALK_ALPHA, MicrofacetBsdf, NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SMOOTH_ALPHA,
-    SampleFlags, ShadingFrame, SpecularEvent, SpecularLimit, Technique, Transport, WalkTabulated,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, MAX_WALK_ALPHA,
+    MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Technique, Transport,
 };
+pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
-pub use fresnel::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+pub use fresnel::ComplexIor;
+pub use material::{Conductor, Dielectric, Diffuse};
+pub use slope::{Beckmann, Elliptical, Ggx};
+
 /// The vector library of the public API, re-exported so that users on another `glam` version
 /// can name the crate's types.
 pub use glam;
-pub use height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
-pub use leadr::{
-    CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, MomentLevel,
-    SlopeMoments,
-};
-pub use material::{Conductor, Dielectric, Diffuse, Event, Interaction, Material, PhaseSample, Side};
-pub use merl::{MERL_PHI_D, MERL_THETA_D, MERL_THETA_H, MerlBrdf, MerlError, half_diff_angles};
-pub use microsurface::{
-    HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
-};
-pub use position_free::{Estimator, PositionFree, Shadowing};
 /// The random-number traits the research layer's walks take, re-exported for the same reason.
 pub use rand;
-pub use sampling::{concentric_disk, sample_cosine_hemisphere};
-pub use single_scattering::{SingleSample, SingleScattering};
-pub use slope::{
-    AxisAlignedSlope, BackscatterShadowing, Beckmann, Elliptical, Extraction, Ggx, GridExtraction, GridSlope,
-    MAX_RINGS, MicrosurfaceSlope, Noncentral, StretchedTabulated, TabulatedSlope, Tail, extract_anisotropic,
-    extract_anisotropic_fn, extract_fresnel, extract_isotropic, extract_isotropic_fn,
-};
-pub use special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma, sin_cos_turns};
-pub use vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
-};
+
+/// The research layer: the papers' models with the papers' interfaces.
+///
+/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`]: heights,
+/// slopes and a material, evaluated and sampled by tracing a ray through the microsurface),
+/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`]), the
+/// position-free estimators of Wang et al. 2022 ([`PositionFree`], feature `position-free`),
+/// the height distributions, the materials' phase functions ([`Material`]) and the geometry
+/// queries of the microsurface ([`MicrosurfaceGeometry`]).
+///
+/// Conventions (the papers'): `eval(wi, wo)` with `wi` towards the light and `wo` towards the
+/// viewer returns f·|cos θo| per RGB channel; stochastic evaluations take `&mut impl Rng` and
+/// are unbiased estimates; a walk sample's weight is f·|cos θo|/pdf. The renderer layer
+/// ([`Bsdf`](crate::Bsdf)) is built on these types.
+///
+/// # Examples
+///
+/// ```
+/// use microsurface::glam::Vec3;
+/// use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
+/// use microsurface::{Conductor, Ggx};
+/// use rand::SeedableRng;
+///
+/// let surface = Microsurface::new(UniformHeight, Ggx::isotropic(0.5)?, Conductor::perfect());
+/// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
+/// let (wi, wo) = (Vec3::new(0.3, 0.0, 0.954).normalize(), Vec3::Z);
+/// let n = 10_000;
+/// // f·|cos θo|, averaged over independent walks
+/// let f_cos: f32 = (0..n).map(|_| surface.eval(wi, wo, ScatteringOrder::All, &mut rng).x).sum::<f32>() / n as f32;
+/// let single = surface.eval_single_scattering(wi, wo, &mut rng).x;
+/// assert!(f_cos > single); // multiple scattering adds energy
+/// # Ok::<(), microsurface::Error>(())
+/// ```
+pub mod research {
+    pub use crate::basis::orthonormal_basis;
+    pub use crate::bsdf::{EnergyByOrder, SpecularEvent, SpecularLimit};
+    pub use crate::height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+    #[cfg(feature = "invariance")]
+    pub use crate::invariance::{Invariance, MIN_FIRST_RATE};
+    pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
+    pub use crate::microsurface::{
+        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
+    };
+    pub use crate::path::Shadowing;
+    #[cfg(feature = "position-free")]
+    pub use crate::position_free::{Estimator, PositionFree};
+    pub use crate::sampling::{concentric_disk, sample_cosine_hemisphere};
+    pub use crate::single_scattering::{SingleSample, SingleScattering};
+}
 
 /// The README's code blocks, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

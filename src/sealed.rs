@@ -3,10 +3,10 @@
 //! bound a public trait, but no other crate can name it, hence none can implement those
 //! traits.
 //!
-//! [`MicrosurfaceSlope`]: crate::MicrosurfaceSlope
-//! [`VCavitySlope`]: crate::VCavitySlope
-//! [`MicrosurfaceHeight`]: crate::MicrosurfaceHeight
-//! [`Material`]: crate::Material
+//! [`MicrosurfaceSlope`]: crate::slope::MicrosurfaceSlope
+//! [`VCavitySlope`]: crate::vndf::VCavitySlope
+//! [`MicrosurfaceHeight`]: crate::research::MicrosurfaceHeight
+//! [`Material`]: crate::research::Material
 
 /// Implemented by the crate's slope and height distributions and materials only.
 pub trait Sealed {}

@@ -4,7 +4,7 @@
 
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
-use crate::position_free::{Incident, PositionFree, Shadowing, VertexRole};
+use crate::path::{Incident, PathModel, Shadowing, VertexRole};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
@@ -56,7 +56,8 @@ pub struct SingleSample {
 ///
 /// ```
 /// use microsurface::glam::Vec3;
-/// use microsurface::{ComplexIor, Conductor, Ggx, SingleScattering};
+/// use microsurface::{ComplexIor, Conductor, Ggx};
+/// use microsurface::research::SingleScattering;
 /// use rand::SeedableRng;
 ///
 /// let gold = SingleScattering::new(Ggx::isotropic(0.5)?, Conductor::new(ComplexIor::GOLD));
@@ -75,26 +76,26 @@ pub struct SingleSample {
 pub struct SingleScattering<S, M> {
     /// The one-vertex position-free model with height-correlated shadowing: its incident
     /// states, exit data and relative shadowing factors are those of the single-scattering BSDF.
-    model: PositionFree<S, M>,
+    model: PathModel<S, M>,
 }
 
 impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// The single-scattering BSDF of the given slope distribution and material.
     #[inline]
     pub fn new(slope: S, material: M) -> Self {
-        Self { model: PositionFree::new(slope, material, Shadowing::Correlated) }
+        Self { model: PathModel::new(slope, material, Shadowing::Correlated) }
     }
 
     /// The slope distribution.
     #[inline]
     pub fn slope(&self) -> &S {
-        self.model.slope()
+        &self.model.slope
     }
 
     /// The material.
     #[inline]
     pub fn material(&self) -> &M {
-        self.model.material()
+        &self.model.material
     }
 
     /// f·|cos θo| (see the type's documentation); 0 for ωi on the horizon, for an opaque
@@ -161,22 +162,25 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::eval`] for directions the caller has validated.
     #[inline(always)]
     pub(crate) fn eval_unchecked(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
-        let (Some(start), Some(wo_side)) =
-            (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
-        else {
-            return Vec3::ZERO;
-        };
-        self.model.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
+        self.model.eval_single_scattering(wi, wo, rng)
+    }
+
+    /// The approximate density of the multiple-scattering techniques' samples that the
+    /// renderer uses for MIS weights, for validated directions: 0.8 × this BSDF's sampling
+    /// density plus 0.2 × a cosine lobe on ωo's side (see `PathModel::mis_pdf`).
+    #[inline(always)]
+    pub(crate) fn mis_pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
+        self.model.mis_pdf(wi, wo)
     }
 
     /// [`SingleScattering::pdf`] for directions the caller has validated.
     #[inline(always)]
     pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
         if M::MIRROR_FACETS && wi.z > 0.0 && wo.z > 0.0 {
-            return Self::mirror_density(self.model.slope(), wi, wo);
+            return Self::mirror_density(&self.model.slope, wi, wo);
         }
         let (Some(start), Some(wo_side)) =
-            (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
         else {
             return 0.0;
         };
@@ -186,8 +190,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// [`SingleScattering::eval_with_pdf`] for directions the caller has validated.
     #[inline(always)]
     pub(crate) fn eval_with_pdf_unchecked(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> (Vec3, f32) {
-        let (Some(at), Some(wo_side)) =
-            (PositionFree::<S, M>::incident(wi), PositionFree::<S, M>::exit_side(wo))
+        let (Some(at), Some(wo_side)) = (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
         else {
             return (Vec3::ZERO, 0.0);
         };
@@ -201,13 +204,13 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
             let f_cos = self.model.connect_known(at, k_in, out, VertexRole::Last, rng).as_vec3();
             return (f_cos, self.density(at, wo, wo_side));
         }
-        let m = self.model.material();
+        let m = &self.model.material;
         let (vertex, pdf) = if M::MIRROR_FACETS {
             // the density `pdf` and `sample` give (wo is above the horizon: `exit_side`)
-            let vertex = m.vertex_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
-            (vertex, Self::mirror_density(self.model.slope(), wi, wo))
+            let vertex = m.vertex_unchecked(&self.model.slope, &at.to(wo, wo_side), rng);
+            (vertex, Self::mirror_density(&self.model.slope, wi, wo))
         } else {
-            let (vertex, pdf, _) = m.connection_unchecked(self.model.slope(), &at.to(wo, wo_side), rng);
+            let (vertex, pdf, _) = m.connection_unchecked(&self.model.slope, &at.to(wo, wo_side), rng);
             (vertex, pdf)
         };
         let factor = self.model.shadowing_factor(at, k_in, self.model.exit(wo, wo_side), VertexRole::Last);
@@ -220,10 +223,10 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         if M::MIRROR_FACETS && wi.z > 0.0 {
             // the uniforms in the order the material's own sampler draws them
             let (u1, u2) = (uniform(rng), uniform(rng));
-            return Self::sample_mirror_front(self.model.slope(), self.model.material(), wi, u1, u2);
+            return Self::sample_mirror_front(&self.model.slope, &self.model.material, wi, u1, u2);
         }
-        let at = PositionFree::<S, M>::incident(wi)?;
-        let (slope, m) = (self.model.slope(), self.model.material());
+        let at = PathModel::<S, M>::incident(wi)?;
+        let (slope, m) = (&self.model.slope, &self.model.material);
         let s = m.sample_phase_unchecked(slope, at.w, at.side, rng);
         let k_in = self.model.incident_k(at);
         let out = self.model.exit(s.wo, s.side);
@@ -301,6 +304,6 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// The phase-function density of ωo from the incident state `at`.
     #[inline(always)]
     fn density(&self, at: Incident, wo: Vec3, wo_side: Side) -> f32 {
-        self.model.material().pdf_phase_unchecked(self.model.slope(), &at.to(wo, wo_side))
+        self.model.material.pdf_phase_unchecked(&self.model.slope, &at.to(wo, wo_side))
     }
 }

@@ -4,11 +4,13 @@
 //! the range policy.
 
 use glam::Vec3;
-use microsurface::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, Beckmann, Bsdf, Conductor, DIELECTRIC_TABLE_SIZE, Dielectric,
-    DielectricAlbedoTable, EtaRange, Ggx, MicrofacetBsdf, Microsurface, MicrosurfaceSlope,
-    ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable, Technique, Transport, UniformHeight,
+use microsurface::compensation::{
+    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, EtaRange,
+    ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable,
 };
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Bsdf, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique, Transport};
 use rand::RngExt;
 use validation::{Stats, TestRng, assert_mean, family_z, par_map, rng, uniform32};
 
@@ -348,7 +350,7 @@ fn out_of_range_gives_none() {
 // ---------------------------------------------------------------------------------------------
 
 /// The measured interpolation errors of R + T of the dielectric lookups (max over 256 random
-/// points against quadrature, `examples/tables --interpolation`; `DESIGN.md`), per family
+/// points against quadrature, `tools --bin tables -- --interpolation`; `DESIGN.md`), per family
 /// (GGX, Beckmann) and side (outside, inside).
 const STATED_DIELECTRIC_ERROR: [[f64; 2]; 2] = [
     [DIELECTRIC_ERROR_GGX_OUT, DIELECTRIC_ERROR_GGX_IN],

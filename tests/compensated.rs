@@ -3,11 +3,14 @@
 //! albedo tables' interpolation error, the normalization of the Kulla–Conty lobe, its
 //! reciprocity, and the constructor's range.
 
+use microsurface::compensation::{
+    ALBEDO_TABLE_SIZE, AlbedoTable, AlbedoTabulated, LAST_TABULATED_ORDER, ORDER_TABLES,
+};
 use microsurface::glam::{Vec2, Vec3};
+use microsurface::research::Side;
 use microsurface::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, AlbedoTabulated, Beckmann, Bsdf, CompensatedConductor,
-    CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx, LAST_TABULATED_ORDER,
-    ORDER_TABLES, Side, Transport,
+    Beckmann, Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor,
+    Dielectric, Ggx, Transport,
 };
 use validation::check::{assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw};
 use validation::chi2::{BsdfChi2, sampler_chi2};
@@ -201,7 +204,7 @@ fn per_order_lobe_has_the_model_albedo() {
     fn run<S: AlbedoTabulated>(
         slope_of: impl Fn(f32) -> S,
         table: AlbedoTable,
-        orders: microsurface::ScatteringOrderTable,
+        orders: microsurface::compensation::ScatteringOrderTable,
     ) {
         let n = ALBEDO_TABLE_SIZE;
         for (name, conductor) in [("gold", gold()), ("aluminium", Conductor::new(ComplexIor::ALUMINIUM))] {
@@ -262,8 +265,8 @@ fn per_order_lobe_has_the_model_albedo() {
             }
         }
     }
-    run(ggx, AlbedoTable::GGX, microsurface::ScatteringOrderTable::GGX);
-    run(beckmann, AlbedoTable::BECKMANN, microsurface::ScatteringOrderTable::BECKMANN);
+    run(ggx, AlbedoTable::GGX, microsurface::compensation::ScatteringOrderTable::GGX);
+    run(beckmann, AlbedoTable::BECKMANN, microsurface::compensation::ScatteringOrderTable::BECKMANN);
 }
 
 /// For F = 1 (F̄ = 1) the per-order lobe is the Kulla–Conty lobe: the same f to relative 1e-5
@@ -468,7 +471,7 @@ fn invalid_input_gives_nothing() {
 // ---------------------------------------------------------------------------------------------
 
 /// The dielectric tables' measured interpolation error of R + T (max at 256 random points,
-/// `cargo run --release --example tables -- --interpolation --only dielectric`), per family
+/// `cargo run --release -p tools --bin tables -- --interpolation --only dielectric`), per family
 /// (GGX, Beckmann) and side (outside, inside).
 const DIELECTRIC_TABLE_ERROR: [[f64; 2]; 2] = [[4.80e-2, 6.17e-2], [7.50e-2, 1.30e-1]];
 /// The error of E at a node: quadrature 1e-5 (checked by the generator) and the f32 rounding

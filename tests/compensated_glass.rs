@@ -4,12 +4,13 @@
 //! the white furnace, per-side R and T against the walk, reciprocity across the interface, an
 //! independent recomputation of table cells, the constructor's range and finite edges.
 
+use microsurface::compensation::{DielectricWalkTable, EtaRange, MAX_WALK_TABLE_SE, WalkTabulated};
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::SeedableRng;
+use microsurface::research::{Microsurface, Side, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Beckmann, Bsdf, Dielectric, DielectricWalkTable, EtaRange, Ggx, KullaContyDielectric, MAX_WALK_TABLE_SE,
-    MicrofacetBsdf, Microsurface, MicrosurfaceSlope, Side, Technique, Transport, UniformHeight,
-    WalkTabulated,
+    Beckmann, Bsdf, Dielectric, Ggx, KullaContyDielectric, MicrofacetBsdf, Technique, Transport,
 };
 use validation::check::{
     EDGE_VIEW_COSINES, assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw, edge_view,
@@ -47,7 +48,7 @@ fn range_of(above: bool) -> EtaRange {
     if above { EtaRange::AtLeastOne } else { EtaRange::AtMostOne }
 }
 
-/// (μ, α, η ≥ 1) of table node (i, j, l), as the generator places it (`examples/tables/walk_dielectric.rs`).
+/// (μ, α, η ≥ 1) of table node (i, j, l), as the generator places it (`tools/src/bin/tables/walk_dielectric.rs`).
 fn node(i: usize, j: usize, l: usize) -> (f32, f32, f32) {
     let r = j as f64 / 15.0;
     let alpha = r * r;
@@ -357,7 +358,7 @@ fn table_cells_recompute_independently() {
                 let wi = view(mu, above).normalize();
                 let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(0xabcd_0000 + k as u64);
                 let (mut r, mut t) = (0u32, 0u32);
-                let mut count = |s: Option<microsurface::WalkSample>| {
+                let mut count = |s: Option<microsurface::research::WalkSample>| {
                     if let Some(s) = s.filter(|s| s.bounces >= 2) {
                         if (s.wo.z > 0.0) == above { r += 1 } else { t += 1 }
                     }

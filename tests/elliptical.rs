@@ -3,7 +3,8 @@
 //! the sampler's chi-square fit and the constructors' rejections.
 
 use glam::Vec3;
-use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Elliptical, Error, Ggx};
 
 /// Eq. 2.26 written out independently: the standard density at the decorrelated slopes, and
 /// their squared radius (Beckmann's exponent).
@@ -110,7 +111,8 @@ fn constructors_reject_invalid_parameters() {
     assert!(Elliptical::<Ggx>::from_bivariate(0.3, 0.2, 0.999_999).is_ok());
 }
 
-use microsurface::{ComplexIor, Conductor, Dielectric, Microsurface, UniformHeight};
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::{ComplexIor, Conductor, Dielectric};
 use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::{Domain, integrate_sphere};
@@ -343,10 +345,13 @@ fn isotropic_table_rejects_a_correlated_slope() {
     let rotated = Elliptical::<Beckmann>::from_bivariate(0.3, 0.3, 0.6).unwrap();
     let (a1, a2, phi) = rotated.ellipse();
     assert!(a1 > 1.5 * a2 && (phi - std::f32::consts::FRAC_PI_4).abs() < 1e-6, "({a1}, {a2}, {phi})");
-    assert!(microsurface::TabulatedSlope::from_slope(&rotated, 4.0, 64).is_err());
+    assert!(microsurface::tabulated::TabulatedSlope::from_slope(&rotated, 4.0, 64).is_err());
     let round = Elliptical::<Beckmann>::from_ellipse(0.3, 0.3, 1.0).unwrap();
-    assert!(microsurface::TabulatedSlope::from_slope(&round, 4.0, 64).is_ok());
-    assert!(microsurface::TabulatedSlope::from_slope(&Beckmann::isotropic(0.3).unwrap(), 4.0, 64).is_ok());
+    assert!(microsurface::tabulated::TabulatedSlope::from_slope(&round, 4.0, 64).is_ok());
+    assert!(
+        microsurface::tabulated::TabulatedSlope::from_slope(&Beckmann::isotropic(0.3).unwrap(), 4.0, 64)
+            .is_ok()
+    );
 }
 
 /// The compensated conductor of a rotated ellipse is the axis-aligned one seen from rotated

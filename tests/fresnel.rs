@@ -5,7 +5,8 @@
 //! Everything here is deterministic: the tolerances are f32 rounding bounds, stated per test.
 
 use glam::Vec3;
-use microsurface::{ComplexIor, fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+use microsurface::ComplexIor;
+use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 
 /// cos θ on a grid of [0, 1] including both ends, denser near grazing incidence.
 fn cosines() -> Vec<f64> {

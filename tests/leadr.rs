@@ -7,10 +7,10 @@
 //! stated at each assertion.
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
-use microsurface::{
-    Beckmann, CovarianceTreatment, Error, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO,
-    MIN_LEADR_ALPHA, SlopeMoments,
+use microsurface::leadr::{
+    CovarianceTreatment, HeightMap, LeadrLobe, LeadrMap, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA, SlopeMoments,
 };
+use microsurface::{Beckmann, Error};
 use validation::leadr::surface::{NormalMip, direction, procedural_height_map};
 use validation::leadr::validate::{filter_error, filter_errors, texel_lobe};
 

@@ -19,11 +19,10 @@ use validation::stochastic::{StochasticGrid, stochastic_chi2_with};
 use validation::uniform_sphere;
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, Microsurface, MicrosurfaceSlope,
-    PhaseSample, UniformHeight,
-};
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::research::{Material, Microsurface, PhaseSample, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};
 use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::{Domain, integrate_sphere};

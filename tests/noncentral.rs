@@ -3,7 +3,9 @@
 //! eq. 3.3, the sampler's chi-square fit (eq. 3.4) and the constructor's rejections.
 
 use glam::{Vec2, Vec3};
-use microsurface::{Beckmann, Elliptical, Error, Ggx, MicrosurfaceSlope, Noncentral};
+use microsurface::leadr::Noncentral;
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Elliptical, Error, Ggx};
 use std::f64::consts::PI;
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::{Domain, integrate_sphere};

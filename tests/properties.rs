@@ -14,16 +14,24 @@
 //! CI runs the same cases every time (override the count with `PROPTEST_CASES` if needed).
 //! Case counts: 384 per property, 96 for the random walks and position-free estimators.
 use glam::{Vec2, Vec3};
-use microsurface::{
-    Beckmann, BeckmannNewton, Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor,
-    Dielectric, Diffuse, Estimator, GaussianHeight, GgxDisk, GgxSphericalCap, HeightSample, Material,
-    MicrofacetBsdf, Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, SmithVndf, SpecularLimit, Technique, Transport, UniformHeight, VCavity,
-    VCavitySlope, VisibleNormalSampler, beta, erf, erfc, erfinv, fresnel_conductor, fresnel_dielectric,
-    fresnel_schlick, ln_beta, ln_gamma, smith_normalization,
+use microsurface::Ggx;
+use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+use microsurface::research::MAX_BOUNCES;
+use microsurface::research::{
+    Estimator, GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry,
+    MicrosurfaceHeight, PositionFree, ScatteringOrder, Shadowing, SpecularLimit, UniformHeight,
 };
-use microsurface::{Ggx, MAX_BOUNCES};
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma};
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
+    smith_normalization,
+};
+use microsurface::{
+    Beckmann, Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor, Dielectric, Diffuse,
+    MicrofacetBsdf, Technique, Transport,
+};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseResult};
 use rand::SeedableRng;

@@ -9,10 +9,9 @@
 //! * invalid directions give 0 / `None` (a debug assertion in debug builds).
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, Material, MicrosurfaceSlope, PositionFree,
-    Shadowing, SingleScattering,
-};
+use microsurface::research::{Material, PositionFree, Shadowing, SingleScattering};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::quadrature::{Domain, integrate_sphere};
 use validation::{dir, sidak, uniform32, z_two_sided};

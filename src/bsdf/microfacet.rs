@@ -7,9 +7,14 @@ use super::{
 };
 use crate::error::Error;
 use crate::height::UniformHeight;
+#[cfg(feature = "invariance")]
+use crate::invariance::Invariance;
 use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
-use crate::position_free::{Estimator, PositionFree, Shadowing};
+#[cfg(feature = "position-free")]
+use crate::path::Shadowing;
+#[cfg(feature = "position-free")]
+use crate::position_free::{Estimator, PositionFree};
 use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use glam::{Vec2, Vec3};
@@ -35,7 +40,7 @@ pub const SMOOTH_ALPHA: f32 = 1e-3;
 /// A walk's length grows linearly with α: for a perfect GGX conductor seen at normal
 /// incidence the mean number of bounces was measured at 2.3 (α = 1), 9.2 (α = 4), 26 (α = 10)
 /// and 305 (α = 100), i.e. about 2.7α, and a sample's cost with it (≈ 2.6 µs at α = 10 on the
-/// development machine). From α ≈ 300 on walks reach the bounce cap [`crate::MAX_BOUNCES`]
+/// development machine). From α ≈ 300 on walks reach the bounce cap [`crate::research::MAX_BOUNCES`]
 /// and lose their energy (at α = 10⁶ every walk does: 0.33 ms per sample and no light).
 /// Roughnesses above 10 describe no real surface, so the renderer layer rejects them rather
 /// than let a scene's cost explode; the research layer ([`Microsurface`], [`PositionFree`])
@@ -53,9 +58,9 @@ pub enum Technique {
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
     /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term or GGX's f32
-    /// conductor density, see [`crate::SingleScattering::pdf`]) for every
+    /// conductor density, see [`crate::research::SingleScattering::pdf`]) for every
     /// roughness; samples whose pdf or f would be subnormal are not returned (at most
-    /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::SingleScattering::sample`] for the f32
+    /// 4π·`f32::MIN_POSITIVE` of probability). See [`crate::research::SingleScattering::sample`] for the f32
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
@@ -71,12 +76,21 @@ pub enum Technique {
     /// vertex is a vertex reached from below (DESIGN.md); for Beckmann seen from so far below
     /// that Λ underflows f64 (|cot θo|/α ≳ 26.6) `sample` returns nothing and eval keeps only
     /// the first order.
+    #[cfg(feature = "position-free")]
     PositionFree {
         /// PT or BDPT.
         estimator: Estimator,
         /// Height-correlated or uncorrelated shadowing.
         shadowing: Shadowing,
     },
+    /// The invariance-principle estimator of Cui et al. 2023 ([`Invariance`]): the random
+    /// walk's BSDF (the same model as [`Technique::RandomWalk`]) with the heights integrated
+    /// out, stochastic eval with less variance, exact sample weights, approximate pdf (the
+    /// position-free model's, as for the walk). Opaque materials only (conductors, diffuse
+    /// facets): [`MicrofacetBsdf::with_technique`] refuses it for a dielectric. Valid for
+    /// backfacing views, as the walk.
+    #[cfg(feature = "invariance")]
+    Invariance,
 }
 
 /// The share of a BSDF's albedo carried by each scattering order, estimated from sampled
@@ -112,7 +126,7 @@ impl EnergyByOrder {
 /// The microsurface BSDF does not depend on the height distribution (Heitz et al. 2016,
 /// §3.2: the walk is invariant under a monotonic change of heights), so there is none to
 /// choose here; the height distribution matters only to the geometry queries of the research
-/// layer ([`crate::MicrosurfaceGeometry`]).
+/// layer ([`crate::research::MicrosurfaceGeometry`]).
 ///
 /// Orientation: the research-layer models are evaluated and sampled *from the viewer* — the
 /// walk enters along the renderer's `wo` and leaves along `wi` (the adjoint orientation), with
@@ -214,7 +228,13 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 
     /// The same BSDF evaluated with another technique.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): [`Technique::Invariance`] for a material
+    /// that transmits (a dielectric, which that estimator does not cover) is a contract
+    /// violation: a debug assertion in debug builds, the BSDF unchanged in release builds.
     pub fn with_technique(self, technique: Technique) -> Self {
+        #[cfg(feature = "invariance")]
+        require!(!(M::TRANSMITS && technique == Technique::Invariance), self; technique);
         Self { technique, ..self }.with_derived()
     }
 
@@ -258,9 +278,18 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 
     /// The position-free model with the given shadowing over the same slope and material.
+    #[cfg(feature = "position-free")]
     #[inline(always)]
     fn position_free(&self, shadowing: Shadowing) -> PositionFree<S, M> {
         PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
+    }
+
+    /// The invariance-principle estimator over the same slope and material, `None` for a
+    /// material that transmits (which `with_technique` keeps from choosing it).
+    #[cfg(feature = "invariance")]
+    #[inline(always)]
+    fn invariance(&self) -> Option<Invariance<S, M>> {
+        Invariance::new(*self.surface.slope(), *self.surface.material()).ok()
     }
 
     /// The single-scattering BSDF over the same slope and material.
@@ -322,6 +351,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         for _ in 0..walks {
             // the walk enters along the view direction
             let sample = match self.technique {
+                #[cfg(feature = "position-free")]
                 Technique::PositionFree { shadowing, .. } => self.position_free(shadowing).sample(wo, rng),
                 _ => self.surface.sample(wo, rng),
             };
@@ -343,9 +373,15 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         match self.technique {
             Technique::SingleScattering => self.single().eval_unchecked(walk_in, walk_out, rng),
             Technique::RandomWalk => self.surface.eval(walk_in, walk_out, self.order, rng),
+            #[cfg(feature = "position-free")]
             Technique::PositionFree { estimator, shadowing } => {
                 self.position_free(shadowing).eval(walk_in, walk_out, estimator, self.order, rng)
             }
+            #[cfg(feature = "invariance")]
+            Technique::Invariance => match self.invariance() {
+                Some(invariance) => invariance.eval(walk_in, walk_out, self.order, rng),
+                None => self.surface.eval(walk_in, walk_out, self.order, rng),
+            },
         }
     }
 
@@ -355,7 +391,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn research_pdf_out(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
         match self.technique {
             Technique::SingleScattering => self.single().pdf_unchecked(walk_in, walk_out),
-            _ => self.position_free(Shadowing::Correlated).pdf_unchecked(walk_in, walk_out),
+            _ => self.single().mis_pdf_unchecked(walk_in, walk_out),
         }
     }
 
@@ -511,10 +547,20 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
                 let mut rng = PrimedPcg::after_one_private(&uniforms, hash());
                 self.surface.sample(walk_in, &mut rng)
             }
+            #[cfg(feature = "position-free")]
             Technique::PositionFree { shadowing, .. } => {
                 // the estimators draw beyond the caller's uniforms from the first bounce on
                 let mut rng = PrimedPcg::new(&uniforms, hash());
                 self.position_free(shadowing).sample(walk_in, &mut rng)
+            }
+            #[cfg(feature = "invariance")]
+            Technique::Invariance => {
+                // the first visible normal from (u.x, u.y), the first exit test from uc
+                let mut rng = PrimedPcg::new(&uniforms, hash());
+                match self.invariance() {
+                    Some(invariance) => invariance.sample(walk_in, &mut rng),
+                    None => self.surface.sample(walk_in, &mut rng),
+                }
             }
         };
         let s = s?;

@@ -13,28 +13,19 @@
 //!   BSDF's seed ([`MicrofacetBsdf::with_seed`]) and the caller's key (the `_keyed`
 //!   methods), so identical calls give identical bits on any thread.
 //!
-//! (The research layer, [`crate::Microsurface`] and [`crate::PositionFree`], keeps the papers'
+//! (The research layer, [`crate::research::Microsurface`] and [`crate::research::PositionFree`], keeps the papers'
 //! convention instead: `eval(wi, wo)` with `wi` the direction light arrives from, returning
 //! f·|cos θo|, and `&mut impl Rng` arguments.)
 
 mod classic;
-mod compensated;
-mod compensated_dielectric;
 mod frame;
-mod kulla_conty_dielectric;
-mod lobe_profile;
 mod microfacet;
-mod noncentral;
 mod seed;
 mod specular;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
-pub use compensated::{AlbedoTabulated, CompensatedConductor, Compensation};
-pub use compensated_dielectric::CompensatedDielectric;
 pub use frame::ShadingFrame;
-pub use kulla_conty_dielectric::{KullaContyDielectric, WalkTabulated};
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
-pub use noncentral::{NoncentralBsdf, NoncentralMasking, NoncentralMaterial};
 pub use specular::{SpecularEvent, SpecularLimit};
 
 use glam::{Vec2, Vec3};

@@ -146,6 +146,7 @@ impl PrimedPcg {
     /// A generator returning `uniforms` (each in [0, 1), at most four) first, then the
     /// numbers of the PCG generator seeded by `hash`.
     #[inline(always)]
+    #[cfg_attr(not(feature = "position-free"), allow(dead_code))]
     pub(crate) fn new(uniforms: &[f32], hash: Hasher) -> Self {
         let mut primed = [0; MAX_PRIMED];
         for (p, &u) in primed.iter_mut().zip(uniforms) {

@@ -11,7 +11,7 @@ use glam::Vec2;
 /// # Examples
 ///
 /// ```
-/// use microsurface::HeightMap;
+/// use microsurface::leadr::HeightMap;
 ///
 /// // a ramp of slope 0.5 along x would not be periodic; a ridge is
 /// let heights = vec![0.0, 0.5, 1.0, 0.5];

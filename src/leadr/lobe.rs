@@ -1,10 +1,10 @@
 //! The noncentral anisotropic Beckmann lobe of a LEAN/LEADR texel.
 
 use super::SlopeMoments;
-use crate::bsdf::NoncentralBsdf;
 use crate::error::Error;
 use crate::material::Conductor;
-use crate::slope::{Beckmann, Elliptical, Noncentral};
+use crate::noncentral::{Noncentral, NoncentralBsdf};
+use crate::slope::{Beckmann, Elliptical};
 use glam::Vec2;
 
 /// The smallest roughness a LEADR lobe is given along any direction: the covariance's
@@ -23,7 +23,8 @@ pub const MIN_EIGENVALUE_RATIO: f32 = 1e-6;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Beckmann, CovarianceTreatment, LeadrLobe, SlopeMoments};
+/// use microsurface::Beckmann;
+/// use microsurface::leadr::{CovarianceTreatment, LeadrLobe, SlopeMoments};
 /// use microsurface::glam::Vec2;
 ///
 /// let base = Beckmann::isotropic(0.2)?;
@@ -60,7 +61,8 @@ pub enum CovarianceTreatment {
 ///
 /// ```
 /// use microsurface::glam::Vec2;
-/// use microsurface::{Beckmann, CovarianceTreatment, LeadrLobe, SlopeMoments};
+/// use microsurface::Beckmann;
+/// use microsurface::leadr::{CovarianceTreatment, LeadrLobe, SlopeMoments};
 ///
 /// let m = SlopeMoments::from_slope(Vec2::new(0.1, -0.2), Beckmann::new(0.3, 0.1)?)?;
 /// let lobe = LeadrLobe::from_moments(&m);

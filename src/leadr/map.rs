@@ -10,7 +10,8 @@ use glam::{Vec2, Vec3};
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Beckmann, HeightMap, LeadrMap};
+/// use microsurface::Beckmann;
+/// use microsurface::leadr::{HeightMap, LeadrMap};
 ///
 /// // a flat 4 × 4 map: every level keeps the base roughness, variance α²/2 per axis
 /// let map = LeadrMap::from_height_map(&HeightMap::new(4, 4, 0.25, vec![0.0; 16])?, Beckmann::isotropic(0.1)?)?;
@@ -113,7 +114,8 @@ impl MomentLevel {
 /// # Examples
 ///
 /// ```
-/// use microsurface::{Beckmann, HeightMap, LeadrMap};
+/// use microsurface::Beckmann;
+/// use microsurface::leadr::{HeightMap, LeadrMap};
 ///
 /// // a 4 × 4 periodic bump map with bumps of slope ±0.5 along x
 /// let heights: Vec<f32> = (0..16).map(|i| [0.0, 0.5, 1.0, 0.5][i % 4]).collect();

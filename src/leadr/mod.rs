@@ -12,6 +12,7 @@ mod lobe;
 mod map;
 mod moments;
 
+pub use crate::noncentral::{Noncentral, NoncentralBsdf, NoncentralMasking, NoncentralMaterial};
 pub use height_map::HeightMap;
 pub use lobe::{CovarianceTreatment, LeadrLobe, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA};
 pub use map::{LeadrMap, MomentLevel};

@@ -25,7 +25,8 @@ use glam::{DMat2, DVec2, Mat2, Vec2, Vec3};
 ///
 /// ```
 /// use microsurface::glam::Vec2;
-/// use microsurface::{Beckmann, SlopeMoments};
+/// use microsurface::Beckmann;
+/// use microsurface::leadr::SlopeMoments;
 ///
 /// let base = Beckmann::isotropic(0.2)?;
 /// let a = SlopeMoments::from_slope(Vec2::new(0.3, 0.0), base)?;
@@ -49,7 +50,7 @@ impl SlopeMoments {
     /// The moments (E₁, …, E₅) as given.
     ///
     /// They need not form a positive-definite covariance (filtering and rounding can break
-    /// it); [`LeadrLobe::from_moments`](crate::LeadrLobe::from_moments) states what it does
+    /// it); [`LeadrLobe::from_moments`](crate::leadr::LeadrLobe::from_moments) states what it does
     /// then.
     ///
     /// # Errors
@@ -170,7 +171,7 @@ impl SlopeMoments {
 
     /// The slope covariance [Σxx, Σyy, Σxy] = [E₃ − E₁², E₄ − E₂², E₅ − E₁E₂], formed in f64
     /// (and rounded to f32). It may fail to be positive definite; see
-    /// [`LeadrLobe::from_moments`](crate::LeadrLobe::from_moments).
+    /// [`LeadrLobe::from_moments`](crate::leadr::LeadrLobe::from_moments).
     #[must_use]
     pub fn covariance(&self) -> [f32; 3] {
         self.covariance64().map(|c| c as f32)

@@ -252,7 +252,7 @@ impl Material for Dielectric {
     /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not
     /// transparent: from the denser side a ray below the critical angle, cos θ < √(2|η − 1|),
     /// is totally reflected, and elsewhere the walk's many crossings do bend it (see
-    /// [`crate::MAX_BOUNCES`]).
+    /// [`crate::research::MAX_BOUNCES`]).
     #[inline]
     fn is_transparent(&self) -> bool {
         self.eta == 1.0

@@ -10,7 +10,7 @@ use glam::Vec3;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Event, Interaction, Side};
+/// use microsurface::research::{Event, Interaction, Side};
 /// use microsurface::glam::Vec3;
 ///
 /// let (wi, wo) = (Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.6, 0.0, -0.8));
@@ -25,7 +25,7 @@ pub enum Event {
     Transmission,
 }
 
-/// The arguments of a [`Material`](crate::Material) evaluation: the incident direction ωi,
+/// The arguments of a [`Material`](crate::research::Material) evaluation: the incident direction ωi,
 /// the outgoing direction ωo (both pointing away from the scattering point, ωi towards where
 /// light comes from) and the side of the interface each lies on.
 ///
@@ -38,7 +38,8 @@ pub enum Event {
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Conductor, Ggx, Interaction, Material, Side};
+/// use microsurface::{Conductor, Ggx};
+/// use microsurface::research::{Interaction, Material, Side};
 /// use microsurface::glam::Vec3;
 /// use microsurface::rand::SeedableRng;
 ///
@@ -62,7 +63,7 @@ pub struct Interaction {
 
 impl Interaction {
     /// The event ωi → ωo with ωi on `wi_side` and ωo on `wo_side`. The directions are
-    /// checked by the [`Material`](crate::Material) methods, not here.
+    /// checked by the [`Material`](crate::research::Material) methods, not here.
     #[inline]
     #[must_use]
     pub fn new(wi: Vec3, wo: Vec3, wi_side: Side, wo_side: Side) -> Self {

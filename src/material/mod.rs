@@ -51,7 +51,7 @@ impl crate::sealed::Sealed for Diffuse {}
 /// configurations are mapped to it.
 ///
 /// The vertex terms of the position-free model ([`Material::vertex`], [`Material::connection`])
-/// are here rather than in [`PositionFree`](crate::PositionFree): they are the material's
+/// are here rather than in [`PositionFree`](crate::research::PositionFree): they are the material's
 /// local BSDF without shadowing (Wang et al. 2022, eqs. 2–3), built from the same half
 /// vector, refraction geometry and Fresnel term as the phase function, which equals the
 /// vertex term times 1/G1(ωi); keeping both in one place keeps them consistent.

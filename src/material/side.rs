@@ -11,7 +11,7 @@ use glam::Vec3;
 ///
 /// # Examples
 /// ```
-/// use microsurface::Side;
+/// use microsurface::research::Side;
 /// use microsurface::glam::Vec3;
 ///
 /// assert_eq!(Side::of(-0.5), Some(Side::Inside));

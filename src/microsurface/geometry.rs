@@ -126,7 +126,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope> MicrosurfaceGeometry<H, S> {
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction or a
     /// uniform outside [0, 1] gives `None` (a debug assertion in debug builds).
     ///
-    /// [`Microsurface::eval_from_below`]: crate::Microsurface::eval_from_below
+    /// [`Microsurface::eval_from_below`]: crate::research::Microsurface::eval_from_below
     #[inline]
     pub fn sample_height_from_below(&self, wi: Vec3, u: f32) -> Option<f32> {
         require!(is_direction(wi) && is_uniform(u), None; wi, u);

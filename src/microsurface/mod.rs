@@ -5,12 +5,14 @@ mod geometry;
 mod walk;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
+#[cfg(feature = "invariance")]
+pub(crate) use walk::incident_area;
 pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
 use crate::material::{Interaction, Material, PhaseSample, Side};
-use crate::position_free::{PositionFree, Shadowing};
+use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use glam::Vec3;
 use rand::Rng;
@@ -27,12 +29,13 @@ use rand::Rng;
 /// C¹(h) (supplement §1.1), so they carry ln C¹ instead of h, and their results are the same
 /// for every height distribution (bit for bit, given the same random numbers). `H` serves the
 /// height-space queries of [`MicrosurfaceGeometry`]; `tests/walk/random_walk.rs` checks the walks against
-/// the supplement's height-space algorithm run on [`UniformHeight`](crate::UniformHeight) and
-/// [`GaussianHeight`](crate::GaussianHeight).
+/// the supplement's height-space algorithm run on [`UniformHeight`](crate::research::UniformHeight) and
+/// [`GaussianHeight`](crate::research::GaussianHeight).
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Dielectric, Ggx, Microsurface, ScatteringOrder, UniformHeight};
+/// use microsurface::{Dielectric, Ggx};
+/// use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
 /// use microsurface::glam::Vec3;
 /// use microsurface::rand::SeedableRng;
 ///
@@ -122,8 +125,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
         if !M::TRANSMITS && (wi.z <= 0.0 || wo.z <= 0.0) {
             if wi.z < 0.0 && wo.z > 0.0 {
-                let pf = PositionFree::new(*self.slope(), self.material, Shadowing::Correlated);
-                return pf.eval_single_scattering(wi, wo, rng);
+                return SingleScattering::new(*self.slope(), self.material).eval_unchecked(wi, wo, rng);
             }
             return Vec3::ZERO;
         }

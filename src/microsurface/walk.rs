@@ -20,7 +20,7 @@ use rand::Rng;
 /// through a dielectric with η within a few f32 ulps of 1, which crosses the nearly
 /// index-matched interface about Λ(ωi) ≈ αᵢ tan θi/2 times before refraction turns it (at
 /// most about 10⁴ bounces); η = 1 exactly is transparent
-/// ([`crate::Material::is_transparent`]). Loss bound (`tests/walk/cap.rs`, 99 % family-wise
+/// ([`crate::research::Material::is_transparent`]). Loss bound (`tests/walk/cap.rs`, 99 % family-wise
 /// confidence): below 1e-4 of the albedo for every material at α = 2, and no capped walk for
 /// |η − 1| ≥ 1e-7 at cos θi ≥ 1e-3. The measurements behind the value are in DESIGN.md
 /// (“The bounce cap”).
@@ -494,7 +494,7 @@ struct Hit {
 /// materials then form the density in f64) and where Λ saturated at ±`f32::MAX`
 /// (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
 #[inline(always)]
-fn incident_area(z: f32, lambda: f32) -> Option<f32> {
+pub(crate) fn incident_area(z: f32, lambda: f32) -> Option<f32> {
     // Λ(ω) and ω.z have the same sign (Λ ≤ −1 below the horizon), so the product is ≥ 0
     let area = lambda * z;
     (area >= f32::MIN_POSITIVE && lambda.abs() < f32::MAX).then_some(area)

@@ -1,11 +1,12 @@
 //! The bidirectional estimator (Wang et al. 2022, §4.2, eqs. 27–29), with the exact
 //! per-strategy path densities and the balance heuristic.
 
-use super::shadowing::{VertexRole, inv_g1};
-use super::{BDPT_ROULETTE_FROM, Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree, Roulette};
+use super::{BDPT_ROULETTE_FROM, PositionFree, Roulette};
 use crate::contract::is_direction;
 use crate::material::{Material, Side};
 use crate::microsurface::ScatteringOrder;
+use crate::path::{Exit, Incident, LAMBDA_RATIO_LOG_BELOW, PathModel};
+use crate::path::{VertexRole, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::{DVec3, Vec3};
@@ -72,7 +73,7 @@ const INLINE_VERTICES: usize = 8;
 /// The vertices of one sub-path: the first [`INLINE_VERTICES`] inline, the rest (up to
 /// [`BDPT_MAX_SUBPATH`]) in an array formed only when the sub-path grows beyond them. Filling
 /// all 48 slots of both sub-paths on every evaluation cost more than the connections of a
-/// typical evaluation at α = 1 (DESIGN.md, “BDPT against PT where BDPT loses”).
+/// typical evaluation at α = 1 (DESIGN.md, “BDPT against PT”).
 struct Vertices<T: Copy> {
     head: [T; INLINE_VERTICES],
     tail: Option<[T; BDPT_MAX_SUBPATH - INLINE_VERTICES]>,
@@ -148,18 +149,20 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         order: ScatteringOrder,
         rng: &mut impl Rng,
     ) -> (Vec3, usize, usize) {
-        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) =
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        else {
             return (Vec3::ZERO, 0, 0);
         };
         let last = order.last() as usize;
         let max_sub = (last - 1).min(BDPT_MAX_SUBPATH);
         let mut camera = Vertices::new(EMPTY_CAMERA);
         let mut light = Vertices::new(EMPTY_LIGHT);
-        let to_wo = self.exit(wo, wo_side);
-        let k_start = inv_g1(&self.slope, start.in_frame());
+        let to_wo = self.model.exit(wo, wo_side);
+        let k_start = inv_g1(&self.model.slope, start.in_frame());
         // the (0, 0) connection (single scattering) first: the camera's roulette compares with it
         let single =
-            order.includes(1).then(|| self.connect_known(start, k_start, to_wo, VertexRole::Last, rng));
+            order.includes(1).then(|| self.model.connect_known(start, k_start, to_wo, VertexRole::Last, rng));
         let roulette = Roulette::new(self, start, k_start, single);
         self.camera_subpath(start, k_start, to_wo, max_sub, &mut camera, &roulette, rng);
         self.light_subpath(to_wo, max_sub, &mut light, rng);
@@ -210,7 +213,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
                     let area =
                         out.lambda.and_then(|lambda| known_area(out.side.frame(out.w).z, 1.0 + lambda));
                     let reverse = at.towards(out).reversed().with_incident_area(area);
-                    (contribution, f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse)))
+                    (
+                        contribution,
+                        f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse)),
+                    )
                 }
             };
             Connection { contribution, forward: 0.0, reverse }
@@ -219,24 +225,26 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             // carries Λ(−ωin) itself (diffuse facets: it underflows f32 below 1e-38, and the
             // connection was lost, BDPT's order 3 from below at a = 28.9 7.5 % low): v·S =
             // p·(k_in S) with the relative factor (see `connect_known`); the densities separately
-            let factor = self.relative_shadowing(at, k_at, out).middle;
+            let factor = self.model.relative_shadowing(at, k_at, out).middle;
             if factor == 0.0 {
                 return None;
             }
             let it = at.towards(out);
-            let phase = self.material.eval_phase_unchecked(&self.slope, &it, rng);
+            let phase = self.model.material.eval_phase_unchecked(&self.model.slope, &it, rng);
             Connection {
                 contribution: phase.as_dvec3() * factor,
-                forward: f64::from(self.material.pdf_phase_unchecked(&self.slope, &it)),
-                reverse: f64::from(self.material.pdf_phase_unchecked(&self.slope, &it.reversed())),
+                forward: f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &it)),
+                reverse: f64::from(
+                    self.model.material.pdf_phase_unchecked(&self.model.slope, &it.reversed()),
+                ),
             }
         } else {
-            let factor = self.shadowing_factor(at, k_at, out, VertexRole::Middle);
+            let factor = self.model.shadowing_factor(at, k_at, out, VertexRole::Middle);
             if factor == 0.0 {
                 return None;
             }
             let (v, forward, reverse) =
-                self.material.connection_unchecked(&self.slope, &at.towards(out), rng);
+                self.model.material.connection_unchecked(&self.model.slope, &at.towards(out), rng);
             Connection {
                 contribution: v.as_dvec3() * factor,
                 forward: f64::from(forward),
@@ -278,11 +286,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             // the step already knows (1 + Λ(x) for x facing up: 1 + k_next)
             let x = -next.w;
             let step = at.to(x, next.side).with_incident_area(known_area(at.in_frame().z, k_at));
-            let pdf_forward = f64::from(self.material.pdf_phase_unchecked(&self.slope, &step));
+            let pdf_forward = f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &step));
             let reverse = step.reversed().with_incident_area(known_area(-next.in_frame().z, 1.0 + k_next));
-            let pdf_reverse_prev = f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse));
+            let pdf_reverse_prev =
+                f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse));
             // the connection of the new vertex to ωo, the (s, 0) strategy's
-            let connection = self.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
+            let connection = self.model.connect_known(next, k_next, to_wo, VertexRole::Last, rng);
             let vertex = CameraVertex { next, k_next, connection, throughput, pdf_forward, pdf_reverse_prev };
             out.push(vertex, EMPTY_CAMERA);
             (at, k_at) = (next, k_next);
@@ -297,10 +306,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let mut b = to_wo;
         let mut throughput = DVec3::ONE;
         for i in 0..max {
-            let s = self.material.sample_phase_unchecked(&self.slope, b.w, b.side, rng);
+            let s = self.model.material.sample_phase_unchecked(&self.model.slope, b.w, b.side, rng);
             let a = Incident { w: s.wo, side: s.side };
             let a_frame = a.in_frame();
-            let k_in = inv_g1(&self.slope, a_frame);
+            let k_in = inv_g1(&self.model.slope, a_frame);
             if a.w.z == 0.0 || k_in == 0.0 || !k_in.is_finite() {
                 return;
             }
@@ -309,9 +318,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             // A(ωout) = (1 + Λ(ωout)) cos θout where ωout faces up in its frame (Λ known)
             let b_frame_z = b.side.frame(b.w).z;
             let b_area = b.lambda.and_then(|lambda| known_area(b_frame_z, 1.0 + lambda));
-            let factor = self.shadowing_factor(a, k_in, b, role)
-                * f64::from(self.material.relative_eta_sq(a.side, b.side))
-                * f64::from(b_area.unwrap_or_else(|| self.slope.projected_area_unchecked(b.side.frame(b.w))))
+            let factor = self.model.shadowing_factor(a, k_in, b, role)
+                * f64::from(self.model.material.relative_eta_sq(a.side, b.side))
+                * f64::from(
+                    b_area.unwrap_or_else(|| self.model.slope.projected_area_unchecked(b.side.frame(b.w))),
+                )
                 / f64::from(a.w.z.abs());
             throughput *= s.weight.as_dvec3() * factor;
             if throughput == DVec3::ZERO || !throughput.is_finite() {
@@ -326,9 +337,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             }
             let step = a.to(b.w, b.side).with_incident_area(known_area(a_frame.z, k_in));
             let reverse = step.reversed().with_incident_area(b_area);
-            let pdf_reverse = f64::from(self.material.pdf_phase_unchecked(&self.slope, &reverse));
-            let pdf_forward_out =
-                if i == 0 { 0.0 } else { f64::from(self.material.pdf_phase_unchecked(&self.slope, &step)) };
+            let pdf_reverse = f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &reverse));
+            let pdf_forward_out = if i == 0 {
+                0.0
+            } else {
+                f64::from(self.model.material.pdf_phase_unchecked(&self.model.slope, &step))
+            };
             // −a can leave the surface where a points down in its frame, and then its Λ is
             // 1 + L̃ of a (Λ(−ω) = −1 − Λ(ω)): the exit data without another Λ
             let out_next = Exit { w: -a.w, side: a.side, lambda: (a_frame.z < 0.0).then_some(k_in) };

@@ -11,27 +11,16 @@
 mod bdpt;
 mod pt;
 mod roulette;
-mod shadowing;
-
-pub use shadowing::Shadowing;
 
 use crate::contract::is_direction;
-use crate::material::{Event, Interaction, Material, Side};
-use crate::microsurface::WalkSample;
+use crate::material::Material;
+use crate::microsurface::{MAX_BOUNCES, ScatteringOrder, WalkSample};
+use crate::path::{Exit, Incident, PathModel, Shadowing, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
-use core::f32::consts::FRAC_1_PI;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use rand::Rng;
 use roulette::{BDPT_ROULETTE_FROM, PeakScales, ROULETTE_FROM_BOUNCE, Roulette};
-pub(crate) use shadowing::VertexRole;
-use shadowing::{LAMBDA_SATURATION, VertexShadowing, inv_g1};
-
-/// Below this incident 1 + L̃ (a backfacing Λ(−ωin) near f64 underflow) the masking ratio
-/// Λo/k_in of a correlated reflection is formed from logarithms.
-const LAMBDA_RATIO_LOG_BELOW: f64 = 1e-290;
-/// Share of the cosine lobe in the approximate MIS density [`PositionFree::pdf`].
-const PDF_COSINE_SHARE: f32 = 0.2;
 
 /// Which estimator evaluates the position-free BSDF.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -55,7 +44,8 @@ pub enum Estimator {
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Conductor, Estimator, Ggx, PositionFree, ScatteringOrder, Shadowing};
+/// use microsurface::{Conductor, Ggx};
+/// use microsurface::research::{Estimator, PositionFree, ScatteringOrder, Shadowing};
 /// use microsurface::glam::Vec3;
 /// use microsurface::rand::SeedableRng;
 ///
@@ -70,82 +60,34 @@ pub enum Estimator {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PositionFree<S, M> {
-    slope: S,
-    material: M,
-    shadowing: Shadowing,
+    /// The vertex terms and shadowing factors of the model.
+    model: PathModel<S, M>,
     /// The scales of the phase function's peak for the camera paths' roulette.
     peaks: PeakScales,
-}
-
-/// An outgoing direction of a vertex with what its shadowing factors need.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Exit {
-    /// The direction.
-    pub(crate) w: Vec3,
-    /// Its side of the interface.
-    pub(crate) side: Side,
-    /// Λ in its side frame where it can leave the surface (points up there); `None` where it
-    /// cannot.
-    pub(crate) lambda: Option<f64>,
-}
-
-/// The incident state at a vertex: the direction towards the previous vertex and its side.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Incident {
-    pub(crate) w: Vec3,
-    pub(crate) side: Side,
-}
-
-impl Incident {
-    /// The incident direction in the frame of its side.
-    #[inline(always)]
-    pub(crate) fn in_frame(self) -> Vec3 {
-        self.side.frame(self.w)
-    }
-
-    /// The event from this incident direction to `w` on `side`.
-    #[inline(always)]
-    pub(crate) fn to(self, w: Vec3, side: Side) -> Interaction {
-        Interaction::new(self.w, w, self.side, side)
-    }
-
-    /// The event from this incident direction to the outgoing one.
-    #[inline(always)]
-    pub(crate) fn towards(self, out: Exit) -> Interaction {
-        self.to(out.w, out.side)
-    }
-}
-
-impl Exit {
-    /// Whether the direction can leave the surface.
-    #[inline(always)]
-    pub(crate) fn can_exit(self) -> bool {
-        self.lambda.is_some()
-    }
 }
 
 impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// A position-free BSDF with the given slope distribution, material and shadowing model.
     pub fn new(slope: S, material: M, shadowing: Shadowing) -> Self {
-        Self { slope, material, shadowing, peaks: PeakScales::new(&slope, &material) }
+        Self { model: PathModel::new(slope, material, shadowing), peaks: PeakScales::new(&slope, &material) }
     }
 
     /// The slope distribution.
     #[inline]
     pub fn slope(&self) -> &S {
-        &self.slope
+        &self.model.slope
     }
 
     /// The material.
     #[inline]
     pub fn material(&self) -> &M {
-        &self.material
+        &self.model.material
     }
 
     /// The shadowing model.
     #[inline]
     pub fn shadowing(&self) -> Shadowing {
-        self.shadowing
+        self.model.shadowing
     }
 
     /// Evaluates f·|cos θo| with the chosen estimator and orders; unbiased and stochastic.
@@ -158,7 +100,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         wi: Vec3,
         wo: Vec3,
         estimator: Estimator,
-        order: crate::ScatteringOrder,
+        order: ScatteringOrder,
         rng: &mut impl Rng,
     ) -> Vec3 {
         match estimator {
@@ -176,10 +118,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval_single_scattering(&self, wi: Vec3, wo: Vec3, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return Vec3::ZERO;
-        };
-        self.connect(start, wo, wo_side, VertexRole::Last, rng).as_vec3()
+        self.model.eval_single_scattering(wi, wo, rng)
     }
 
     /// Samples an outgoing direction with the position-free random walk (Wang et al. 2022,
@@ -190,41 +129,41 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// The weight is f·|cos θo|/pdf exactly: the product of the sample weights (Fresnel for
     /// conductors, albedo for diffuse facets, 1 for dielectrics). `None` if ωi cannot light
     /// the material (on the horizon, or at the nadir of an opaque material, where no facet
-    /// faces it), or the walk reached [`crate::MAX_BOUNCES`].
+    /// faces it), or the walk reached [`crate::research::MAX_BOUNCES`].
     ///
     /// Nearly index-matched dielectrics at grazing incidence: a refraction through an
     /// interface with η ≈ 1 barely turns the ray, and this model's exit probability per vertex
     /// then falls to about 2^−Λ (it forgets the height a vertex was reached at, which the
     /// height-tracing walk keeps), so its paths grow as |η − 1| → 0: no path is lost to
-    /// [`crate::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk/cap.rs`), while within one or
+    /// [`crate::research::MAX_BOUNCES`] down to |η − 1| = 1e-5 (`tests/walk/cap.rs`), while within one or
     /// two f32 ulps of 1 nearly all grazing paths are (path lengths measured in DESIGN.md,
-    /// “The bounce cap”). η = 1 itself is transparent ([`crate::Material::is_transparent`]).
+    /// “The bounce cap”). η = 1 itself is transparent ([`crate::research::Material::is_transparent`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         require!(is_direction(wi), None; wi);
-        let mut at = Self::incident(wi)?;
-        if self.material.is_transparent() {
+        let mut at = PathModel::<S, M>::incident(wi)?;
+        if self.model.material.is_transparent() {
             // the Dirac ωo = −ωi of an interface that does not interact (see `Material`)
             return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 1 });
         }
-        if wi.z < 0.0 && self.sees_nothing(at, inv_g1(&self.slope, at.in_frame())) {
+        if wi.z < 0.0 && self.model.sees_nothing(at, inv_g1(&self.model.slope, at.in_frame())) {
             // ωi at the nadir of an opaque material: no facet faces it (projected area 0)
             return None;
         }
         let mut weight = Vec3::ONE;
-        for bounces in 1..=crate::MAX_BOUNCES {
-            let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
+        for bounces in 1..=MAX_BOUNCES {
+            let s = self.model.material.sample_phase_unchecked(&self.model.slope, at.w, at.side, rng);
             weight *= s.weight;
             if weight == Vec3::ZERO {
                 return None;
             }
-            let out = self.exit(s.wo, s.side);
+            let out = self.model.exit(s.wo, s.side);
             if out.can_exit() {
-                let k_in = inv_g1(&self.slope, at.in_frame());
+                let k_in = inv_g1(&self.model.slope, at.in_frame());
                 // P(exit) = S_last/(S_last + S_middle) = S_last/G1(ωin)
-                if f64::from(uniform(rng)) < self.relative_shadowing(at, k_in, out).last {
+                if f64::from(uniform(rng)) < self.model.relative_shadowing(at, k_in, out).last {
                     return Some(WalkSample { wo: s.wo, weight, bounces });
                 }
             }
@@ -254,10 +193,11 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// `None` (a debug assertion in debug builds).
     pub fn sample_single(&self, wi: Vec3, rng: &mut impl Rng) -> Option<(Vec3, Vec3)> {
         require!(is_direction(wi), None; wi);
-        let at = Self::incident(wi)?;
-        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
-        let k_in = inv_g1(&self.slope, at.in_frame());
-        let last = self.relative_shadowing(at, k_in, self.exit(s.wo, s.side)).last;
+        let m = &self.model;
+        let at = PathModel::<S, M>::incident(wi)?;
+        let s = m.material.sample_phase_unchecked(&m.slope, at.w, at.side, rng);
+        let k_in = inv_g1(&m.slope, at.in_frame());
+        let last = m.relative_shadowing(at, k_in, m.exit(s.wo, s.side)).last;
         let weight = s.weight * last as f32;
         (last > 0.0 && weight.is_finite()).then_some((s.wo, weight))
     }
@@ -269,10 +209,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf_single(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(start), Some(wo_side)) =
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        else {
             return 0.0;
         };
-        self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side))
+        self.model.material.pdf_phase_unchecked(&self.model.slope, &start.to(wo, wo_side))
     }
 
     /// An approximate density of [`PositionFree::sample`], for multiple importance sampling
@@ -285,120 +227,19 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wo), 0.0; wi, wo);
-        self.pdf_unchecked(wi, wo)
+        self.model.mis_pdf(wi, wo)
     }
+}
 
-    /// [`PositionFree::pdf`] for directions the caller has validated (the renderer adapter).
-    #[inline]
-    pub(crate) fn pdf_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
-        let (Some(start), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
-            return 0.0;
-        };
-        let single = self.material.pdf_phase_unchecked(&self.slope, &start.to(wo, wo_side));
-        let sides = if M::TRANSMITS { 2.0 } else { 1.0 };
-        (1.0 - PDF_COSINE_SHARE) * single + PDF_COSINE_SHARE * FRAC_1_PI * wo.z.abs() / sides
-    }
-
-    /// The incident state for the macro direction ωi, or `None` on the horizon.
-    ///
-    /// A dielectric lit from below is lit from inside. An opaque material lit from below the
-    /// macrosurface (a backfacing view under a normal map: Tokuyoshi; Wang et al. 2022 §3.5)
-    /// keeps the outside state: its first vertex is then exactly a vertex reached from below,
-    /// which the path integral already contains after any upward bounce (Wang et al. 2022,
-    /// Fig. 5): incident masking G1(ωi) = 1/|1 + Λ(ωi)| = 1/Λ(−ωi) (eq. 10), the VNDF D_ωi on
-    /// the whole sphere, and the shadowing factors of eqs. 17–18 with 1 + L̃ = Λ(−ωi). Every
-    /// exit of an opaque path is upwards. See DESIGN.md, “Multiple scattering for views below
-    /// the macrosurface”.
+impl Exit {
+    /// Whether the direction can leave the surface.
     #[inline(always)]
-    pub(crate) fn incident(wi: Vec3) -> Option<Incident> {
-        let side = Side::of(wi.z)?;
-        Some(Incident { w: wi, side: if M::TRANSMITS { side } else { Side::Outside } })
+    pub(crate) fn can_exit(self) -> bool {
+        self.lambda.is_some()
     }
+}
 
-    /// The side of the macro direction ωo, or `None` if light cannot leave there.
-    #[inline(always)]
-    pub(crate) fn exit_side(wo: Vec3) -> Option<Side> {
-        Side::of(wo.z).filter(|&side| M::TRANSMITS || side == Side::Outside)
-    }
-
-    /// 1 + L̃ of the incident state `at` (the inverse full-spherical masking, `inv_g1`, in its
-    /// side frame).
-    #[inline(always)]
-    pub(crate) fn incident_k(&self, at: Incident) -> f64 {
-        inv_g1(&self.slope, at.in_frame())
-    }
-
-    /// The forward contribution of one vertex in the given role, v(ωin, ωout)·S (S the
-    /// last-vertex or the continuing factor).
-    #[inline]
-    pub(crate) fn connect(
-        &self,
-        at: Incident,
-        wo: Vec3,
-        wo_side: Side,
-        role: VertexRole,
-        rng: &mut impl Rng,
-    ) -> DVec3 {
-        let k_in = inv_g1(&self.slope, at.in_frame());
-        self.connect_known(at, k_in, self.exit(wo, wo_side), role, rng)
-    }
-
-    /// [`Self::connect`] with the incident 1 + L̃ = `k_in` and the outgoing direction's exit
-    /// data already known.
-    #[inline(always)]
-    pub(crate) fn connect_known(
-        &self,
-        at: Incident,
-        k_in: f64,
-        out: Exit,
-        role: VertexRole,
-        rng: &mut impl Rng,
-    ) -> DVec3 {
-        if k_in < 1.0 {
-            // a backfacing incident direction (below the horizon in its side frame): v·S =
-            // p·(k_in S), with the phase function p and the relative factor both free of the
-            // tiny k_in = Λ(−ωin), which v = p·k_in and S ∝ 1/k_in would underflow and overflow
-            let factor = self.relative_shadowing(at, k_in, out).factor(role);
-            if factor == 0.0 {
-                return DVec3::ZERO;
-            }
-            let phase = self.material.eval_phase_unchecked(&self.slope, &at.towards(out), rng);
-            return phase.as_dvec3() * factor;
-        }
-        let factor = self.shadowing_factor(at, k_in, out, role);
-        if factor == 0.0 {
-            return DVec3::ZERO;
-        }
-        self.material.vertex_unchecked(&self.slope, &at.towards(out), rng).as_dvec3() * factor
-    }
-
-    /// The shadowing factors of a vertex relative to its incident masking, k_in·S
-    /// ([`Shadowing::relative`]), with the ratio Λo/k_in of a correlated reflection formed as
-    /// exp(ln Λo − ln k_in) ([`MicrosurfaceSlope::ln_lambda`]) where k_in is below
-    /// `LAMBDA_RATIO_LOG_BELOW` (only backfacing incident directions of low-roughness
-    /// Beckmann surfaces): exact to a few f64 ulps down to the smallest α.
-    #[inline(always)]
-    pub(crate) fn relative_shadowing(&self, at: Incident, k_in: f64, out: Exit) -> VertexShadowing {
-        let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
-        let ratio = match out.lambda {
-            Some(lambda) if event == Event::Reflection && self.shadowing == Shadowing::Correlated => {
-                if k_in >= LAMBDA_RATIO_LOG_BELOW {
-                    lambda / k_in
-                } else {
-                    // k_in = Λ(−ωin) of a backfacing incident direction, in its side frame
-                    let ln_k = self.slope.ln_lambda(-at.in_frame());
-                    if ln_k == f64::NEG_INFINITY {
-                        f64::INFINITY
-                    } else {
-                        (self.slope.ln_lambda(out.side.frame(out.w)) - ln_k).exp()
-                    }
-                }
-            }
-            _ => 0.0,
-        };
-        self.shadowing.relative(k_in, out.lambda, ratio, event)
-    }
-
+impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
     /// Whether the incident state `at` with 1 + L̃ = `k_in` sees no microsurface: Λ(−ωin) = 0
     /// exactly (straight from below), told apart from a Λ(−ωin) that only underflows f64
     /// (Beckmann, |cot θ|/αᵢ > 26.6) by ln Λ (−∞ only in the first case).
@@ -406,36 +247,13 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     pub(crate) fn sees_nothing(&self, at: Incident, k_in: f64) -> bool {
         k_in == 0.0 && self.slope.ln_lambda(-at.in_frame()) == f64::NEG_INFINITY
     }
-
-    /// The exit data of an outgoing direction: whether it points up in its side frame (can
-    /// leave the surface) and then its Λ there (0 otherwise).
-    #[inline]
-    pub(crate) fn exit(&self, w: Vec3, side: Side) -> Exit {
-        let frame = side.frame(w);
-        let lambda = (frame.z > 0.0).then(|| self.slope.lambda64(frame).min(LAMBDA_SATURATION));
-        Exit { w, side, lambda }
-    }
-
-    /// The shadowing factor of a vertex in the given role with incident state `at`
-    /// (1 + L̃ = `k_in`) and outgoing direction `out`; 0 where `at` sees no microsurface and
-    /// where k_in < `LAMBDA_RATIO_LOG_BELOW` (S would overflow: use [`Self::relative_shadowing`]).
-    #[inline(always)]
-    pub(crate) fn shadowing_factor(&self, at: Incident, k_in: f64, out: Exit, role: VertexRole) -> f64 {
-        // S ∝ G1in = 1/k_in overflows for a subnormal f64 k_in; its product with a vertex term
-        // (∝ k_in) is formed by `relative_shadowing` instead, where callers need it
-        if k_in < LAMBDA_RATIO_LOG_BELOW {
-            return 0.0;
-        }
-        let event = if at.side == out.side { Event::Reflection } else { Event::Transmission };
-        self.shadowing.vertex(k_in, out.lambda, event).factor(role)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::Conductor;
-    use crate::microsurface::ScatteringOrder;
+    use crate::material::{Conductor, Side};
+    use crate::path::PDF_COSINE_SHARE;
     use crate::sampling::cosine_hemisphere;
     use crate::slope::Beckmann;
     use rand::SeedableRng;
@@ -603,7 +421,7 @@ mod tests {
         let mut counts = [[0.0f64; 2]; 2];
         for _ in 0..N {
             let wo = if uniform(&mut rng) < 1.0 - PDF_COSINE_SHARE {
-                pf.material.sample_phase(&pf.slope, wi, Side::Outside, &mut rng).wo
+                pf.material().sample_phase(pf.slope(), wi, Side::Outside, &mut rng).wo
             } else {
                 cosine_hemisphere(uniform(&mut rng), uniform(&mut rng))
             };
@@ -646,7 +464,7 @@ mod tests {
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
         for _ in 0..n {
             let wo = if uniform(&mut rng) < 1.0 - PDF_COSINE_SHARE {
-                pf.material.sample_phase(&pf.slope, wi, Side::Outside, &mut rng).wo
+                pf.material().sample_phase(pf.slope(), wi, Side::Outside, &mut rng).wo
             } else {
                 cosine_hemisphere(uniform(&mut rng), uniform(&mut rng))
             };

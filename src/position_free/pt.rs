@@ -1,10 +1,11 @@
 //! The path-tracing estimator (Wang et al. 2022, §4.1, eqs. 24–26).
 
-use super::shadowing::{VertexRole, inv_g1};
-use super::{Incident, PositionFree, ROULETTE_FROM_BOUNCE, Roulette};
+use super::{PositionFree, ROULETTE_FROM_BOUNCE, Roulette};
 use crate::contract::is_direction;
 use crate::material::Material;
 use crate::microsurface::ScatteringOrder;
+use crate::path::{Incident, PathModel};
+use crate::path::{VertexRole, inv_g1};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use glam::{DVec3, Vec3};
@@ -22,7 +23,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
     /// function's peak relative to this path's single-scattering term, keeps it unbiased and
     /// of finite variance and ends the paths lit from below a smooth surface (see
     /// `Roulette::survival`); the throughput is carried in f64. `order` selects all orders (no
-    /// truncation; [`crate::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
+    /// truncation; [`crate::research::MAX_BOUNCES`] is only a guard), exactly the n-th, or the first n.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
@@ -41,15 +42,17 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         order: ScatteringOrder,
         rng: &mut impl Rng,
     ) -> (Vec3, u32) {
-        let (Some(mut at), Some(wo_side)) = (Self::incident(wi), Self::exit_side(wo)) else {
+        let (Some(mut at), Some(wo_side)) =
+            (PathModel::<S, M>::incident(wi), PathModel::<S, M>::exit_side(wo))
+        else {
             return (Vec3::ZERO, 0);
         };
         let mut extensions = 0;
         let last = order.last();
         // the exit data of ωo (constant) and 1 + L̃ of the current incident direction: one Λ
         // per bounce
-        let to_wo = self.exit(wo, wo_side);
-        let mut k_in = inv_g1(&self.slope, at.in_frame());
+        let to_wo = self.model.exit(wo, wo_side);
+        let mut k_in = inv_g1(&self.model.slope, at.in_frame());
         let mut throughput = DVec3::ONE;
         let mut sum = DVec3::ZERO;
         // the reference is the single-scattering term, set at the first vertex where it is evaluated
@@ -57,7 +60,7 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
             if order.includes(1) { Roulette::UNSET } else { Roulette::new(self, at, k_in, None) };
         for bounce in 1..=last {
             if order.includes(bounce) {
-                let contribution = self.connect_known(at, k_in, to_wo, VertexRole::Last, rng);
+                let contribution = self.model.connect_known(at, k_in, to_wo, VertexRole::Last, rng);
                 if bounce == 1 {
                     // the single-scattering term is the roulette's reference
                     roulette.set_reference(self, at, k_in, contribution);
@@ -101,18 +104,18 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         k_in: f64,
         rng: &mut impl Rng,
     ) -> Option<(Incident, f64, DVec3)> {
-        if !k_in.is_finite() || self.sees_nothing(at, k_in) {
+        if !k_in.is_finite() || self.model.sees_nothing(at, k_in) {
             return None;
         }
-        let s = self.material.sample_phase_unchecked(&self.slope, at.w, at.side, rng);
-        let out = self.exit(s.wo, s.side);
+        let s = self.model.material.sample_phase_unchecked(&self.model.slope, at.w, at.side, rng);
+        let out = self.model.exit(s.wo, s.side);
         // k_in·S_middle, exact also where k_in underflows (a backfacing low-roughness vertex)
-        let middle = self.relative_shadowing(at, k_in, out).middle;
+        let middle = self.model.relative_shadowing(at, k_in, out).middle;
         // the next incident direction −ω: below the horizon in its frame where ω can exit, and
         // then 1 + L̃ = Λ(ω)
         let k_next = match out.lambda {
             Some(lambda) => lambda,
-            None => inv_g1(&self.slope, -s.side.frame(s.wo)),
+            None => inv_g1(&self.model.slope, -s.side.frame(s.wo)),
         };
         let next = Incident { w: -s.wo, side: s.side };
         Some((next, k_next, s.weight.as_dvec3() * middle))

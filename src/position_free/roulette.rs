@@ -1,8 +1,9 @@
 //! Russian roulette of the camera paths (PT and BDPT's camera sub-path): the survival
 //! probability and the quantities it compares.
 
-use super::{Incident, LAMBDA_RATIO_LOG_BELOW, PositionFree};
+use super::PositionFree;
 use crate::material::{Material, Side};
+use crate::path::{Incident, LAMBDA_RATIO_LOG_BELOW};
 use crate::slope::MicrosurfaceSlope;
 use core::f64::consts::PI;
 use glam::{DVec3, Vec3};
@@ -13,13 +14,13 @@ pub(crate) const ROULETTE_FROM_BOUNCE: u32 = 3;
 
 /// The bidirectional estimator's sub-paths start their Russian roulette after this many sampled
 /// directions: one earlier than path tracing, whose variance per sample is higher and which
-/// measured worse from the second (DESIGN.md, “BDPT against PT where BDPT loses”).
+/// measured worse from the second (DESIGN.md, “BDPT against PT”).
 pub(crate) const BDPT_ROULETTE_FROM: usize = 2;
 
 /// The margin C of the survival factor's cap C·P/ĉ (see [`Roulette::survival`]). The cap
 /// binds only where G1 overstates the next phase function's peak relative to ĉ by more than C,
-/// as it does by up to e^{a²} below a light-tailed surface. Measured (DESIGN.md, “Paths that
-/// never end from below”): C = 8 raised the variance of BDPT at GGX α = 0.1 by 31 % (mostly at
+/// as it does by up to e^{a²} below a light-tailed surface. Measured (DESIGN.md, “Russian
+/// roulette”): C = 8 raised the variance of BDPT at GGX α = 0.1 by 31 % (mostly at
 /// the mirror direction, whose later vertices keep contributing), C = 64 by 7 %, C = 256 by
 /// 1.5 % (within the noise, at 11 % fewer instructions); below a smooth GGX surface each factor
 /// 4 of C costs about one more bounce (16 extensions at C = 256, 4.7 at C = 1).
@@ -107,8 +108,7 @@ impl Roulette {
     ///
     /// A phase function integrates to 1 over the sphere, so P ≥ 1/(4π) and the cap exceeds G1
     /// wherever C·k_next ≥ 4πĉ: P is evaluated only for smaller k_next (steep or backfacing
-    /// ω). The measurements behind the rule: DESIGN.md, “Russian roulette with the next
-    /// vertex's masking” and “Paths that never end from below”.
+    /// ω). The measurements behind the rule: DESIGN.md, “Russian roulette”.
     #[inline(always)]
     pub(crate) fn survival<S: MicrosurfaceSlope, M: Material>(
         &self,
@@ -210,10 +210,10 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let scale = 0.25 * self.peaks.material;
         let z = f64::from(w.z);
         if z >= 0.0 {
-            return scale * self.slope.d64_unchecked(DVec3::Z) / (k * z);
+            return scale * self.model.slope.d64_unchecked(DVec3::Z) / (k * z);
         }
         let (x, y) = (f64::from(w.x), f64::from(w.y));
-        let (ax, ay) = (f64::from(self.slope.alpha_x()), f64::from(self.slope.alpha_y()));
+        let (ax, ay) = (f64::from(self.model.slope.alpha_x()), f64::from(self.model.slope.alpha_y()));
         let (ax2, ay2) = (ax * ax, ay * ay);
         let q = ax2 * x * x + ay2 * y * y;
         if q <= 0.0 || q.is_nan() {
@@ -224,12 +224,12 @@ impl<S: MicrosurfaceSlope, M: Material> PositionFree<S, M> {
         let l = z / q;
         let m = DVec3::new(-l * ax2 * x, -l * ay2 * y, 1.0).normalize();
         if k >= LAMBDA_RATIO_LOG_BELOW {
-            return scale * self.slope.d64_unchecked(m) / (k * -z);
+            return scale * self.model.slope.d64_unchecked(m) / (k * -z);
         }
         // Λ(−ω) below f64's range: D(m*) underflows with it; D/A from the visible-normal
         // density just inside m*, which forms it in log space
         let w64 = w.as_dvec3();
         let inside = (m + 1e-9 * w64).normalize();
-        scale * self.slope.d_wi64_unchecked(w, inside) / w64.dot(inside)
+        scale * self.model.slope.d_wi64_unchecked(w, inside) / w64.dot(inside)
     }
 }

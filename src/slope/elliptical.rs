@@ -1,9 +1,7 @@
 //! Elliptical anisotropy with correlation: an axis-aligned slope distribution rotated in the
 //! tangent plane (Dupuy 2015, thesis §2.3).
 
-use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction, is_direction64, is_uniform};
-use crate::albedo::{AlbedoTable, DielectricAlbedoTable};
-use crate::bsdf::AlbedoTabulated;
+use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction};
 use crate::error::Error;
 use crate::vector::ensure_visible;
 use glam::{DVec3, Vec3};
@@ -71,12 +69,13 @@ impl AxisAlignedSlope for Beckmann {
 /// for an axis-aligned slope); `MicrofacetBsdf`'s smooth and walk-length limits compare
 /// [`MicrosurfaceSlope::alpha_max`] = max(α₁, α₂), the same for every φα, against their
 /// thresholds.
-/// It does not implement [`VCavitySlope`](crate::VCavitySlope), whose closed forms are written
+/// It does not implement [`VCavitySlope`](crate::vndf::VCavitySlope), whose closed forms are written
 /// in the stretched frame of an axis-aligned distribution.
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Beckmann, Elliptical, MicrosurfaceSlope};
+/// use microsurface::{Beckmann, Elliptical};
+/// use microsurface::slope::MicrosurfaceSlope;
 /// use microsurface::glam::Vec3;
 ///
 /// let slope = Elliptical::<Beckmann>::from_ellipse(0.5, 0.1, 0.3)?;
@@ -234,18 +233,6 @@ impl<S> Elliptical<S> {
     }
 }
 
-impl<S: AxisAlignedSlope + AlbedoTabulated> AlbedoTabulated for Elliptical<S> {
-    const ALBEDO: AlbedoTable = S::ALBEDO;
-    const DIELECTRIC_ALBEDO: DielectricAlbedoTable = S::DIELECTRIC_ALBEDO;
-    const ORDERS: crate::ScatteringOrderTable = S::ORDERS;
-
-    /// √(α₁ α₂): the compensated lobe of the rotated ellipse is that of the axis-aligned one.
-    #[inline]
-    fn albedo_alpha(&self) -> f32 {
-        self.axis_aligned.albedo_alpha()
-    }
-}
-
 impl<S: AxisAlignedSlope> crate::sealed::Sealed for Elliptical<S> {}
 
 impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
@@ -283,20 +270,8 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
     }
 
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        require!(is_direction64(wm), 0.0; wm);
-        self.d64_unchecked(wm)
-    }
-
-    #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
         self.axis_aligned.d64_unchecked(self.to_ellipse64(wm))
-    }
-
-    #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.lambda_unchecked(w)
     }
 
     #[inline]
@@ -312,12 +287,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
     #[inline]
     fn ln_lambda(&self, w: Vec3) -> f64 {
         self.axis_aligned.ln_lambda(self.to_ellipse(w))
-    }
-
-    #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.projected_area_unchecked(w)
     }
 
     #[inline]
@@ -349,12 +318,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         self.d_wi64_unchecked(wi, wm.as_dvec3()) as f32
     }
 
-    #[inline]
-    fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
-        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
-        self.d_wi64_unchecked(wi, wm)
-    }
-
     /// The axis-aligned D_ωi of the rotated pair, with the visibility ⟨ωi, ωm⟩ > 0 decided on the
     /// given (unrotated) vectors, as the samplers guarantee it.
     #[inline]
@@ -375,12 +338,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
 
     /// Eq. 2.35 in its rotated form: `S`'s exact sampler from ωi rotated by −φα, its normal
     /// rotated back by +φα (and made visible from ωi against the rounding of the rotations).
-    #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
-        self.sample_d_wi_unchecked(wi, u1, u2)
-    }
-
     #[inline]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let wm = self.axis_aligned.sample_d_wi_unchecked(self.to_ellipse(wi), u1, u2);

@@ -2,12 +2,10 @@
 //! in Mitsuba 2 and Tokuyoshi's listing 6), for comparison with the exact inversion.
 
 use super::VisibleNormalSampler;
-use super::beckmann_inversion::gaussian_slope;
-use super::stretch::Azimuth;
 use crate::constants::INV_SQRT_PI;
 use crate::contract::{are_uniform, is_direction};
 use crate::rng::cut_tails64;
-use crate::slope::{Beckmann, MicrosurfaceSlope};
+use crate::slope::{Azimuth, Beckmann, MicrosurfaceSlope, gaussian_slope};
 use crate::special::{erf64, erfinv64};
 use glam::Vec3;
 

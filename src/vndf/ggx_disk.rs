@@ -3,9 +3,8 @@
 
 use super::VisibleNormalSampler;
 use super::disk_band::{half_space_band, sample_band};
-use super::stretch::disk_frame;
 use crate::contract::{are_uniform, is_direction};
-use crate::slope::{Ggx, MicrosurfaceSlope};
+use crate::slope::{Ggx, MicrosurfaceSlope, disk_frame};
 use crate::vector::ensure_visible;
 use glam::Vec3;
 

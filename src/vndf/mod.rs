@@ -12,21 +12,17 @@
 //! from the densities and NaN from the other quantities (normalization, masking, hit
 //! probability).
 
-mod beckmann_inversion;
 mod beckmann_newton;
 mod disk_band;
 mod ggx_disk;
 mod smith;
 mod spherical_cap;
-mod stretch;
 mod vcavity;
 
-pub(crate) use beckmann_inversion::{sample_visible_normal, visible_slopes};
 pub use beckmann_newton::BeckmannNewton;
 pub use ggx_disk::GgxDisk;
 pub use smith::SmithVndf;
 pub use spherical_cap::GgxSphericalCap;
-pub(crate) use spherical_cap::{sample_spherical_cap, sample_visible_hemisphere};
 pub use vcavity::{VCavity, VCavitySlope};
 
 use crate::contract::is_direction;

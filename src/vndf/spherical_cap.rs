@@ -3,10 +3,7 @@
 
 use super::VisibleNormalSampler;
 use crate::contract::{are_uniform, is_direction};
-use crate::rng::cut_tails;
 use crate::slope::{Ggx, MicrosurfaceSlope};
-use crate::special::sin_cos_turns;
-use crate::vector::{DIRECT_SCALE_RANGE, ensure_visible, normalize_fast, normalize_scaled};
 use glam::Vec3;
 
 /// GGX visible normals by the spherical-cap method (Dupuy and Benyoub 2023): ωm is the
@@ -16,7 +13,8 @@ use glam::Vec3;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Ggx, GgxSphericalCap, VisibleNormalSampler};
+/// use microsurface::Ggx;
+/// use microsurface::vndf::{GgxSphericalCap, VisibleNormalSampler};
 /// use microsurface::glam::Vec3;
 /// let sampler = GgxSphericalCap(Ggx::isotropic(0.3)?);
 /// let wi = Vec3::new(0.6, 0.0, 0.8);
@@ -38,167 +36,5 @@ impl VisibleNormalSampler for GgxSphericalCap {
     fn pdf(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.0.d_wi(wi, wm)
-    }
-}
-
-/// A GGX visible normal for a unit ωi, exact for every ωi: stretch ωi to α = 1, sample the
-/// visible hemisphere with the spherical cap, unstretch (Dupuy and Benyoub 2023, with the cap
-/// z > −ωi.z, which is also valid for ωi.z < 0). The stretched ωi is not normalized: the cap
-/// is sampled at its scale (a square root, no division). No argument check (the callers have
-/// done it).
-#[must_use]
-#[inline(always)]
-pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-    let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
-    let stretched = Vec3::new(alpha_x * wi.x, alpha_y * wi.y, wi.z);
-    let len_sq = stretched.length_squared();
-    let (v, len) = if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {
-        (stretched, len_sq.sqrt())
-    } else {
-        (normalize_scaled(stretched, Vec3::Z), 1.0)
-    };
-    let h = sample_visible_hemisphere(v, len, u1, u2);
-    ensure_visible(wi, normalize_fast(Vec3::new(alpha_x * h.x, alpha_y * h.y, h.z), Vec3::Z))
-}
-
-/// Samples the normals of the unit upper hemisphere visible from the direction `v` of length
-/// `len` > 0, with density ∝ max(0, v·m) on m.z ≥ 0; returns them **unnormalized** (`len`
-/// times v̂ + c, of length in [0, 2 len]), since every caller rescales anyway.
-///
-/// normalize(v̂ + c) has density max(0, v̂·m)/π when c is uniform on the sphere (the map
-/// c = reflect(v̂, m) has Jacobian 4 v̂·m); restricting m.z ≥ 0 restricts c to the cap
-/// c.z ≥ −v̂.z, sampled uniformly by a uniform c.z. Everything is scaled by `len`, so that
-/// v̂ = v/len is never formed. Returns 0 when v̂ = −z (empty cap).
-///
-/// The cap's height uniform u1 is cut to [2⁻²⁴, 1 − 2⁻²⁴] (the crate's tail policy, `rng`):
-/// the sample for u1 = 0 has 2⁻²⁴ of the cap above it instead of sitting on its pole, the one
-/// for u1 = 1 − 2⁻²⁴ has 2⁻²⁴ below it. The azimuth u2 is not cut.
-///
-/// The horizontal part v_xy + len c_xy is a sum of nearly opposite vectors where c approaches
-/// −v̂ (the bottom of the cap, u1 → 1, on the far side): its f32 error, about 2ε len, is at most
-/// 128ε ≈ 8e-6 relative (the direction of h) while |h| ≥ len/64, and beyond that h is
-/// recomputed by [`cap_near_opposite`] without cancellation (error about ε): a half disk of
-/// radius 1/64 around −v̂ on the cap, 6e-5/(1 + v̂.z) of the samples (0.03 % above the
-/// horizon; about 1.5 % for the thin caps of far backfacing views, v̂.z = −0.998).
-#[must_use]
-#[inline(always)]
-pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> Vec3 {
-    let u1 = cut_tails(u1);
-    // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
-    // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
-    // len + v.z written as (v.x² + v.y²)/(len − v.z) below the horizon: for a backfacing ωi
-    // of a low-roughness surface v̂ ≈ −z and the direct sum cancels (GGX α = 1e-4 at θ = 2.3:
-    // it rounded to 0 and every sample became the fallback horizontal normal)
-    let top = if v.z >= 0.0 { len + v.z } else { (v.x * v.x + v.y * v.y) / (len - v.z) };
-    let h_z = (1.0 - u1) * top;
-    let z_scaled = h_z - v.z;
-    let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = sin_cos_turns(u2);
-    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
-    // |h| ≥ h.z: the height alone clears the test for all but the bottom of the cap
-    if h_z >= NEAR_OPPOSITE * len || h.length_squared() >= NEAR_OPPOSITE * NEAR_OPPOSITE * (len * len) {
-        return h;
-    }
-    cap_near_opposite(v, u1, u2).unwrap_or(h)
-}
-
-/// |h| below this fraction of len is recomputed by [`cap_near_opposite`].
-const NEAR_OPPOSITE: f32 = 1.0 / 64.0;
-
-/// h = v + len c for a cap point c near −v̂, in double precision and in the azimuth frame of v:
-/// with s = |v_xy|, ê = v_xy/s, ψ = 2π u2 − φo the azimuth of c_xy measured from −ê (φo the
-/// azimuth of −ê, so that the map is the direct one up to the f32 error of its azimuth, a
-/// fraction of one 2⁻²⁴ step of u2) and r = len |c_xy|, h_xy = (s − r cos ψ) ê − r sin ψ ê⊥
-/// with s − r cos ψ = (s² − r²)/(s + r) + 2r sin²(ψ/2), all without cancellation: with
-/// z = len c.z = (1 − u1)(len + v.z) − v.z and r² = u1 (len + v.z)(len + z) as in the direct
-/// form, s² − r² = (z − v.z)(z + v.z). Here len = |v| in double precision: the f32 `len` of
-/// the caller differs from |v| by ε len, and near −v̂ a sphere of that radius instead of |v|
-/// moves the point by about as much as |h| itself. sin(ψ/2) and cos(ψ/2) come from
-/// (sin, cos)(π u2) and the half angle of φo by the angle-difference formulas (no library
-/// call). `None` for v along ±z (no cancellation there: v_xy = 0).
-#[inline(never)]
-fn cap_near_opposite(v: Vec3, u1: f32, u2: f32) -> Option<Vec3> {
-    let (vx, vy, vz, u1) = (f64::from(v.x), f64::from(v.y), f64::from(v.z), f64::from(u1));
-    let s_sq = vx * vx + vy * vy;
-    if s_sq == 0.0 {
-        return None;
-    }
-    let s = s_sq.sqrt();
-    let len = (s_sq + vz * vz).sqrt();
-    // as in the f32 form: len + v.z = |v_xy|²/(len − v.z) below the horizon, without cancellation
-    let top = if vz >= 0.0 { len + vz } else { s_sq / (len - vz) };
-    let h_z = (1.0 - u1) * top;
-    let z = h_z - vz;
-    let r = (u1 * top * (len + z)).max(0.0).sqrt();
-    let s_sq_minus_r_sq = (z - vz) * h_z;
-    // half angle of φo ∈ (−π, π]: cos(φo/2) ≥ 0, sin(φo/2) with the sign of sin φo, each from
-    // the half-angle formula that does not cancel (φo = ±π for sin φo = ±0 give the same h)
-    let (cos_o, sin_o) = (-vx / s, -vy / s);
-    let (sin_oh, cos_oh) = if cos_o >= 0.0 {
-        let c = (0.5 * (1.0 + cos_o)).sqrt();
-        (sin_o / (2.0 * c), c)
-    } else {
-        let sh = (0.5 * (1.0 - cos_o)).sqrt().copysign(sin_o);
-        (sh, sin_o / (2.0 * sh))
-    };
-    let (sin_a, cos_a) = sin_cos_turns(0.5 * u2);
-    let (sin_a, cos_a) = (f64::from(sin_a), f64::from(cos_a));
-    let unit = 1.0 / (sin_a * sin_a + cos_a * cos_a).sqrt();
-    let (sin_a, cos_a) = (sin_a * unit, cos_a * unit);
-    let sin_half = sin_a * cos_oh - cos_a * sin_oh;
-    let cos_half = cos_a * cos_oh + sin_a * sin_oh;
-    let along = s_sq_minus_r_sq / (s + r) + 2.0 * r * sin_half * sin_half;
-    let across = -2.0 * r * sin_half * cos_half;
-    let (ex, ey) = (vx / s, vy / s);
-    Some(Vec3::new((along * ex - across * ey) as f32, (along * ey + across * ex) as f32, h_z as f32))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The cancellation-free form of the cap describes the same point as the direct one: where
-    /// the direct form is still accurate (len/64 ≤ |h| ≤ len/2, error ≤ 128ε), the two
-    /// directions agree to 2e-5. Away from the poles of v only: the direct form's len ± v.z
-    /// cancel as v̂.z → ∓1 (relative error ε/(1 ± v̂.z) in r, measured 3e-4 in h at
-    /// 1 − |v̂.z| = 1e-4), which the cancellation-free form, in f64, does not share.
-    #[test]
-    fn cap_near_opposite_is_the_direct_map() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / 16_777_216.0
-        };
-        let (mut compared, mut worst) = (0, 0.0f64);
-        for _ in 0..400_000 {
-            let theta = core::f32::consts::PI * next();
-            let phi = core::f32::consts::TAU * next();
-            let scale = [0.05f32, 0.5, 1.0, 3.0][(4.0 * next()) as usize % 4];
-            let v = Vec3::new(scale * theta.sin() * phi.cos(), scale * theta.sin() * phi.sin(), theta.cos());
-            let len = v.length();
-            if v.z.abs() > 0.9 * len {
-                continue;
-            }
-            // u1 near 1 and u2 near the far side, where |h| is small
-            let (u1, u2) = (1.0 - 0.05 * next() * next(), next());
-            let top = len + v.z;
-            let h_z = (1.0 - u1) * top;
-            let r = (u1 * top * (len + h_z - v.z)).max(0.0).sqrt();
-            let (sin_phi, cos_phi) = sin_cos_turns(u2);
-            let direct = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
-            let ratio = direct.length() / len;
-            if !(1.0 / 64.0..=0.5).contains(&ratio) {
-                continue;
-            }
-            let Some(exact) = cap_near_opposite(v, u1, u2) else { continue };
-            let gap = f64::from((direct.normalize() - exact.normalize()).length());
-            worst = worst.max(gap);
-            compared += 1;
-        }
-        eprintln!("cap_near_opposite vs direct: {compared} samples, largest gap {worst:.2e}");
-        assert!(compared > 1000, "only {compared} samples compared");
-        assert!(worst < 2e-5, "the two forms differ by {worst:e}");
     }
 }

@@ -1,13 +1,14 @@
 //! The V-cavity microsurface as an alternative masking model (Tokuyoshi, supplement §2).
 
 use super::VisibleNormalSampler;
-use super::beckmann_inversion::{gaussian_slope, visible_slope_x_above};
 use super::disk_band::{half_space_band, sample_band};
-use super::stretch::{Azimuth, disk_frame, stretch, stretch64};
 use crate::constants::INV_SQRT_PI;
 use crate::contract::{are_uniform, is_direction, is_plane_normal};
 use crate::rng::cut_tails64;
-use crate::slope::{Beckmann, Ggx, MicrosurfaceSlope};
+use crate::slope::{
+    Azimuth, Beckmann, Ggx, MicrosurfaceSlope, disk_frame, gaussian_slope, stretch, stretch64,
+    visible_slope_x_above,
+};
 use crate::special::{erfc64, erfcx64, erfinv_from_both_ends, one_minus_scaled_erfcx};
 use glam::Vec3;
 /// From this w = |i_z|/√q on, the Beckmann hit probability is evaluated in log space (its

@@ -8,10 +8,9 @@
 //! is Λ(−ωv)/(Λ(−ωv) + Λ(ωl)), a ratio of two such numbers (issue 12, defect 2).
 
 use glam::{Vec2, Vec3};
-use microsurface::{
-    Beckmann, Bsdf, ComplexIor, Conductor, Ggx, Material, MicrofacetBsdf, MicrosurfaceSlope, SpecularLimit,
-    Technique,
-};
+use microsurface::research::{Material, SpecularLimit};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Bsdf, ComplexIor, Conductor, Ggx, MicrofacetBsdf, Technique};
 use statrs::function::erf::erfc;
 use validation::{TestRng, dir, uniform32};
 

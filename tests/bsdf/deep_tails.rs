@@ -5,10 +5,9 @@
 
 use core::convert::Infallible;
 use glam::{Vec2, Vec3};
-use microsurface::{
-    Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Ggx, Material, MicrofacetBsdf, MicrosurfaceSlope,
-    SpecularLimit, Technique,
-};
+use microsurface::research::{Material, SpecularLimit};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Bsdf, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique};
 use validation::dir;
 
 /// Weight against f·|cos|/pdf without a Fresnel weight (perfect conductor, dielectric): both

@@ -184,7 +184,8 @@ fn research_albedo<S: MicrosurfaceSlope, M: Material + SpecularLimit>(
     n: usize,
     rng: &mut TestRng,
 ) -> Stats {
-    let pf = |sh| microsurface::PositionFree::new(*b.surface().slope(), *b.surface().material(), sh);
+    let pf =
+        |sh| microsurface::research::PositionFree::new(*b.surface().slope(), *b.surface().material(), sh);
     let mut st = Stats::default();
     for _ in 0..n {
         let s = match b.technique() {

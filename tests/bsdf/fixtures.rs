@@ -3,10 +3,13 @@
 //! imports every file of the binary uses.
 
 pub(crate) use glam::{Vec2, Vec3};
+pub(crate) use microsurface::research::{
+    Estimator, Material, ScatteringOrder, Shadowing, SpecularLimit, sample_cosine_hemisphere,
+};
+pub(crate) use microsurface::slope::MicrosurfaceSlope;
 pub(crate) use microsurface::{
     Beckmann, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor,
-    Conductor, Dielectric, Diffuse, Estimator, Ggx, Material, MicrofacetBsdf, MicrosurfaceSlope,
-    ScatteringOrder, ShadingFrame, Shadowing, SpecularLimit, Technique, Transport, sample_cosine_hemisphere,
+    Conductor, Dielectric, Diffuse, Ggx, MicrofacetBsdf, ShadingFrame, Technique, Transport,
 };
 pub(crate) use std::f64::consts::PI;
 pub(crate) use validation::check::rel_close;

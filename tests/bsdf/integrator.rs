@@ -100,7 +100,8 @@ fn backfacing_views_keep_their_lobe_across_smooth_alpha() {
 /// and sample near those directions with a density.
 #[test]
 fn the_specular_limit_below_smooth_alpha() {
-    use microsurface::{SMOOTH_ALPHA, fresnel_dielectric};
+    use microsurface::SMOOTH_ALPHA;
+    use microsurface::fresnel::fresnel_dielectric;
     let below = SMOOTH_ALPHA * 0.9;
     let above = SMOOTH_ALPHA * 1.1;
     let wo = dir(0.6, 0.4);
@@ -217,7 +218,7 @@ fn roughness_above_the_walk_range_is_rejected() {
 /// are passed through exactly.
 #[test]
 fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
-    use microsurface::fresnel_dielectric;
+    use microsurface::fresnel::fresnel_dielectric;
     let grid = |x: f32| (x * 16_777_216.0).floor() / 16_777_216.0;
     let slope = ggx(0.4, 0.25);
     let gold_b = mf(slope, gold()).with_technique(Technique::SingleScattering);

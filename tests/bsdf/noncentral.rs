@@ -14,7 +14,8 @@
 use super::densities::chi2_exact;
 use super::fixtures::*;
 use super::invalid_directions::check_bad_input;
-use microsurface::{Elliptical, LeadrLobe, Noncentral, NoncentralBsdf, NoncentralMasking, SlopeMoments};
+use microsurface::Elliptical;
+use microsurface::leadr::{LeadrLobe, Noncentral, NoncentralBsdf, NoncentralMasking, SlopeMoments};
 
 /// The number of chi-square tests of `noncentral_sampling_matches_pdf` (part of
 /// `CHI2_FAMILY`).

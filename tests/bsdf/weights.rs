@@ -3,7 +3,7 @@
 //! microfacet BSDFs.
 
 use super::fixtures::*;
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
 
 /// The proposal of the albedo estimates: with probability `PHASE_SHARE` the single-bounce
 /// phase function of the material seen from `wo` (conductors and dielectrics, whose phase

@@ -1,7 +1,7 @@
 //! The height distributions: the round trip c1(inv_c1(u)) = u, the documented end values,
 //! the density against the CDF by quadrature, the Gaussian CDF against statrs, and no NaN.
 
-use microsurface::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+use microsurface::research::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
 use validation::check::ulp32;
 
 /// Half the f32 spacing at 1: the rounding of a value in [½, 1].

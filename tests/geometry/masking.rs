@@ -7,10 +7,11 @@
 //! A downward ray always hits, with P(c ≤ x) = (x/c0)^|Λ(ω)|, |Λ(ω)| = 1 + Λ(−ω).
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, GaussianHeight, Ggx, HeightSample, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope,
-    UniformHeight,
+use microsurface::research::{
+    GaussianHeight, HeightSample, MicrosurfaceGeometry, MicrosurfaceHeight, UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Ggx};
 use statrs::function::{beta as sbeta, erf as serf};
 use validation::{Stats, TestRng, assert_mean, dir, family_z, sidak, uniform32, uniform64};
 

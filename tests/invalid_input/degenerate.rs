@@ -3,10 +3,11 @@
 //! routine.
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, Material, Microsurface,
-    MicrosurfaceHeight, MicrosurfaceSlope, ScatteringOrder, UniformHeight,
+use microsurface::research::{
+    GaussianHeight, Material, Microsurface, MicrosurfaceHeight, ScatteringOrder, UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};
 use validation::TestRng;
 
 /// Degenerate direction pairs: grazing (z = 0 and 1e-7, both sides), the poles, ωo = −ωi

@@ -13,12 +13,14 @@
 //! was the one of the lower hemisphere.
 
 use glam::{Vec2, Vec3};
-use microsurface::{
-    Beckmann, BeckmannNewton, Conductor, Dielectric, Diffuse, Ggx, GgxDisk, GgxSphericalCap, Material,
-    MicrosurfaceGeometry, MicrosurfaceSlope, SmithVndf, UniformHeight, VCavity, VCavitySlope,
-    VisibleNormalSampler, orthonormal_basis, smith_normalization,
+use microsurface::research::{Interaction, Side};
+use microsurface::research::{Material, MicrosurfaceGeometry, UniformHeight, orthonormal_basis};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
+    smith_normalization,
 };
-use microsurface::{Interaction, Side};
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
 
 type Rng = rand_pcg::Pcg64Mcg;

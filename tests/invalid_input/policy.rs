@@ -11,15 +11,22 @@
 //! directions, signed zeros, lengths within the tolerance) must pass the checks.
 
 use glam::{DVec3, Vec2, Vec3};
-use microsurface::{
-    Beckmann, BeckmannNewton, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Estimator,
-    GaussianHeight, Ggx, GgxDisk, GgxSphericalCap, HeightSample, Material, Microsurface,
-    MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PhaseSample, PositionFree, ScatteringOrder,
-    Shadowing, SmithVndf, UniformHeight, VCavity, VCavitySlope, VisibleNormalSampler, concentric_disk,
-    fresnel_conductor, fresnel_dielectric, fresnel_schlick, orthonormal_basis, sample_cosine_hemisphere,
+use microsurface::Elliptical;
+use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
+use microsurface::leadr::Noncentral;
+use microsurface::research::Invariance;
+use microsurface::research::{
+    Estimator, GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry,
+    MicrosurfaceHeight, PhaseSample, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
+    concentric_disk, orthonormal_basis, sample_cosine_hemisphere,
+};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
     smith_normalization,
 };
-use microsurface::{Elliptical, Interaction, Noncentral, Side};
+use microsurface::{Beckmann, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::fmt::Debug;
@@ -306,6 +313,7 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
     let mut rng = rng();
     let surface = Microsurface::new(UniformHeight, s, m);
     let pf = |shadowing| PositionFree::new(s, m, shadowing);
+    let invariance = Invariance::new(s, m).ok();
     let all = ScatteringOrder::All;
     for b in bad_directions() {
         for (wi, wo, slot) in [(b, good(), "ωi"), (good(), b, "ωo")] {
@@ -352,6 +360,9 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
                 || surface.eval(wi, wo, ScatteringOrder::only(1).unwrap(), &mut rng),
                 zero,
             );
+            if let Some(inv) = &invariance {
+                r.expect_nothing(&format!("{l}: Invariance::eval"), || inv.eval(wi, wo, all, &mut rng), zero);
+            }
             r.expect_nothing(
                 &format!("{l}: Microsurface::eval_phase"),
                 || surface.eval_phase(wi, wo, &mut rng),
@@ -395,6 +406,13 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
             || surface.sample(b, &mut rng),
             Option::is_none,
         );
+        if let Some(inv) = &invariance {
+            r.expect_nothing(
+                &format!("{l}: Invariance::sample"),
+                || inv.sample(b, &mut rng),
+                Option::is_none,
+            );
+        }
         r.expect_nothing(
             &format!("{l}: Microsurface::sample_phase"),
             || surface.sample_phase(b, &mut rng),

@@ -4,7 +4,8 @@
 //! (Wang et al. 2022, §4.3).
 
 use glam::Vec3;
-use microsurface::{Conductor, Dielectric, Ggx, Material, PositionFree, ScatteringOrder, Shadowing};
+use microsurface::research::{Material, PositionFree, ScatteringOrder, Shadowing};
+use microsurface::{Conductor, Dielectric, Ggx};
 use validation::par_map;
 use validation::stochastic::stochastic_chi2;
 

@@ -84,7 +84,7 @@ fn erf_is_within_one_ulp() {
     let (mut ulps, mut frac) = (0u64, MaxErr::new());
     let mut worst_at = 0.0f32;
     for x in erf_arguments() {
-        let r = microsurface::erf(x);
+        let r = microsurface::special::erf(x);
         let reference = serf::erf(f64::from(x));
         assert!(r.is_finite() && (-1.0..=1.0).contains(&r), "erf({x:e}) = {r}");
         let d = ulp_distance(r, reference);
@@ -101,12 +101,12 @@ fn erf_is_within_one_ulp() {
     );
     assert!(ulps <= 1, "erf: {ulps} ulp at x = {worst_at:e}: the doc states 1 ulp");
     // special values and symmetry
-    assert_eq!(microsurface::erf(0.0), 0.0);
-    assert_eq!(microsurface::erf(f32::INFINITY), 1.0);
-    assert_eq!(microsurface::erf(f32::NEG_INFINITY), -1.0);
-    assert!(microsurface::erf(f32::NAN).is_nan());
+    assert_eq!(microsurface::special::erf(0.0), 0.0);
+    assert_eq!(microsurface::special::erf(f32::INFINITY), 1.0);
+    assert_eq!(microsurface::special::erf(f32::NEG_INFINITY), -1.0);
+    assert!(microsurface::special::erf(f32::NAN).is_nan());
     for x in erf_arguments() {
-        assert_eq!(microsurface::erf(-x), -microsurface::erf(x), "erf is odd at {x:e}");
+        assert_eq!(microsurface::special::erf(-x), -microsurface::special::erf(x), "erf is odd at {x:e}");
     }
 }
 
@@ -116,7 +116,7 @@ fn erfc_has_one_ulp_relative_error_where_normal() {
     let mut worst_at = 0.0f32;
     let (mut sub_ulps, mut sub_at) = (0u64, 0.0f32);
     for x in erf_arguments() {
-        let r = microsurface::erfc(x);
+        let r = microsurface::special::erfc(x);
         let reference = serf::erfc(f64::from(x));
         assert!(r.is_finite() && (0.0..=2.0).contains(&r), "erfc({x:e}) = {r}");
         let d = ulp_distance(r, reference);
@@ -142,22 +142,22 @@ fn erfc_has_one_ulp_relative_error_where_normal() {
 
     // the underflow threshold: the largest x with erfc(x) > 0
     let mut x = 10.0f32;
-    while microsurface::erfc(x.next_up()) > 0.0 {
+    while microsurface::special::erfc(x.next_up()) > 0.0 {
         x = x.next_up();
     }
-    println!("erfc: last x with erfc(x) > 0 is {x:.9} (erfc = {:e})", microsurface::erfc(x));
-    assert!(microsurface::erfc(x) > 0.0);
+    println!("erfc: last x with erfc(x) > 0 is {x:.9} (erfc = {:e})", microsurface::special::erfc(x));
+    assert!(microsurface::special::erfc(x) > 0.0);
     for y in [x.next_up(), 10.1, 11.0, 27.0, 1e10, f32::MAX, f32::INFINITY] {
-        assert_eq!(microsurface::erfc(y), 0.0, "erfc({y}) underflows");
+        assert_eq!(microsurface::special::erfc(y), 0.0, "erfc({y}) underflows");
     }
     // the documented threshold: erfc underflows to 0 for x > 10.05
     assert!(
         (10.05..10.06).contains(&x),
         "erfc underflows after x = {x}, the doc states 10.05 (to two decimals)"
     );
-    assert_eq!(microsurface::erfc(f32::NEG_INFINITY), 2.0);
-    assert_eq!(microsurface::erfc(0.0), 1.0);
-    assert!(microsurface::erfc(f32::NAN).is_nan());
+    assert_eq!(microsurface::special::erfc(f32::NEG_INFINITY), 2.0);
+    assert_eq!(microsurface::special::erfc(0.0), 1.0);
+    assert!(microsurface::special::erfc(f32::NAN).is_nan());
 }
 
 /// erf⁻¹(y) in double precision: statrs' erf_inv polished by one Newton step on a residual
@@ -202,7 +202,7 @@ fn erfinv_is_within_one_ulp() {
     let (mut ulps, mut frac, mut worst_at) = (0u64, MaxErr::new(), 0.0f32);
     let mut ys = erfinv_arguments();
     for &y in &ys {
-        let r = microsurface::erfinv(y);
+        let r = microsurface::special::erfinv(y);
         let reference = erfinv_reference(y);
         assert!(r.is_finite(), "erfinv({y:e}) = {r}");
         let d = ulp_distance(r, reference);
@@ -225,22 +225,30 @@ fn erfinv_is_within_one_ulp() {
     let below_one = 1.0f32.next_down();
     println!(
         "erfinv(1 − 2⁻²⁴) = {} (reference {})",
-        microsurface::erfinv(below_one),
+        microsurface::special::erfinv(below_one),
         erfinv_reference(below_one)
     );
     // monotone and odd
     ys.sort_by(f32::total_cmp);
     for w in ys.windows(2) {
-        assert!(microsurface::erfinv(w[0]) <= microsurface::erfinv(w[1]), "erfinv decreases at {:e}", w[1]);
+        assert!(
+            microsurface::special::erfinv(w[0]) <= microsurface::special::erfinv(w[1]),
+            "erfinv decreases at {:e}",
+            w[1]
+        );
     }
     for &y in &ys {
-        assert_eq!(microsurface::erfinv(-y), -microsurface::erfinv(y), "erfinv is odd at {y:e}");
+        assert_eq!(
+            microsurface::special::erfinv(-y),
+            -microsurface::special::erfinv(y),
+            "erfinv is odd at {y:e}"
+        );
     }
     // documented special values
-    assert_eq!(microsurface::erfinv(0.0), 0.0);
-    assert_eq!(microsurface::erfinv(1.0), f32::MAX);
-    assert_eq!(microsurface::erfinv(-1.0), -f32::MAX);
-    assert!(microsurface::erfinv(f32::NAN).is_nan());
+    assert_eq!(microsurface::special::erfinv(0.0), 0.0);
+    assert_eq!(microsurface::special::erfinv(1.0), f32::MAX);
+    assert_eq!(microsurface::special::erfinv(-1.0), -f32::MAX);
+    assert!(microsurface::special::erfinv(f32::NAN).is_nan());
 }
 
 /// ln Γ(x) at exactly representable x, from mpmath at 50 digits (the f64 literal is the correctly
@@ -332,7 +340,7 @@ fn ln_gamma_matches_statrs_and_mpmath() {
     // against the 50-digit table: within 1 f64 ulp of the correctly rounded value everywhere
     let mut vs_table = MaxErr::new();
     for (x, reference) in LN_GAMMA_TABLE {
-        let r = microsurface::ln_gamma(x);
+        let r = microsurface::special::ln_gamma(x);
         vs_table.push((r - reference).abs() / ulp64(reference), x);
     }
     println!("ln_gamma vs mpmath (50 digits): max {:.3} f64 ulps (at x = {:e})", vs_table.err, vs_table.at);
@@ -343,7 +351,7 @@ fn ln_gamma_matches_statrs_and_mpmath() {
     // is on err / max(1, |ln Γ|) (measured: about 2e-14, from statrs)
     let (mut abs_below, mut rel_above, mut scaled) = (MaxErr::new(), MaxErr::new(), MaxErr::new());
     for x in ln_gamma_arguments() {
-        let r = microsurface::ln_gamma(x);
+        let r = microsurface::special::ln_gamma(x);
         let reference = sgamma::ln_gamma(x);
         assert!(r.is_finite(), "ln_gamma({x:e}) = {r}");
         let err = (r - reference).abs();
@@ -367,9 +375,9 @@ fn ln_gamma_matches_statrs_and_mpmath() {
     );
     assert!(scaled.err < 5e-14, "ln_gamma: scaled error {:.3e} at x = {:e}", scaled.err, scaled.at);
     // exact values
-    assert_eq!(microsurface::ln_gamma(1.0), 0.0);
-    assert_eq!(microsurface::ln_gamma(2.0), 0.0);
-    assert!((microsurface::ln_gamma(0.5) - 0.5 * std::f64::consts::PI.ln()).abs() <= ulp64(0.57));
+    assert_eq!(microsurface::special::ln_gamma(1.0), 0.0);
+    assert_eq!(microsurface::special::ln_gamma(2.0), 0.0);
+    assert!((microsurface::special::ln_gamma(0.5) - 0.5 * std::f64::consts::PI.ln()).abs() <= ulp64(0.57));
 }
 
 /// a, b on a log grid of [1e-3, 1e4].
@@ -392,13 +400,13 @@ fn ln_beta_and_beta_match_statrs_and_mpmath() {
     let (mut ln_table, mut rel_table) = (MaxErr::new(), MaxErr::new());
     for (a, b, reference) in LN_BETA_TABLE {
         let scale = ln_beta_scale(a, b);
-        ln_table.push((microsurface::ln_beta(a, b) - reference).abs() / scale, a);
+        ln_table.push((microsurface::special::ln_beta(a, b) - reference).abs() / scale, a);
         let exact = reference.exp();
         if exact < f64::MIN_POSITIVE {
             continue;
         }
         // exp adds its own rounding and amplifies the ln B error into a relative one
-        rel_table.push((microsurface::beta(a, b) - exact).abs() / exact / (scale + f64::EPSILON), a);
+        rel_table.push((microsurface::special::beta(a, b) - exact).abs() / exact / (scale + f64::EPSILON), a);
     }
     println!(
         "ln_beta vs mpmath: max {:.3} × 2⁻⁵³(|lnΓa|+|lnΓb|+|lnΓ(a+b)|+1) (a = {:e}); beta: max relative error \
@@ -420,7 +428,7 @@ fn ln_beta_and_beta_match_statrs_and_mpmath() {
     let (a, b, reference) = LN_BETA_TABLE[9];
     println!(
         "ln_beta({a}, {b}): absolute error {:.3e} vs mpmath (the doc states < 1e-11)",
-        (microsurface::ln_beta(a, b) - reference).abs()
+        (microsurface::special::ln_beta(a, b) - reference).abs()
     );
 
     // against statrs, which forms the same three-term sum with its own ln Γ
@@ -430,8 +438,8 @@ fn ln_beta_and_beta_match_statrs_and_mpmath() {
     for &a in &grid {
         for &b in &grid {
             let reference = sbeta::ln_beta(a, b);
-            let l = microsurface::ln_beta(a, b);
-            let bb = microsurface::beta(a, b);
+            let l = microsurface::special::ln_beta(a, b);
+            let bb = microsurface::special::beta(a, b);
             assert!(l.is_finite() && bb.is_finite() && bb >= 0.0, "ln_beta({a}, {b}) = {l}, beta = {bb}");
             let e = (l - reference).abs();
             if e > ln_abs.err {
@@ -448,7 +456,7 @@ fn ln_beta_and_beta_match_statrs_and_mpmath() {
             if expected > f64::MIN_POSITIVE {
                 rel.push((bb - expected).abs() / expected, a);
             }
-            assert_eq!(microsurface::beta(b, a), bb, "beta is symmetric");
+            assert_eq!(microsurface::special::beta(b, a), bb, "beta is symmetric");
         }
     }
     println!(
@@ -470,9 +478,9 @@ fn ln_beta_and_beta_match_statrs_and_mpmath() {
     let mut identity = MaxErr::new();
     for &a in &grid {
         let scale = ln_beta_scale(a, 1.0) + f64::EPSILON;
-        identity.push((microsurface::beta(a, 1.0) * a - 1.0).abs() / scale, a);
+        identity.push((microsurface::special::beta(a, 1.0) * a - 1.0).abs() / scale, a);
         for &b in grid.iter().step_by(7) {
-            let (hi, lo) = (microsurface::beta(a + 1.0, b), microsurface::beta(a, b));
+            let (hi, lo) = (microsurface::special::beta(a + 1.0, b), microsurface::special::beta(a, b));
             if hi > f64::MIN_POSITIVE && lo > f64::MIN_POSITIVE {
                 let scale = ln_beta_scale(a + 1.0, b) + ln_beta_scale(a, b) + 2.0 * f64::EPSILON;
                 identity.push((hi / lo * (a + b) / a - 1.0).abs() / scale, a);
@@ -480,14 +488,14 @@ fn ln_beta_and_beta_match_statrs_and_mpmath() {
         }
     }
     identity.push(
-        (microsurface::beta(0.5, 0.5) / std::f64::consts::PI - 1.0).abs() / ln_beta_scale(0.5, 0.5),
+        (microsurface::special::beta(0.5, 0.5) / std::f64::consts::PI - 1.0).abs() / ln_beta_scale(0.5, 0.5),
         0.5,
     );
     println!("beta identities: max relative error {:.3} scale units (a = {:e})", identity.err, identity.at);
     assert!(identity.err <= 8.0, "beta identities: {:.3} scale units at a = {:e}", identity.err, identity.at);
     // huge arguments underflow to 0 rather than forming ∞/∞
-    assert_eq!(microsurface::beta(1e6, 1e6), 0.0);
-    assert_eq!(microsurface::beta(1.0, 1.0), 1.0);
+    assert_eq!(microsurface::special::beta(1e6, 1e6), 0.0);
+    assert_eq!(microsurface::special::beta(1.0, 1.0), 1.0);
 }
 
 /// The documented bound of `sin_cos_turns`: absolute error over [0, 1].
@@ -500,7 +508,7 @@ fn sin_cos_turns_is_within_its_documented_bound_on_every_f32_in_the_unit_interva
     // float with exponent ≥ −24 is visited and the rest, where sin ≈ 2πu, on a stride)
     let (mut worst, mut at) = (0.0f64, 0.0f32);
     let mut check = |u: f32| {
-        let (s, c) = microsurface::sin_cos_turns(u);
+        let (s, c) = microsurface::special::sin_cos_turns(u);
         let angle = core::f64::consts::TAU * f64::from(u);
         let err = (f64::from(s) - angle.sin()).abs().max((f64::from(c) - angle.cos()).abs());
         if err > worst {

@@ -5,11 +5,13 @@
 //! and the extraction's cost.
 
 use glam::Vec3;
-use microsurface::{
-    BackscatterShadowing, Beckmann, ComplexIor, Conductor, Error, Ggx, Microsurface, MicrosurfaceSlope,
-    TabulatedSlope, UniformHeight, extract_fresnel, extract_isotropic, extract_isotropic_fn,
-    fresnel_conductor,
+use microsurface::fresnel::fresnel_conductor;
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::tabulated::{
+    BackscatterShadowing, TabulatedSlope, extract_fresnel, extract_isotropic, extract_isotropic_fn,
 };
+use microsurface::{Beckmann, ComplexIor, Conductor, Error, Ggx};
 use std::f64::consts::FRAC_PI_2;
 use validation::dir;
 
@@ -251,7 +253,7 @@ fn extraction_cost() {
 /// eight; the per-ring P stays noisy, 30–50 % relative at θ′ ≤ 60°, from the data's noise).
 #[test]
 fn multiple_scattering_inversion() {
-    use microsurface::ScatteringOrder;
+    use microsurface::research::ScatteringOrder;
     let alpha = 1.0f32;
     let rings = 48;
     let samples = 4000;
@@ -280,7 +282,7 @@ fn multiple_scattering_inversion() {
     };
     // the data: the walk on the (tabulated) truth, so that the table is the exact answer
     let (data, data_se, _) = backscatter(&truth, 1000);
-    let summary = |label: &str, e: &microsurface::Extraction| {
+    let summary = |label: &str, e: &microsurface::tabulated::Extraction| {
         let (p, g1) = compare(&e.slope, &ggx, &truth);
         println!(
             "{label}: F0 = {:.4}, fitted α = {:.4}, max |ΔG1| = {g1:.3e}, max P rel. error (θ′ ≤ 60°) = {p:.3e}",
@@ -321,7 +323,7 @@ fn multiple_scattering_inversion() {
 /// at 2 × 24 cells F0 = 1.010, Λ 8.7 %, α +1.5 % (about (16/24)^1.7).
 #[test]
 fn anisotropic_round_trip() {
-    use microsurface::{GridSlope, extract_anisotropic_fn};
+    use microsurface::tabulated::{GridSlope, extract_anisotropic_fn};
     let ggx = Ggx::new(0.3, 0.6).unwrap();
     let surface = Microsurface::new(UniformHeight, ggx, Conductor::perfect());
     let start = std::time::Instant::now();
@@ -375,7 +377,7 @@ fn anisotropic_round_trip() {
 /// (measured 1.0 %).
 #[test]
 fn grid_fresnel_round_trip() {
-    use microsurface::extract_anisotropic_fn;
+    use microsurface::tabulated::extract_anisotropic_fn;
     let ggx = Ggx::new(0.3, 0.6).unwrap();
     let gold = ComplexIor::new(Vec3::new(0.143, 0.374, 1.442), Vec3::new(3.983, 2.385, 1.603)).unwrap();
     let surface = Microsurface::new(UniformHeight, ggx, Conductor::new(gold));

@@ -8,7 +8,8 @@
 //! it), and the stretched-space primitive finite. Deterministic (fixed seeds).
 
 use glam::Vec3;
-use microsurface::{GridSlope, MicrosurfaceSlope, TabulatedSlope, Tail};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::tabulated::{GridSlope, TabulatedSlope, Tail};
 use validation::{rng, uniform32, uniform64};
 
 /// A direction of the fuzz domain (a third of them special).

@@ -5,9 +5,10 @@
 //! GGX, and the white furnace of the walk.
 
 use glam::Vec3;
-use microsurface::{
-    Conductor, Ggx, GridSlope, Microsurface, MicrosurfaceSlope, ScatteringOrder, UniformHeight,
-};
+use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::tabulated::GridSlope;
+use microsurface::{Conductor, Ggx};
 use std::f64::consts::{PI, TAU};
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::{Stats, assert_mean, dir, family_z, rng, sidak, uniform32, uniform64};
@@ -168,7 +169,7 @@ fn reproduces_ggx_and_white_furnace() {
     let wi = dir(0.9, 1.1);
     let mut stats = Stats::default();
     for _ in 0..60_000 {
-        let wo = microsurface::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
+        let wo = microsurface::research::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
         let pdf = f64::from(wo.z) / PI;
         stats.push(if pdf > 0.0 {
             f64::from(surface.eval(wi, wo, ScatteringOrder::All, &mut g).x) / pdf

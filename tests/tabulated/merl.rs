@@ -2,10 +2,11 @@
 //! MERL's nearest-bin lookup, bad files, and the extraction (Dupuy 2015 §4.2) run on a file.
 
 use glam::Vec3;
-use microsurface::{
-    BackscatterShadowing, Conductor, Ggx, MerlBrdf, MerlError, Microsurface, TabulatedSlope, UniformHeight,
-    extract_isotropic_fn, half_diff_angles,
+use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::tabulated::{
+    BackscatterShadowing, MerlBrdf, MerlError, TabulatedSlope, extract_isotropic_fn, half_diff_angles,
 };
+use microsurface::{Conductor, Ggx};
 use std::f64::consts::{FRAC_PI_2, PI};
 use validation::{dir, rng, uniform64};
 
@@ -122,10 +123,10 @@ fn extraction_from_a_merl_file() {
 /// 0.5 % for the 128-ring table from the same file.
 #[test]
 fn grid_extraction_from_a_merl_file() {
-    use microsurface::{
-        BackscatterShadowing, ComplexIor, Conductor, GridSlope, MicrosurfaceSlope, extract_anisotropic_fn,
-        extract_fresnel, fresnel_conductor,
-    };
+    use microsurface::fresnel::fresnel_conductor;
+    use microsurface::slope::MicrosurfaceSlope;
+    use microsurface::tabulated::{BackscatterShadowing, GridSlope, extract_anisotropic_fn, extract_fresnel};
+    use microsurface::{ComplexIor, Conductor};
     let alpha = 0.5f32;
     let gold = ComplexIor::new(Vec3::new(0.143, 0.374, 1.442), Vec3::new(3.983, 2.385, 1.603)).unwrap();
     let surface = Microsurface::new(UniformHeight, Ggx::isotropic(alpha).unwrap(), Conductor::new(gold));

@@ -5,10 +5,12 @@
 //! on a non-analytic distribution (a mixture of two GGX lobes): white furnace and reciprocity.
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, Error, Estimator, Ggx, MicrofacetBsdf, Microsurface,
-    MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, TabulatedSlope, UniformHeight,
+use microsurface::research::{
+    Estimator, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::tabulated::TabulatedSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Error, Ggx, MicrofacetBsdf};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use validation::chi2::{Chi2Grid, chi2_test};
 use validation::{Stats, assert_mean, assert_two_sample, dir, family_z, rng, sidak, uniform32, uniform64};
@@ -108,7 +110,7 @@ fn bad_input_is_an_error() {
         }
     }
     assert!(TabulatedSlope::from_radial_fn(1.0, 0, |_| 1.0).is_err());
-    assert!(TabulatedSlope::from_radial_fn(1.0, microsurface::MAX_RINGS + 1, |_| 1.0).is_err());
+    assert!(TabulatedSlope::from_radial_fn(1.0, microsurface::tabulated::MAX_RINGS + 1, |_| 1.0).is_err());
     assert!(TabulatedSlope::from_radial_fn(1.0, 8, |_| 0.0).is_err());
     let aniso = Ggx::new(0.2, 0.4).unwrap();
     assert!(TabulatedSlope::from_slope(&aniso, 0.3, 8).is_err());
@@ -444,7 +446,8 @@ fn white_furnace_on_mixture() {
         for (label, eval) in [("conductor", c), ("diffuse", d)] {
             let mut stats = Stats::default();
             for _ in 0..n {
-                let wo = microsurface::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
+                let wo =
+                    microsurface::research::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
                 let pdf = f64::from(wo.z) / PI;
                 stats.push(if pdf > 0.0 { f64::from(eval(wi, wo, &mut g)) / pdf } else { 0.0 });
             }
@@ -558,7 +561,7 @@ fn stretched_anisotropic() {
     let wi = dir(1.0, 0.7);
     let mut stats = Stats::default();
     for _ in 0..150_000 {
-        let wo = microsurface::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
+        let wo = microsurface::research::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
         let pdf = f64::from(wo.z) / PI;
         stats.push(if pdf > 0.0 {
             f64::from(surface.eval(wi, wo, ScatteringOrder::All, &mut g).x) / pdf
@@ -583,7 +586,8 @@ fn dielectric_white_furnace_on_mixture() {
         let wi = dir(theta, 0.3);
         let mut stats = Stats::default();
         for _ in 0..1_000_000 {
-            let mut wo = microsurface::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
+            let mut wo =
+                microsurface::research::sample_cosine_hemisphere(uniform32(&mut g), uniform32(&mut g));
             if uniform32(&mut g) < 0.5 {
                 wo.z = -wo.z;
             }
@@ -604,7 +608,7 @@ fn dielectric_white_furnace_on_mixture() {
 /// never a plausible value (they used to give 0 and +z).
 #[test]
 fn invalid_input_gives_the_documented_nothing() {
-    use microsurface::GridSlope;
+    use microsurface::tabulated::GridSlope;
     let table = TabulatedSlope::from_slope(&Ggx::isotropic(0.5).unwrap(), 0.5, 32).unwrap();
     let stretched = table.stretched(0.3, 0.8).unwrap();
     let grid = GridSlope::from_p22(1.0, 1.0, 2, &[1.0; 16]).unwrap();

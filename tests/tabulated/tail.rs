@@ -5,7 +5,9 @@
 //! of the directions that see only the tail.
 
 use glam::{DVec3, Vec3};
-use microsurface::{Beckmann, Ggx, MicrosurfaceSlope, TabulatedSlope, Tail};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::tabulated::{TabulatedSlope, Tail};
+use microsurface::{Beckmann, Ggx};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use validation::chi2::SlopeGrid;
 use validation::quadrature::CrossMap;

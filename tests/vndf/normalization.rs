@@ -15,7 +15,8 @@
 //! instead, so that the slope-space mapping is not trusted blindly.
 
 use glam::Vec3;
-use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Ggx};
 use std::f64::consts::FRAC_PI_2;
 use validation::quadrature::{self, CrossMap, Domain, VisibleTolerance, integrate_sphere};
 

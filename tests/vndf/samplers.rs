@@ -19,10 +19,10 @@
 //! isotropic or not, all become unit-width lobes there.
 
 use glam::{DVec3, Vec3};
-use microsurface::{
-    Beckmann, BeckmannNewton, Ggx, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
-    smith_normalization,
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler, smith_normalization,
 };
+use microsurface::{Beckmann, Ggx};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use validation::check::panic_message;
@@ -480,7 +480,11 @@ fn vcavity_g(i: DVec3, m: DVec3) -> f64 {
 /// divides by H.
 #[test]
 fn vcavity_hit_probability_matches_quadrature() {
-    fn check<S: microsurface::VCavitySlope + SlopeFamily>(name: &str, slope: S, failures: &mut Vec<String>) {
+    fn check<S: microsurface::vndf::VCavitySlope + SlopeFamily>(
+        name: &str,
+        slope: S,
+        failures: &mut Vec<String>,
+    ) {
         let alpha = (slope.alpha_x(), slope.alpha_y());
         let cavity = VCavity(slope);
         for theta in [0.0, 0.5, 1.2, 1.55, FRAC_PI_2 + 1e-3, 1.8, 2.0, 2.4, 2.9, 3.1] {
@@ -519,7 +523,7 @@ fn vcavity_hit_probability_matches_quadrature() {
 /// decreases monotonically below it (in f32 rounding) and reaches 0 at the nadir.
 #[test]
 fn vcavity_hit_probability_shape() {
-    fn check<S: microsurface::VCavitySlope>(name: &str, slope: S) {
+    fn check<S: microsurface::vndf::VCavitySlope>(name: &str, slope: S) {
         let alpha = (slope.alpha_x(), slope.alpha_y());
         let cavity = VCavity(slope);
         for phi in [0.0, PHI, FRAC_PI_2] {

@@ -11,7 +11,8 @@
 //! the same harness rejects wrong samplers.
 
 use glam::Vec3;
-use microsurface::{Beckmann, Ggx, MicrosurfaceSlope};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Ggx};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use validation::check::panic_message;

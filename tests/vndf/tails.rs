@@ -16,11 +16,15 @@
 //! at the top of the surface (tail 0).
 
 use glam::{DVec3, Vec3};
-use microsurface::{
-    Beckmann, BeckmannNewton, GaussianHeight, Ggx, GgxDisk, GgxSphericalCap, HeightSample,
-    MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, SmithVndf, UniformHeight, VCavity,
-    VisibleNormalSampler, concentric_disk, sample_cosine_hemisphere,
+use microsurface::research::{
+    GaussianHeight, HeightSample, MicrosurfaceGeometry, MicrosurfaceHeight, UniformHeight, concentric_disk,
+    sample_cosine_hemisphere,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::vndf::{
+    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
+};
+use microsurface::{Beckmann, Ggx};
 use statrs::function::erf::erfc;
 
 /// A quarter of the uniforms' spacing: the smallest tail accepted beyond an extreme sample.

@@ -27,11 +27,14 @@
 //! m)` over the m assertions of a test function, each with an upper bound on its SE.
 
 use glam::{DVec3, Vec2, Vec3};
-use microsurface::{
-    Beckmann, Bsdf, ComplexIor, Conductor, Diffuse, Estimator, Ggx, Material, MicrofacetBsdf, Microsurface,
-    MicrosurfaceSlope, PositionFree, ScatteringOrder, ShadingFrame, Shadowing, Technique, UniformHeight,
+use microsurface::research::{
+    Estimator, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{
+    Beckmann, Bsdf, ComplexIor, Conductor, Diffuse, Ggx, MicrofacetBsdf, ShadingFrame, Technique,
+};
 use std::f64::consts::{PI, TAU};
 use validation::stochastic::stochastic_chi2;
 use validation::{Stats, assert_mean, assert_two_sample, family_z, par_map, sidak, uniform32};
@@ -174,8 +177,10 @@ fn importance<S: MicrosurfaceSlope, M: Material>(
 ) -> (Vec3, f64) {
     let cosine = |w: Vec3| f64::from(w.z.max(0.0)) / PI;
     if !M::EXACT_PHASE_PDF {
-        let w =
-            microsurface::sample_cosine_hemisphere(validation::uniform32(rng), validation::uniform32(rng));
+        let w = microsurface::research::sample_cosine_hemisphere(
+            validation::uniform32(rng),
+            validation::uniform32(rng),
+        );
         return (w, cosine(w));
     }
     let w = if validation::uniform64(rng) < 0.5 {
@@ -183,7 +188,10 @@ fn importance<S: MicrosurfaceSlope, M: Material>(
         // horizon, where every integrand here is 0, is kept with its density)
         pf.material().sample_phase(pf.slope(), wi, Side::Outside, rng).wo
     } else {
-        microsurface::sample_cosine_hemisphere(validation::uniform32(rng), validation::uniform32(rng))
+        microsurface::research::sample_cosine_hemisphere(
+            validation::uniform32(rng),
+            validation::uniform32(rng),
+        )
     };
     let phase = f64::from(pf.material().pdf_phase(pf.slope(), &Interaction::reflection(wi, w)));
     (w, 0.5 * phase + 0.5 * cosine(w))
@@ -697,11 +705,20 @@ fn first_height_from_below_follows_the_full_spherical_masking() {
         for _ in 0..20_000 {
             let u = validation::uniform32(&mut rng);
             let c = if gaussian {
-                let g = microsurface::MicrosurfaceGeometry::new(microsurface::GaussianHeight, slope);
-                microsurface::MicrosurfaceHeight::c1(g.height(), g.sample_height_from_below(wi, u).unwrap())
+                let g = microsurface::research::MicrosurfaceGeometry::new(
+                    microsurface::research::GaussianHeight,
+                    slope,
+                );
+                microsurface::research::MicrosurfaceHeight::c1(
+                    g.height(),
+                    g.sample_height_from_below(wi, u).unwrap(),
+                )
             } else {
-                let g = microsurface::MicrosurfaceGeometry::new(UniformHeight, slope);
-                microsurface::MicrosurfaceHeight::c1(g.height(), g.sample_height_from_below(wi, u).unwrap())
+                let g = microsurface::research::MicrosurfaceGeometry::new(UniformHeight, slope);
+                microsurface::research::MicrosurfaceHeight::c1(
+                    g.height(),
+                    g.sample_height_from_below(wi, u).unwrap(),
+                )
             };
             st.push(f64::from(c).powf(f64::from(a)));
         }
@@ -710,7 +727,7 @@ fn first_height_from_below_follows_the_full_spherical_masking() {
         assert_mean(&label, &st, expected, z, 0.01, 2e-6);
     }
     // no first hit for directions that are not below the horizon, or from the nadir
-    let g = microsurface::MicrosurfaceGeometry::new(UniformHeight, slope);
+    let g = microsurface::research::MicrosurfaceGeometry::new(UniformHeight, slope);
     assert_eq!(g.sample_height_from_below(Vec3::Z, 0.5), None);
     assert_eq!(g.sample_height_from_below(-Vec3::Z, 0.5), None);
 }
@@ -721,7 +738,7 @@ fn first_height_from_below_follows_the_full_spherical_masking() {
 /// uniform heights (gold, GGX and Beckmann).
 #[test]
 fn height_space_walk_from_below_matches_the_c1_walk() {
-    use microsurface::{GaussianHeight, HeightSample, MicrosurfaceGeometry};
+    use microsurface::research::{GaussianHeight, HeightSample, MicrosurfaceGeometry};
     // The height-space walk needs f32 heights that resolve the first hit's depth
     // (E[ln C¹₁] = −1/Λ(−ωi)): uniform heights resolve C¹ only to ~6e-8 near the bottom
     // (h = 2C¹ − 1; below, h = −1 and C¹ = 0, where no walk escapes), and any f32 C¹ leaves the
@@ -758,7 +775,7 @@ fn height_space_walk_from_below_matches_the_c1_walk() {
                     g_u.sample_height_from_below(wi, u)?
                 };
                 let (mut wr, mut weight) = (-wi, Vec3::ONE);
-                for bounces in 1..=microsurface::MAX_BOUNCES {
+                for bounces in 1..=microsurface::research::MAX_BOUNCES {
                     let p = material.sample_phase(&s, -wr, Side::Outside, rng);
                     wr = p.wo;
                     weight *= p.weight;
@@ -869,7 +886,7 @@ fn walk_furnace_from_below_for_smooth_beckmann() {
         let wo = if validation::uniform64(&mut rng) < 0.8 {
             Conductor::perfect().sample_phase(&slope, wi, Side::Outside, &mut rng).wo
         } else {
-            microsurface::sample_cosine_hemisphere(uniform32(&mut rng), uniform32(&mut rng))
+            microsurface::research::sample_cosine_hemisphere(uniform32(&mut rng), uniform32(&mut rng))
         };
         let phase = f64::from(Conductor::perfect().pdf_phase(&slope, &Interaction::reflection(wi, wo)));
         let pdf = 0.8 * phase + 0.2 * f64::from(wo.z.max(0.0)) / PI;

@@ -10,10 +10,11 @@
 //! 64 bounces (the truncation of `tests/walk/random_walk.rs`'s order sum).
 
 use glam::Vec3;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, MAX_BOUNCES, Material, Microsurface,
-    MicrosurfaceHeight, MicrosurfaceSlope, UniformHeight, WalkSample,
+use microsurface::research::{
+    GaussianHeight, MAX_BOUNCES, Material, Microsurface, MicrosurfaceHeight, UniformHeight, WalkSample,
 };
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use statrs::distribution::{Beta, ContinuousCDF};
 use validation::{Stats, TestRng};
 
@@ -230,7 +231,7 @@ fn near_index_matched_dielectrics_terminate() {
 /// (cos θi = 0.1).
 #[test]
 fn position_free_near_index_matched_dielectrics_terminate() {
-    use microsurface::{PositionFree, Shadowing};
+    use microsurface::research::{PositionFree, Shadowing};
     const N: usize = 1_000;
     const BOUND: f64 = 1e-2;
     let mut cases: Vec<(Shadowing, f32, f32)> = Vec::new();
@@ -263,7 +264,7 @@ fn position_free_near_index_matched_dielectrics_terminate() {
 
 #[test]
 fn index_matched_dielectric_is_transparent() {
-    use microsurface::{Estimator, PositionFree, ScatteringOrder, Shadowing};
+    use microsurface::research::{Estimator, PositionFree, ScatteringOrder, Shadowing};
     let mut rng = validation::rng(9200);
     let m = Dielectric::new(1.0).unwrap();
     for cos in [1.0f32, 1e-3, 1e-8] {

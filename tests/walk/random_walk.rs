@@ -19,12 +19,13 @@ use validation::par_map;
 use validation::stochastic::stochastic_chi2;
 
 use glam::{DVec3, Vec3};
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, GaussianHeight, Ggx, HeightSample, Material,
-    Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight, MicrosurfaceSlope, PhaseSample, ScatteringOrder,
-    UniformHeight, WalkSample,
+use microsurface::research::{
+    GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry, MicrosurfaceHeight,
+    PhaseSample, ScatteringOrder, UniformHeight, WalkSample,
 };
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Diffuse, Ggx};
 use statrs::distribution::{ContinuousCDF, Normal};
 use std::f64::consts::{PI, TAU};
 use validation::{Stats, TestRng};
@@ -139,7 +140,7 @@ fn reference_eval<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
     // the height in the frame of the outside; a walk starts above (below) the whole surface
     let mut h = if outside { f32::INFINITY } else { f32::NEG_INFINITY };
     let (mut throughput, mut sum) = (Vec3::ONE, Vec3::ZERO);
-    for _ in 0..microsurface::MAX_BOUNCES {
+    for _ in 0..microsurface::research::MAX_BOUNCES {
         let u = validation::uniform32(rng);
         match geometry.sample_height(side(wr, outside), if outside { h } else { -h }, u) {
             HeightSample::Escape => break,

@@ -10,7 +10,7 @@
 //! lengths: mean bounces of `sample()` below the configuration's stated bound, no walk
 //! dropped. Seeds are fixed (PCG).
 
-use microsurface::Estimator;
+use microsurface::research::Estimator;
 use validation::stability::stiff::{self, Tech, configs};
 use validation::{assert_mean, family_z};
 

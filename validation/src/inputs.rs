@@ -1,5 +1,5 @@
 //! The pre-generated inputs of the BSDF benches (`benches/bsdf.rs`) and of the profiling driver
-//! that counts their instructions (`examples/compensated_calls.rs`): `N` views uniform on the
+//! that counts their instructions (`tools/src/bin/profile_compensated.rs`): `N` views uniform on the
 //! upper hemisphere, `N` light directions (upper hemisphere, or the whole sphere for a
 //! transmitting material) and `N` triples of uniforms, from a fixed seed.
 

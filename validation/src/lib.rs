@@ -17,9 +17,13 @@
 //! rectangles, the sphere, and the slope-space integrals of visible normals), one f64
 //! reference model ([`reference`](mod@reference)), one set of statistical assertions (seeded generators,
 //! Šidák-corrected z, mean within z·SE with SE small enough: the crate root), the pooling of
-//! low-expectation cells ([`chi2::pool`]), and the code of the examples that the tests also
-//! run: the report ([`report`]), the path tracer ([`tracer`]), the stability report
-//! ([`stability`]) and the LEADR validation ([`leadr`](mod@leadr)).
+//! low-expectation cells ([`chi2::pool`]), the per-order albedos of the walk and the
+//! position-free models in closed form for GGX α = 1 ([`per_order`]), the stability study's
+//! configurations
+//! ([`stability`]), the LEADR validation ([`leadr`](mod@leadr)), and what the benches share
+//! (the measurement clock [`clock`], the pre-generated inputs [`inputs`], the research calls
+//! the renderer's techniques wrap [`research`]). The applications built on it (the report, the
+//! path tracer, the studies) are the `lab` crate's.
 //!
 //! # Examples
 //!
@@ -40,14 +44,13 @@ pub mod chi2;
 pub mod clock;
 pub mod inputs;
 pub mod leadr;
+pub mod per_order;
 pub mod quadrature;
 pub mod reference;
-pub mod report;
 pub mod research;
 pub mod stability;
 mod stats;
 pub mod stochastic;
-pub mod tracer;
 
 pub use stats::{
     Stats, TestRng, assert_mean, assert_refusal_rate, assert_two_sample, dir, family_z, par_map, rng, sidak,

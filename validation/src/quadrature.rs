@@ -159,7 +159,7 @@ pub enum SlopeTails {
 
 /// A slope distribution whose tails are known to the quadratures (instead of a switch on the
 /// type's name).
-pub trait SlopeFamily: microsurface::MicrosurfaceSlope {
+pub trait SlopeFamily: microsurface::slope::MicrosurfaceSlope {
     /// The tails of the distribution.
     const TAILS: SlopeTails;
 }

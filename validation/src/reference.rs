@@ -1,7 +1,7 @@
 //! A test-only double-precision reference for the f32 crate and the accuracy map built on it.
 //!
 //! Used by `tests/special/accuracy_map.rs` (which asserts the bounds) and
-//! `examples/stability.rs` (which prints the map).
+//! `lab/src/bin/stability.rs` (which prints the map).
 //!
 //! The reference evaluates the definitions of the supplement (Heitz et al. 2016) in f64, on
 //! the *same* f32 inputs the crate receives (widened exactly), with `statrs` special functions.
@@ -18,11 +18,11 @@
 //! absolute error (≤ bound × 1e-6) below.
 
 use glam::{DVec3, Vec3};
-use microsurface::{
-    Beckmann, ComplexIor, Conductor, Dielectric, Ggx, Material, MicrosurfaceGeometry, MicrosurfaceSlope,
-    UniformHeight, fresnel_conductor, fresnel_dielectric,
-};
-use microsurface::{Interaction, Side};
+use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric};
+use microsurface::research::{Interaction, Side};
+use microsurface::research::{Material, MicrosurfaceGeometry, UniformHeight};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, ComplexIor, Conductor, Dielectric, Ggx};
 use rand::SeedableRng;
 use statrs::function::erf::erfc;
 use statrs::function::gamma::ln_gamma;

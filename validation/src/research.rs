@@ -1,12 +1,14 @@
 //! The research-layer calls that the renderer trait's techniques wrap, in the trait's
 //! orientation, as the BSDF benches (`benches/bsdf.rs`) and their instruction-count driver
-//! (`examples/bsdf_calls.rs`) call them.
+//! (`tools/src/bin/profile_bsdf.rs`) call them.
 
 use glam::Vec3;
-use microsurface::{
-    Material, Microsurface, MicrosurfaceSlope, PositionFree, ScatteringOrder, Shadowing, SingleScattering,
-    Technique, UniformHeight,
+use microsurface::Technique;
+use microsurface::research::{
+    Invariance, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, SingleScattering,
+    UniformHeight,
 };
+use microsurface::slope::MicrosurfaceSlope;
 use rand_pcg::Pcg64Mcg;
 
 /// The research-layer calls a technique wraps, in the adjoint orientation of the trait (the
@@ -38,6 +40,10 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
             Technique::PositionFree { estimator, shadowing } => {
                 self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
             }
+            Technique::Invariance => match Invariance::new(*self.surface.slope(), *self.surface.material()) {
+                Ok(invariance) => invariance.eval(walk_in, walk_out, ScatteringOrder::All, rng),
+                Err(_) => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
+            },
         }
     }
 
@@ -64,6 +70,10 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
             Technique::PositionFree { shadowing, .. } => {
                 self.pf(shadowing).sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0))
             }
+            Technique::Invariance => match Invariance::new(*self.surface.slope(), *self.surface.material()) {
+                Ok(invariance) => invariance.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
+                Err(_) => self.surface.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
+            },
         }
     }
 

@@ -11,7 +11,7 @@ fn harness_accepts_cosine_and_rejects_uniform() {
         Chi2Grid::sphere(10, 20),
         cosine,
         || {
-            Some(microsurface::sample_cosine_hemisphere(
+            Some(microsurface::research::sample_cosine_hemisphere(
                 validation::uniform32(&mut rng),
                 validation::uniform32(&mut rng),
             ))

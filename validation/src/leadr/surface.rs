@@ -1,8 +1,8 @@
 //! The procedural displacement map of the LEADR validation, and the naive alternative to
-//! LEADR (a MIP pyramid of averaged normals). Shared by `examples/leadr` and `tests/leadr.rs`.
+//! LEADR (a MIP pyramid of averaged normals). Shared by `lab/src/bin/leadr` and `tests/leadr.rs`.
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
-use microsurface::HeightMap;
+use microsurface::leadr::HeightMap;
 use rand::{RngExt, SeedableRng};
 use std::f64::consts::TAU;
 

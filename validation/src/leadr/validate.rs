@@ -5,7 +5,8 @@
 //! 3.2–3.3, the separable Torrance–Sparrow form of §2.1).
 
 use glam::{DVec2, DVec3};
-use microsurface::{Beckmann, Conductor, LeadrLobe, Noncentral, SlopeMoments};
+use microsurface::leadr::{LeadrLobe, Noncentral, SlopeMoments};
+use microsurface::{Beckmann, Conductor};
 
 /// Half-width of the slope-space quadrature box, in standard deviations of each lobe.
 const BOX_SIGMAS: f64 = 6.0;

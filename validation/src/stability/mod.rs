@@ -2,7 +2,7 @@
 //! against the double-precision reference model [`crate::reference`] on a dense grid over
 //! the whole parameter domain) and the stiff-walk table ([`stiff`]: white-furnace albedo ±
 //! standard error and mean walk length of every estimator at α = 1e-3, α = 4, θi = 1.57 rad
-//! and near total internal reflection). Printed by `examples/stability.rs`, asserted by
+//! and near total internal reflection). Printed by `lab/src/bin/stability.rs`, asserted by
 //! `tests/special/accuracy_map.rs` and `tests/walk/stiff.rs`.
 
 pub mod stiff;

@@ -1,7 +1,7 @@
 //! Stiff random walks: the Heitz et al. 2016 walk and the position-free PT and BDPT estimators
 //! (both shadowing models) at α = 1e-3, at α = 4, at θi = 1.57 rad and for a dielectric lit
 //! from inside near the critical angle. Used by `tests/walk/stiff.rs` (assertions) and
-//! `examples/stability.rs` (the report).
+//! `lab/src/bin/stability.rs` (the report).
 //!
 //! Albedo: ∫ eval(ωi, ωo) dωo by importance-sampled Monte Carlo, ωo drawn from the mixture
 //! 0.8 × the material's phase-function sampler (whose exact density `pdf_phase` is summed over
@@ -11,11 +11,13 @@
 
 use crate::{Stats, TestRng};
 use glam::Vec3;
-use microsurface::{
-    Beckmann, Conductor, Dielectric, Estimator, Ggx, Material, Microsurface, MicrosurfaceSlope, PositionFree,
-    ScatteringOrder, Shadowing, UniformHeight, WalkSample, sample_cosine_hemisphere,
+use microsurface::research::{
+    Estimator, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight, WalkSample,
+    sample_cosine_hemisphere,
 };
-use microsurface::{Interaction, Side};
+use microsurface::research::{Interaction, Side};
+use microsurface::slope::MicrosurfaceSlope;
+use microsurface::{Beckmann, Conductor, Dielectric, Ggx};
 use rand::RngExt;
 use std::f64::consts::PI;
 

@@ -1,0 +1,11 @@
+//! Noncentral (sheared) microsurfaces (Dupuy 2015, thesis §3.2): the slope distribution
+//! offset by a mean slope, single scattering on it with a material, and its renderer BSDF,
+//! the lobe a LEADR-filtered texel evaluates.
+
+mod bsdf;
+mod single_scattering;
+mod slope;
+
+pub use bsdf::{NoncentralBsdf, NoncentralMasking};
+pub use single_scattering::NoncentralMaterial;
+pub use slope::Noncentral;

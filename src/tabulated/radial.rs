@@ -40,7 +40,9 @@ const EXACT_OUTER_RINGS: usize = 16;
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Ggx, MicrosurfaceSlope, TabulatedSlope, Tail};
+/// use microsurface::Ggx;
+/// use microsurface::slope::MicrosurfaceSlope;
+/// use microsurface::tabulated::{TabulatedSlope, Tail};
 /// use microsurface::glam::Vec3;
 /// let ggx = Ggx::isotropic(0.5)?;
 /// let table = TabulatedSlope::from_slope(&ggx, 0.5, 256)?.with_tail(Tail::Continued);
@@ -133,7 +135,9 @@ pub enum Tail {
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Ggx, MicrosurfaceSlope, TabulatedSlope};
+/// use microsurface::Ggx;
+/// use microsurface::slope::MicrosurfaceSlope;
+/// use microsurface::tabulated::TabulatedSlope;
 /// use microsurface::glam::Vec3;
 /// // a mixture of two GGX lobes, tabulated on 128 rings at scale 0.3
 /// let p = |a: f64, r: f64| a * a / (std::f64::consts::PI * (a * a + r * r).powi(2));

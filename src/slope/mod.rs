@@ -14,7 +14,10 @@ pub use elliptical::{AxisAlignedSlope, Elliptical};
 pub use ggx::Ggx;
 
 pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
-pub(crate) use ggx::{cap_bound, sample_bounded_cap, sample_spherical_cap, sample_visible_hemisphere};
+pub(crate) use ggx::{cap_bound, sample_bounded_cap};
+// the spherical-cap kernels, for the tabulated slopes' tail (feature `data-driven`).
+#[cfg(feature = "data-driven")]
+pub(crate) use ggx::{sample_spherical_cap, sample_visible_hemisphere};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};

@@ -28,6 +28,10 @@ pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
 pub use specular::{SpecularEvent, SpecularLimit};
 
+/// The deterministic randomness of the stochastic evaluations, for the renderer BSDFs of the
+/// layers above (the noncentral lobes).
+pub(crate) use seed::{Hasher, PrimedRng};
+
 use glam::{Vec2, Vec3};
 
 /// Which quantity a path carries across a dielectric interface.

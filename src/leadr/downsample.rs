@@ -131,7 +131,11 @@ impl DownsampledSlope {
         let mean_slope = mean.as_vec2();
         if !(mean_slope.is_finite() && mean_slope.length_squared().is_finite()) {
             let value = mean_slope.length_squared();
-            return Err(Error::InvalidParameter { name: "mean_slope", value, expected: "finite, x̃n² + ỹn² finite" });
+            return Err(Error::InvalidParameter {
+                name: "mean_slope",
+                value,
+                expected: "finite, x̃n² + ỹn² finite",
+            });
         }
         if let Some(&c) = covariance.iter().find(|c| !c.is_finite()) {
             return Err(Error::InvalidParameter { name: "covariance", value: c as f32, expected: "finite" });
@@ -160,7 +164,9 @@ impl DownsampledSlope {
             }
             Displacement::Moments(_) => {
                 let conv = GaussianConvolution::new(&gaussian, alpha_y, &density);
-                GridSlope::from_fn(scale.x as f32, scale.y as f32, half_cells, |x, y| conv.p22(DVec2::new(x, y), &density))?
+                GridSlope::from_fn(scale.x as f32, scale.y as f32, half_cells, |x, y| {
+                    conv.p22(DVec2::new(x, y), &density)
+                })?
             }
         };
         Ok(Self { grid, mean_slope })
@@ -184,7 +190,8 @@ impl DownsampledSlope {
     /// displaced surface (Dupuy 2015, eq. 3.2 with P_std = P_Z).
     #[must_use]
     pub fn slope(&self) -> Noncentral<&GridSlope> {
-        Noncentral::new(&self.grid, self.mean_slope).expect("a finite mean slope (checked by the constructor)")
+        Noncentral::new(&self.grid, self.mean_slope)
+            .expect("a finite mean slope (checked by the constructor)")
     }
 
     /// The single-scattering BSDF of [`Self::slope`] with `material`, for renderers.
@@ -227,7 +234,11 @@ impl Gaussian {
         let phi = 0.5 * xy.atan2(half_diff);
         let e1 = DVec2::new(phi.cos(), phi.sin());
         let e2 = e1.perp();
-        let cov = [l1 * e1.x * e1.x + l2 * e2.x * e2.x, l1 * e1.y * e1.y + l2 * e2.y * e2.y, l1 * e1.x * e1.y + l2 * e2.x * e2.y];
+        let cov = [
+            l1 * e1.x * e1.x + l2 * e2.x * e2.x,
+            l1 * e1.y * e1.y + l2 * e2.y * e2.y,
+            l1 * e1.x * e1.y + l2 * e2.x * e2.y,
+        ];
         Self { cov, sigma: DVec2::new(l1.sqrt(), l2.sqrt()), axes: [e1, e2] }
     }
 
@@ -350,7 +361,11 @@ impl GaussianConvolution {
             .iter()
             .map(|&(x, w)| {
                 let y = h - x;
-                if y.x.abs() <= self.core_half.x && y.y.abs() <= self.core_half.y { 0.0 } else { w * density(y) }
+                if y.x.abs() <= self.core_half.x && y.y.abs() <= self.core_half.y {
+                    0.0
+                } else {
+                    w * density(y)
+                }
             })
             .sum();
         self.core_at(h) + tail
@@ -366,7 +381,8 @@ impl GaussianConvolution {
         let (i, j) = (p.x as usize, p.y as usize);
         let (fx, fy) = (p.x - i as f64, p.y - j as f64);
         let at = |i: usize, j: usize| self.core[j * nx + i];
-        (1.0 - fy) * ((1.0 - fx) * at(i, j) + fx * at(i + 1, j)) + fy * ((1.0 - fx) * at(i, j + 1) + fx * at(i + 1, j + 1))
+        (1.0 - fy) * ((1.0 - fx) * at(i, j) + fx * at(i + 1, j))
+            + fy * ((1.0 - fx) * at(i, j + 1) + fx * at(i + 1, j + 1))
     }
 }
 
@@ -423,7 +439,8 @@ fn base_rule(alpha: DVec2, half: DVec2, density: &impl Fn(DVec2) -> f64) -> Vec<
     let mut points = Vec::with_capacity(4 * xs.len() * ys.len());
     for wy in ys.windows(2) {
         for wx in xs.windows(2) {
-            let (cx, hx, cy, hy) = (0.5 * (wx[0] + wx[1]), 0.5 * (wx[1] - wx[0]), 0.5 * (wy[0] + wy[1]), 0.5 * (wy[1] - wy[0]));
+            let (cx, hx, cy, hy) =
+                (0.5 * (wx[0] + wx[1]), 0.5 * (wx[1] - wx[0]), 0.5 * (wy[0] + wy[1]), 0.5 * (wy[1] - wy[0]));
             for gy in GL2 {
                 for gx in GL2 {
                     let p = DVec2::new(cx + gx * hx, cy + gy * hy);

@@ -138,7 +138,9 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        for ((anx, any), (bnx, bny)) in [((5, 3), (4, 7)), ((1, 1), (6, 2)), ((8, 8), (1, 9)), ((13, 2), (3, 3))] {
+        for ((anx, any), (bnx, bny)) in
+            [((5, 3), (4, 7)), ((1, 1), (6, 2)), ((8, 8), (1, 9)), ((13, 2), (3, 3))]
+        {
             let a = Grid2 { nx: anx, ny: any, values: (0..anx * any).map(|_| next() - 0.3).collect() };
             let b = Grid2 { nx: bnx, ny: bny, values: (0..bnx * bny).map(|_| next()).collect() };
             let c = convolve(&a, &b);

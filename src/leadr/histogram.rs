@@ -56,16 +56,21 @@ impl SlopeHistogram {
             });
         }
         if slopes.is_empty() {
-            return Err(Error::InvalidParameter { name: "slopes", value: 0.0, expected: "at least one slope" });
+            return Err(Error::InvalidParameter {
+                name: "slopes",
+                value: 0.0,
+                expected: "at least one slope",
+            });
         }
         if let Some(bad) = slopes.iter().find(|s| !s.is_finite()) {
             let value = if bad.x.is_finite() { bad.y } else { bad.x };
             return Err(Error::InvalidParameter { name: "slopes", value, expected: "finite" });
         }
         let s: Vec<DVec2> = slopes.iter().map(|s| s.as_dvec2()).collect();
-        let (lo, hi) = s.iter().fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(a, b), p| {
-            (a.min(*p), b.max(*p))
-        });
+        let (lo, hi) =
+            s.iter().fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            });
         let n = s.len() as f64;
         let mean = s.iter().sum::<DVec2>() / n;
         let mut covariance = [0.0; 3];
@@ -76,7 +81,8 @@ impl SlopeHistogram {
             covariance[2] += d.x * d.y / n;
         }
         let width = (hi - lo) / bins as f64;
-        let index = |v: f64, lo: f64, w: f64| if w > 0.0 { (((v - lo) / w) as usize).min(bins - 1) } else { 0 };
+        let index =
+            |v: f64, lo: f64, w: f64| if w > 0.0 { (((v - lo) / w) as usize).min(bins - 1) } else { 0 };
         let mut sums = vec![(DVec2::ZERO, 0usize); bins * bins];
         for p in &s {
             let k = index(p.y, lo.y, width.y) * bins + index(p.x, lo.x, width.x);
@@ -99,7 +105,13 @@ impl SlopeHistogram {
     ///
     /// # Errors
     /// As [`Self::from_slopes`]; `"level"` if 2^level overflows (level ≥ 32).
-    pub fn from_height_map(map: &HeightMap, level: usize, x: usize, y: usize, bins: usize) -> Result<Self, Error> {
+    pub fn from_height_map(
+        map: &HeightMap,
+        level: usize,
+        x: usize,
+        y: usize,
+        bins: usize,
+    ) -> Result<Self, Error> {
         if level >= 32 {
             return Err(Error::InvalidParameter { name: "level", value: level as f32, expected: "below 32" });
         }

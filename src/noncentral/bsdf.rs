@@ -175,9 +175,9 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> NoncentralBsdf<S, M> {
     #[inline(always)]
     fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self.transport {
-            Transport::Radiance => self
-                .material
-                .relative_eta_sq(Side::above_or_inside(wi.z), Side::above_or_inside(wo.z)),
+            Transport::Radiance => {
+                self.material.relative_eta_sq(Side::above_or_inside(wi.z), Side::above_or_inside(wo.z))
+            }
             Transport::Importance => 1.0,
         }
     }

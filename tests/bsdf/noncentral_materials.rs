@@ -12,12 +12,14 @@
 //!   the quadrature's f (and so reciprocal in expectation); the energy of both maskings.
 //! * Invalid input and finiteness over extreme lobes.
 
-use super::densities::chi2_exact;
+use super::densities::chi2_exact_refined;
 use super::fixtures::*;
 use super::invalid_directions::check_bad_input;
 use glam::{DVec2, DVec3};
 use microsurface::Elliptical;
-use microsurface::leadr::{LeadrLobe, Noncentral, NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SlopeMoments};
+use microsurface::leadr::{
+    LeadrLobe, Noncentral, NoncentralBsdf, NoncentralMasking, NoncentralMaterial, SlopeMoments,
+};
 use validation::chi2::chi2_test;
 use validation::reference::fresnel_dielectric_ref;
 
@@ -41,8 +43,17 @@ fn glass() -> Dielectric {
 /// A LEADR lobe: mean slope (0.3, 0.2), Σ = [[0.02, 0.01], [0.01, 0.045]].
 fn leadr_lobe() -> LeadrLobe {
     let (mx, my) = (0.3f32, 0.2f32);
-    LeadrLobe::from_moments(&SlopeMoments::new(mx, my, 0.02 + mx * mx, 0.045 + my * my, 0.01 + mx * my).unwrap())
+    LeadrLobe::from_moments(
+        &SlopeMoments::new(mx, my, 0.02 + mx * mx, 0.045 + my * my, 0.01 + mx * my).unwrap(),
+    )
 }
+
+/// Splits of the χ² cells before their adaptive quadrature: the glass densities jump along
+/// curves the cells do not follow (a GGX D is not 0 at the horizon, so the density of a
+/// refraction stops short where its half vector reaches the horizon; the base plane cuts the
+/// lobes), and an unsplit cell whose Gauss nodes all miss the thin nonzero sliver along such a
+/// curve agrees with its children on 0 (GGX inside θo 1.3: 1.2e-3 of mass lost in five cells).
+const SPLITS: u32 = 2;
 
 #[test]
 fn noncentral_glass_sampling_matches_pdf() {
@@ -54,20 +65,44 @@ fn noncentral_glass_sampling_matches_pdf() {
         p.push(pv);
     };
     let a = nc(ell(0.3, 0.2, 0.5), Vec2::new(0.4, -0.1), glass());
-    run("outside", &|| chi2_exact("glass outside θo 0.5", &a, dir(0.5, 0.6), 8000, z, 1.0), 0.5);
+    run(
+        "outside",
+        &|| chi2_exact_refined("glass outside θo 0.5", &a, dir(0.5, 0.6), 8000, z, 1.0, SPLITS),
+        0.5,
+    );
     let b = nc(ggx(0.4, 0.4), Vec2::new(1.0, 0.5), glass()).with_transport(Transport::Importance);
-    run("importance", &|| chi2_exact("glass GGX importance θo 1.2", &b, dir(1.2, 2.5), 8010, z, 1.0), 0.3);
+    run(
+        "importance",
+        &|| chi2_exact_refined("glass GGX importance θo 1.2", &b, dir(1.2, 2.5), 8010, z, 1.0, SPLITS),
+        0.3,
+    );
     // from inside: η ↦ 1/η, total internal reflection beyond the critical angle
     let c = nc(ell(0.25, 0.4, -0.6), Vec2::new(-0.8, 0.6), glass());
     // a 45° tilt: half the refractions out of the glass would leave below the base plane
-    run("inside", &|| chi2_exact("glass inside θo 0.4", &c, -dir(0.4, 1.0), 8020, z, 1.0), 0.3);
+    run(
+        "inside",
+        &|| chi2_exact_refined("glass inside θo 0.4", &c, -dir(0.4, 1.0), 8020, z, 1.0, SPLITS),
+        0.3,
+    );
     let d = nc(Elliptical::<Ggx>::from_bivariate(0.5, 0.3, 0.7).unwrap(), Vec2::new(0.3, 0.2), glass());
-    run("inside grazing", &|| chi2_exact("glass GGX inside θo 1.3", &d, -dir(1.3, 0.2), 8030, z, 1.0), 0.3);
+    run(
+        "inside grazing",
+        &|| chi2_exact_refined("glass GGX inside θo 1.3", &d, -dir(1.3, 0.2), 8030, z, 1.0, SPLITS),
+        0.3,
+    );
     // behind the tilted mean plane: c = cos θo − sin θo x̃n < 0
     let e = nc(ell(0.4, 0.3, 0.2), Vec2::new(2.0, 0.0), glass());
-    run("behind", &|| chi2_exact("glass behind the mean plane", &e, dir(1.2, 0.0), 8040, z, 1.0), 0.02);
+    run(
+        "behind",
+        &|| chi2_exact_refined("glass behind the mean plane", &e, dir(1.2, 0.0), 8040, z, 1.0, SPLITS),
+        0.02,
+    );
     let f = leadr_lobe().bsdf(glass()).unwrap();
-    run("leadr", &|| chi2_exact("LeadrLobe::bsdf(glass) θo 0.9", &f, dir(0.9, 1.0), 8050, z, 1.0), 0.5);
+    run(
+        "leadr",
+        &|| chi2_exact_refined("LeadrLobe::bsdf(glass) θo 0.9", &f, dir(0.9, 1.0), 8050, z, 1.0, SPLITS),
+        0.5,
+    );
     assert_eq!(p.len(), 6);
 }
 
@@ -176,10 +211,11 @@ fn noncentral_glass_weak_furnace() {
 }
 
 /// Generalized reciprocity of the radiance BSDF, f(wo, wi)/η_wo² = f(wi, wo)/η_wi², for both
-/// maskings over random pairs on the whole sphere: within 1e-5 of the larger value in the lobe
-/// (> 1e-3) and 1e-4 in the tails, where the two orders' f32 half vectors (from outside or
-/// from inside, η or 1/η) round differently and D's tails amplify it (measured worst 2.5e-6
-/// in the lobe, 1.8e-5 at f = 2e-8 with a grazing wi); importance transport differs from
+/// maskings over pairs on the whole sphere (half uniform, half wi sampled from wo, so that the
+/// lobes and the transmissions are well covered): within 1e-6 of the larger value everywhere
+/// (a refraction is evaluated in the outside frame with the same η whichever way the light
+/// travels, a reflection from directions renormalized in f64, so the two orders share every
+/// rounding but the f32 ones; measured worst 2.2e-7); importance transport differs from
 /// radiance by exactly (η_wo/η_wi)².
 #[test]
 fn noncentral_glass_is_reciprocal() {
@@ -188,9 +224,18 @@ fn noncentral_glass_is_reciprocal() {
     for masking in [NoncentralMasking::BasePlane, NoncentralMasking::Clamped] {
         let b = nc(ell(0.4, 0.25, 0.6), Vec2::new(0.7, -0.4), glass()).with_masking(masking);
         let imp = b.with_transport(Transport::Importance);
-        let (mut checked, mut crossing, mut worst_lobe, mut worst_tail) = (0, 0, 0.0f32, 0.0f32);
-        for _ in 0..20_000 {
-            let (wo, wi) = (uniform_sphere(&mut rng), uniform_sphere(&mut rng));
+        let (mut checked, mut crossing, mut worst) = (0, 0, 0.0f32);
+        for k in 0..20_000 {
+            let wo = uniform_sphere(&mut rng);
+            let wi = if k % 2 == 0 {
+                uniform_sphere(&mut rng)
+            } else {
+                let (uc, u) = (uniform32(&mut rng), Vec2::new(uniform32(&mut rng), uniform32(&mut rng)));
+                match b.sample(wo, uc, u) {
+                    Some(s) => s.wi,
+                    None => continue,
+                }
+            };
             let (fa, fb) = (b.eval(wo, wi).f, b.eval(wi, wo).f);
             let (a, c) = (fa / eta2(wo), fb / eta2(wi));
             let m = a.max(c).max_element();
@@ -198,18 +243,27 @@ fn noncentral_glass_is_reciprocal() {
                 checked += 1;
                 crossing += usize::from((wo.z > 0.0) != (wi.z > 0.0) && m > 1e-3);
                 let rel = (a - c).abs().max_element() / m;
-                let (worst, tol) = if m > 1e-3 { (&mut worst_lobe, 1e-5) } else { (&mut worst_tail, 1e-4) };
-                *worst = worst.max(rel);
+                worst = worst.max(rel);
                 assert!(
-                    rel <= tol,
+                    rel <= 1e-6,
                     "{masking:?}: f(wo, wi)/η_wo² = {a} ≠ f(wi, wo)/η_wi² = {c} (wo {wo}, wi {wi})"
                 );
             }
-            let ratio = eta_ratio_sq(wo, wi);
-            assert!(rel_close(fa, imp.eval(wo, wi).f * ratio, 1e-6), "{masking:?}: transports at {wo}, {wi}");
+            // (η_wo/η_wi)² to f32 rounding, absolute f32::MIN_POSITIVE where f is subnormal
+            let want = imp.eval(wo, wi).f * eta_ratio_sq(wo, wi);
+            assert!(
+                (fa - want).abs().max_element()
+                    <= 1e-6 * fa.abs().max(want.abs()).max_element() + f32::MIN_POSITIVE,
+                "{masking:?}: transports at {wo}, {wi}: {fa} ≠ {want}"
+            );
         }
-        println!("{masking:?}: {checked} pairs, worst relative difference {worst_lobe:.2e} (lobe), {worst_tail:.2e} (tails)");
-        assert!(checked > 5_000 && crossing > 1_000, "{masking:?}: {checked} pairs, {crossing} transmissions");
+        println!(
+            "{masking:?}: {checked} pairs ({crossing} transmissions), worst relative difference {worst:.2e}"
+        );
+        assert!(
+            checked > 10_000 && crossing > 2_000,
+            "{masking:?}: {checked} pairs, {crossing} transmissions"
+        );
     }
 }
 
@@ -245,7 +299,11 @@ fn noncentral_glass_and_diffuse_energy() {
             e_clamped.mean(),
             e_clamped.se()
         );
-        assert!(e_clamped.mean() > 1e-3 && e_clamped.mean() <= 1.0, "{label}: clamped albedo {}", e_clamped.mean());
+        assert!(
+            e_clamped.mean() > 1e-3 && e_clamped.mean() <= 1.0,
+            "{label}: clamped albedo {}",
+            e_clamped.mean()
+        );
         if gains {
             assert!(e_base.se() < 0.2, "{label}: SE {} too large", e_base.se());
             assert!(
@@ -271,7 +329,12 @@ fn diffuse_cases() -> Vec<(&'static str, NoncentralBsdf<Ell, Diffuse>, Vec3, f64
     let albedo = Diffuse::new(Vec3::new(0.9, 0.6, 0.3)).unwrap();
     vec![
         ("diffuse sheared", nc(ell(0.4, 0.3, 0.5), Vec2::new(0.5, -0.3), albedo), dir(0.6, 0.4), 0.3),
-        ("diffuse steep, grazing", nc(ell(0.3, 0.5, -0.3), Vec2::new(-1.2, 0.4), albedo), dir(1.3, 3.5), 0.36),
+        (
+            "diffuse steep, grazing",
+            nc(ell(0.3, 0.5, -0.3), Vec2::new(-1.2, 0.4), albedo),
+            dir(1.3, 3.5),
+            0.36,
+        ),
         ("diffuse behind the tilt", nc(ell(0.5, 0.5, 0.0), Vec2::new(1.5, 0.0), albedo), dir(1.1, 0.0), 0.36),
     ]
 }
@@ -304,7 +367,12 @@ fn noncentral_diffuse_sampler_matches_its_density() {
                 assert!(!s.flags.exact_pdf && s.flags.reflection && s.wi.z > 0.0, "{label}: {s:?}");
                 assert_eq!(s.pdf, b.pdf(*wo, s.wi), "{label}: the sample's pdf");
                 let g1 = b.surface().g1(s.wi);
-                assert!(rel_close(s.weight, albedo * g1, 1e-6), "{label}: weight {} ≠ a·G1 = {}", s.weight, albedo * g1);
+                assert!(
+                    rel_close(s.weight, albedo * g1, 1e-6),
+                    "{label}: weight {} ≠ a·G1 = {}",
+                    s.weight,
+                    albedo * g1
+                );
                 Some(s.wi)
             },
             N,
@@ -312,7 +380,10 @@ fn noncentral_diffuse_sampler_matches_its_density() {
             mass,
         );
         validation::assert_refusal_rate(label, out.failures, N, mass, 2e-3, z);
-        println!("{label}: χ² = {:.1}, dof = {}, p = {:.3}, ∫density = {mass:.5}", out.statistic, out.dof, out.p_value);
+        println!(
+            "{label}: χ² = {:.1}, dof = {}, p = {:.3}, ∫density = {mass:.5}",
+            out.statistic, out.dof, out.p_value
+        );
         assert!(mass > 0.3, "{label}: ∫density = {mass}");
     });
 }
@@ -337,7 +408,8 @@ fn noncentral_diffuse_eval_is_unbiased_and_reciprocal() {
         pairs.extend(front.windows(2).map(|w| (c, w[0], w[1])));
     }
     let z = family_z(0.01, 2 * pairs.len());
-    let rules: Vec<SlopeRule> = cases.iter().map(|(_, b, _, sigma)| SlopeRule::new(b.surface(), *sigma, 6.0, 160)).collect();
+    let rules: Vec<SlopeRule> =
+        cases.iter().map(|(_, b, _, sigma)| SlopeRule::new(b.surface(), *sigma, 6.0, 160)).collect();
     for (k, &(c, wo, wi)) in pairs.iter().enumerate() {
         let (label, b, rule) = (cases[c].0, &cases[c].1, &rules[c]);
         let (o, i) = (wo.as_dvec3(), wi.as_dvec3());
@@ -401,7 +473,13 @@ fn noncentral_materials_flags_and_eta() {
         if let Some(s) = s {
             let crossed = (s.wi.z > 0.0) != (wo.z > 0.0);
             assert_eq!((s.flags.transmission, s.flags.reflection), (crossed, !crossed));
-            let want = if !crossed { 1.0 } else if wo.z > 0.0 { ETA } else { 1.0 / ETA };
+            let want = if !crossed {
+                1.0
+            } else if wo.z > 0.0 {
+                ETA
+            } else {
+                1.0 / ETA
+            };
             assert!((s.eta - want).abs() < 1e-6, "η {} for {wo} → {}", s.eta, s.wi);
             entering += usize::from(crossed && wo.z > 0.0);
             leaving += usize::from(crossed && wo.z < 0.0);

@@ -166,8 +166,8 @@ pub fn filter_errors<R: Lobe, C: Lobe>(
             // f·cos θo times the Jacobian |dωo/dh̃| = 4 (ωi·ωh) cos³θh of the mirror map h̃ ↦ ωo
             let jacobian = 4.0 * cos_ih * h.z * h.z * h.z;
             let wo32 = wo.as_vec3();
-            let reference_value =
-                reference.iter().map(|l| l.f_cos(wi32, wo32)).sum::<f64>() * jacobian / reference.len() as f64;
+            let reference_value = reference.iter().map(|l| l.f_cos(wi32, wo32)).sum::<f64>() * jacobian
+                / reference.len() as f64;
             for (d, c) in diff.iter_mut().zip(candidates) {
                 *d += (c.f_cos(wi32, wo32) * jacobian - reference_value).abs();
             }

@@ -128,8 +128,10 @@ fn checked<S: MicrosurfaceSlope>(b: &NoncentralBsdf<S>, wo: Vec3, wi: Vec3) -> C
     let v = b.eval(wo, wi);
     assert!(v.exact);
     let f_research = s.eval_single_scattering(c, wo, wi, &mut validation::rng(0)) / wi.z;
-    let wh = (wo.as_dvec3() + wi.as_dvec3()).normalize();
-    let fresnel = c.fresnel(wi.as_dvec3().dot(wh) as f32);
+    // the model takes unit directions: the f32 ones renormalized in f64
+    let (o, i) = (wo.as_dvec3().normalize(), wi.as_dvec3().normalize());
+    let wh = (o + i).normalize();
+    let fresnel = c.fresnel(i.dot(wh) as f32);
     let scalar = s.d64(wh) * f64::from(s.g1(wo)) * f64::from(s.g1(wi)) / (4.0 * f64::from(wo.z * wi.z));
     Checked {
         f: v.f,

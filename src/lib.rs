@@ -113,6 +113,7 @@
 
 #[macro_use]
 mod contract;
+mod albedo;
 mod basis;
 mod bsdf;
 mod constants;
@@ -163,17 +164,17 @@ pub use rand;
 
 /// The research layer: the papers' models with the papers' interfaces.
 ///
-/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`]: heights,
+/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`](crate::research::Microsurface): heights,
 /// slopes and a material, evaluated and sampled by tracing a ray through the microsurface),
-/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`]), the
-/// position-free estimators of Wang et al. 2022 ([`PositionFree`], feature `position-free`),
-/// the height distributions, the materials' phase functions ([`Material`]) and the geometry
-/// queries of the microsurface ([`MicrosurfaceGeometry`]).
+/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`](crate::research::SingleScattering)), the
+/// position-free estimators of Wang et al. 2022 ([`PositionFree`](crate::research::PositionFree), feature `position-free`),
+/// the height distributions, the materials' phase functions ([`Material`](crate::research::Material)) and the geometry
+/// queries of the microsurface ([`MicrosurfaceGeometry`](crate::research::MicrosurfaceGeometry)).
 ///
 /// Conventions (the papers'): `eval(wi, wo)` with `wi` towards the light and `wo` towards the
 /// viewer returns f·|cos θo| per RGB channel; stochastic evaluations take `&mut impl Rng` and
 /// are unbiased estimates; a walk sample's weight is f·|cos θo|/pdf. The renderer layer
-/// ([`Bsdf`](crate::Bsdf)) is built on these types.
+/// ([`Bsdf`]) is built on these types.
 ///
 /// # Examples
 ///

@@ -25,8 +25,8 @@ use microsurface::research::{Interaction, Side};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::special::{beta, erf, erfc, erfinv, ln_beta, ln_gamma};
 use microsurface::vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
+    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope,
+    VisibleNormalSampler, smith_normalization,
 };
 use microsurface::{
     Beckmann, Bsdf, ClassicBrdf, ClassicMasking, ClassicNdf, ComplexIor, Conductor, Dielectric, Diffuse,
@@ -509,6 +509,7 @@ proptest! {
             let s = Ggx::new(ax, ay).unwrap();
             vcavity_props(s, wi, m, u)?;
             sampler_props(GgxSphericalCap(s), wi, m, u)?;
+            sampler_props(GgxBoundedCap(s), wi, m, u)?;
             sampler_props(GgxDisk(s), wi, m, u)?;
         }
     }

@@ -64,7 +64,8 @@ pub enum Technique {
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
-    /// weights, approximate pdf. Valid for backfacing views of opaque materials (normal
+    /// weights, approximate pdf (0.8 × the single-scattering density + 0.2 × a cosine lobe,
+    /// for MIS weights only). Valid for backfacing views of opaque materials (normal
     /// mapping): the walk starts with the full-spherical first intersection
     /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there, except
     /// for smooth Beckmann surfaces seen from well below (|cot θo|/α ≳ 9.6), where the walk's
@@ -72,7 +73,7 @@ pub enum Technique {
     #[default]
     RandomWalk,
     /// The position-free estimators of Wang et al. 2022: stochastic eval, exact sample
-    /// weights, approximate pdf. Valid for backfacing views of opaque materials, whose first
+    /// weights, approximate pdf (that of [`Technique::RandomWalk`]). Valid for backfacing views of opaque materials, whose first
     /// vertex is a vertex reached from below (DESIGN.md); for Beckmann seen from so far below
     /// that Λ underflows f64 (|cot θo|/α ≳ 26.6) `sample` returns nothing and eval keeps only
     /// the first order.

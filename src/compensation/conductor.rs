@@ -7,12 +7,12 @@ pub(crate) use super::shared::{ONE_MINUS_ULP, Tables, check_tabulated, mixture_s
 use super::lobe_profile::{
     DirectionAxis, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, valid_direction, valid_uniforms};
-use crate::bsdf::{MicrofacetBsdf, Technique};
-use crate::compensation::tables::{
+use crate::albedo::{
     ALBEDO_TABLE_SIZE, AlbedoTable, DielectricAlbedoTable, LAST_TABULATED_ORDER, ORDER_TABLES,
     ScatteringOrderTable, node_cell,
 };
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, valid_direction, valid_uniforms};
+use crate::bsdf::{MicrofacetBsdf, Technique};
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;
@@ -156,7 +156,7 @@ pub enum Compensation {
 /// taken in its sampler's form F G2/G1 · pdf_ss (within 1e-5 of eval's, as its sampler's
 /// weight is). Turquin samples and has the density of the single-scattering lobe.
 ///
-/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) are
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`crate::SMOOTH_ALPHA`]) are
 /// the Dirac mirror of the single-scattering BSDF, uncompensated (the energy the single
 /// bounce loses vanishes with α). View directions below the horizon (a backfacing shading
 /// normal, which single scattering supports) have no tabulated albedo: the lobe is then the
@@ -436,18 +436,22 @@ impl<S: MicrosurfaceSlope> CompensatedConductor<S> {
     }
 
     /// Single scattering's f·cos θi and density at a pair of directions above the horizon, in
-    /// the form its sampler gives them for a sampled direction: F(ωo·ωh) G2/G1 · pdf, with
-    /// G2/G1 = 1/(1 + Λi/(1 + Λo)) from the f32 Λ and F at the half vector of the f32 directions
-    /// (within 1e-5 of eval's f64 form, as the sampler's weight is).
+    /// the form its sampler gives them for a sampled direction: F(ωo·ωh) G2/G1 · (As/A) · pdf,
+    /// with G2/G1 = 1/(1 + Λi/(1 + Λo)) from the f32 Λ, As/A the ratio of the sampler's area to
+    /// the projected area of ωo (below 1 for GGX's bounded cap, else 1) and F at the half
+    /// vector of the f32 directions (within 1e-5 of eval's f64 form, as the sampler's weight is).
     #[inline(always)]
     fn single_at(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         let surface = self.single.surface();
         let slope = surface.slope();
         let pdf = self.single_pdf(wo, wi);
         let shadowing = 1.0 / (1.0 + slope.lambda_unchecked(wi) / (1.0 + slope.lambda_unchecked(wo)));
+        // the sampler's density is D/(4 As), f·cos θi = F (G2/G1) D/(4 A): As/A = 1 but for
+        // GGX's bounded cap
+        let areas = slope.mirror_sampling_area_unchecked(wo) / slope.projected_area_unchecked(wo);
         // wo + wi ≠ 0 above the horizon
         let cos = wo.dot((wo + wi).normalize());
-        (surface.material().fresnel(cos) * (shadowing * pdf), pdf)
+        (surface.material().fresnel(cos) * (shadowing * areas * pdf), pdf)
     }
 
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
@@ -553,7 +557,7 @@ impl<S: MicrosurfaceSlope> Bsdf for CompensatedConductor<S> {
 /// 1 − E at the direction nodes for roughness α: the table's two roughness rows around
 /// r = √α blended linearly (as its bilinear interpolation does), from the complements of the
 /// f32 nodes (exact in f32 for E ≥ 1/2, and every E node is above 0.2).
-fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZE] {
+pub(crate) fn blended_complement(table: &AlbedoTable, alpha: f32) -> [f32; ALBEDO_TABLE_SIZE] {
     let nodes = table.directional_nodes();
     let t = alpha.sqrt() * LAST;
     let j = (t as usize).min(ALBEDO_TABLE_SIZE - 2);

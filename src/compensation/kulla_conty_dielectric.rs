@@ -7,9 +7,9 @@ use super::conductor::{AlbedoTabulated, ONE_MINUS_ULP, Tables, check_tabulated, 
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MixtureTable, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
+use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
 use crate::bsdf::{MicrofacetBsdf, Technique};
-use crate::compensation::tables::{DIELECTRIC_TABLE_SIZE, DielectricWalkTable};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::single_scattering::SingleScattering;
@@ -123,7 +123,7 @@ struct SideLobes {
 /// BSDF above.
 ///
 /// **Special cases.** Effectively smooth surfaces (largest principal roughness below
-/// [`super::SMOOTH_ALPHA`]) and η = 1 are the Dirac lobes of the single-scattering BSDF,
+/// [`crate::SMOOTH_ALPHA`]) and η = 1 are the Dirac lobes of the single-scattering BSDF,
 /// uncompensated. A view or light on the horizon has no added lobe.
 ///
 /// # Examples

@@ -6,15 +6,14 @@ mod conductor;
 mod kulla_conty_dielectric;
 mod lobe_profile;
 mod shared;
-pub(crate) mod tables;
 mod turquin_dielectric;
 
-pub use conductor::{AlbedoTabulated, CompensatedConductor, Compensation};
-pub use kulla_conty_dielectric::{KullaContyDielectric, WalkTabulated};
-pub use tables::{
+pub use crate::albedo::{
     ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
     DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
     MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable,
     TabulatedOrder, WALK_BATCH,
 };
+pub use conductor::{AlbedoTabulated, CompensatedConductor, Compensation};
+pub use kulla_conty_dielectric::{KullaContyDielectric, WalkTabulated};
 pub use turquin_dielectric::CompensatedDielectric;

@@ -1,8 +1,8 @@
 //! What the energy-compensated BSDFs share: the tables' range check of their constructors and
 //! the final filter of a sample drawn from a sampling mixture.
 
+use crate::albedo::{MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
 use crate::bsdf::{BsdfSample, SampleFlags};
-use crate::compensation::tables::{MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
 use crate::error::Error;
 use glam::Vec3;
 

@@ -4,9 +4,9 @@
 //! ([`crate::compensation::DielectricAlbedoTable`]).
 
 use super::conductor::{AlbedoTabulated, Tables, check_tabulated};
+use crate::albedo::{DIELECTRIC_TABLE_SIZE, DielectricDirection, node_cell};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction};
 use crate::bsdf::{MicrofacetBsdf, Technique};
-use crate::compensation::tables::{DIELECTRIC_TABLE_SIZE, DielectricDirection, node_cell};
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::slope::MicrosurfaceSlope;
@@ -42,7 +42,7 @@ const LAST: f32 = (DIELECTRIC_TABLE_SIZE - 1) as f32;
 /// per call). `pdf` and `sample` are those of single scattering: the density is exact and a
 /// sample's weight is the single-scattering weight divided by E(μo), i.e. f·|cos θi|/pdf.
 ///
-/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`super::SMOOTH_ALPHA`]) and
+/// **Special cases.** Effectively smooth surfaces (largest principal roughness [`MicrosurfaceSlope::alpha_max`](crate::slope::MicrosurfaceSlope::alpha_max) < [`crate::SMOOTH_ALPHA`]) and
 /// η = 1 are the Dirac lobes of the single-scattering BSDF, uncompensated (the loss vanishes
 /// with α). A view on the horizon (μo = 0) has no lobe. Near η = 1 at grazing views E(μo)
 /// approaches 0 (single scattering reflects almost nothing and masks every refraction at the

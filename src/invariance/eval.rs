@@ -24,12 +24,12 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
     /// while the next-event term keeps P as a weight: where an upward d_{j−1} barely hits
     /// (Λ → 0) the phase function p ∝ 1/A(−d_{j−1}) = 1/(Λ|cos|) is unbounded but P·p is not,
     /// whereas the walk's next-event term after a sampled hit has unbounded variance there.
-    /// `order` truncates the paths (all orders: [`crate::MAX_BOUNCES`] is only a guard). Precision: the depth law is in f64 with positive terms only (relative error
+    /// `order` truncates the paths (all orders: [`crate::research::MAX_BOUNCES`] is only a guard). Precision: the depth law is in f64 with positive terms only (relative error
     /// a few f64 ulps per bounce); Λ in f64.
     ///
     /// 0 for ωi or ωo on the horizon and for ωo below it. ωi below the horizon (a backfacing
-    /// view) enters with σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`](crate::MIN_FIRST_RATE) the walk from
-    /// below answers ([`crate::Microsurface::eval_from_below`], the same model).
+    /// view) enters with σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`](crate::research::MIN_FIRST_RATE) the walk from
+    /// below answers ([`crate::research::Microsurface::eval_from_below`], the same model).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).

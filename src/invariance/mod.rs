@@ -35,7 +35,7 @@ pub const MIN_FIRST_RATE: f64 = 1e-200;
 /// height distribution (supplement §1.1); Λ(−ω) = −1 − Λ(ω) on the whole sphere; and an
 /// opaque material (light stays on the outer side, so depths are measured in one frame).
 /// Neither isotropy nor a particular slope distribution is assumed: the estimator is generic
-/// over [`MicrosurfaceSlope`](crate::MicrosurfaceSlope) (GGX, Beckmann, anisotropic,
+/// over [`MicrosurfaceSlope`](crate::slope::MicrosurfaceSlope) (GGX, Beckmann, anisotropic,
 /// elliptical, tabulated) and over the opaque materials ([`Conductor`](crate::Conductor) with
 /// its RGB Fresnel term, and [`Diffuse`](crate::Diffuse) facets); a dielectric is rejected by
 /// [`Invariance::new`].

@@ -20,8 +20,8 @@ impl<S: MicrosurfaceSlope, M: Material> Invariance<S, M> {
     ///
     /// `None` if ωi lies on the horizon, if the path was absorbed (a zero weight) or if it
     /// reached [`MAX_BOUNCES`]. ωi below the horizon (a backfacing view) enters with
-    /// σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`](crate::MIN_FIRST_RATE) the walk from below answers
-    /// ([`crate::Microsurface::sample_from_below`]).
+    /// σ₀ = Λ(−ωi); where that is below [`MIN_FIRST_RATE`](crate::research::MIN_FIRST_RATE) the walk from below answers
+    /// ([`crate::research::Microsurface::sample_from_below`]).
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).

@@ -48,7 +48,11 @@ pub(crate) struct Refraction {
 ///   |ωi·ωh| |ωo·ωh| η² (1 − F) D / (|cos θi| (ωi·ωh + η ωo·ωh)²) (Wang et al. 2022,
 ///   eqs. 2–3, every refraction included, see DESIGN.md);
 /// - sampling: ωm from D_ωi, reflect with probability F(ωi·ωm), refract otherwise; weight 1
-///   (supplement §3.4, Algorithm 7), the side of ωo always returned explicitly;
+///   (supplement §3.4, Algorithm 7), the side of ωo always returned explicitly. The bounded
+///   cap of Eto and Tokuyoshi 2023 ([`GgxBoundedCap`](crate::vndf::GgxBoundedCap)), which the
+///   conductors' single scattering uses, does not apply: the one normal serves both events,
+///   and the normals it leaves out (all of whose reflections point into the surface) refract
+///   validly, so dropping them would lose transmission;
 /// - single scattering: reflection F D G2/(4 cos θi); transmission
 ///   |ωi·ωh| |ωo·ωh| η² (1 − F) D B(1 + Λ(ωi), 1 + Λ(−ωo)) / (cos θi (ωi·ωh + η ωo·ωh)²)
 ///   (supplement §3.4).

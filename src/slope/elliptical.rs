@@ -343,4 +343,17 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         let wm = self.axis_aligned.sample_d_wi_unchecked(self.to_ellipse(wi), u1, u2);
         ensure_visible(wi, self.to_tangent(wm))
     }
+
+    /// `S`'s reflection sampler in the ellipse's frame (for GGX the bounded cap, whose bound
+    /// depends on min(α₁, α₂) and on θi only, both rotation invariant), rotated back.
+    #[inline]
+    fn sample_mirror_normal_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        let (wm, area) = self.axis_aligned.sample_mirror_normal_unchecked(self.to_ellipse(wi), u1, u2);
+        (ensure_visible(wi, self.to_tangent(wm)), area)
+    }
+
+    #[inline]
+    fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
+        self.axis_aligned.mirror_sampling_area_unchecked(self.to_ellipse(wi))
+    }
 }

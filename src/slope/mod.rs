@@ -14,6 +14,7 @@ pub use elliptical::{AxisAlignedSlope, Elliptical};
 pub use ggx::Ggx;
 
 pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
+pub(crate) use ggx::{cap_bound, sample_bounded_cap};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
@@ -28,9 +29,9 @@ use glam::{DVec3, Vec3};
 /// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
 ///
 /// Sealed: implemented by the crate's distributions only ([`Ggx`], [`Beckmann`],
-/// `&`[`TabulatedSlope`], [`StretchedTabulated`], `&`[`GridSlope`]). A distribution of one's
-/// own goes through [`TabulatedSlope`] (isotropic: from P²² or D values on rings, or a radial
-/// function) or [`GridSlope`] (anisotropic: from a grid of slope densities), which check their
+/// `&`[`TabulatedSlope`](crate::tabulated::TabulatedSlope), [`StretchedTabulated`](crate::tabulated::StretchedTabulated), `&`[`GridSlope`](crate::tabulated::GridSlope)). A distribution of one's
+/// own goes through [`TabulatedSlope`](crate::tabulated::TabulatedSlope) (isotropic: from P²² or D values on rings, or a radial
+/// function) or [`GridSlope`](crate::tabulated::GridSlope) (anisotropic: from a grid of slope densities), which check their
 /// input, derive Λ, the projected area and D_ωi from it and sample it exactly, so that the
 /// random walks, the position-free estimators and the samplers are valid for it unchanged.
 /// Sealing lets the crate rely on the contract below (which its test suite checks for every
@@ -274,6 +275,38 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     fn reflection_density_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
         reflection_density64(self, wi, wo)
     }
+
+    /// D(ωh)/(4 `area`) for a reflection off mirror facets from ωi to ωo (as
+    /// [`Self::reflection_density_unchecked`], which is this with `area` = A(ωi)): the density
+    /// of a reflection sampler whose normals have the density ⟨ωi, ωm⟩ D(ωm)/`area` where they
+    /// reflect above the horizon. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn reflection_density_over_unchecked(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
+        reflection_density64_over(self, wi, wo, area)
+    }
+
+    /// A facet normal for a reflection off mirror facets from a unit ωi above the horizon, from
+    /// two uniforms, and the area A_s(ωi) = [`Self::mirror_sampling_area_unchecked`] of its
+    /// sampler: the renderer layer's single scattering draws its reflections with it, and
+    /// those above the horizon have the density D(ωh)/(4 A_s). By default D_ωi
+    /// ([`Self::sample_d_wi_unchecked`], A_s = A); [`Ggx`] draws from the bounded cap (Eto and
+    /// Tokuyoshi 2023, [`GgxBoundedCap`](crate::GgxBoundedCap)), which leaves out normals
+    /// whose reflections all point into the surface (A_s = A_b ≤ A). No argument check
+    /// (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_mirror_normal_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        (self.sample_d_wi_unchecked(wi, u1, u2), self.projected_area_unchecked(wi))
+    }
+
+    /// The area A_s(ωi) of [`Self::sample_mirror_normal_unchecked`] (the same bits): A(ωi) by
+    /// default, GGX's bounded A_b. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
+        self.projected_area_unchecked(wi)
+    }
 }
 
 /// The default D_ωi(ωm) in double precision, cos⟨ωi, ωm⟩ D(ωm)/A(ωi), without the argument check.
@@ -292,8 +325,19 @@ pub(crate) fn smith_d_wi64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: DVec3)
 /// ωi·ωh > 0).
 #[inline(always)]
 pub(crate) fn reflection_density64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
+    reflection_density64_over(slope, wi, wo, slope.projected_area_unchecked(wi))
+}
+
+/// [`reflection_density64`] with the area given: 0.25 D(ωh)/`area` in f64 rounded once.
+#[inline(always)]
+pub(crate) fn reflection_density64_over<S: MicrosurfaceSlope>(
+    slope: &S,
+    wi: Vec3,
+    wo: Vec3,
+    area: f32,
+) -> f32 {
     let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
-    let area = f64::from(slope.projected_area_unchecked(wi));
+    let area = f64::from(area);
     if area <= 0.0 { 0.0 } else { (0.25 * slope.d64_unchecked(wh) / area) as f32 }
 }
 

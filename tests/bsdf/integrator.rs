@@ -213,9 +213,10 @@ fn roughness_above_the_walk_range_is_rejected() {
 }
 
 /// Single scattering uses the caller's uniforms directly: `u` is the visible-normal sample
-/// (`sample_d_wi(wo, u.x, u.y)`, the reflection about it) and `uc` the Fresnel event of a
-/// dielectric (reflection iff uc < F(wo·m)). Uniforms on the 2⁻²⁴ grid the crate draws on
-/// are passed through exactly.
+/// (a GGX conductor: the bounded cap's `GgxBoundedCap.sample(wo, [u.x, u.y, ·])`; a
+/// dielectric: `sample_d_wi(wo, u.x, u.y)`; the reflection about it) and `uc` the Fresnel
+/// event of a dielectric (reflection iff uc < F(wo·m)). Uniforms on the 2⁻²⁴ grid the crate
+/// draws on are passed through exactly.
 #[test]
 fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
     use microsurface::fresnel::fresnel_dielectric;
@@ -229,11 +230,21 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
         let wo = dir(1.4 * uniform64(&mut rng), 2.0 * PI * uniform64(&mut rng));
         let u = Vec2::new(grid(uniform32(&mut rng)), grid(uniform32(&mut rng)));
         let uc = grid(uniform32(&mut rng));
+        let m_gold = microsurface::vndf::VisibleNormalSampler::sample(
+            &microsurface::vndf::GgxBoundedCap(slope),
+            wo,
+            [u.x, u.y, 0.0],
+        );
+        let mirror_gold = 2.0 * wo.dot(m_gold) * m_gold - wo;
+        if let Some(s) = gold_b.sample(wo, uc, u) {
+            assert!(
+                (s.wi - mirror_gold).length() <= 1e-5,
+                "wo {wo}, u {u}: wi {} ≠ reflection {mirror_gold}",
+                s.wi
+            );
+        }
         let m = slope.sample_d_wi(wo, u.x, u.y);
         let mirror = 2.0 * wo.dot(m) * m - wo;
-        if let Some(s) = gold_b.sample(wo, uc, u) {
-            assert!((s.wi - mirror).length() <= 1e-5, "wo {wo}, u {u}: wi {} ≠ reflection {mirror}", s.wi);
-        }
         let f = fresnel_dielectric(wo.dot(m), ETA);
         if let Some(s) = glass_b.sample(wo, uc, u) {
             let reflected = s.wi.z > 0.0;

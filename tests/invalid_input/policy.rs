@@ -23,8 +23,8 @@ use microsurface::research::{
 use microsurface::research::{Interaction, Side};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
+    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope,
+    VisibleNormalSampler, smith_normalization,
 };
 use microsurface::{Beckmann, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
@@ -592,6 +592,7 @@ fn visible_normal_samplers() {
     check_sampler(&mut r, "SmithVndf<GGX>", SmithVndf(ggx));
     check_sampler(&mut r, "SmithVndf<Beckmann>", SmithVndf(beckmann));
     check_sampler(&mut r, "GgxSphericalCap", GgxSphericalCap(ggx));
+    check_sampler(&mut r, "GgxBoundedCap", GgxBoundedCap(ggx));
     check_sampler(&mut r, "GgxDisk", GgxDisk(ggx));
     check_sampler(&mut r, "BeckmannNewton", BeckmannNewton(beckmann));
     check_sampler(&mut r, "VCavity<GGX>", VCavity(ggx));

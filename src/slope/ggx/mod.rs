@@ -2,14 +2,15 @@
 
 use super::{
     MicrosurfaceSlope, check_roughness, is_direction, is_uniform, projected_roughness_sq,
-    reflection_density64, smith_d_wi64,
+    reflection_density64_over, smith_d_wi64,
 };
 use crate::error::Error;
 mod visible;
 
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
-use visible::{sample_spherical_cap, sample_visible_hemisphere};
+use visible::{bounded_area, sample_spherical_cap, sample_visible_hemisphere};
+pub(crate) use visible::{cap_bound, sample_bounded_cap};
 
 /// 1/(4π), the constant of the reflection density D(ωh)/(4 A(ωi)).
 const FRAC_1_4PI: f32 = 0.25 * FRAC_1_PI;
@@ -250,17 +251,46 @@ impl MicrosurfaceSlope for Ggx {
     /// 2⁻¹⁰⁰ (subnormal terms) or the result is not a normal f32, the f64 form serves.
     #[inline(always)]
     fn reflection_density_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
+        self.reflection_density_over(wi, wo, self.projected_area_unchecked(wi))
+    }
+
+    /// [`Self::reflection_density_unchecked`]'s f32 form with the given area.
+    #[inline(always)]
+    fn reflection_density_over_unchecked(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
+        self.reflection_density_over(wi, wo, area)
+    }
+
+    /// The bounded cap of Eto and Tokuyoshi 2023 ([`GgxBoundedCap`](crate::GgxBoundedCap)),
+    /// with its bounded projected area A_b = (L + k ωi.z)/2 (eq. 8).
+    #[inline(always)]
+    fn sample_mirror_normal_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        (sample_bounded_cap(self, wi, u1, u2), bounded_area(self, wi))
+    }
+
+    #[inline(always)]
+    fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
+        bounded_area(self, wi)
+    }
+}
+
+impl Ggx {
+    /// D(ωh)/(4 `area`) in f32 from the unnormalized sum h = ωi + ωo (see
+    /// [`MicrosurfaceSlope::reflection_density_unchecked`], which passes A(ωi); the bounded cap
+    /// passes its A_b), with the f64 form where a term is subnormal or the result is not a
+    /// normal f32.
+    #[inline(always)]
+    pub(crate) fn reflection_density_over(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
         let h = wi + wo;
         let (x, y) = (h.x / ax, h.y / ay);
         let t = x * x + y * y + h.z * h.z;
         let len_sq = h.length_squared();
         let ratio = len_sq / t;
-        let density = FRAC_1_4PI * (ratio * ratio) / (ax * ay * self.projected_area_unchecked(wi));
+        let density = FRAC_1_4PI * (ratio * ratio) / (ax * ay * area);
         if len_sq >= F32_DENSITY_MIN_SUM && t >= F32_DENSITY_MIN_SUM && density.is_normal() {
             density
         } else {
-            reflection_density64(self, wi, wo)
+            reflection_density64_over(self, wi, wo, area)
         }
     }
 }

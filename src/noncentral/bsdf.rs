@@ -252,8 +252,7 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> Bsdf for NoncentralBsdf<S, M> 
         // as MicrofacetBsdf: the density and f = weight·pdf/|cos θi| must be normal f32 numbers
         // (eval could not reproduce a subnormal f), and a weight saturated by G1 = f32::MAX
         // is not f·cos/pdf
-        if !(pdf >= f32::MIN_POSITIVE
-            && pdf <= f32::MAX
+        if !((f32::MIN_POSITIVE..=f32::MAX).contains(&pdf)
             && weight.is_finite()
             && weight.max_element() < f32::MAX
             && wi.z != 0.0)

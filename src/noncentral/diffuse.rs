@@ -55,7 +55,7 @@ impl NoncentralMaterial for Diffuse {
         let wm = surface.sample_d_wi_unchecked(wi, u.x, u.y);
         let lobe = self.sample_at_facet(wm, rng);
         // a direction below the base plane is masked by it
-        if !(lobe.wo.z > 0.0) {
+        if lobe.wo.z.is_nan() || lobe.wo.z <= 0.0 {
             return None;
         }
         let weight = lobe.weight * saturate(surface.g1_unchecked(lobe.wo));

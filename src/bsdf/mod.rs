@@ -30,6 +30,7 @@ pub use specular::{SpecularEvent, SpecularLimit};
 
 /// The deterministic randomness of the stochastic evaluations, for the renderer BSDFs of the
 /// layers above (the noncentral lobes).
+#[cfg(feature = "leadr")]
 pub(crate) use seed::{Hasher, PrimedRng};
 
 use glam::{Vec2, Vec3};

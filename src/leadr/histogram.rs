@@ -139,6 +139,7 @@ impl SlopeHistogram {
     }
 
     /// The mean slope in f64.
+    #[cfg(feature = "data-driven")]
     pub(crate) fn mean64(&self) -> DVec2 {
         self.mean
     }
@@ -150,6 +151,7 @@ impl SlopeHistogram {
     }
 
     /// [`Self::covariance`] in f64.
+    #[cfg(feature = "data-driven")]
     pub(crate) fn covariance64(&self) -> [f64; 3] {
         self.covariance
     }

@@ -36,6 +36,21 @@ const HERMITE5: [(f64, f64); 5] = [
 ];
 
 /// The slope distribution of a displacement, the input P_X of [`DownsampledSlope`].
+///
+/// # Examples
+/// ```
+/// use microsurface::glam::Vec2;
+/// use microsurface::leadr::{Displacement, SlopeHistogram, SlopeMoments};
+///
+/// // a Gaussian of mean slope (0.1, 0) and variance 0.01 per axis, or the slopes themselves
+/// let moments = SlopeMoments::new(0.1, 0.0, 0.01 + 0.01, 0.01, 0.0)?;
+/// let gaussian = Displacement::Moments(&moments);
+/// let slopes = [Vec2::new(0.0, -0.1), Vec2::new(0.2, 0.1)];
+/// let histogram = SlopeHistogram::from_slopes(&slopes, 8)?;
+/// let tabulated = Displacement::Histogram(&histogram);
+/// assert!(matches!((gaussian, tabulated), (Displacement::Moments(_), Displacement::Histogram(_))));
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy)]
 pub enum Displacement<'a> {
     /// The displacement's LEADR moments, a Gaussian of their mean and covariance (eqs.
@@ -81,10 +96,15 @@ pub enum Displacement<'a> {
 ///   constant on its cells: its resolution, not the convolution's, bounds the accuracy (cells of
 ///   ≈ π α_Z/(N + 1) at the centre).
 ///
-/// Validated against the closed form (Beckmann(α) ∗ N(0, σ²I) = Beckmann(√(α² + 2σ²)), the
-/// slope variance α²/2 per axis of the Beckmann density exp(−x̃²/α²)/(πα²)), against LEADR
-/// (Beckmann bases) and against the supersampled BRDF of a displaced rough surface
-/// (`tests/leadr.rs`).
+/// Validated (`tests/downsample.rs`) against the closed form, with the convention that a
+/// Beckmann density exp(−x̃²/α²)/(πα²) has slope variance α²/2 per axis, so that
+/// Beckmann(α) ∗ N(0, σ²I) = Beckmann(√(α² + 2σ²)) (with a covariance, the elliptical Beckmann
+/// of Σ_Y + Σ_X, LEADR's lobe): within L1 1e-3 of the closed form tabulated the same way, G1
+/// within 1e-3; the table itself is at L1 4e-2 of the continuous density at 48 cells per half
+/// axis (∝ 1/N). Against the supersampled BRDF of a displaced rough surface (the LEADR
+/// validation metric, 128 cells): relative L1 0.016–0.019 over Beckmann and GGX bases.
+///
+/// Requires the features `leadr` and `data-driven`.
 ///
 /// # Examples
 /// ```
@@ -98,8 +118,9 @@ pub enum Displacement<'a> {
 /// let moments = SlopeMoments::new(mx, 0.0, var + mx * mx, var, 0.0)?;
 /// let z = DownsampledSlope::new(Displacement::Moments(&moments), Ggx::isotropic(0.2)?, 24)?;
 /// assert_eq!(z.mean_slope(), Vec2::new(0.2, 0.0));
-/// // the centred table is wider than the base: its roughness at the horizon grows
-/// assert!(z.grid().alpha_x() > 0.25);
+/// // the centred table is rougher than the base: more masking at a grazing view
+/// let w = microsurface::glam::Vec3::new(0.8, 0.0, 0.6);
+/// assert!(z.grid().lambda(w) > Ggx::isotropic(0.2)?.lambda(w));
 /// assert!(z.slope().g1(microsurface::glam::Vec3::Z) > 0.9);
 /// # Ok::<(), microsurface::Error>(())
 /// ```

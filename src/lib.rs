@@ -56,10 +56,11 @@
 //! # Ok::<(), microsurface::Error>(())
 //! ```
 //!
-//! [`Technique`] chooses single scattering (exact, cheapest; it loses the energy of the higher
-//! orders), the random walk (the exact model, stochastic), the invariance-principle estimator of
-//! the same model, or the position-free PT and BDPT estimators; the compensated lobes restore the
-//! lost energy deterministically from tables. [`ClassicBrdf`] is the classic Lambert plus
+//! [`Technique`] chooses single scattering (exact on conductors and dielectrics, stochastic on
+//! diffuse facets; the cheapest; it loses the energy of the higher orders), the random walk (the
+//! exact model, stochastic), the invariance-principle estimator of the same model, or the
+//! position-free PT and BDPT estimators; the compensated lobes restore the lost energy
+//! deterministically from tables. [`ClassicBrdf`] is the classic Lambert plus
 //! Cook–Torrance BRDF. Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes
 //! (`flags().specular`).
 //!
@@ -76,6 +77,13 @@
 //!   direction light arrives from and `wo` the one it leaves along returns **f·|cos θo|**,
 //!   stochastic evaluations take `&mut impl Rng`, and a walk sample's weight is f·|cos θo|/pdf.
 //!
+//! The renderer layer accepts what a real pipeline sends: directions within
+//! [`BSDF_DIRECTION_TOLERANCE`] (10⁻²) of unit length are renormalized, and a uniform of exactly
+//! 1 is taken as 1 − 2⁻²⁴ (see [`Bsdf`], “Inputs”); the research layer keeps the strict
+//! [`DIRECTION_TOLERANCE`]. With the `mint` feature, `MintBsdf` takes and returns the
+//! `mint` interop vectors (which glam, nalgebra and cgmath convert to and from), for a
+//! renderer on another vector library or another glam version.
+//!
 //! A zero component of a direction may have either sign: −0 is treated exactly like +0
 //! (ω.z = −0 is the horizon seen from above). Samplers take uniforms in [0, 1) and cut the
 //! tails of every quantile they invert at 2⁻²⁴, the spacing of 24-bit uniforms (u is used as
@@ -86,7 +94,8 @@
 //!
 //! One policy for every public entry point: an argument outside its function's domain (a
 //! direction that is zero, has a NaN or ±∞ component, or is not unit within
-//! [`DIRECTION_TOLERANCE`]; a NaN scalar; a uniform outside [0, 1], a cosine beyond
+//! [`DIRECTION_TOLERANCE`] — within [`BSDF_DIRECTION_TOLERANCE`] of unit length for the
+//! renderer layer, which renormalizes; a NaN scalar; a uniform outside [0, 1], a cosine beyond
 //! ±(1 + [`DIRECTION_TOLERANCE`]), an η that is not finite and > 0) is a contract violation. It
 //! panics in debug builds (a debug assertion whose message starts with `invalid input`), and
 //! release builds return the function's documented *nothing*, never a plausible value: 0 for
@@ -102,7 +111,9 @@
 //! `data-driven` ([`tabulated`]). A renderer that needs only this page's types, the compensated
 //! lobes and the walk builds with `default-features = false`.
 
-#![forbid(unsafe_code)]
+// No unsafe code, except the runtime dispatch of the batch loops to their AVX2 build
+// (`lanes::dispatch`: a call of a `#[target_feature]` function after the CPU check).
+#![deny(unsafe_code)]
 #![deny(missing_docs)]
 // One allowance for the fitted coefficient tables of src/special (the erfcx pieces, the
 // Gaussian-quantile fits, the azimuth polynomials) and their reference values: they are written
@@ -121,6 +132,7 @@ mod error;
 mod height;
 #[cfg(feature = "invariance")]
 mod invariance;
+mod lanes;
 mod material;
 mod microsurface;
 #[cfg(feature = "leadr")]
@@ -132,6 +144,7 @@ mod rng;
 mod sampling;
 mod sealed;
 mod single_scattering;
+mod soa;
 mod vector;
 
 pub mod compensation;
@@ -146,15 +159,19 @@ pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, MAX_WALK_ALPHA,
-    MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Technique, Transport,
+    BSDF_DIRECTION_TOLERANCE, BatchBsdf, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking,
+    ClassicNdf, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, SampleOutputs, ShadingFrame,
+    Sidedness, Technique, Transport,
 };
+#[cfg(feature = "mint")]
+pub use bsdf::{MintBsdf, MintSample};
 pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
 pub use fresnel::ComplexIor;
 pub use material::{Conductor, Dielectric, Diffuse};
 pub use slope::{Beckmann, Elliptical, Ggx};
+pub use soa::{Channels, Directions};
 
 /// The vector library of the public API, re-exported so that users on another `glam` version
 /// can name the crate's types.
@@ -202,7 +219,8 @@ pub mod research {
     pub use crate::invariance::{Invariance, MIN_FIRST_RATE};
     pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
     pub use crate::microsurface::{
-        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
+        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkOutputs,
+        WalkSample,
     };
     pub use crate::path::Shadowing;
     #[cfg(feature = "position-free")]

@@ -1,12 +1,13 @@
 //! Dielectric microfacets.
 
 use super::{
-    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
-    reflection_half_vector,
+    HalfSum, Interaction, LaneMaterial, Material, PhaseSample, Side, g2_reflection, phase_reflection,
+    reflect, reflection_half_vector,
 };
 use crate::contract::is_direction;
 use crate::error::Error;
 use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
+use crate::lanes::Lanes;
 use crate::rng::{uniform, uniform_pair};
 use crate::slope::{MicrosurfaceSlope, renormalize};
 use crate::special::beta;
@@ -134,6 +135,43 @@ impl Dielectric {
         Some(Refraction { wh: h, cos_ih, cos_oh, denom_sq: len * len, transmittance })
     }
 
+    /// The transmission density of the phase function for ωi outside and ωo inside with
+    /// A(ωi) = `area` known (the walk's next-event estimation), from the refraction half vector
+    /// unnormalized: h = ±(ωi + η ωo) with h.z > 0, valid where ωi·h > 0 > ωo·h (the signs of
+    /// [`Self::refraction`]'s tests, and its degenerate pairs, |h| ≤ `REFRACTION_DEGENERATE`
+    /// max(1, η), excluded alike). With kᵢ = ωi·h and kₒ = −ωo·h, cos θi = kᵢ/|h| and
+    /// cos θt = kₒ/|h|, and ωi·ωh + η ωo·ωh = ±|h|, so
+    ///
+    /// η² (1 − F) D(ωh) (ωi·ωh)(−ωo·ωh) / (A(ωi) (ωi·ωh + η ωo·ωh)²) = η² (1 − F) D(ωh) kᵢ kₒ / (A |h|⁴),
+    ///
+    /// F = `fresnel_dielectric_cosines`(kᵢ, kₒ, η) (its ratios are homogeneous in the cosines)
+    /// and D from h directly ([`MicrosurfaceSlope::d64_of_sum_unchecked`]): no square root and
+    /// no normalization; the factor beside D is formed while D is. In f64, rounded once.
+    #[inline(always)]
+    fn transmission_density_of_sum<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        wi: Vec3,
+        wo: Vec3,
+        area: f32,
+    ) -> f32 {
+        let (i, o, eta) = (wi.as_dvec3(), wo.as_dvec3(), f64::from(self.eta));
+        let sum = i + eta * o;
+        let len_sq = sum.length_squared();
+        let degenerate = REFRACTION_DEGENERATE * eta.max(1.0);
+        if len_sq.is_nan() || len_sq <= degenerate * degenerate {
+            return 0.0;
+        }
+        let h = if sum.z > 0.0 { sum } else { -sum };
+        let (k_i, k_o) = (i.dot(h), -o.dot(h));
+        if !(h.z > 0.0 && k_i > 0.0 && k_o > 0.0) {
+            return 0.0;
+        }
+        let transmittance = 1.0 - fresnel_dielectric_cosines(k_i, k_o, eta);
+        let factor = eta * eta * transmittance * k_i * k_o / (f64::from(area) * (len_sq * len_sq));
+        (factor * slope.d64_of_sum_unchecked(h)) as f32
+    }
+
     /// The phase function for ωi outside, `it` in that frame.
     #[inline(always)]
     fn eval_phase_outside<S: MicrosurfaceSlope>(&self, slope: &S, it: &Interaction) -> f32 {
@@ -151,13 +189,13 @@ impl Dielectric {
                     * phase_reflection(slope, wi, wh, it.incident_area())
             }
             Side::Inside => {
+                if let Some(area) = it.incident_area() {
+                    // the walk's next-event estimation: A(ωi) known, the half vector unnormalized
+                    return self.transmission_density_of_sum(slope, wi, wo, area);
+                }
                 let Some(r) = self.refraction(wi, wo) else { return 0.0 };
                 let eta = f64::from(self.eta);
-                // D_ωi(ωh) = (ωi·ωh) D(ωh)/A(ωi), with A known where the walk computed it
-                let d_wi = match it.incident_area() {
-                    Some(area) => r.cos_ih * slope.d64_unchecked(r.wh) / f64::from(area),
-                    None => slope.d_wi64_unchecked(wi, r.wh),
-                };
+                let d_wi = slope.d_wi64_unchecked(wi, r.wh);
                 (eta * eta * r.transmittance * d_wi * (-r.cos_oh) / r.denom_sq) as f32
             }
         }
@@ -195,19 +233,7 @@ impl Dielectric {
     /// cosine with l = 1.
     #[inline(always)]
     fn reflectance_scaled(&self, k: f64, l_sq: f64) -> (f64, f64) {
-        let eta = f64::from(self.eta);
-        let s_sq = k * k + (eta - 1.0) * (eta + 1.0) * l_sq;
-        if s_sq <= 0.0 {
-            return (1.0, 0.0);
-        }
-        let s = s_sq.sqrt();
-        let eta2_k = eta * eta * k;
-        let (den_s, den_p) = (k + s, eta2_k + s);
-        if den_s <= 0.0 || den_p <= 0.0 {
-            return (1.0, s);
-        }
-        let (rs, rp) = ((k - s) / den_s, (eta2_k - s) / den_p);
-        (0.5 * (rs * rs + rp * rp), s)
+        reflectance_scaled_of(f64::from(self.eta), k, l_sq)
     }
 
     /// The refraction of ωi through the facet ωm with c = ωi·ωm ≥ 0 and s = η cos θt
@@ -249,9 +275,29 @@ impl Dielectric {
     }
 }
 
+/// [`Dielectric`]'s `reflectance_scaled` for every lane type, with η = `eta`: (F, s) for
+/// cos θi = k/l, l² = `l_sq`, s = l η cos θt (F = 1, s = 0 under total internal reflection).
+#[inline(always)]
+pub(crate) fn reflectance_scaled_of<L: Lanes>(eta: L, k: L, l_sq: L) -> (L, L) {
+    let (zero, one) = (L::lit(0.0), L::lit(1.0));
+    let s_sq = k * k + (eta - one) * (eta + one) * l_sq;
+    let total = s_sq.le(zero);
+    let s = L::select(total, zero, s_sq.sqrt());
+    let eta2_k = eta * eta * k;
+    let (den_s, den_p) = (k + s, eta2_k + s);
+    let (rs, rp) = ((k - s) / den_s, (eta2_k - s) / den_p);
+    let f = L::select(total | den_s.le(zero) | den_p.le(zero), one, L::lit(0.5) * (rs * rs + rp * rp));
+    (f, s)
+}
+
 impl Material for Dielectric {
     const TRANSMITS: bool = true;
     const EXACT_PHASE_PDF: bool = true;
+
+    #[inline]
+    fn lane_material(&self) -> LaneMaterial {
+        LaneMaterial::Dielectric(self.eta)
+    }
 
     /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not
     /// transparent: from the denser side a ray below the critical angle, cos θ < √(2|η − 1|),
@@ -298,7 +344,7 @@ impl Material for Dielectric {
 
     // out of line: the walk instantiated with the renderer layer's primed generator inlined
     // it and ran 25 % slower than with the research layer's generator, which does not
-    // (DESIGN.md, “renderer trait speed, session 6”)
+    // (DESIGN.md, “Speed against the research calls”)
     #[inline(never)]
     fn sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
@@ -313,8 +359,8 @@ impl Material for Dielectric {
 
     /// The visible normal's two uniforms from one 64-bit draw (the walks' stream). Out of
     /// line: inlined with the GGX visible normal into the walk's loop, the listing's GGX
-    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Integration,
-    /// session 6”).
+    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Speed against
+    /// the research calls”).
     #[inline(never)]
     fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
         &self,
@@ -325,6 +371,26 @@ impl Material for Dielectric {
     ) -> PhaseSample {
         let (u1, u2) = uniform_pair(rng);
         self.sample_at_facet(slope, wi, side, u1, u2, rng)
+    }
+
+    /// The walk's next-event phase function and next direction in one call, with the results
+    /// of the default's two calls (the phase function draws no uniform): the visible normal's
+    /// uniforms are drawn first, as [`Material::sample_phase_walk_unchecked`] draws them, then
+    /// the phase function at `it` is formed, then the sample. The phase function's long f64
+    /// chain (Fresnel, density) so starts ahead of the sampler's instead of after its call
+    /// returns: measured −5 % (GGX, ωo above) and −10 % (ωo inside) per walk `eval`; the
+    /// conductor, whose next-event density is short, keeps the two calls (its phase function
+    /// first measured +19 %).
+    #[inline(never)]
+    fn eval_and_sample_phase_unchecked<S: MicrosurfaceSlope>(
+        &self,
+        slope: &S,
+        it: &Interaction,
+        rng: &mut impl Rng,
+    ) -> (Vec3, PhaseSample) {
+        let (u1, u2) = uniform_pair(rng);
+        let phase = self.pdf_phase_unchecked(slope, it);
+        (Vec3::splat(phase), self.sample_at_facet(slope, it.wi(), it.wi_side(), u1, u2, rng))
     }
 
     /// The single-scattering terms of the type's documentation; for ωi below the surface, the

@@ -149,7 +149,7 @@ pub use bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, MAX_WALK_ALPHA,
     MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Technique, Transport,
 };
-pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
+pub use compensation::{Compensated, Compensation};
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
 pub use fresnel::ComplexIor;

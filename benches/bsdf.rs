@@ -20,7 +20,7 @@
 //! direction, what the trait's sample computes),
 //! `{material}/single/eval_with_pdf/{research|static|dyn}` (the research call is
 //! `SingleScattering::eval_with_pdf`; its `sample` returns the density too),
-//! `gold/single/sample-vs-vndf/{sample_d_wi|static}`, and
+//! `gold/single/sample-vs-vndf/{sample_d_wi|bounded_cap|static}`, and
 //! `per_hit/{material} {technique}/{prebuilt|per-hit} {static|dyn}`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -178,8 +178,9 @@ fn bench_material<M: Material + SpecularLimit>(c: &mut Criterion<Clock>, name: &
     }
 }
 
-/// Single-scattering `Bsdf::sample` of a GGX conductor against the spherical-cap visible-normal
-/// sampler it is built on (the target: at most 2× its cost).
+/// Single-scattering `Bsdf::sample` of a GGX conductor against the visible-normal samplers:
+/// the spherical cap (`sample_d_wi`) and the bounded cap it draws its reflections from (the
+/// target: at most 2× the spherical cap).
 fn sample_vs_vndf(c: &mut Criterion<Clock>) {
     let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
     let gold = MicrofacetBsdf::new(slope, Conductor::new(ComplexIor::GOLD))
@@ -192,6 +193,19 @@ fn sample_vs_vndf(c: &mut Criterion<Clock>) {
         b.iter(|| {
             let k = next(&mut i);
             black_box(&slope).sample_d_wi(black_box(x.wo[k]), black_box(x.u[k].x), black_box(x.u[k].y))
+        })
+    });
+    let bounded = microsurface::vndf::GgxBoundedCap(slope);
+    g.bench_function("bounded_cap", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            let u = [x.u[k].x, x.u[k].y, 0.0];
+            microsurface::vndf::VisibleNormalSampler::sample(
+                black_box(&bounded),
+                black_box(x.wo[k]),
+                black_box(u),
+            )
         })
     });
     g.bench_function("static", |b| {

@@ -1,8 +1,10 @@
 //! All visible-normal samplers side by side on the same inputs (Tokuyoshi's comparison):
-//! GGX by spherical caps (the crate's default), Heitz's 2018 disk and the V-cavity model;
+//! GGX by spherical caps (the crate's default), the bounded caps of Eto and Tokuyoshi 2023
+//! (reflections; target at most 1.15× the spherical cap), Heitz's 2018 disk and the V-cavity model;
 //! Beckmann by the safeguarded log-space inversion (default), the erf-domain Newton method and
 //! the V-cavity model. One call per iteration on 1024 pre-generated (direction, uniforms)
-//! pairs from a fixed seed, rotated behind `black_box`.
+//! pairs from a fixed seed, rotated behind `black_box`. `MICROSURFACE_BENCH_CLOCK=cpu` times
+//! the thread's CPU time (`validation::clock`), which leaves out preemption on a loaded machine.
 //!
 //! Benchmark ids: `vndf/{sampler}/a{α}/t{θi}`; the cost of elliptical anisotropy (a rotated
 //! ellipse against the axis-aligned one of the same radii, 0.5 × 0.1, θi = 0.9):
@@ -13,13 +15,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use microsurface::slope::{AxisAlignedSlope, MicrosurfaceSlope};
 use microsurface::vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
+    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VisibleNormalSampler,
 };
 use microsurface::{Beckmann, Elliptical, Ggx};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
-use std::time::Duration;
+use validation::clock::{Clock, config};
 
 /// Pre-generated inputs per configuration (a power of two).
 const N: usize = 1024;
@@ -39,7 +41,7 @@ fn inputs(theta: f32, seed: u64) -> Vec<(Vec3, [f32; 3])> {
         .collect()
 }
 
-fn bench_sampler<V: VisibleNormalSampler>(c: &mut Criterion, name: &str, make: impl Fn(f32) -> V) {
+fn bench_sampler<V: VisibleNormalSampler>(c: &mut Criterion<Clock>, name: &str, make: impl Fn(f32) -> V) {
     let mut group = c.benchmark_group("vndf");
     for (k, &a) in ALPHAS.iter().enumerate() {
         for (j, &t) in THETAS.iter().enumerate() {
@@ -58,10 +60,11 @@ fn bench_sampler<V: VisibleNormalSampler>(c: &mut Criterion, name: &str, make: i
     group.finish();
 }
 
-fn samplers(c: &mut Criterion) {
+fn samplers(c: &mut Criterion<Clock>) {
     let ggx = |a: f32| Ggx::isotropic(a).expect("valid α");
     let beckmann = |a: f32| Beckmann::isotropic(a).expect("valid α");
     bench_sampler(c, "ggx_spherical_cap", |a| GgxSphericalCap(ggx(a)));
+    bench_sampler(c, "ggx_bounded_cap", |a| GgxBoundedCap(ggx(a)));
     bench_sampler(c, "ggx_disk", |a| GgxDisk(ggx(a)));
     bench_sampler(c, "ggx_vcavity", |a| VCavity(ggx(a)));
     bench_sampler(c, "beckmann_safeguarded", |a| SmithVndf(beckmann(a)));
@@ -70,7 +73,7 @@ fn samplers(c: &mut Criterion) {
 }
 
 /// D, Λ and `sample_d_wi` of one slope on the pre-generated inputs.
-fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion, name: &str, slope: S) {
+fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion<Clock>, name: &str, slope: S) {
     let mut group = c.benchmark_group("elliptical");
     let data = inputs(0.9, 7_100);
     let mut i = 0usize;
@@ -99,7 +102,7 @@ fn bench_slope<S: MicrosurfaceSlope>(c: &mut Criterion, name: &str, slope: S) {
     group.finish();
 }
 
-fn elliptical_pair<S: AxisAlignedSlope>(c: &mut Criterion, family: &str) {
+fn elliptical_pair<S: AxisAlignedSlope>(c: &mut Criterion<Clock>, family: &str) {
     let (a1, a2, phi) = (0.5, 0.1, 0.6);
     bench_slope(c, &format!("{family}/aligned"), S::axis_aligned(a1, a2).expect("valid radii"));
     bench_slope(
@@ -109,17 +112,14 @@ fn elliptical_pair<S: AxisAlignedSlope>(c: &mut Criterion, family: &str) {
     );
 }
 
-fn elliptical(c: &mut Criterion) {
+fn elliptical(c: &mut Criterion<Clock>) {
     elliptical_pair::<Ggx>(c, "ggx");
     elliptical_pair::<Beckmann>(c, "beckmann");
 }
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(1))
-        .sample_size(20);
+    config = config();
     targets = samplers, elliptical
 }
 criterion_main!(benches);

@@ -13,8 +13,8 @@
 //! about that many times the cost of one bounce.
 //!
 //! Benchmark ids: `{material}/{slope}/{eval|sample|single}/a{α}/t{θi}` (θi in radians), and
-//! `listing/{material}/{slope}/{eval|sample}` for the fixed directions of the supplement's
-//! listing timing (`../shared/bench/heitz2016-listing`; `benches/compare-listing.sh`).
+//! `listing/{material}/{slope}/{eval|sample|eval_inside}` for the fixed directions of the
+//! supplement's listing timing (`../shared/bench/heitz2016-listing`; `benches/compare-listing.sh`).
 
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -130,37 +130,50 @@ fn spherical(theta: f64, phi: f64) -> Vec3 {
     Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32)
 }
 
+/// ωo of the listing's timing: θ = 0.8, φ = 3.5 (a reflection).
+const LISTING_WO: (f64, f64) = (0.8, 3.5);
+/// ωo of the listing's dielectric transmission timing: θ = π − 0.6, φ = 3.5 (seen from inside).
+const LISTING_WO_INSIDE: (f64, f64) = (2.541_592_653_589_793, 3.5);
+
 /// The configuration of `../shared/bench/heitz2016-listing` exactly: uniform heights, α = 0.5,
-/// ωi at θ = 0.5 (φ = 0), ωo at θ = 0.8, φ = 3.5, both fixed; one call per iteration.
+/// ωi at θ = 0.5 (φ = 0), ωo at `wo` (θ, φ), both fixed; one call per iteration. `sample`
+/// does not depend on ωo and is benchmarked when `with_sample`.
 fn bench_listing<S: MicrosurfaceSlope, M: Material>(
     c: &mut Criterion<Clock>,
-    material_name: &str,
+    id: (&str, &str),
     material: M,
-    slope_name: &str,
     slope: S,
+    (eval_name, wo): (&str, (f64, f64)),
+    with_sample: bool,
 ) {
     let surface = Microsurface::new(UniformHeight, slope, material);
-    let (wi, wo) = (spherical(0.5, 0.0), spherical(0.8, 3.5));
+    let (wi, wo) = (spherical(0.5, 0.0), spherical(wo.0, wo.1));
     let mut rng = Pcg64Mcg::seed_from_u64(6000);
-    let mut group = c.benchmark_group(format!("listing/{material_name}/{slope_name}"));
-    group.bench_function("eval", |b| {
+    let mut group = c.benchmark_group(format!("listing/{}/{}", id.0, id.1));
+    group.bench_function(eval_name, |b| {
         b.iter(|| black_box(&surface).eval(black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng))
     });
-    group.bench_function("sample", |b| b.iter(|| black_box(&surface).sample(black_box(wi), &mut rng)));
+    if with_sample {
+        group.bench_function("sample", |b| b.iter(|| black_box(&surface).sample(black_box(wi), &mut rng)));
+    }
     group.finish();
 }
 
-/// The listing's six configurations (`benches/compare-listing.sh` prints the ratios).
+/// The listing's configurations (`benches/compare-listing.sh` prints the ratios): the six
+/// materials and slopes with ωo above, and the GGX dielectric's `eval` with ωo inside
+/// (`eval_inside`).
 fn listing(c: &mut Criterion<Clock>) {
     let ggx = Ggx::isotropic(0.5).expect("valid roughness");
     let beckmann = Beckmann::isotropic(0.5).expect("valid roughness");
     let dielectric = Dielectric::new(1.5).expect("valid index");
-    bench_listing(c, "conductor", Conductor::perfect(), "ggx", ggx);
-    bench_listing(c, "diffuse", Diffuse::white(), "ggx", ggx);
-    bench_listing(c, "dielectric", dielectric, "ggx", ggx);
-    bench_listing(c, "conductor", Conductor::perfect(), "beckmann", beckmann);
-    bench_listing(c, "diffuse", Diffuse::white(), "beckmann", beckmann);
-    bench_listing(c, "dielectric", dielectric, "beckmann", beckmann);
+    let above = ("eval", LISTING_WO);
+    bench_listing(c, ("conductor", "ggx"), Conductor::perfect(), ggx, above, true);
+    bench_listing(c, ("diffuse", "ggx"), Diffuse::white(), ggx, above, true);
+    bench_listing(c, ("dielectric", "ggx"), dielectric, ggx, above, true);
+    bench_listing(c, ("dielectric", "ggx"), dielectric, ggx, ("eval_inside", LISTING_WO_INSIDE), false);
+    bench_listing(c, ("conductor", "beckmann"), Conductor::perfect(), beckmann, above, true);
+    bench_listing(c, ("diffuse", "beckmann"), Diffuse::white(), beckmann, above, true);
+    bench_listing(c, ("dielectric", "beckmann"), dielectric, beckmann, above, true);
 }
 
 fn walks(c: &mut Criterion<Clock>) {

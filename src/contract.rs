@@ -94,6 +94,18 @@ pub(crate) fn violated(what: &str, args: core::fmt::Arguments<'_>) {
     }
 }
 
+/// Reports an invalid argument of the renderer layer: panics in debug builds with
+/// `invalid input: ` and the description (which names the argument and its value), does
+/// nothing in release builds. Cold, as [`violated`].
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn violated_argument(description: core::fmt::Arguments<'_>) {
+    if cfg!(debug_assertions) {
+        panic!("invalid input: {description}");
+    }
+}
+
 /// `require!(condition, nothing; arg, …)`: if `condition` is false, reports a contract
 /// violation (a panic in debug builds, see [`violated`]) and returns `nothing` from the
 /// enclosing function. The listed arguments are printed in the panic message.

@@ -18,6 +18,13 @@ pub enum Error {
         /// The range the parameter must lie in, in words (`"finite and > 0"`).
         expected: &'static str,
     },
+    /// A model was given a material it does not cover.
+    UnsupportedMaterial {
+        /// The model (its type name, `"Invariance"`).
+        model: &'static str,
+        /// The materials it covers, in words.
+        expected: &'static str,
+    },
 }
 
 impl Error {
@@ -54,6 +61,9 @@ impl fmt::Display for Error {
         match self {
             Error::InvalidParameter { name, value, expected } => {
                 write!(f, "invalid parameter `{name}` = {value}: expected {expected}")
+            }
+            Error::UnsupportedMaterial { model, expected } => {
+                write!(f, "unsupported material for `{model}`: expected {expected}")
             }
         }
     }

@@ -1,18 +1,31 @@
 //! # microsurface
 //!
-//! Physically based microfacet BSDFs on Smith microsurfaces, **with multiple scattering**:
-//! the random-walk BSDFs of Heitz, Hanika, d'Eon and Dachsbacher 2016 (“Multiple-Scattering
-//! Microfacet BSDFs with the Smith Model”) and the position-free estimators of Wang et al.
-//! 2022 on conductor, diffuse and dielectric microfacets, built on exact visible-normal
-//! sampling, behind a small renderer-facing trait.
+//! Physically based microfacet BSDFs on Smith microsurfaces, **with multiple scattering**: the
+//! random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016, the position-free estimators of
+//! Wang et al. 2022 and the invariance-principle estimator of Cui et al. 2023 on conductor,
+//! diffuse and dielectric microfacets, energy-compensated lobes built from tables of the exact
+//! model, and exact visible-normal sampling on the whole sphere — behind one renderer-facing
+//! trait.
 //!
-//! ## For a renderer: [`Bsdf`]
+//! The documentation is grouped by use:
 //!
-//! Build a material once, then evaluate, sample and query the density in the local shading
-//! frame of each hit ([`ShadingFrame`]). `sample` takes the renderer's own uniforms (a 1D
-//! and a 2D sample, like pbrt's `Sample_f(wo, uc, u)`); every call is a pure function of its
-//! arguments, so renders are reproducible for any thread count, and `Vec<Box<dyn Bsdf>>`
-//! holds mixed materials.
+//! | you want | start at |
+//! |---|---|
+//! | a BSDF in a renderer | [`Bsdf`], [`MicrofacetBsdf`], [`ShadingFrame`] (this page) |
+//! | energy-conserving lobes at single-scattering cost | [`Compensated`], [`Compensation`], [`compensation`] |
+//! | the papers' models for references and experiments | [`research`] |
+//! | slope distributions and visible normals | [`slope`], [`vndf`] |
+//! | measured materials, data-driven slopes | [`tabulated`] (feature `data-driven`) |
+//! | filtered displacement and normal maps | [`leadr`] (feature `leadr`) |
+//! | Fresnel terms, special functions | [`fresnel`], [`special`] |
+//!
+//! ## A BSDF in a renderer
+//!
+//! Build a material (cheap: per hit from textured parameters, or once), then evaluate, sample
+//! and query the density in the local shading frame of each hit ([`ShadingFrame`]). `sample`
+//! takes the renderer's own uniforms (a 1D and a 2D sample, like pbrt's `Sample_f(wo, uc, u)`);
+//! every call is a pure function of its arguments, so renders are reproducible for any thread
+//! count, and `Vec<Box<dyn Bsdf>>` holds mixed materials.
 //!
 //! ```
 //! use microsurface::glam::{Vec2, Vec3};
@@ -43,9 +56,11 @@
 //! # Ok::<(), microsurface::Error>(())
 //! ```
 //!
-//! [`Technique`] chooses single scattering (exact, cheapest: the research layer's
-//! [`SingleScattering`], whose sampler returns its density), the random walk, or the
-//! position-free PT and BDPT estimators; [`ClassicBrdf`] is the classic Lambert plus
+//! [`Technique`] chooses single scattering (exact on conductors and dielectrics, stochastic on
+//! diffuse facets; the cheapest; it loses the energy of the higher orders), the random walk (the
+//! exact model, stochastic), the invariance-principle estimator of the same model, or the
+//! position-free PT and BDPT estimators; the compensated lobes restore the lost energy
+//! deterministically from tables. [`ClassicBrdf`] is the classic Lambert plus
 //! Cook–Torrance BRDF. Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes
 //! (`flags().specular`).
 //!
@@ -58,10 +73,16 @@
 //! * **Renderer layer** ([`Bsdf`], pbrt's convention): `eval(wo, wi)` with `wo` towards the
 //!   viewer and `wi` towards the light returns **f** (no cosine); a sample's weight is
 //!   f·|cos θi|/pdf.
-//! * **Research layer** ([`Microsurface`], [`PositionFree`], [`Material`], the papers'
-//!   convention): `eval(wi, wo)` with `wi` the direction light arrives from and `wo` the one it
-//!   leaves along returns **f·|cos θo|**, stochastic evaluations take `&mut impl Rng`, and a
-//!   walk sample's weight is f·|cos θo|/pdf.
+//! * **Research layer** ([`research`], the papers' convention): `eval(wi, wo)` with `wi` the
+//!   direction light arrives from and `wo` the one it leaves along returns **f·|cos θo|**,
+//!   stochastic evaluations take `&mut impl Rng`, and a walk sample's weight is f·|cos θo|/pdf.
+//!
+//! The renderer layer accepts what a real pipeline sends: directions within
+//! [`BSDF_DIRECTION_TOLERANCE`] (10⁻²) of unit length are renormalized, and a uniform of exactly
+//! 1 is taken as 1 − 2⁻²⁴ (see [`Bsdf`], “Inputs”); the research layer keeps the strict
+//! [`DIRECTION_TOLERANCE`]. With the `mint` feature, `MintBsdf` takes and returns the
+//! `mint` interop vectors (which glam, nalgebra and cgmath convert to and from), for a
+//! renderer on another vector library or another glam version.
 //!
 //! A zero component of a direction may have either sign: −0 is treated exactly like +0
 //! (ω.z = −0 is the horizon seen from above). Samplers take uniforms in [0, 1) and cut the
@@ -69,34 +90,12 @@
 //! clamp(u, 2⁻²⁴, 1 − 2⁻²⁴)): no sample lies beyond the last 2⁻²⁴ of its distribution, so the
 //! extreme uniforms never put a point mass where the model has almost nothing.
 //!
-//! See the README for the model table, the validation suite and the report.
-//!
-//! ## For research: the random walks themselves
-//!
-//! ```
-//! use microsurface::{Conductor, Ggx};
-//! use microsurface::research::{Microsurface, ScatteringOrder, UniformHeight};
-//! use glam::Vec3;
-//! use rand::SeedableRng;
-//!
-//! let surface = Microsurface::new(UniformHeight, Ggx::isotropic(0.5)?, Conductor::perfect());
-//! let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
-//! let (wi, wo) = (Vec3::new(0.3, 0.0, 0.954).normalize(), Vec3::Z);
-//! let n = 10_000;
-//! // f·|cos θo| (the research layer's convention), averaged over independent walks
-//! let f_cos: f32 = (0..n).map(|_| surface.eval(wi, wo, ScatteringOrder::All, &mut rng).x).sum::<f32>() / n as f32;
-//! let single = surface.eval_single_scattering(wi, wo, &mut rng).x;
-//! assert!(f_cos > single); // multiple scattering adds energy
-//! let s = surface.sample(wi, &mut rng).expect("a walk from above always exits");
-//! assert!(s.bounces >= 1 && s.weight == Vec3::ONE);
-//! # Ok::<(), microsurface::Error>(())
-//! ```
-//!
 //! # Invalid input
 //!
 //! One policy for every public entry point: an argument outside its function's domain (a
 //! direction that is zero, has a NaN or ±∞ component, or is not unit within
-//! [`DIRECTION_TOLERANCE`]; a NaN scalar; a uniform outside [0, 1], a cosine beyond
+//! [`DIRECTION_TOLERANCE`] — within [`BSDF_DIRECTION_TOLERANCE`] of unit length for the
+//! renderer layer, which renormalizes; a NaN scalar; a uniform outside [0, 1], a cosine beyond
 //! ±(1 + [`DIRECTION_TOLERANCE`]), an η that is not finite and > 0) is a contract violation. It
 //! panics in debug builds (a debug assertion whose message starts with `invalid input`), and
 //! release builds return the function's documented *nothing*, never a plausible value: 0 for
@@ -104,6 +103,13 @@
 //! and a NaN direction (with a zero weight) from those that do not; NaN for quantities
 //! without a neutral value (Λ, G1, projected areas, Fresnel terms, heights). Grazing, exactly
 //! horizontal and below-horizon unit directions are valid input.
+//!
+//! # Features
+//!
+//! All on by default: `position-free` ([`research::PositionFree`], `Technique::PositionFree`),
+//! `invariance` ([`research::Invariance`], `Technique::Invariance`), `leadr` ([`leadr`]) and
+//! `data-driven` ([`tabulated`]). A renderer that needs only this page's types, the compensated
+//! lobes and the walk builds with `default-features = false`.
 
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -116,11 +122,14 @@
 
 #[macro_use]
 mod contract;
+mod albedo;
 mod basis;
 mod bsdf;
 mod constants;
 mod error;
 mod height;
+#[cfg(feature = "invariance")]
+mod invariance;
 mod material;
 mod microsurface;
 #[cfg(feature = "leadr")]
@@ -146,9 +155,12 @@ pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf, MAX_WALK_ALPHA,
-    MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Technique, Transport,
+    BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking,
+    ClassicNdf, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Sidedness,
+    Technique, Transport,
 };
+#[cfg(feature = "mint")]
+pub use bsdf::{MintBsdf, MintSample};
 pub use compensation::{Compensated, Compensation};
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
@@ -164,17 +176,17 @@ pub use rand;
 
 /// The research layer: the papers' models with the papers' interfaces.
 ///
-/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`]: heights,
+/// The random walks of Heitz, Hanika, d'Eon and Dachsbacher 2016 ([`Microsurface`](crate::research::Microsurface): heights,
 /// slopes and a material, evaluated and sampled by tracing a ray through the microsurface),
-/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`]), the
-/// position-free estimators of Wang et al. 2022 ([`PositionFree`], feature `position-free`),
-/// the height distributions, the materials' phase functions ([`Material`]) and the geometry
-/// queries of the microsurface ([`MicrosurfaceGeometry`]).
+/// the exact single-scattering BSDF with full-spherical masking ([`SingleScattering`](crate::research::SingleScattering)), the
+/// position-free estimators of Wang et al. 2022 ([`PositionFree`](crate::research::PositionFree), feature `position-free`),
+/// the height distributions, the materials' phase functions ([`Material`](crate::research::Material)) and the geometry
+/// queries of the microsurface ([`MicrosurfaceGeometry`](crate::research::MicrosurfaceGeometry)).
 ///
 /// Conventions (the papers'): `eval(wi, wo)` with `wi` towards the light and `wo` towards the
 /// viewer returns f·|cos θo| per RGB channel; stochastic evaluations take `&mut impl Rng` and
 /// are unbiased estimates; a walk sample's weight is f·|cos θo|/pdf. The renderer layer
-/// ([`Bsdf`](crate::Bsdf)) is built on these types.
+/// ([`Bsdf`]) is built on these types.
 ///
 /// # Examples
 ///
@@ -198,6 +210,8 @@ pub mod research {
     pub use crate::basis::orthonormal_basis;
     pub use crate::bsdf::{EnergyByOrder, SpecularEvent, SpecularLimit};
     pub use crate::height::{GaussianHeight, MicrosurfaceHeight, UniformHeight};
+    #[cfg(feature = "invariance")]
+    pub use crate::invariance::{Invariance, MIN_FIRST_RATE};
     pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
     pub use crate::microsurface::{
         HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,

@@ -111,10 +111,13 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     }
 
     /// The density with which [`SingleScattering::sample`] draws ωo: the material's phase-function
-    /// density (exact for conductors and dielectrics). For a conductor with ωi and ωo above
-    /// the horizon, D(ωh)/(4 A(ωi)): GGX evaluates it in f32 from the unnormalized half
-    /// vector (relative error below 4e-6 for every α and pair of directions), other slopes in
-    /// f64 (a few f32 ulps); `sample` and `eval_with_pdf` return the same bits.
+    /// density (exact for conductors and dielectrics), except for a conductor with ωi and ωo
+    /// above the horizon: D(ωh)/(4 A_s(ωi)) with A_s the area of the slope's reflection sampler
+    /// (`sample_mirror_front`): the projected area A, or for GGX the bounded cap's
+    /// A_b = (L + k cos θi)/2 ≤ A (Eto and Tokuyoshi 2023, eq. 8, see
+    /// [`GgxBoundedCap`](crate::vndf::GgxBoundedCap)). GGX evaluates it in f32 from the unnormalized
+    /// half vector (relative error below 4e-6 for every α and pair of directions), other
+    /// slopes in f64 (a few f32 ulps); `sample` and `eval_with_pdf` return the same bits.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` or `wo` that is not a unit
     /// direction gives 0 (a debug assertion in debug builds).
@@ -149,7 +152,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// the Fresnel term taken at the sampled normal, see [`Conductor`](crate::Conductor)).
     /// `None` if ωi cannot light the material (on the horizon, or at the nadir of an opaque
     /// material) or the sampled direction cannot leave the surface. Resolution limit of
-    /// backfacing Beckmann views below α ≈ 1e-3: see [`PositionFree::sample_single`].
+    /// backfacing Beckmann views below α ≈ 1e-3: see [`crate::research::PositionFree::sample_single`].
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).
@@ -248,8 +251,11 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
 
     /// [`SingleScattering::sample`] of mirror facets ([`Material::MIRROR_FACETS`]: conductors)
     /// seen from above the horizon (ωi.z > 0, unit), from the two uniforms of the visible
-    /// normal: ωm ~ D_ωi, ωo = reflect(ωi, ωm), the weight F·G2/G1 with G2/G1 = (1 + Λi)/(1 +
-    /// Λi + Λo) from the f32 projected areas A = (1 + Λ) cos θ, as Ai zo/(Ai zo + zi (Ao − zo))
+    /// normal: ωm from the slope's reflection sampler
+    /// ([`MicrosurfaceSlope::sample_mirror_normal_unchecked`]: D_ωi, or GGX's bounded cap of
+    /// area A_s = A_b, which leaves out only normals that reflect below the horizon),
+    /// ωo = reflect(ωi, ωm), the weight F·G2 A_s/zi = F·(G2/G1)·(A_s/Ai) with G2/G1 = (1 + Λi)/(1 +
+    /// Λi + Λo) from the f32 projected areas A = (1 + Λ) cos θ, as As zo/(Ai zo + zi (Ao − zo))
     /// (z = cos θ; one division, and Ai is the density's): the rounding of Ao − zo = Λo zo,
     /// which cancels where Λo is small, is at most ε Ao, and relative to the denominator (at
     /// least zi zo max(1, Λo)) that is at most 3ε, so the ratio keeps a few f32 ulps; and
@@ -266,23 +272,25 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         u1: f32,
         u2: f32,
     ) -> Option<SingleSample> {
-        let s = material.sample_mirror_unchecked(slope, wi, u1, u2);
+        let (wm, area_s) = slope.sample_mirror_normal_unchecked(wi, u1, u2);
+        let s = material.mirror_reflection_unchecked(wi, wm);
         let exits = s.wo.z > 0.0;
         if !exits {
             return None;
         }
-        // G2/G1 = (1 + Λi)/(1 + Λi + Λo) with 1 + Λ = A/cos θ: Ai zo/(Ai zo + zi (Ao − zo))
+        // G2/G1 = (1 + Λi)/(1 + Λi + Λo) with 1 + Λ = A/cos θ: Ai zo/(Ai zo + zi (Ao − zo)),
+        // times As/Ai for a sampler of area As (f·cos/pdf = F G2 As/zi)
         let (zi, zo) = (wi.z, s.wo.z);
         let (area_i, area_o) = (slope.projected_area_unchecked(wi), slope.projected_area_unchecked(s.wo));
-        let front = area_i * zo;
-        let last = front / (front + zi * (area_o - zo));
-        let pdf = Self::mirror_density(slope, wi, s.wo);
+        let last = area_s * zo / (area_i * zo + zi * (area_o - zo));
+        let pdf = Self::mirror_density_over(slope, wi, s.wo, area_s);
         (last > 0.0 && pdf > 0.0).then(|| SingleSample { wo: s.wo, weight: s.weight * last, pdf })
     }
 
     /// The density of a reflection of mirror facets ([`Material::MIRROR_FACETS`]) between ωi
-    /// and ωo strictly above the horizon: D(ωh)/(4 A(ωi)) from the slope
-    /// ([`MicrosurfaceSlope::reflection_density_unchecked`]; for GGX in f32, relative error
+    /// and ωo strictly above the horizon as `sample_mirror_front` draws it: D(ωh)/(4 A_s(ωi))
+    /// from the slope ([`MicrosurfaceSlope::mirror_sampling_area_unchecked`] and
+    /// [`MicrosurfaceSlope::reflection_density_over_unchecked`]; for GGX in f32, relative error
     /// below 4e-6), the one function `pdf`, `eval_with_pdf` and `sample` share, so that their
     /// densities agree bit for bit.
     /// 0 where the half vector is not a facet normal ωi can see (ωi·(ωi + ωo) ≤ 0, in f64 as
@@ -290,6 +298,12 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
     /// rounding of −ωi, where the f32 directions' lengths decide the sign).
     #[inline(always)]
     pub(crate) fn mirror_density(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
+        Self::mirror_density_over(slope, wi, wo, slope.mirror_sampling_area_unchecked(wi))
+    }
+
+    /// [`Self::mirror_density`] with the sampler's area A_s(ωi) known (the sampler returns it).
+    #[inline(always)]
+    fn mirror_density_over(slope: &S, wi: Vec3, wo: Vec3, area_s: f32) -> f32 {
         // the f32 dot product of ωi with ωi + ωo (|ωi + ωo| ≤ 2) is within 4e-7 of the exact one
         let visible = wi.dot(wi + wo) > VISIBLE_SUM_MARGIN || {
             let w = wi.as_dvec3();
@@ -298,7 +312,7 @@ impl<S: MicrosurfaceSlope, M: Material> SingleScattering<S, M> {
         if !visible {
             return 0.0;
         }
-        slope.reflection_density_unchecked(wi, wo)
+        slope.reflection_density_over_unchecked(wi, wo, area_s)
     }
 
     /// The phase-function density of ωo from the incident state `at`.

@@ -10,7 +10,13 @@ use std::path::Path;
 
 fn quick_report() -> (pipeline::Report, std::path::PathBuf) {
     let out_dir = std::env::temp_dir().join(format!("microsurface-report-test-{}", std::process::id()));
-    let opts = Options { size: RunSize::Quick, out_dir: out_dir.clone(), threads: 2, progress: false };
+    let opts = Options {
+        size: RunSize::Quick,
+        out_dir: out_dir.clone(),
+        threads: 2,
+        progress: false,
+        results_page: None,
+    };
     (pipeline::run(&opts).expect("the report runs"), out_dir)
 }
 
@@ -263,6 +269,16 @@ fn quick_report_is_complete_finite_and_consistent() {
         );
     }
     assert!(report.markdown.contains("95 % CI"));
+    // the invariance-principle estimator's efficiency table: written, and every ratio with
+    // reliable cases a finite interval around its estimate
+    assert!(report.files.iter().any(|f| f.ends_with("invariance_efficiency.csv")));
+    assert!(report.markdown.contains("Efficiency of the invariance-principle estimator"));
+    for (c, est, r) in report.invariance.ratios.iter().filter(|r| r.2.cases > 0) {
+        assert!(
+            r.lo <= r.estimate && r.estimate <= r.hi && r.lo > 0.0 && r.hi.is_finite(),
+            "{c} {est:?}: {r:?}"
+        );
+    }
     assert!(report.markdown.contains("Efficiency ratios"));
     assert_eq!(results.choices.len(), Config::ALL.len());
     assert!(!results.cost.is_empty());

@@ -2,7 +2,8 @@
 //! Cook–Torrance microfacet lobe with Blinn–Phong, Beckmann or GGX normals, separable Smith
 //! masking and Schlick's Fresnel (Cook and Torrance 1982; Walter et al. 2007; Schlick 1994).
 
-use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
+use super::sidedness::{Facing, Sidedness, mirror_z};
+use super::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, unit_directions, unit_view};
 use crate::error::Error;
 use crate::fresnel::fresnel_schlick;
 use crate::rng::cut_tails;
@@ -42,7 +43,9 @@ pub enum ClassicMasking {
 /// by choosing the diffuse lobe with probability ‖K_d‖/(‖K_d‖ + ‖K_s‖) (cosine sampling) and
 /// the specular lobe otherwise (sampling D(m) cos θm and reflecting); the pdf is the mixture of
 /// both lobes' densities, so `sample`'s weight is exactly f·cos θi/pdf. Reflection only, in
-/// the upper hemisphere of the shading frame. `sample`'s `uc` chooses the lobe and `u` the
+/// the upper hemisphere of the shading frame: a view from below gives nothing (the classic
+/// model has no backfacing lobe), unless [`ClassicBrdf::with_sidedness`] makes the material
+/// two-sided ([`Sidedness::TwoSided`]). `sample`'s `uc` chooses the lobe and `u` the
 /// direction: the caller's sampler drives it completely.
 ///
 /// # Examples
@@ -66,6 +69,7 @@ pub struct ClassicBrdf {
     ndf: ClassicNdf,
     masking: ClassicMasking,
     p_diffuse: f32,
+    sidedness: Sidedness,
 }
 
 impl ClassicBrdf {
@@ -91,7 +95,33 @@ impl ClassicBrdf {
         if total == 0.0 {
             return Err(Error::InvalidParameter { name: "kd + ks", value: 0.0, expected: "not both zero" });
         }
-        Ok(Self { kd, ks, ndf, masking, p_diffuse: kd.length() / total })
+        Ok(Self { kd, ks, ndf, masking, p_diffuse: kd.length() / total, sidedness: Sidedness::default() })
+    }
+
+    /// The same BRDF with another answer for views from below the shading plane:
+    /// [`Sidedness::TwoSided`] mirrors them into the upper hemisphere;
+    /// [`Sidedness::BackfacingLobe`] (the default) and [`Sidedness::Black`] give nothing, the
+    /// classic model having no backfacing lobe.
+    #[must_use]
+    pub fn with_sidedness(self, sidedness: Sidedness) -> Self {
+        Self { sidedness, ..self }
+    }
+
+    /// What views from below the shading plane give.
+    #[must_use]
+    pub fn sidedness(&self) -> Sidedness {
+        self.sidedness
+    }
+
+    /// Whether the view `wo` is answered mirrored (`Some(true)`), as given (`Some(false)`) or
+    /// not at all.
+    #[inline(always)]
+    fn mirrored(&self, wo: Vec3) -> Option<bool> {
+        match self.sidedness.facing(wo) {
+            Facing::AsGiven => Some(false),
+            Facing::Mirrored => Some(true),
+            Facing::Nothing => None,
+        }
     }
 
     /// D(m) for a unit normal in the shading frame.
@@ -208,7 +238,40 @@ impl Bsdf for ClassicBrdf {
 
     /// `uc` chooses the lobe, `u` the direction within it (exact: no other random number).
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, _key: u64) -> Option<BsdfSample> {
-        if !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z <= 0.0 {
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, 0));
+        if self.mirrored(wo)? {
+            let s = self.sample_above(mirror_z(wo), uc, u)?;
+            return Some(BsdfSample { wi: mirror_z(s.wi), ..s });
+        }
+        self.sample_above(wo, uc, u)
+    }
+
+    /// p_d cos θi/π + p_r D(m) cos θm/(4 |ωi·m|).
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.eval_with_pdf_keyed(wo, wi, 0).1
+    }
+
+    /// One half vector and one D for both.
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> (BsdfValue, f32) {
+        unit_directions!(wo, wi, (BsdfValue::ZERO, 0.0), self.eval_with_pdf_keyed(wo, wi, 0));
+        let (wo, wi) = match self.mirrored(wo) {
+            Some(false) => (wo, wi),
+            Some(true) => (mirror_z(wo), mirror_z(wi)),
+            None => return (BsdfValue::ZERO, 0.0),
+        };
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (BsdfValue::ZERO, 0.0);
+        }
+        let (f, pdf) = self.eval_and_pdf(wo, wi);
+        (BsdfValue { f, exact: true }, pdf)
+    }
+}
+
+impl ClassicBrdf {
+    /// The sample for a valid view and uniforms, answered as it is (nothing from below).
+    #[inline]
+    fn sample_above(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
             return None;
         }
         let wi = if uc < self.p_diffuse {
@@ -236,19 +299,5 @@ impl Bsdf for ClassicBrdf {
         let weight = f * (wi.z / pdf);
         let flags = SampleFlags { reflection: true, transmission: false, specular: false, exact_pdf: true };
         weight.is_finite().then_some(BsdfSample { wi, weight, pdf, eta: 1.0, flags })
-    }
-
-    /// p_d cos θi/π + p_r D(m) cos θm/(4 |ωi·m|).
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.eval_with_pdf_keyed(wo, wi, 0).1
-    }
-
-    /// One half vector and one D for both.
-    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> (BsdfValue, f32) {
-        if !valid_direction(wo) || !valid_direction(wi) || wo.z <= 0.0 || wi.z <= 0.0 {
-            return (BsdfValue::ZERO, 0.0);
-        }
-        let (f, pdf) = self.eval_and_pdf(wo, wi);
-        (BsdfValue { f, exact: true }, pdf)
     }
 }

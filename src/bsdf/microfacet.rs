@@ -1,12 +1,15 @@
 //! The renderer-facing BSDF of a microsurface, with a choice of technique.
 
 use super::seed::{Hasher, PrimedPcg, PrimedRng};
+use super::sidedness::{Facing, Sidedness, mirror_z};
 use super::specular::SpecularLimit;
 use super::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, valid_direction, valid_uniforms,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, renormalized, unit_directions, unit_view,
 };
 use crate::error::Error;
 use crate::height::UniformHeight;
+#[cfg(feature = "invariance")]
+use crate::invariance::Invariance;
 use crate::material::{Material, Side};
 use crate::microsurface::{Microsurface, ScatteringOrder, WalkSample};
 #[cfg(feature = "position-free")]
@@ -27,10 +30,13 @@ const TABULATED_ORDERS: usize = 8;
 /// `flags().specular` is set. The lobes of α < 10⁻³ are narrower than 0.06° and the energy
 /// of the higher orders vanishes with α, so the Dirac lobe is the limit every technique
 /// converges to; a density that narrow is useless to an integrator (NEE and MIS never hit
-/// it). Diffuse facets have no specular limit and are unaffected. One exception: an opaque
-/// surface seen from below its shading hemisphere (a normal map) sees only the tails of its
-/// distribution, whose lobe does not shrink to a direction as α → 0; those views keep the
-/// rough technique at every roughness.
+/// it). Diffuse facets have no specular limit and are unaffected. An opaque surface seen from
+/// below its shading hemisphere (a normal map) sees only the tails of its distribution, whose
+/// lobe does not shrink to a direction as α → 0: `sample` keeps drawing those views from the
+/// rough technique at every roughness (unbiased weights), but flags the samples `specular`
+/// (with pdf 1, the probability of the event) and `eval` and `pdf` stay 0 there, so that the
+/// BSDF is a Dirac BSDF on the whole sphere, as its flags say: an integrator skips light
+/// sampling on it and finds the light of those views through `sample` alone.
 pub const SMOOTH_ALPHA: f32 = 1e-3;
 
 /// The largest roughness [`MicrofacetBsdf::new`] accepts: max(αx, αy) ≤ 10.
@@ -50,9 +56,18 @@ pub const MAX_WALK_ALPHA: f32 = 10.0;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Technique {
     /// The classic single-scattering microfacet BSDF (Cook–Torrance / Walter) with
-    /// height-correlated Smith masking-shadowing: exact eval, pdf and sample (the caller's
-    /// uniforms drive the visible-normal sample and the Fresnel event directly); loses the
-    /// energy of higher orders. Valid for backfacing view directions (normal mapping): the
+    /// height-correlated Smith masking-shadowing: on conductors and dielectrics, exact eval,
+    /// pdf and sample (the caller's uniforms drive the visible-normal sample and the Fresnel
+    /// event directly); loses the energy of higher orders. On diffuse facets it is
+    /// **stochastic**: their single-scattering BSDF (a/π)∫⟨ωo, ωm⟩⁺ D_ωi(ωm) G2/G1 dωm has no
+    /// closed form and `eval` returns an unbiased one-sample estimate (one visible normal drawn
+    /// from a hash of the arguments and the key; `BsdfValue::exact` is false, and so is the
+    /// samples' `exact_pdf`: the density is the documented approximation of
+    /// [`Diffuse`](crate::Diffuse)'s phase function). A fixed quadrature over the visible
+    /// normals is no substitute at a comparable cost: ⟨ωo, ωm⟩⁺ has a kink across the visible
+    /// normals, and a 4 × 4 midpoint rule in the sampler's uniforms (16 visible normals, 16×
+    /// the estimate's) is off by up to 63 % of the value for GGX α = 0.5 and 100 % at α = 1
+    /// (8 × 8: 2.4 % and 41 %). Valid for backfacing view directions (normal mapping): the
     /// view's masking is the full-spherical 1/|1 + Λ| and the VNDF is sampled exactly on the
     /// whole sphere (Tokuyoshi), so estimates stay unbiased. A sample's weight equals
     /// f·|cos θi|/pdf at its direction to a few f32 ulps (1e-5 with a Fresnel term or GGX's f32
@@ -62,7 +77,8 @@ pub enum Technique {
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
-    /// weights, approximate pdf. Valid for backfacing views of opaque materials (normal
+    /// weights, approximate pdf (0.8 × the single-scattering density + 0.2 × a cosine lobe,
+    /// for MIS weights only). Valid for backfacing views of opaque materials (normal
     /// mapping): the walk starts with the full-spherical first intersection
     /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there, except
     /// for smooth Beckmann surfaces seen from well below (|cot θo|/α ≳ 9.6), where the walk's
@@ -70,7 +86,7 @@ pub enum Technique {
     #[default]
     RandomWalk,
     /// The position-free estimators of Wang et al. 2022: stochastic eval, exact sample
-    /// weights, approximate pdf. Valid for backfacing views of opaque materials, whose first
+    /// weights, approximate pdf (that of [`Technique::RandomWalk`]). Valid for backfacing views of opaque materials, whose first
     /// vertex is a vertex reached from below (DESIGN.md); for Beckmann seen from so far below
     /// that Λ underflows f64 (|cot θo|/α ≳ 26.6) `sample` returns nothing and eval keeps only
     /// the first order.
@@ -81,6 +97,14 @@ pub enum Technique {
         /// Height-correlated or uncorrelated shadowing.
         shadowing: Shadowing,
     },
+    /// The invariance-principle estimator of Cui et al. 2023 ([`Invariance`]): the random
+    /// walk's BSDF (the same model as [`Technique::RandomWalk`]) with the heights integrated
+    /// out, stochastic eval with less variance, exact sample weights, approximate pdf (the
+    /// position-free model's, as for the walk). Opaque materials only (conductors, diffuse
+    /// facets): [`MicrofacetBsdf::with_technique`] refuses it for a dielectric. Valid for
+    /// backfacing views, as the walk.
+    #[cfg(feature = "invariance")]
+    Invariance,
 }
 
 /// The share of a BSDF's albedo carried by each scattering order, estimated from sampled
@@ -160,6 +184,8 @@ pub struct MicrofacetBsdf<S, M> {
     transport: Transport,
     seed: u64,
     specular: bool,
+    /// What views from below the shading plane give (opaque materials).
+    sidedness: Sidedness,
     /// Mirror facets ([`Material::MIRROR_FACETS`]) with single scattering and no Dirac limit:
     /// the sample of a view from above is the exact reflection off a visible normal drawn
     /// from the caller's uniforms (the one flag the trait's fast path tests).
@@ -193,6 +219,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             transport: Transport::default(),
             seed: 0,
             specular,
+            sidedness: Sidedness::default(),
             exact_mirror: false,
         }
         .with_derived())
@@ -218,7 +245,13 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 
     /// The same BSDF evaluated with another technique.
+    ///
+    /// Invalid input ([policy](crate#invalid-input)): [`Technique::Invariance`] for a material
+    /// that transmits (a dielectric, which that estimator does not cover) is a contract
+    /// violation: a debug assertion in debug builds, the BSDF unchanged in release builds.
     pub fn with_technique(self, technique: Technique) -> Self {
+        #[cfg(feature = "invariance")]
+        require!(!(M::TRANSMITS && technique == Technique::Invariance), self; technique);
         Self { technique, ..self }.with_derived()
     }
 
@@ -239,6 +272,19 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         Self { seed, ..self }
     }
 
+    /// The same BSDF with another answer for views from below the shading plane (see
+    /// [`Sidedness`]; the default is [`Sidedness::BackfacingLobe`]). Ignored by dielectrics,
+    /// whose views from below are views from inside.
+    #[must_use]
+    pub fn with_sidedness(self, sidedness: Sidedness) -> Self {
+        Self { sidedness, ..self }
+    }
+
+    /// What views from below the shading plane give (for opaque materials).
+    pub fn sidedness(&self) -> Sidedness {
+        self.sidedness
+    }
+
     /// The seed.
     pub fn seed(&self) -> u64 {
         self.seed
@@ -256,7 +302,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 
     /// Whether the BSDF is a Dirac lobe (effectively smooth, or an index-matched dielectric).
     /// An effectively smooth opaque BSDF seen from below its shading hemisphere (a normal map)
-    /// still answers with its rough lobe, which does not shrink to a direction as α → 0.
+    /// samples its rough lobe, which does not shrink to a direction as α → 0, and flags those
+    /// samples specular (see [`SMOOTH_ALPHA`]).
     pub fn is_specular(&self) -> bool {
         self.specular
     }
@@ -266,6 +313,14 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     #[inline(always)]
     fn position_free(&self, shadowing: Shadowing) -> PositionFree<S, M> {
         PositionFree::new(*self.surface.slope(), *self.surface.material(), shadowing)
+    }
+
+    /// The invariance-principle estimator over the same slope and material, `None` for a
+    /// material that transmits (which `with_technique` keeps from choosing it).
+    #[cfg(feature = "invariance")]
+    #[inline(always)]
+    fn invariance(&self) -> Option<Invariance<S, M>> {
+        Invariance::new(*self.surface.slope(), *self.surface.material()).ok()
     }
 
     /// The single-scattering BSDF over the same slope and material.
@@ -301,20 +356,29 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         }
     }
 
-    /// Whether the Dirac lobe answers for the view `wo`: for an effectively smooth BSDF,
-    /// except an opaque one seen from below the shading hemisphere (a normal map), whose
-    /// visible facets are the tails of the distribution: that lobe does not shrink to a
-    /// direction as α → 0 (GGX gold at θo = 100°: walk albedo 0.942 at α = 1.01e-3), so the
-    /// rough technique serves it at every roughness.
+    /// Whether the Dirac lobe's sample answers for the view `wo` of an effectively smooth
+    /// BSDF: every view of a dielectric, the views from above of an opaque one. Seen from below
+    /// the shading hemisphere (a normal map) an opaque surface's visible facets are the tails
+    /// of the distribution, whose lobe does not shrink to a direction as α → 0 (GGX gold at
+    /// θo = 100°: walk albedo 0.942 at α = 1.01e-3): the rough technique samples it at every
+    /// roughness, flagged specular (see [`SMOOTH_ALPHA`]).
     #[inline(always)]
     fn dirac(&self, wo: Vec3) -> bool {
         self.specular && (M::TRANSMITS || wo.z > 0.0)
     }
 
-    /// Whether `eval` is exact (not a stochastic estimate) for the view `wo`.
+    /// How the view `wo` is answered: dielectrics as given, opaque materials by their
+    /// [`Sidedness`].
     #[inline(always)]
-    fn exact_eval(&self, wo: Vec3) -> bool {
-        self.dirac(wo) || (self.technique == Technique::SingleScattering && M::EXACT_PHASE_PDF)
+    fn facing(&self, wo: Vec3) -> Facing {
+        if M::TRANSMITS { Facing::AsGiven } else { self.sidedness.facing(wo) }
+    }
+
+    /// Whether `eval` is exact (not a stochastic estimate): a Dirac BSDF's 0, single
+    /// scattering of conductors and dielectrics.
+    #[inline(always)]
+    fn exact_eval(&self) -> bool {
+        self.specular || (self.technique == Technique::SingleScattering && M::EXACT_PHASE_PDF)
     }
 
     /// The energy per scattering order for the view direction `wo`, from `walks` sampled
@@ -353,6 +417,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             Technique::PositionFree { estimator, shadowing } => {
                 self.position_free(shadowing).eval(walk_in, walk_out, estimator, self.order, rng)
             }
+            #[cfg(feature = "invariance")]
+            Technique::Invariance => match self.invariance() {
+                Some(invariance) => invariance.eval(walk_in, walk_out, self.order, rng),
+                None => self.surface.eval(walk_in, walk_out, self.order, rng),
+            },
         }
     }
 
@@ -475,12 +544,25 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             flags,
         })
     }
-    /// [`Bsdf::eval_keyed`] for directions the caller has validated (`valid_direction`):
-    /// the compensated lobes validate once for both their own term and this one.
+    /// [`Bsdf::eval_keyed`] for directions the caller has validated (`valid_direction`, and
+    /// renormalized here if they drifted): the compensated lobes validate once for both their
+    /// own term and this one.
     #[inline(always)]
     pub(crate) fn eval_valid(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        let exact = self.exact_eval(wo);
-        if wi.z == 0.0 || self.dirac(wo) {
+        self.eval_unit(renormalized(wo), renormalized(wi), key)
+    }
+
+    /// [`Bsdf::eval_keyed`] for unit directions.
+    #[inline(always)]
+    fn eval_unit(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
+        let exact = self.exact_eval();
+        let (wo, wi) = match self.facing(wo) {
+            Facing::AsGiven => (wo, wi),
+            Facing::Mirrored => (mirror_z(wo), mirror_z(wi)),
+            Facing::Nothing => return BsdfValue { f: Vec3::ZERO, exact },
+        };
+        // a Dirac BSDF has no density on the whole sphere (see `SMOOTH_ALPHA`)
+        if wi.z == 0.0 || self.specular {
             return BsdfValue { f: Vec3::ZERO, exact };
         }
         BsdfValue { f: self.f_checked(wo, wi, key), exact }
@@ -492,12 +574,39 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         self.sample_general(wo, uc, u, key)
     }
 
-    /// [`Bsdf::sample_keyed`] for valid arguments (see `sample_general_outlined`).
+    /// [`Bsdf::sample_keyed`] for valid arguments (see `sample_general_outlined`): the view
+    /// answered by its [`Sidedness`].
     #[inline(always)]
     fn sample_general(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
-        if self.dirac(wo) {
-            return self.sample_specular(wo, uc);
+        match self.facing(wo) {
+            Facing::AsGiven => self.sample_facing(wo, uc, u, key),
+            Facing::Mirrored => {
+                let s = self.sample_facing(mirror_z(wo), uc, u, key)?;
+                Some(BsdfSample { wi: mirror_z(s.wi), ..s })
+            }
+            Facing::Nothing => None,
         }
+    }
+
+    /// [`Bsdf::sample_keyed`] for valid arguments and a view the lobe answers as it is.
+    #[inline(always)]
+    fn sample_facing(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        if self.specular {
+            if self.dirac(wo) {
+                return self.sample_specular(wo, uc);
+            }
+            // a smooth opaque surface seen from below (a normal map): the rough lobe's sample,
+            // flagged specular with the probability 1 of the event (see `SMOOTH_ALPHA`)
+            let s = self.sample_rough(wo, uc, u, key)?;
+            let flags = SampleFlags { specular: true, exact_pdf: true, ..s.flags };
+            return Some(BsdfSample { pdf: 1.0, flags, ..s });
+        }
+        self.sample_rough(wo, uc, u, key)
+    }
+
+    /// The rough technique's sample for valid arguments.
+    #[inline(always)]
+    fn sample_rough(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
         // (the exact mirror reflection of a view from above was handled by `sample_keyed`)
         let seed = self.seed;
         let hash = || Hasher::direction_uniforms(seed, key, wo, uc, u);
@@ -523,6 +632,15 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
                 // the estimators draw beyond the caller's uniforms from the first bounce on
                 let mut rng = PrimedPcg::new(&uniforms, hash());
                 self.position_free(shadowing).sample(walk_in, &mut rng)
+            }
+            #[cfg(feature = "invariance")]
+            Technique::Invariance => {
+                // the first visible normal from (u.x, u.y), the first exit test from uc
+                let mut rng = PrimedPcg::new(&uniforms, hash());
+                match self.invariance() {
+                    Some(invariance) => invariance.sample(walk_in, &mut rng),
+                    None => self.surface.sample(walk_in, &mut rng),
+                }
             }
         };
         let s = s?;
@@ -552,17 +670,18 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return BsdfValue { f: Vec3::ZERO, exact: self.exact_eval(wo) };
-        }
-        self.eval_valid(wo, wi, key)
+        unit_directions!(
+            wo,
+            wi,
+            BsdfValue { f: Vec3::ZERO, exact: self.exact_eval() },
+            self.eval_keyed(wo, wi, key)
+        );
+        self.eval_unit(wo, wi, key)
     }
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
-        if !valid_direction(wo) || !valid_uniforms(uc, u) {
-            return None;
-        }
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, key));
         if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
             // a conductor seen from above: the caller's (u.x, u.y) are the visible normal's
             // uniforms, taken as they are (no generator, no hash); the research sample's
@@ -583,9 +702,17 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
     /// vector, D and Λ of the view ([`SingleScattering::eval_with_pdf`]).
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
-        let exact = self.exact_eval(wo);
-        if !valid_direction(wo) || !valid_direction(wi) || self.dirac(wo) {
-            return (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
+        let exact = self.exact_eval();
+        let nothing = (BsdfValue { f: Vec3::ZERO, exact }, 0.0);
+        unit_directions!(wo, wi, nothing, self.eval_with_pdf_keyed(wo, wi, key));
+        let (wo, wi) = match self.facing(wo) {
+            Facing::AsGiven => (wo, wi),
+            Facing::Mirrored => (mirror_z(wo), mirror_z(wi)),
+            Facing::Nothing => return nothing,
+        };
+        // a Dirac BSDF has no density on the whole sphere (see `SMOOTH_ALPHA`)
+        if self.specular {
+            return nothing;
         }
         if self.technique == Technique::SingleScattering && wi.z != 0.0 {
             // one half vector, D and Λ(wo) for both (the walk enters along wo)
@@ -606,20 +733,26 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> Bsdf for MicrofacetBsdf<
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return 0.0;
-        }
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
         let pdf = if M::MIRROR_FACETS && self.exact_mirror && wo.z > 0.0 {
             // the exact reflection density (the single-scattering density of a view from
-            // above: 0 for a light below the horizon), without the Dirac and technique tests
+            // above: 0 for a light below the horizon), without the Dirac, sidedness and
+            // technique tests (a view from above is answered as it is)
             if wi.z > 0.0 {
                 SingleScattering::<S, M>::mirror_density(self.surface.slope(), wo, wi)
             } else {
                 0.0
             }
-        } else if self.dirac(wo) {
-            return 0.0;
         } else {
+            let (wo, wi) = match self.facing(wo) {
+                Facing::AsGiven => (wo, wi),
+                Facing::Mirrored => (mirror_z(wo), mirror_z(wi)),
+                Facing::Nothing => return 0.0,
+            };
+            // a Dirac BSDF has no density on the whole sphere (see `SMOOTH_ALPHA`)
+            if self.specular {
+                return 0.0;
+            }
             self.research_pdf_out(wo, wi)
         };
         if pdf.is_finite() { pdf } else { 0.0 }

@@ -5,7 +5,8 @@
 //!
 //! * `wo` points towards the viewer (the previous path vertex), `wi` towards the light (the
 //!   direction to sample); both point away from the surface, in the local shading frame
-//!   (z = shading normal), unit length.
+//!   (z = shading normal), unit length within [`BSDF_DIRECTION_TOLERANCE`] (renormalized on
+//!   entry: see [Inputs](Bsdf#inputs)).
 //! * [`Bsdf::eval`] returns the BSDF **f itself** (not multiplied by a cosine); a sample's
 //!   `weight` is f·|cos θi|/pdf; [`Bsdf::pdf`] is a solid-angle density of `wi`.
 //! * Every method is a **pure function of its arguments**: the stochastic techniques draw
@@ -20,12 +21,18 @@
 mod classic;
 mod frame;
 mod microfacet;
+#[cfg(feature = "mint")]
+mod mint;
 mod seed;
+mod sidedness;
 mod specular;
 
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};
+#[cfg(feature = "mint")]
+pub use mint::{MintBsdf, MintSample};
+pub use sidedness::Sidedness;
 pub use specular::{SpecularEvent, SpecularLimit};
 
 use glam::{Vec2, Vec3};
@@ -96,8 +103,17 @@ pub struct BsdfSample {
     /// specular sample the probability of the chosen event.
     pub pdf: f32,
     /// The relative index of refraction η_wi/η_wo of a transmission (pbrt's `etap`: η when
-    /// entering a dielectric of index η, 1/η when leaving it), 1 for a reflection. Russian
-    /// roulette on radiance should divide the throughput by η² to track the energy.
+    /// entering a dielectric of index η, 1/η when leaving it), 1 for a reflection.
+    ///
+    /// Russian roulette on radiance should **multiply** the throughput by η² to track the
+    /// energy: radiance transport scales a transmission's weight by (η_wo/η_wi)² = 1/η²
+    /// (entering glass of η = 1.5 the weight is T/2.25, ≈ 0.43 at normal incidence), so
+    /// the throughput drops inside the denser medium while the energy it carries does not.
+    /// Keep the product of η² over the path's transmissions (pbrt-v4's `etaScale`) and decide
+    /// the roulette on throughput × that product; it returns to 1 when the path leaves the
+    /// medium again (η·(1/η)). Dividing instead would make the survival probability 1/η⁴ of
+    /// the energy inside glass (0.2 for η = 1.5) and kill those paths about 5× too often.
+    /// With [`Transport::Importance`] the weights carry no η² and the product is not needed.
     pub eta: f32,
     /// The kind of event.
     pub flags: SampleFlags,
@@ -124,11 +140,34 @@ impl BsdfValue {
 /// Object safe: scenes can hold `Vec<Box<dyn Bsdf>>` (or `&dyn Bsdf`), and the trait has
 /// `Send + Sync` as supertraits so such a scene can be shared by render threads.
 ///
-/// Every method returns finite values. Invalid arguments (a direction that is zero, NaN,
-/// infinite or not of unit length; a uniform outside [0, 1)) trip a `debug_assert!` in debug
-/// builds and give a zero value, a zero pdf or `None` in release builds. Valid but degenerate
-/// directions (on the horizon, or below it for reflection-only models) give zero or `None`
-/// without asserting.
+/// Every method returns finite values.
+///
+/// # Inputs
+///
+/// What a real pipeline sends is answered:
+///
+/// * a direction whose length is within [`BSDF_DIRECTION_TOLERANCE`] of 1 (|‖ω‖ − 1| ≤ 10⁻²:
+///   the drift of an f32 instance transform or of a few frame changes) is renormalized on
+///   entry and answered as its unit direction; a direction that is unit to
+///   [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE) (|‖ω‖² − 1| ≤ 10⁻³, what f32
+///   normalization gives) is used as it is, with no extra work;
+/// * a uniform equal to 1 (an f64 → f32 rounding) is taken as 1 − 2⁻²⁴, the largest f32
+///   below 1, as pbrt's samplers clamp theirs.
+///
+/// Only garbage gets the documented *nothing*: a direction that is zero, NaN, infinite or
+/// further from unit length, or a uniform that is NaN, negative or above 1, trips a debug
+/// assertion naming the argument and its value (`invalid input: `wo` = Vec3(…) is not a unit
+/// direction (|wo| = …)`) and gives a zero value, a zero pdf or `None` in release builds.
+/// Valid but degenerate directions (on the horizon, or below it for reflection-only models)
+/// give zero or `None` without asserting.
+///
+/// # Flags
+///
+/// [`Bsdf::flags`] holds over the whole domain (both sides of the shading plane, every
+/// roughness, every index): a BSDF whose flags have no non-specular lobe has `eval` and `pdf`
+/// 0 everywhere and returns only specular samples, so an integrator may skip light sampling
+/// on it; a sample flagged specular has `eval` and `pdf` 0 at its direction, and one that is
+/// not has a positive `pdf` there.
 ///
 /// # Determinism and decorrelation
 ///
@@ -210,22 +249,168 @@ pub trait Bsdf: Send + Sync {
     }
 }
 
-/// Whether a direction is usable: the crate's one definition of a unit direction
-/// ([`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE)), shared with the research layer.
+/// The largest |‖ω‖ − 1| of a direction given to a [`Bsdf`] method: 10⁻². Such a direction is
+/// renormalized on entry (one comparison when it is already unit to
+/// [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE), the research layer's bound, which
+/// stays strict); beyond it the direction is invalid input (see [Inputs](Bsdf#inputs)).
+pub const BSDF_DIRECTION_TOLERANCE: f32 = 1e-2;
+
+/// (1 − [`BSDF_DIRECTION_TOLERANCE`])² and (1 + [`BSDF_DIRECTION_TOLERANCE`])²: the range of
+/// ‖ω‖² the renderer layer renormalizes.
+const LENGTH_SQ_RANGE: core::ops::RangeInclusive<f32> = {
+    let (lo, hi) = (1.0 - BSDF_DIRECTION_TOLERANCE, 1.0 + BSDF_DIRECTION_TOLERANCE);
+    (lo * lo)..=(hi * hi)
+};
+
+/// 1 − 2⁻²⁴, the largest f32 below 1: what a uniform of exactly 1 is taken as.
+pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Whether `w` is unit by the research layer's bound: the fast path of the entry checks.
 pub(crate) use crate::contract::is_direction;
 
-/// [`is_direction`], asserted in debug builds: the trait's entry-point check of a direction.
-#[inline(always)]
-pub(crate) fn valid_direction(w: Vec3) -> bool {
-    let ok = is_direction(w);
-    debug_assert!(ok, "Bsdf: invalid direction {w} (expected finite and of unit length)");
-    ok
+/// `unit_directions!(wo, wi, nothing, retry)`, at the top of a [`Bsdf`] method: if `wo` or
+/// `wi` is not unit to [`DIRECTION_TOLERANCE`](crate::DIRECTION_TOLERANCE) (one comparison
+/// each, the whole cost for unit input), returns `retry` evaluated with both renormalized
+/// (rebound under their names) if they lie within [`BSDF_DIRECTION_TOLERANCE`], and
+/// `nothing` otherwise, after a debug assertion naming the argument and its value.
+macro_rules! unit_directions {
+    ($wo:ident, $wi:ident, $nothing:expr, $retry:expr) => {
+        if !$crate::bsdf::is_direction($wo) || !$crate::bsdf::is_direction($wi) {
+            return match $crate::bsdf::renormalize_pair($wo, $wi) {
+                Some(($wo, $wi)) => $retry,
+                None => $nothing,
+            };
+        }
+    };
+}
+pub(crate) use unit_directions;
+
+/// `unit_view!(wo, uc, u, nothing, retry)`, at the top of a `sample` method: as
+/// [`unit_directions!`] for the view `wo`, and uniforms of exactly 1 taken as 1 − 2⁻²⁴
+/// (`nothing` for a NaN, negative or above 1).
+macro_rules! unit_view {
+    ($wo:ident, $uc:ident, $u:ident, $nothing:expr, $retry:expr) => {
+        if !$crate::bsdf::is_direction($wo) || !$crate::bsdf::are_unit_uniforms($uc, $u) {
+            return match $crate::bsdf::renormalize_view($wo, $uc, $u) {
+                Some(($wo, $uc, $u)) => $retry,
+                None => $nothing,
+            };
+        }
+    };
+}
+pub(crate) use unit_view;
+
+/// The slow path of [`unit_directions!`]: both directions renormalized, or `None` (with the
+/// debug assertion) if one is beyond [`BSDF_DIRECTION_TOLERANCE`].
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn renormalize_pair(wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
+    Some((unit_or_report("wo", wo)?, unit_or_report("wi", wi)?))
 }
 
-/// Whether the caller's uniforms lie in [0, 1), asserted in debug builds.
+/// The slow path of [`unit_view!`].
+#[cold]
+#[inline(never)]
+#[track_caller]
+pub(crate) fn renormalize_view(wo: Vec3, uc: f32, u: Vec2) -> Option<(Vec3, f32, Vec2)> {
+    let wo = unit_or_report("wo", wo)?;
+    let r = clamp_ones(uc, u);
+    if r.is_none() {
+        report_uniforms(uc, u);
+    }
+    let (uc, u) = r?;
+    Some((wo, uc, u))
+}
+
+/// The unit direction of the argument `name`: `w` if unit, renormalized within
+/// [`BSDF_DIRECTION_TOLERANCE`], otherwise `None` after the debug assertion.
+#[inline(always)]
+#[track_caller]
+fn unit_or_report(name: &str, w: Vec3) -> Option<Vec3> {
+    if is_direction(w) {
+        return Some(w);
+    }
+    let r = renormalize_drifted(w);
+    if r.is_none() {
+        report_direction(name, w);
+    }
+    r
+}
+
+/// The debug assertion of an invalid direction argument.
+#[cold]
+#[inline(never)]
+#[track_caller]
+fn report_direction(name: &str, w: Vec3) {
+    crate::contract::violated_argument(format_args!(
+        "`{name}` = {w:?} is not a unit direction (|{name}| = {})",
+        w.length()
+    ));
+}
+
+/// `w/‖w‖` for a length within [`BSDF_DIRECTION_TOLERANCE`] of 1, `None` beyond (NaN, ±∞
+/// and zero included).
+#[cold]
+#[inline(never)]
+fn renormalize_drifted(w: Vec3) -> Option<Vec3> {
+    let len_sq = w.length_squared();
+    LENGTH_SQ_RANGE.contains(&len_sq).then(|| w / len_sq.sqrt())
+}
+
+/// A direction already accepted by [`valid_direction`], renormalized if it drifted (for the
+/// wrappers that validate once and call the inner lobe's `*_valid` methods).
+#[inline(always)]
+pub(crate) fn renormalized(w: Vec3) -> Vec3 {
+    if is_direction(w) { w } else { renormalize_drifted(w).unwrap_or(w) }
+}
+
+/// Whether a direction is accepted by the renderer layer (within [`BSDF_DIRECTION_TOLERANCE`]),
+/// without a debug assertion: for the wrappers that hand invalid input on to an inner lobe,
+/// whose own check reports it.
+#[inline(always)]
+pub(crate) fn valid_direction(w: Vec3) -> bool {
+    is_direction(w) || renormalize_drifted(w).is_some()
+}
+
+/// Whether the caller's uniforms all lie in [0, 1) (NaN fails): the fast path of
+/// [`unit_view!`].
+#[inline(always)]
+pub(crate) fn are_unit_uniforms(uc: f32, u: Vec2) -> bool {
+    in_unit_interval(uc) & in_unit_interval(u.x) & in_unit_interval(u.y)
+}
+
+/// The debug assertion of invalid uniforms, naming the first bad argument.
+#[cold]
+#[inline(never)]
+#[track_caller]
+fn report_uniforms(uc: f32, u: Vec2) {
+    if (0.0..=1.0).contains(&uc) {
+        crate::contract::violated_argument(format_args!("`u` = {u:?} is not a pair of uniforms in [0, 1]"));
+    } else {
+        crate::contract::violated_argument(format_args!("`uc` = {uc:?} is not a uniform in [0, 1]"));
+    }
+}
+
+/// Whether `x` ∈ [0, 1) (NaN fails).
+#[inline(always)]
+fn in_unit_interval(x: f32) -> bool {
+    (0.0..1.0).contains(&x)
+}
+
+/// The uniforms with every 1 replaced by 1 − 2⁻²⁴ if all lie in [0, 1], `None` otherwise.
+#[inline(always)]
+fn clamp_ones(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
+    let all = [uc, u.x, u.y];
+    all.iter().all(|x| (0.0..=1.0).contains(x)).then(|| {
+        let [uc, x, y] = all.map(|x| x.min(ONE_MINUS_EPSILON));
+        (uc, Vec2::new(x, y))
+    })
+}
+
+/// Whether the caller's uniforms are accepted (in [0, 1]), without a debug assertion: for the
+/// wrappers that hand invalid input on to an inner lobe, whose own check reports it.
 #[inline(always)]
 pub(crate) fn valid_uniforms(uc: f32, u: Vec2) -> bool {
-    let ok = (0.0..1.0).contains(&uc) && (0.0..1.0).contains(&u.x) && (0.0..1.0).contains(&u.y);
-    debug_assert!(ok, "Bsdf::sample: uniforms ({uc}, {u}) outside [0, 1)");
-    ok
+    are_unit_uniforms(uc, u) || clamp_ones(uc, u).is_some()
 }

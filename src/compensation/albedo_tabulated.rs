@@ -1,6 +1,6 @@
 //! The slope families with compensation tables.
 
-use crate::compensation::tables::{AlbedoTable, DielectricAlbedoTable, DielectricWalkTable, ScatteringOrderTable};
+use crate::albedo::{AlbedoTable, DielectricAlbedoTable, DielectricWalkTable, ScatteringOrderTable};
 use crate::slope::{AxisAlignedSlope, Beckmann, Elliptical, Ggx, MicrosurfaceSlope};
 
 /// A slope family with the crate's compensation tables (GGX, Beckmann, and their elliptical

@@ -30,7 +30,7 @@ use super::shared::{Shared, mixture_sample};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
 use crate::bsdf::MicrofacetBsdf;
 use crate::compensation::AlbedoTabulated;
-use crate::compensation::tables::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, ORDER_TABLE_SIZE, node_cell};
+use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, ORDER_TABLE_SIZE, node_cell};
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;
@@ -353,18 +353,22 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     }
 
     /// Single scattering's f·cos θi and density at a pair of directions above the horizon, in
-    /// the form its sampler gives them for a sampled direction: F(ωo·ωh) G2/G1 · pdf, with
-    /// G2/G1 = 1/(1 + Λi/(1 + Λo)) from the f32 Λ and F at the half vector of the f32 directions
-    /// (within 1e-5 of eval's f64 form, as the sampler's weight is).
+    /// the form its sampler gives them for a sampled direction: F(ωo·ωh) G2/G1 · (As/A) · pdf,
+    /// with G2/G1 = 1/(1 + Λi/(1 + Λo)) from the f32 Λ, As/A the ratio of the sampler's area to
+    /// the projected area of ωo (below 1 for GGX's bounded cap, else 1) and F at the half
+    /// vector of the f32 directions (within 1e-5 of eval's f64 form, as the sampler's weight is).
     #[inline(always)]
     fn single_at(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         let surface = self.single.surface();
         let slope = surface.slope();
         let pdf = self.single_pdf(wo, wi);
         let shadowing = 1.0 / (1.0 + slope.lambda_unchecked(wi) / (1.0 + slope.lambda_unchecked(wo)));
+        // the sampler's density is D/(4 As), f·cos θi = F (G2/G1) D/(4 A): As/A = 1 but for
+        // GGX's bounded cap
+        let areas = slope.mirror_sampling_area_unchecked(wo) / slope.projected_area_unchecked(wo);
         // wo + wi ≠ 0 above the horizon
         let cos = wo.dot((wo + wi).normalize());
-        (surface.material().fresnel(cos) * (shadowing * pdf), pdf)
+        (surface.material().fresnel(cos) * (shadowing * areas * pdf), pdf)
     }
 }
 

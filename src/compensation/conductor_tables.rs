@@ -15,7 +15,7 @@
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MuProfile, axis_average, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
-use crate::compensation::tables::{
+use crate::albedo::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, Family, ORDER_TABLE_SIZE, ORDER_TABLES,
     ScatteringOrderTable, node_cell,
 };
@@ -165,7 +165,7 @@ impl ConductorTables {
     #[inline(always)]
     pub(crate) fn averages_at(&self, (j, f): (usize, f32)) -> [Vec4; 2] {
         let t = f * SUBSTEPS as f32;
-        let s = crate::compensation::tables::floor_index(t, SUBSTEPS - 1);
+        let s = crate::albedo::floor_index(t, SUBSTEPS - 1);
         let w = t - s as f32;
         let n = j * (SUBSTEPS + 1) + s;
         let (a, b) = (self.averages[n], self.averages[n + 1]);

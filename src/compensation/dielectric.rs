@@ -52,7 +52,7 @@ use super::shared::{ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, valid_direction};
 use crate::bsdf::valid_uniforms;
 use crate::compensation::AlbedoTabulated;
-use crate::compensation::tables::{
+use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable, MAX_TABULATED_ETA,
     node_cell,
 };

@@ -104,8 +104,8 @@ pub(crate) fn fresnel_average(ior: &ComplexIor) -> Vec3 {
     let v = k / (Vec3::splat(K_SCALE) + k) * LAST;
     let t = table();
     let residual = Vec3::from_array(core::array::from_fn(|c| {
-        let (i, fi) = crate::compensation::tables::node_cell(u[c], NODES);
-        let (j, fj) = crate::compensation::tables::node_cell(v[c], NODES);
+        let (i, fi) = crate::albedo::node_cell(u[c], NODES);
+        let (j, fj) = crate::albedo::node_cell(v[c], NODES);
         let row = i * NODES + j;
         let (a, b) = (t[row], t[row + 1]);
         let (c0, d) = (t[row + NODES], t[row + NODES + 1]);

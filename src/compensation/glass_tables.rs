@@ -16,7 +16,7 @@
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
-use crate::compensation::tables::{
+use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricWalkTable, EtaRange, Family, Grid, SideGrids,
     floor_index,
 };

@@ -8,7 +8,7 @@
 //! ([`mu_cell`]: one multiply and one truncation per lookup, no division, no root, no branch):
 //! [`MuProfile`] samples g(μ) μ by cells of that axis (alias method) and gives its density.
 
-use crate::compensation::tables::floor_index;
+use crate::albedo::floor_index;
 use crate::special::sin_cos_turns;
 use core::f64::consts::PI;
 use glam::{Vec2, Vec3};

@@ -12,13 +12,12 @@ mod fresnel_average;
 mod glass_tables;
 mod lobe_profile;
 mod shared;
-pub(crate) mod tables;
 
-pub use albedo_tabulated::AlbedoTabulated;
-pub use compensated::{Compensated, CompensatedMaterial, Compensation};
-pub use tables::{
+pub use crate::albedo::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo,
     DielectricAlbedoTable, DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
     MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES,
     ScatteringOrderTable, TabulatedOrder, WALK_BATCH,
 };
+pub use albedo_tabulated::AlbedoTabulated;
+pub use compensated::{Compensated, CompensatedMaterial, Compensation};

@@ -32,7 +32,8 @@ const FRESNEL_AT_HALF_VECTOR_BELOW: f32 = 0.05;
 ///   f32 ωi and ωo, as the evaluations do, so that weight = F·(the phase density ratio) holds
 ///   to f32 precision;
 /// - single scattering F(ωi·ωh) D(ωh) G2(ωi, ωo)/(4 cos θi) (the Cook–Torrance BRDF times
-///   cos θo).
+///   cos θo), sampled for views above the horizon from the slope's reflection sampler (GGX:
+///   the bounded cap of Eto and Tokuyoshi 2023, [`GgxBoundedCap`](crate::vndf::GgxBoundedCap)).
 ///
 /// # Examples
 /// ```
@@ -177,7 +178,7 @@ impl Material for Conductor {
     ) -> PhaseSample {
         // the uniforms in the order drawn: the visible normal's u1, then u2
         let (u1, u2) = (uniform(rng), uniform(rng));
-        self.sample_mirror_unchecked(slope, wi, u1, u2)
+        self.mirror_reflection_unchecked(wi, slope.sample_d_wi_unchecked(wi, u1, u2))
     }
 
     /// The visible normal's two uniforms from one 64-bit draw (the walks' stream).
@@ -190,18 +191,11 @@ impl Material for Conductor {
         rng: &mut impl Rng,
     ) -> PhaseSample {
         let (u1, u2) = uniform_pair(rng);
-        self.sample_mirror_unchecked(slope, wi, u1, u2)
+        self.mirror_reflection_unchecked(wi, slope.sample_d_wi_unchecked(wi, u1, u2))
     }
 
     #[inline(always)]
-    fn sample_mirror_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        u1: f32,
-        u2: f32,
-    ) -> PhaseSample {
-        let wm = slope.sample_d_wi_unchecked(wi, u1, u2);
+    fn mirror_reflection_unchecked(&self, wi: Vec3, wm: Vec3) -> PhaseSample {
         let c = wi.dot(wm);
         let wo = renormalize(reflect(wi, wm), wm);
         // near-perpendicular facets: ωo is within (ulp of ωo)/c of −ωi... the half vector that

@@ -90,6 +90,13 @@ impl Diffuse {
     }
 }
 
+/// ⟨ωo, ωm⟩⁺ = max(c, 0) with a +0 for c = ±0 in every build (`f32::max` may return either
+/// zero for −0, and debug and release builds differ there).
+#[inline(always)]
+fn positive_part(c: f32) -> f32 {
+    if c > 0.0 { c } else { 0.0 }
+}
+
 /// Below this projected area (f64) the bound of [`pdf_below_horizon`] is formed from logarithms.
 const AREA_LOG_BELOW: f64 = 1e-280;
 
@@ -141,7 +148,7 @@ impl Material for Diffuse {
             return Vec3::ZERO;
         }
         let wm = slope.sample_d_wi_unchecked(it.wi(), uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
+        self.albedo * (FRAC_1_PI * positive_part(it.wo().dot(wm)))
     }
 
     #[inline]
@@ -168,7 +175,8 @@ impl Material for Diffuse {
             return Vec3::ZERO;
         }
         let wm = slope.sample_d_wi_unchecked(wi, uniform(rng), uniform(rng));
-        self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0) * slope.projected_area_unchecked(wi) / wi.z.abs())
+        self.albedo
+            * (FRAC_1_PI * positive_part(it.wo().dot(wm)) * slope.projected_area_unchecked(wi) / wi.z.abs())
     }
 
     #[inline]
@@ -212,7 +220,7 @@ impl Material for Diffuse {
         let (u1, u2) = uniform_pair(rng);
         let wm = slope.sample_d_wi_unchecked(it.wi(), u1, u2);
         let phase = if it.is_outside_reflection() {
-            self.albedo * (FRAC_1_PI * it.wo().dot(wm).max(0.0))
+            self.albedo * (FRAC_1_PI * positive_part(it.wo().dot(wm)))
         } else {
             Vec3::ZERO
         };
@@ -239,6 +247,6 @@ impl Material for Diffuse {
         // (1 + Λi)/(1 + Λi + Λo) in f64: the f32 factors saturate near grazing
         let k = 1.0 + slope.lambda64(wi);
         let g2_given_g1 = (k / (k + slope.lambda64(wo))) as f32;
-        self.albedo * (FRAC_1_PI * wo.dot(wm).max(0.0) * g2_given_g1)
+        self.albedo * (FRAC_1_PI * positive_part(wo.dot(wm)) * g2_given_g1)
     }
 }

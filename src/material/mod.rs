@@ -209,22 +209,16 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
         rng: &mut impl Rng,
     ) -> PhaseSample;
 
-    /// [`Material::sample_phase`] of mirror facets ([`Material::MIRROR_FACETS`]) from the two
-    /// uniforms of the visible normal (the ones `sample_phase` draws, in that order), without
-    /// the argument check, for callers that hold the uniforms themselves (the renderer
-    /// layer's single scattering). Other materials never have it called and return a NaN
-    /// direction with a zero weight.
+    /// The reflection of ωi off the mirror facet ωm (visible from ωi) with its weight, for
+    /// mirror facets ([`Material::MIRROR_FACETS`]), without the argument check: the phase
+    /// sample for a normal the caller drew (`sample_phase` draws it from D_ωi; the renderer
+    /// layer's single scattering from [`MicrosurfaceSlope::sample_mirror_normal_unchecked`]).
+    /// Other materials never have it called and return a NaN direction with a zero weight.
     #[doc(hidden)]
     #[inline]
     #[must_use]
-    fn sample_mirror_unchecked<S: MicrosurfaceSlope>(
-        &self,
-        slope: &S,
-        wi: Vec3,
-        u1: f32,
-        u2: f32,
-    ) -> PhaseSample {
-        let _ = (slope, wi, u1, u2);
+    fn mirror_reflection_unchecked(&self, wi: Vec3, wm: Vec3) -> PhaseSample {
+        let _ = (wi, wm);
         PhaseSample { wo: Vec3::NAN, weight: Vec3::ZERO, side: Side::Outside }
     }
 

@@ -5,6 +5,8 @@ mod geometry;
 mod walk;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
+#[cfg(feature = "invariance")]
+pub(crate) use walk::incident_area;
 pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
 
 use crate::contract::is_direction;

@@ -5,7 +5,7 @@ use super::Microsurface;
 use super::geometry::{MIN_HIT_DEPTH, ScaledDepth, flip_ln_c1, next_ln_c1};
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;
-use crate::material::{Interaction, Material, Side};
+use crate::material::{Interaction, Material, PhaseSample, Side};
 use crate::rng::uniform;
 use crate::slope::MicrosurfaceSlope;
 use crate::special::exp_f32;
@@ -141,7 +141,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// direction gives 0 (a debug assertion in debug builds).
     pub fn eval(&self, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut impl Rng) -> Vec3 {
         require!(is_direction(wi) && is_direction(wo), Vec3::ZERO; wi, wo);
-        let Some(mut side) = Self::starting_side(wi) else {
+        let Some(side) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 {
                 self.eval_from_below(wi, wo, order, rng)
             } else {
@@ -152,61 +152,13 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             // a transparent interface scatters into the Dirac of ωo = −ωi only: no density
             return Vec3::ZERO;
         }
-        let slope = self.geometry.slope();
         let wo_side = if M::TRANSMITS { Side::above_or_inside(wo.z) } else { Side::Outside };
         // Λ of ωo seen from its own side, constant along the walk
-        let lambda_o = slope.lambda_unchecked(wo_side.frame(wo));
-        let last = order.last();
-
-        let mut wr = -wi;
-        // the height in the frame of the current side (ln C¹ = 0: above the surface); it may
-        // stay undrawn on ωi's side, where ωo's masking is then known in closed form
-        let mut depth = Depth::ABOVE;
-        let mut throughput = Vec3::ONE;
-        let mut sum = Vec3::ZERO;
-        for bounce in 1..=last {
-            let Some(hit) = self.next_hit(wr, depth, side, rng) else { break };
-            depth = hit.depth;
-            let it = Interaction::new(-wr, wo, side, wo_side).with_incident_area(hit.incident_area);
-            let includes = order.includes(bounce);
-            // the masking of ωo in closed form at an undrawn depth, and at a dielectric's first
-            // hit on ωo's side (whose depth is drawn at once: see `Self::LAZY`)
-            let closed = match Self::undrawn_rate(depth) {
-                Some(rate) => Some(rate),
-                None if !Self::LAZY => (bounce == 1 && side == wo_side).then_some(-hit.lambda),
-                None => None,
-            };
-            if bounce == last {
-                if includes {
-                    let phase = self.material.eval_phase_unchecked(slope, &it, rng);
-                    if phase != Vec3::ZERO {
-                        sum += throughput * phase * masking(closed, depth, lambda_o, side == wo_side);
-                    }
-                }
-                break;
-            }
-            let s = if includes {
-                // next-event estimation and the next direction in one material call
-                let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
-                if phase != Vec3::ZERO {
-                    sum += throughput * phase * masking(closed, depth, lambda_o, side == wo_side);
-                }
-                s
-            } else {
-                self.material.sample_phase_walk_unchecked(slope, -wr, side, rng)
-            };
-            let next_side = Self::side_after(s.side);
-            if next_side != side {
-                depth = Depth::at(flip_ln_c1(Self::drawn(depth, rng)));
-            }
-            wr = s.wo;
-            side = next_side;
-            throughput *= s.weight;
-            if throughput == Vec3::ZERO {
-                break;
-            }
-        }
-        sum
+        let lambda_o = self.geometry.slope().lambda_unchecked(wo_side.frame(wo));
+        // the height in the frame of the current side starts above the surface (ln C¹ = 0); it
+        // may stay undrawn on ωi's side, where ωo's masking is then known in closed form
+        let Some(first) = Depth::ABOVE.hit(self, -wi, side, rng) else { return Vec3::ZERO };
+        self.walk(-wi, side, first, Evaluation::<Depth>::new(wo, wo_side, order, lambda_o), rng)
     }
 
     /// Samples the multiple-scattering BSDF by a random walk (supplement §3.1 Algorithm 3;
@@ -230,34 +182,16 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// `None` (a debug assertion in debug builds).
     pub fn sample(&self, wi: Vec3, rng: &mut impl Rng) -> Option<WalkSample> {
         require!(is_direction(wi), None; wi);
-        let Some(mut side) = Self::starting_side(wi) else {
+        let Some(side) = Self::starting_side(wi) else {
             return if !M::TRANSMITS && wi.z < 0.0 { self.sample_from_below(wi, rng) } else { None };
         };
         if self.material.is_transparent() {
             return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 1 });
         }
-        let slope = self.geometry.slope();
-        let mut wr = -wi;
-        let mut depth = Depth::ABOVE;
-        let mut weight = Vec3::ONE;
-        for bounces in 0..MAX_BOUNCES {
-            let Some(hit) = self.next_hit(wr, depth, side, rng) else {
-                return Some(WalkSample { wo: wr, weight, bounces });
-            };
-            depth = hit.depth;
-            let s = self.material.sample_phase_walk_unchecked(slope, -wr, side, rng);
-            let next_side = Self::side_after(s.side);
-            if next_side != side {
-                depth = Depth::at(flip_ln_c1(Self::drawn(depth, rng)));
-            }
-            wr = s.wo;
-            side = next_side;
-            weight *= s.weight;
-            if weight == Vec3::ZERO {
-                return None;
-            }
-        }
-        None
+        let Some(first) = Depth::ABOVE.hit(self, -wi, side, rng) else {
+            return Some(WalkSample { wo: -wi, weight: Vec3::ONE, bounces: 0 });
+        };
+        self.walk(-wi, side, first, Sampling { weight: Vec3::ONE }, rng)
     }
 
     /// [`Microsurface::eval`] for an opaque material lit from below the macrosurface
@@ -284,43 +218,12 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             return Vec3::ZERO;
         }
         let slope = self.geometry.slope();
-        let mut wr = -wi;
-        let Some(mut depth) = ScaledDepth::first(slope.ln_lambda(wr), uniform(rng)) else {
+        let Some(first) = ScaledDepth::first(slope.ln_lambda(-wi), uniform(rng)) else {
             return Vec3::ZERO;
         };
         let ln_lambda_o = slope.ln_lambda(wo);
-        let last = order.last();
-        let mut throughput = Vec3::ONE;
-        let mut sum = Vec3::ZERO;
-        let mut bounce = 1;
-        loop {
-            let continues = bounce != last;
-            let sampled = if order.includes(bounce) {
-                let it = Interaction::reflection(-wr, wo);
-                let (phase, sampled) = if continues {
-                    let (phase, s) = self.material.eval_and_sample_phase_unchecked(slope, &it, rng);
-                    (phase, Some(s))
-                } else {
-                    (self.material.eval_phase_unchecked(slope, &it, rng), None)
-                };
-                if phase != Vec3::ZERO {
-                    sum += throughput * phase * depth.escape_probability(ln_lambda_o) as f32;
-                }
-                sampled
-            } else {
-                continues.then(|| self.material.sample_phase_walk_unchecked(slope, -wr, Side::Outside, rng))
-            };
-            let Some(s) = sampled else { break };
-            wr = s.wo;
-            throughput *= s.weight;
-            if throughput == Vec3::ZERO {
-                break;
-            }
-            let Some(next) = depth.next(slope, wr, uniform(rng)) else { break };
-            depth = next;
-            bounce += 1;
-        }
-        sum
+        let evaluation = Evaluation::<ScaledDepth>::new(wo, Side::Outside, order, ln_lambda_o);
+        self.walk(-wi, Side::Outside, Vertex::from_below(first), evaluation, rng)
     }
 
     /// [`Microsurface::sample`] for an opaque material lit from below the macrosurface
@@ -337,56 +240,373 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
         if M::TRANSMITS || wi.z.is_nan() || wi.z >= 0.0 {
             return None;
         }
-        let slope = self.geometry.slope();
-        let mut wr = -wi;
-        let mut depth = ScaledDepth::first(slope.ln_lambda(wr), uniform(rng))?;
-        let mut weight = Vec3::ONE;
-        for bounces in 1..=MAX_BOUNCES {
-            let s = self.material.sample_phase_walk_unchecked(slope, -wr, Side::Outside, rng);
-            wr = s.wo;
-            weight *= s.weight;
-            if weight == Vec3::ZERO {
-                return None;
-            }
-            match depth.next(slope, wr, uniform(rng)) {
-                Some(next) => depth = next,
-                None => return Some(WalkSample { wo: wr, weight, bounces }),
-            }
-        }
-        None
+        let first = ScaledDepth::first(self.geometry.slope().ln_lambda(-wi), uniform(rng))?;
+        self.walk(-wi, Side::Outside, Vertex::from_below(first), Sampling { weight: Vec3::ONE }, rng)
     }
 
-    /// The next intersection of the ray ωr leaving a point at `depth` on `side`, or `None` if
-    /// it escapes. Both are in the frame of that side: inside a dielectric the configuration is
-    /// flipped vertically (supplement §3.4). One Λ per bounce: the Λ(ωr) of the height step
-    /// also gives the projected area of the next vertex's incident direction
-    /// ([`incident_area`]).
-    ///
-    /// For an opaque material ([`Self::LAZY`]), the first hit of a ray from above the surface
-    /// is left undrawn ([`Depth::undrawn`]), and so is every later hit as long as the rays go
-    /// up: such a ray escapes with probability E[C¹^Λ(ωr)] = a/(a + Λ(ωr)) (one uniform, no
-    /// logarithm), and otherwise hits at a height with the same law a e^{aℓ} (see [`Depth`]).
-    /// A ray going down (or horizontally) from an undrawn depth draws it first (one uniform),
-    /// then steps as Algorithm 1 does.
+    /// The random walk itself (supplement §3.1, Algorithms 2 and 3; §3.4 inside a dielectric),
+    /// from its first vertex `first`, reached by the ray `wr` on `side`, to its exit, its
+    /// absorption or its last bounce: at each vertex the `estimator` evaluates and/or samples
+    /// the phase function ([`Estimator`]: `eval` or `sample`), the heights ([`Heights`]: ln C¹
+    /// from above, or the first hit's scale from below) cross the interface with the sampled
+    /// direction and give the next vertex. Bounce k is the k-th vertex; `sample` walks at
+    /// most [`MAX_BOUNCES`], `eval` up to the last order it counts.
     #[inline(always)]
-    fn next_hit(&self, wr: Vec3, depth: Depth, side: Side, rng: &mut impl Rng) -> Option<Hit> {
+    fn walk<D: Heights, E: Estimator<D>>(
+        &self,
+        wr: Vec3,
+        side: Side,
+        first: Vertex<D>,
+        mut estimator: E,
+        rng: &mut impl Rng,
+    ) -> E::Output {
+        let (mut wr, mut side, mut at) = (wr, side, first);
+        let mut bounce = 1;
+        loop {
+            let Some((s, other_side)) = estimator.vertex(self, bounce, &at, wr, side, rng) else {
+                return estimator.end();
+            };
+            let next_side = Self::side_after(s.side);
+            let depth = if next_side != side {
+                other_side.unwrap_or_else(|| D::other_side(&at, self, rng))
+            } else {
+                at.depth
+            };
+            wr = s.wo;
+            side = next_side;
+            if !estimator.carry(s.weight) {
+                return estimator.end();
+            }
+            let Some(next) = depth.hit(self, wr, side, rng) else {
+                return estimator.escaped(wr, bounce);
+            };
+            if estimator.capped(bounce) {
+                return estimator.end();
+            }
+            at = next;
+            bounce += 1;
+        }
+    }
+}
+
+/// What a walk does at its vertices: `eval`'s next-event estimation ([`Evaluation`]) or
+/// `sample`'s path ([`Sampling`]), over the heights `D`. Every method is inlined into
+/// [`Microsurface::walk`], which compiles to one loop per estimator and height model.
+trait Estimator<D: Heights> {
+    /// The walk's result.
+    type Output;
+
+    /// The phase-function work at bounce `bounce`, the vertex `at` reached by the ray `wr` on
+    /// `side`: the sample of the next direction and, where the estimator formed it, the
+    /// vertex's point seen from the other side of the interface ([`Heights::other_side`],
+    /// which a crossing reuses); or `None` to end the walk there.
+    fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        &mut self,
+        surface: &Microsurface<H, S, M>,
+        bounce: u32,
+        at: &Vertex<D>,
+        wr: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> Option<(PhaseSample, Option<D>)>;
+
+    /// Multiplies the path's weight by a phase sample's; false once it is zero (absorbed).
+    fn carry(&mut self, weight: Vec3) -> bool;
+
+    /// Whether the walk ends (is dropped) after bounce `bounce` although it did not escape.
+    fn capped(&self, bounce: u32) -> bool;
+
+    /// The result of a walk that left the surface along `wo` after `bounces` bounces.
+    fn escaped(self, wo: Vec3, bounces: u32) -> Self::Output;
+
+    /// The result of a walk that ended otherwise: absorbed, capped or at its last bounce.
+    fn end(self) -> Self::Output;
+}
+
+/// `eval`'s estimator: next-event estimation of f·|cos θo| towards ωo (supplement §3.1,
+/// Algorithm 2), for the orders `order` selects.
+struct Evaluation<D: Heights> {
+    wo: Vec3,
+    /// The side ωo lies on ([`Side::Outside`] for opaque materials).
+    wo_side: Side,
+    order: ScatteringOrder,
+    /// The last bounce the walk needs to simulate ([`ScatteringOrder::last`]).
+    last: u32,
+    /// What the masking of ωo needs from ωo ([`Heights::Wo`]).
+    masking_wo: D::Wo,
+    throughput: Vec3,
+    sum: Vec3,
+}
+
+impl<D: Heights> Evaluation<D> {
+    #[inline(always)]
+    fn new(wo: Vec3, wo_side: Side, order: ScatteringOrder, masking_wo: D::Wo) -> Self {
+        Self { wo, wo_side, order, last: order.last(), masking_wo, throughput: Vec3::ONE, sum: Vec3::ZERO }
+    }
+}
+
+impl<D: Heights> Estimator<D> for Evaluation<D> {
+    type Output = Vec3;
+
+    /// The next-event term (where `order` counts the bounce) and the next direction in one
+    /// material call; at the last bounce the term alone. Where ωo lies across the interface
+    /// (a dielectric), the masking takes the vertex's point seen from ωo's side, which is
+    /// returned for a crossing of the sampled direction: one ln(1 − C¹) per vertex.
+    #[inline(always)]
+    fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        &mut self,
+        surface: &Microsurface<H, S, M>,
+        bounce: u32,
+        at: &Vertex<D>,
+        wr: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> Option<(PhaseSample, Option<D>)> {
+        let (slope, material) = (surface.geometry.slope(), &surface.material);
+        let it = Interaction::new(-wr, self.wo, side, self.wo_side).with_incident_area(at.incident_area);
+        let includes = self.order.includes(bounce);
+        let same_side = side == self.wo_side;
+        if bounce == self.last {
+            if includes {
+                let phase = material.eval_phase_unchecked(slope, &it, rng);
+                if phase != Vec3::ZERO {
+                    let seen = if same_side { at.depth } else { D::other_side(at, surface, rng) };
+                    let masking = D::masking(surface, at, bounce, seen, same_side, self.masking_wo);
+                    self.sum += self.throughput * phase * masking;
+                }
+            }
+            return None;
+        }
+        if !includes {
+            return Some((material.sample_phase_walk_unchecked(slope, -wr, side, rng), None));
+        }
+        let (phase, s) = material.eval_and_sample_phase_unchecked(slope, &it, rng);
+        let other_side = (!same_side).then(|| D::other_side(at, surface, rng));
+        if phase != Vec3::ZERO {
+            let seen = other_side.unwrap_or(at.depth);
+            let masking = D::masking(surface, at, bounce, seen, same_side, self.masking_wo);
+            self.sum += self.throughput * phase * masking;
+        }
+        Some((s, other_side))
+    }
+
+    #[inline(always)]
+    fn carry(&mut self, weight: Vec3) -> bool {
+        self.throughput *= weight;
+        self.throughput != Vec3::ZERO
+    }
+
+    /// Never: the walk ends at its last bounce ([`ScatteringOrder::last`] ≤ [`MAX_BOUNCES`]).
+    #[inline(always)]
+    fn capped(&self, _bounce: u32) -> bool {
+        false
+    }
+
+    #[inline(always)]
+    fn escaped(self, _wo: Vec3, _bounces: u32) -> Vec3 {
+        self.sum
+    }
+
+    #[inline(always)]
+    fn end(self) -> Vec3 {
+        self.sum
+    }
+}
+
+/// `sample`'s estimator: the path's weight, the product of the phase samples' (supplement
+/// §3.1, Algorithm 3).
+struct Sampling {
+    weight: Vec3,
+}
+
+impl<D: Heights> Estimator<D> for Sampling {
+    type Output = Option<WalkSample>;
+
+    #[inline(always)]
+    fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        &mut self,
+        surface: &Microsurface<H, S, M>,
+        _bounce: u32,
+        _at: &Vertex<D>,
+        wr: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> Option<(PhaseSample, Option<D>)> {
+        Some((surface.material.sample_phase_walk_unchecked(surface.geometry.slope(), -wr, side, rng), None))
+    }
+
+    #[inline(always)]
+    fn carry(&mut self, weight: Vec3) -> bool {
+        self.weight *= weight;
+        self.weight != Vec3::ZERO
+    }
+
+    /// After [`MAX_BOUNCES`] bounces (the walk is dropped: its energy is lost).
+    #[inline(always)]
+    fn capped(&self, bounce: u32) -> bool {
+        bounce == MAX_BOUNCES
+    }
+
+    #[inline(always)]
+    fn escaped(self, wo: Vec3, bounces: u32) -> Option<WalkSample> {
+        Some(WalkSample { wo, weight: self.weight, bounces })
+    }
+
+    #[inline(always)]
+    fn end(self) -> Option<WalkSample> {
+        None
+    }
+}
+
+/// How a walk tracks the heights of its vertices (supplement §3.1, Algorithm 1): as ln C¹ in
+/// the frame of the current side for walks from above ([`Depth`]), in the scale of the first
+/// hit for walks from below the macrosurface ([`ScaledDepth`]).
+trait Heights: Copy {
+    /// What the masking of ωo needs from ωo, constant along the walk.
+    type Wo: Copy;
+
+    /// The next vertex of the ray `wr` leaving a point at this height on `side` (both in the
+    /// frame of that side), or `None` if it escapes.
+    fn hit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        self,
+        surface: &Microsurface<H, S, M>,
+        wr: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> Option<Vertex<Self>>;
+
+    /// The point of the vertex `at` seen from the other side of a dielectric interface.
+    fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        at: &Vertex<Self>,
+        surface: &Microsurface<H, S, M>,
+        rng: &mut impl Rng,
+    ) -> Self;
+
+    /// The masking of ωo at the vertex `at` of bounce `bounce`, whose point seen from ωo's
+    /// side is `seen` (`at.depth`, or [`Heights::other_side`] where ωo lies across the
+    /// interface: `same_side` false): the probability that a ray from there escapes along ωo,
+    /// or its conditional expectation where that is known in closed form.
+    fn masking<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        surface: &Microsurface<H, S, M>,
+        at: &Vertex<Self>,
+        bounce: u32,
+        seen: Self,
+        same_side: bool,
+        wo: Self::Wo,
+    ) -> f32;
+}
+
+impl Heights for Depth {
+    /// Λ(ωo) seen from ωo's side.
+    type Wo = f32;
+
+    /// One Λ per bounce: the Λ(ωr) of the height step also gives the projected area of the
+    /// next vertex's incident direction ([`incident_area`]).
+    ///
+    /// For an opaque material (`Microsurface::LAZY`), the first hit of a ray from above the
+    /// surface is left undrawn ([`Depth::undrawn`]), and so is every later hit as long as the
+    /// rays go up: such a ray escapes with probability E[C¹^Λ(ωr)] = a/(a + Λ(ωr)) (one
+    /// uniform, no logarithm), and otherwise hits at a height with the same law a e^{aℓ} (see
+    /// [`Depth`]). A ray going down (or horizontally) from an undrawn depth draws it first (one
+    /// uniform), then steps as Algorithm 1 does.
+    #[inline(always)]
+    fn hit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        self,
+        surface: &Microsurface<H, S, M>,
+        wr: Vec3,
+        side: Side,
+        rng: &mut impl Rng,
+    ) -> Option<Vertex<Self>> {
+        let lazy = Microsurface::<H, S, M>::LAZY;
         let w = side.frame(wr);
-        let lambda = self.geometry.slope().lambda_unchecked(w);
-        let depth = match Self::undrawn_rate(depth) {
+        let lambda = surface.geometry.slope().lambda_unchecked(w);
+        let depth = match Microsurface::<H, S, M>::undrawn_rate(self) {
             // the ray from above the surface (ln C¹ = 0, going down): its hit ln C¹ has the
             // density a e^{aℓ} with a = |Λ(ωr)| = 1 + Λ(ωi)
-            None if Self::LAZY && depth == Depth::ABOVE && w.z < 0.0 => Depth::undrawn(-lambda),
+            None if lazy && self == Depth::ABOVE && w.z < 0.0 => Depth::undrawn(-lambda),
             Some(rate) if w.z > 0.0 => {
                 // rate/(rate + Λ) ≤ 1, 0 where Λ saturates at f32::MAX (a discrete choice: u
                 // is not cut, P(u < p) = p to 2⁻²⁴, as for the dielectric's Fresnel choice)
                 if uniform(rng) < rate / (rate + lambda) {
                     return None;
                 }
-                depth
+                self
             }
-            _ => Depth::at(next_ln_c1(w.z, lambda, Self::drawn(depth, rng), uniform(rng))?),
+            _ => {
+                let ln_c1 = Microsurface::<H, S, M>::drawn(self, rng);
+                Depth::at(next_ln_c1(w.z, lambda, ln_c1, uniform(rng))?)
+            }
         };
-        Some(Hit { depth, lambda, incident_area: incident_area(w.z, lambda) })
+        Some(Vertex { depth, lambda, incident_area: incident_area(w.z, lambda) })
+    }
+
+    /// ln(1 − C¹) ([`flip_ln_c1`]), the depth drawn first if it was not.
+    #[inline(always)]
+    fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        at: &Vertex<Self>,
+        _surface: &Microsurface<H, S, M>,
+        rng: &mut impl Rng,
+    ) -> Self {
+        Depth::at(flip_ln_c1(Microsurface::<H, S, M>::drawn(at.depth, rng)))
+    }
+
+    /// [`masking`], in closed form at an undrawn depth, and at a dielectric's first hit on
+    /// ωo's side (whose depth is drawn at once: see `Microsurface::LAZY`).
+    #[inline(always)]
+    fn masking<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        _surface: &Microsurface<H, S, M>,
+        at: &Vertex<Self>,
+        bounce: u32,
+        seen: Self,
+        same_side: bool,
+        lambda_o: f32,
+    ) -> f32 {
+        let closed = match Microsurface::<H, S, M>::undrawn_rate(at.depth) {
+            Some(rate) => Some(rate),
+            None if !Microsurface::<H, S, M>::LAZY => (bounce == 1 && same_side).then_some(-at.lambda),
+            None => None,
+        };
+        masking(closed, seen, lambda_o)
+    }
+}
+
+impl Heights for ScaledDepth {
+    /// ln Λ(ωo).
+    type Wo = f64;
+
+    /// [`ScaledDepth::next`]; every vertex is outside (opaque materials only).
+    #[inline(always)]
+    fn hit<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        self,
+        surface: &Microsurface<H, S, M>,
+        wr: Vec3,
+        _side: Side,
+        rng: &mut impl Rng,
+    ) -> Option<Vertex<Self>> {
+        self.next(surface.geometry.slope(), wr, uniform(rng)).map(Vertex::from_below)
+    }
+
+    /// Never called: the walks from below are those of opaque materials, which no ray crosses.
+    #[inline(always)]
+    fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        at: &Vertex<Self>,
+        _surface: &Microsurface<H, S, M>,
+        _rng: &mut impl Rng,
+    ) -> Self {
+        at.depth
+    }
+
+    /// C¹^Λ(ωo) ([`ScaledDepth::escape_probability`]), rounded to f32.
+    #[inline(always)]
+    fn masking<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
+        _surface: &Microsurface<H, S, M>,
+        _at: &Vertex<Self>,
+        _bounce: u32,
+        seen: Self,
+        _same_side: bool,
+        ln_lambda_o: f64,
+    ) -> f32 {
+        seen.escape_probability(ln_lambda_o) as f32
     }
 }
 
@@ -447,10 +667,10 @@ impl Depth {
     }
 }
 
-/// The masking factor of the next-event estimate at a hit at `depth` (in the frame of the
-/// walk's side), for ωo with Λ(ωo) = `lambda_o` seen from its own side: C¹^Λ(ωo), the
-/// probability that a ray from there escapes along ωo (supplement §3.1; through the other
-/// side, ln(1 − C¹), for a dielectric's ωo across the interface).
+/// The masking factor of the next-event estimate at a hit at `depth`, seen from ωo's side
+/// (ln(1 − C¹) for a dielectric's ωo across the interface), for ωo with Λ(ωo) = `lambda_o`
+/// seen from its own side: C¹^Λ(ωo), the probability that a ray from there escapes along ωo
+/// (supplement §3.1).
 ///
 /// Where `closed` holds a rate a, the conditional expectation a/(a + Λ(ωo)) instead: at an
 /// undrawn depth (see [`Depth`]) and at the first hit of a ray from above on ωo's side (a =
@@ -459,29 +679,34 @@ impl Depth {
 /// depend on the height, so the estimate stays unbiased (Rao–Blackwell) and its variance drops.
 /// In f64 (no overflow where Λ saturates at grazing angles), rounded once.
 #[inline(always)]
-fn masking(closed: Option<f32>, depth: Depth, lambda_o: f32, same_side: bool) -> f32 {
-    match (closed, depth) {
-        (Some(rate), _) => {
+fn masking(closed: Option<f32>, depth: Depth, lambda_o: f32) -> f32 {
+    match closed {
+        Some(rate) => {
             let rate = f64::from(rate);
             (rate / (rate + f64::from(lambda_o))) as f32
         }
-        (None, depth) => {
-            // `closed` holds the rate of every undrawn depth, so this is ln C¹ ≤ 0
-            let ln_c1 = depth.0.min(0.0);
-            exp_f32(lambda_o * if same_side { ln_c1 } else { flip_ln_c1(ln_c1) })
-        }
+        // `closed` holds the rate of every undrawn depth, so this is ln C¹ ≤ 0
+        None => exp_f32(lambda_o * depth.0.min(0.0)),
     }
 }
 
-/// An intersection of the walk's ray with the microsurface.
+/// A vertex of the walk: an intersection of its ray with the microsurface.
 #[derive(Debug, Clone, Copy)]
-struct Hit {
+struct Vertex<D> {
     /// Its height, in the frame of the ray's side.
-    depth: Depth,
-    /// Λ(ωr) of the ray, in the same frame.
+    depth: D,
+    /// Λ(ωr) of the ray, in the same frame (walks from above).
     lambda: f32,
     /// A(ωi) of the incident direction ωi = −ωr there, in the same frame, where known.
     incident_area: Option<f32>,
+}
+
+impl Vertex<ScaledDepth> {
+    /// A vertex of a walk from below, which passes neither Λ nor the incident area on.
+    #[inline(always)]
+    fn from_below(depth: ScaledDepth) -> Self {
+        Self { depth, lambda: 0.0, incident_area: None }
+    }
 }
 
 /// The projected area A(ωi) = (1 + Λ(ωi)) cos θi (supplement §2.2) of the incident direction
@@ -494,7 +719,7 @@ struct Hit {
 /// materials then form the density in f64) and where Λ saturated at ±`f32::MAX`
 /// (|cos θ| below ~1e-38·αᵢ, where the product would not be A).
 #[inline(always)]
-fn incident_area(z: f32, lambda: f32) -> Option<f32> {
+pub(crate) fn incident_area(z: f32, lambda: f32) -> Option<f32> {
     // Λ(ω) and ω.z have the same sign (Λ ≤ −1 below the horizon), so the product is ≥ 0
     let area = lambda * z;
     (area >= f32::MIN_POSITIVE && lambda.abs() < f32::MAX).then_some(area)

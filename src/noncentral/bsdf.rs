@@ -3,7 +3,7 @@
 
 use super::NoncentralMaterial;
 use super::slope::Noncentral;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, valid_direction, valid_uniforms};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, unit_directions, unit_view};
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::slope::MicrosurfaceSlope;
@@ -52,8 +52,11 @@ pub enum NoncentralMasking {
 /// * Every method is deterministic and exact (`exact_pdf`, `BsdfValue::exact`); `uc` and the
 ///   key are unused. Samples whose pdf or f would not be a normal f32 are not returned (at most
 ///   4π·`f32::MIN_POSITIVE` of probability), nor those whose weight saturates.
-/// * Invalid input ([policy](crate#invalid-input)): non-unit or non-finite directions and
-///   uniforms outside [0, 1) trip a debug assertion and give 0 / `None` in release builds.
+/// * Inputs as for every [`Bsdf`] ([Inputs](Bsdf#inputs)): directions within
+///   [`BSDF_DIRECTION_TOLERANCE`](crate::BSDF_DIRECTION_TOLERANCE) of unit length are
+///   renormalized and a uniform of 1 is taken as 1 − 2⁻²⁴; other non-unit or non-finite
+///   directions and uniforms outside [0, 1] trip a debug assertion and give 0 / `None` in
+///   release builds.
 ///
 /// Dielectrics are not supported (see [`NoncentralMaterial`]).
 ///
@@ -168,15 +171,14 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> Bsdf for NoncentralBsdf<S, M> 
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> BsdfValue {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return BsdfValue::ZERO;
-        }
+        unit_directions!(wo, wi, BsdfValue::ZERO, self.eval_keyed(wo, wi, 0));
         BsdfValue { f: self.f_checked(wo, wi), exact: true }
     }
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, _key: u64) -> Option<BsdfSample> {
-        if !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z <= 0.0 {
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, 0));
+        if wo.z <= 0.0 {
             return None;
         }
         let mut s = self.material.sample_single(&self.surface, wo, u)?;
@@ -203,17 +205,13 @@ impl<S: MicrosurfaceSlope, M: NoncentralMaterial> Bsdf for NoncentralBsdf<S, M> 
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return 0.0;
-        }
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
         self.pdf_checked(wo, wi)
     }
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, _key: u64) -> (BsdfValue, f32) {
-        if !valid_direction(wo) || !valid_direction(wi) {
-            return (BsdfValue::ZERO, 0.0);
-        }
+        unit_directions!(wo, wi, (BsdfValue::ZERO, 0.0), self.eval_with_pdf_keyed(wo, wi, 0));
         (BsdfValue { f: self.f_checked(wo, wi), exact: true }, self.pdf_checked(wo, wi))
     }
 }

@@ -117,8 +117,7 @@ impl<S: MicrosurfaceSlope, M: Material> PathModel<S, M> {
     /// which the path integral already contains after any upward bounce (Wang et al. 2022,
     /// Fig. 5): incident masking G1(ωi) = 1/|1 + Λ(ωi)| = 1/Λ(−ωi) (eq. 10), the VNDF D_ωi on
     /// the whole sphere, and the shadowing factors of eqs. 17–18 with 1 + L̃ = Λ(−ωi). Every
-    /// exit of an opaque path is upwards. See DESIGN.md, “Multiple scattering for views below
-    /// the macrosurface”.
+    /// exit of an opaque path is upwards. See DESIGN.md, “Paths from below”.
     #[inline(always)]
     pub(crate) fn incident(wi: Vec3) -> Option<Incident> {
         let side = Side::of(wi.z)?;

@@ -124,7 +124,7 @@ impl Shadowing {
     ///
     /// The correlated middle factors are the differences written without cancellation:
     /// Λo/(k_in (k_in + Λo)) and −expm1(ln Γ(1 + k_in) + ln Γ(1 + Λo) − ln Γ(1 + k_in + Λo))/k_in.
-    /// Both are ≥ 0 without clamping (for G1in > 1 too, see DESIGN.md).
+    /// Both are ≥ 0 without clamping (for G1in > 1 too, see DESIGN.md, “Departures from the released code”).
     #[inline]
     pub(crate) fn vertex(self, k_in: f64, exit: Option<f64>, event: Event) -> VertexShadowing {
         let g1_in = 1.0 / k_in;

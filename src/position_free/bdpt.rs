@@ -73,7 +73,7 @@ const INLINE_VERTICES: usize = 8;
 /// The vertices of one sub-path: the first [`INLINE_VERTICES`] inline, the rest (up to
 /// [`BDPT_MAX_SUBPATH`]) in an array formed only when the sub-path grows beyond them. Filling
 /// all 48 slots of both sub-paths on every evaluation cost more than the connections of a
-/// typical evaluation at α = 1 (DESIGN.md, “BDPT against PT where BDPT loses”).
+/// typical evaluation at α = 1 (DESIGN.md, “BDPT against PT”).
 struct Vertices<T: Copy> {
     head: [T; INLINE_VERTICES],
     tail: Option<[T; BDPT_MAX_SUBPATH - INLINE_VERTICES]>,

@@ -14,13 +14,13 @@ pub(crate) const ROULETTE_FROM_BOUNCE: u32 = 3;
 
 /// The bidirectional estimator's sub-paths start their Russian roulette after this many sampled
 /// directions: one earlier than path tracing, whose variance per sample is higher and which
-/// measured worse from the second (DESIGN.md, “BDPT against PT where BDPT loses”).
+/// measured worse from the second (DESIGN.md, “BDPT against PT”).
 pub(crate) const BDPT_ROULETTE_FROM: usize = 2;
 
 /// The margin C of the survival factor's cap C·P/ĉ (see [`Roulette::survival`]). The cap
 /// binds only where G1 overstates the next phase function's peak relative to ĉ by more than C,
-/// as it does by up to e^{a²} below a light-tailed surface. Measured (DESIGN.md, “Paths that
-/// never end from below”): C = 8 raised the variance of BDPT at GGX α = 0.1 by 31 % (mostly at
+/// as it does by up to e^{a²} below a light-tailed surface. Measured (DESIGN.md, “Russian
+/// roulette”): C = 8 raised the variance of BDPT at GGX α = 0.1 by 31 % (mostly at
 /// the mirror direction, whose later vertices keep contributing), C = 64 by 7 %, C = 256 by
 /// 1.5 % (within the noise, at 11 % fewer instructions); below a smooth GGX surface each factor
 /// 4 of C costs about one more bounce (16 extensions at C = 256, 4.7 at C = 1).
@@ -108,8 +108,7 @@ impl Roulette {
     ///
     /// A phase function integrates to 1 over the sphere, so P ≥ 1/(4π) and the cap exceeds G1
     /// wherever C·k_next ≥ 4πĉ: P is evaluated only for smaller k_next (steep or backfacing
-    /// ω). The measurements behind the rule: DESIGN.md, “Russian roulette with the next
-    /// vertex's masking” and “Paths that never end from below”.
+    /// ω). The measurements behind the rule: DESIGN.md, “Russian roulette”.
     #[inline(always)]
     pub(crate) fn survival<S: MicrosurfaceSlope, M: Material>(
         &self,

@@ -1,7 +1,7 @@
 //! Elliptical anisotropy with correlation: an axis-aligned slope distribution rotated in the
 //! tangent plane (Dupuy 2015, thesis §2.3).
 
-use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction, is_direction64, is_uniform};
+use super::{Beckmann, Ggx, MicrosurfaceSlope, is_direction};
 use crate::error::Error;
 use crate::vector::ensure_visible;
 use glam::{DVec3, Vec3};
@@ -270,20 +270,8 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
     }
 
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        require!(is_direction64(wm), 0.0; wm);
-        self.d64_unchecked(wm)
-    }
-
-    #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
         self.axis_aligned.d64_unchecked(self.to_ellipse64(wm))
-    }
-
-    #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.lambda_unchecked(w)
     }
 
     #[inline]
@@ -299,12 +287,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
     #[inline]
     fn ln_lambda(&self, w: Vec3) -> f64 {
         self.axis_aligned.ln_lambda(self.to_ellipse(w))
-    }
-
-    #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.projected_area_unchecked(w)
     }
 
     #[inline]
@@ -336,12 +318,6 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
         self.d_wi64_unchecked(wi, wm.as_dvec3()) as f32
     }
 
-    #[inline]
-    fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
-        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
-        self.d_wi64_unchecked(wi, wm)
-    }
-
     /// The axis-aligned D_ωi of the rotated pair, with the visibility ⟨ωi, ωm⟩ > 0 decided on the
     /// given (unrotated) vectors, as the samplers guarantee it.
     #[inline]
@@ -363,14 +339,21 @@ impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
     /// Eq. 2.35 in its rotated form: `S`'s exact sampler from ωi rotated by −φα, its normal
     /// rotated back by +φα (and made visible from ωi against the rounding of the rotations).
     #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
-        self.sample_d_wi_unchecked(wi, u1, u2)
-    }
-
-    #[inline]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let wm = self.axis_aligned.sample_d_wi_unchecked(self.to_ellipse(wi), u1, u2);
         ensure_visible(wi, self.to_tangent(wm))
+    }
+
+    /// `S`'s reflection sampler in the ellipse's frame (for GGX the bounded cap, whose bound
+    /// depends on min(α₁, α₂) and on θi only, both rotation invariant), rotated back.
+    #[inline]
+    fn sample_mirror_normal_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        let (wm, area) = self.axis_aligned.sample_mirror_normal_unchecked(self.to_ellipse(wi), u1, u2);
+        (ensure_visible(wi, self.to_tangent(wm)), area)
+    }
+
+    #[inline]
+    fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
+        self.axis_aligned.mirror_sampling_area_unchecked(self.to_ellipse(wi))
     }
 }

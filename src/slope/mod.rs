@@ -14,6 +14,7 @@ pub use elliptical::{AxisAlignedSlope, Elliptical};
 pub use ggx::Ggx;
 
 pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
+pub(crate) use ggx::{cap_bound, sample_bounded_cap};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
@@ -28,9 +29,9 @@ use glam::{DVec3, Vec3};
 /// (`MicrosurfaceSlope` in Heitz et al. 2016, supplement §2.1).
 ///
 /// Sealed: implemented by the crate's distributions only ([`Ggx`], [`Beckmann`],
-/// `&`[`TabulatedSlope`], [`StretchedTabulated`], `&`[`GridSlope`]). A distribution of one's
-/// own goes through [`TabulatedSlope`] (isotropic: from P²² or D values on rings, or a radial
-/// function) or [`GridSlope`] (anisotropic: from a grid of slope densities), which check their
+/// `&`[`TabulatedSlope`](crate::tabulated::TabulatedSlope), [`StretchedTabulated`](crate::tabulated::StretchedTabulated), `&`[`GridSlope`](crate::tabulated::GridSlope)). A distribution of one's
+/// own goes through [`TabulatedSlope`](crate::tabulated::TabulatedSlope) (isotropic: from P²² or D values on rings, or a radial
+/// function) or [`GridSlope`](crate::tabulated::GridSlope) (anisotropic: from a grid of slope densities), which check their
 /// input, derive Λ, the projected area and D_ωi from it and sample it exactly, so that the
 /// random walks, the position-free estimators and the samplers are valid for it unchanged.
 /// Sealing lets the crate rely on the contract below (which its test suite checks for every
@@ -82,12 +83,20 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// nadir). At exactly grazing ω.z = ±0 (both signs of zero are the horizon seen from
     /// above) the exact value is +∞; the result saturates to `f32::MAX` there (and to
     /// −`f32::MAX` just below it), never leaving the finite numbers.
-    fn lambda(&self, w: Vec3) -> f32;
+    #[inline]
+    fn lambda(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.lambda_unchecked(w)
+    }
 
     /// The projected area ∫⟨ω, ωm⟩ D(ωm) dωm = (1 + Λ(ω)) cos θ ≥ 0, for every ω
     /// (supplement §2.2–2.3), evaluated without forming 1 + Λ. It is cos θ at the zenith,
     /// 0 at the nadir and ½ αᵢ sin θ at the horizon.
-    fn projected_area(&self, w: Vec3) -> f32;
+    #[inline]
+    fn projected_area(&self, w: Vec3) -> f32 {
+        require!(is_direction(w), f32::NAN; w);
+        self.projected_area_unchecked(w)
+    }
 
     /// Λ(ω) in double precision, unsaturated: ±∞ at exactly grazing ω.z = ±0 (see
     /// [`Self::lambda`] for the rest of the contract).
@@ -139,14 +148,14 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     #[inline]
     fn d64(&self, wm: DVec3) -> f64 {
         require!(is_direction64(wm), 0.0; wm);
-        f64::from(self.d(wm.as_vec3()))
+        self.d64_unchecked(wm)
     }
 
     /// D_ωi(ωm) in double precision for ωm given in double precision (see [`Self::d64`]).
     #[inline]
     fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
         require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
-        smith_d_wi64(self, wi, wm)
+        self.d_wi64_unchecked(wi, wm)
     }
 
     /// The projected roughness αᵢ = √(cos²φ αx² + sin²φ αy²) in the azimuth of ω
@@ -194,32 +203,31 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// it. For ωi = −z, which sees no microsurface, returns +z. The quantiles it inverts use
     /// u as clamp(u, 2⁻²⁴, 1 − 2⁻²⁴) (the crate's tail policy): no sample lies beyond the last
     /// 2⁻²⁴ of the model.
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
-
-    // The same quantities without the argument check, for the crate's walks, which call them
-    // once or more per bounce with directions they produced themselves (unit up to rounding).
-    // Each defaults to the checked method; the analytic slopes override them with the
-    // unchecked bodies.
-
-    /// [`Self::lambda`] without the argument check (crate-internal hot path).
-    #[doc(hidden)]
-    #[inline(always)]
-    fn lambda_unchecked(&self, w: Vec3) -> f32 {
-        self.lambda(w)
+    #[inline]
+    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+        self.sample_d_wi_unchecked(wi, u1, u2)
     }
 
-    /// [`Self::projected_area`] without the argument check (crate-internal hot path).
-    #[doc(hidden)]
-    #[inline(always)]
-    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
-        self.projected_area(w)
-    }
+    // The cores of the checked methods above: each public method checks its arguments once
+    // (the crate's input policy) and calls its core, which every implementation provides. The
+    // crate's walks call the cores directly, once or more per bounce, with directions they
+    // produced themselves (unit up to rounding).
 
-    /// [`Self::d64`] without the argument check (crate-internal hot path).
+    /// The core of [`Self::lambda`]: no argument check.
+    #[doc(hidden)]
+    fn lambda_unchecked(&self, w: Vec3) -> f32;
+
+    /// The core of [`Self::projected_area`]: no argument check.
+    #[doc(hidden)]
+    fn projected_area_unchecked(&self, w: Vec3) -> f32;
+
+    /// The core of [`Self::d64`]: no argument check. The default rounds the normal to f32 and
+    /// widens [`Self::d`]; [`Ggx`] and [`Beckmann`] evaluate D in f64.
     #[doc(hidden)]
     #[inline(always)]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
-        self.d64(wm)
+        f64::from(self.d(wm.as_vec3()))
     }
 
     /// D(ωh) in double precision for the direction ωh = h/|h| of a vector `h` given
@@ -244,19 +252,17 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         (0.25 * self.d64_of_sum_unchecked(h) / f64::from(area)) as f32
     }
 
-    /// [`Self::d_wi64`] without the argument check (crate-internal hot path).
+    /// The core of [`Self::d_wi64`]: no argument check. The default is the Smith form
+    /// ⟨ωi, ωm⟩ D(ωm)/A(ωi) in f64.
     #[doc(hidden)]
     #[inline(always)]
     fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
-        self.d_wi64(wi, wm)
+        smith_d_wi64(self, wi, wm)
     }
 
-    /// [`Self::sample_d_wi`] without the argument check (crate-internal hot path).
+    /// The core of [`Self::sample_d_wi`]: no argument check.
     #[doc(hidden)]
-    #[inline(always)]
-    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        self.sample_d_wi(wi, u1, u2)
-    }
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
 
     /// The density D(ωh)/(4 A(ωi)) of a reflection off mirror facets from ωi to ωo, both unit
     /// and strictly above the horizon, ωh = (ωi + ωo)/|ωi + ωo| (the single-scattering density
@@ -268,6 +274,38 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     #[inline(always)]
     fn reflection_density_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
         reflection_density64(self, wi, wo)
+    }
+
+    /// D(ωh)/(4 `area`) for a reflection off mirror facets from ωi to ωo (as
+    /// [`Self::reflection_density_unchecked`], which is this with `area` = A(ωi)): the density
+    /// of a reflection sampler whose normals have the density ⟨ωi, ωm⟩ D(ωm)/`area` where they
+    /// reflect above the horizon. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn reflection_density_over_unchecked(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
+        reflection_density64_over(self, wi, wo, area)
+    }
+
+    /// A facet normal for a reflection off mirror facets from a unit ωi above the horizon, from
+    /// two uniforms, and the area A_s(ωi) = [`Self::mirror_sampling_area_unchecked`] of its
+    /// sampler: the renderer layer's single scattering draws its reflections with it, and
+    /// those above the horizon have the density D(ωh)/(4 A_s). By default D_ωi
+    /// ([`Self::sample_d_wi_unchecked`], A_s = A); [`Ggx`] draws from the bounded cap (Eto and
+    /// Tokuyoshi 2023, [`GgxBoundedCap`](crate::GgxBoundedCap)), which leaves out normals
+    /// whose reflections all point into the surface (A_s = A_b ≤ A). No argument check
+    /// (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_mirror_normal_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        (self.sample_d_wi_unchecked(wi, u1, u2), self.projected_area_unchecked(wi))
+    }
+
+    /// The area A_s(ωi) of [`Self::sample_mirror_normal_unchecked`] (the same bits): A(ωi) by
+    /// default, GGX's bounded A_b. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
+        self.projected_area_unchecked(wi)
     }
 }
 
@@ -287,8 +325,19 @@ pub(crate) fn smith_d_wi64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wm: DVec3)
 /// ωi·ωh > 0).
 #[inline(always)]
 pub(crate) fn reflection_density64<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3) -> f32 {
+    reflection_density64_over(slope, wi, wo, slope.projected_area_unchecked(wi))
+}
+
+/// [`reflection_density64`] with the area given: 0.25 D(ωh)/`area` in f64 rounded once.
+#[inline(always)]
+pub(crate) fn reflection_density64_over<S: MicrosurfaceSlope>(
+    slope: &S,
+    wi: Vec3,
+    wo: Vec3,
+    area: f32,
+) -> f32 {
     let wh = (wi.as_dvec3() + wo.as_dvec3()).normalize_or_zero();
-    let area = f64::from(slope.projected_area_unchecked(wi));
+    let area = f64::from(area);
     if area <= 0.0 { 0.0 } else { (0.25 * slope.d64_unchecked(wh) / area) as f32 }
 }
 

@@ -3,7 +3,6 @@
 //! microsurface).
 
 use super::radial::{check_ring_count, grid_angle};
-use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
 use crate::slope::MicrosurfaceSlope;
 use crate::vector::{ensure_visible, normal_from_slopes};
@@ -517,13 +516,13 @@ impl MicrosurfaceSlope for &GridSlope {
 
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
-        self.d64(wm.as_dvec3()) as f32
+        self.d64_unchecked(wm.as_dvec3()) as f32
     }
 
     /// P_ij/cos⁴θm (0 for ωm.z ≤ 0, outside the grid and for a non-finite normal).
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
+        debug_assert!(wm.is_finite(), "d64_unchecked: non-finite normal {wm}");
         if !wm.is_finite() || wm.z <= 0.0 {
             return 0.0;
         }
@@ -539,8 +538,7 @@ impl MicrosurfaceSlope for &GridSlope {
     /// B/cos θ above the horizon, −1 − B/|cos θ| below (B interpolated); ±`f32::MAX` at ±0;
     /// invalid input ([policy](crate#invalid-input)): NaN.
     #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let b = self.backface_of(w);
         let l = (b / f64::from(w.z).abs()).min(f64::from(f32::MAX)) as f32;
         if w.z >= 0.0 { l } else { -1.0 - l }
@@ -549,16 +547,14 @@ impl MicrosurfaceSlope for &GridSlope {
     /// cos θ + B above the horizon, B below (B interpolated); invalid input
     /// ([policy](crate#invalid-input)): NaN.
     #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let b = self.backface_of(w);
         (if w.z >= 0.0 { f64::from(w.z) + b } else { b }) as f32
     }
 
     /// Exact for every ωi; +z for ωi = −z. Invalid input ([policy](crate#invalid-input)): a
     /// non-unit ωi or a uniform outside [0, 1] gives NaN.
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let Some(w) = wi.as_dvec3().try_normalize() else { return Vec3::Z };
         match self.sample_slopes(w, f64::from(u1), f64::from(u2)) {
             Some((x, y)) => ensure_visible(wi, normal_from_slopes(x as f32, y as f32)),

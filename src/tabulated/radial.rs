@@ -1,7 +1,6 @@
 //! A tabulated isotropic slope distribution (Dupuy 2015, thesis §4.2: data-driven
 //! microsurfaces), with exact visible-normal sampling on the whole sphere.
 
-use crate::contract::{is_direction, is_uniform};
 use crate::error::Error;
 use crate::slope::{Azimuth, MicrosurfaceSlope};
 use crate::vector::ensure_visible;
@@ -643,13 +642,13 @@ impl MicrosurfaceSlope for &TabulatedSlope {
     /// pₖ/cos⁴θm in f64, rounded (0 for ωm.z ≤ 0 and beyond R_N, which bounds 1/cos θm).
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
-        self.d64(wm.as_dvec3()) as f32
+        self.d64_unchecked(wm.as_dvec3()) as f32
     }
 
     /// As `d`; 0 for a non-finite normal (a debug assertion in debug builds).
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
+        debug_assert!(wm.is_finite(), "d64_unchecked: non-finite normal {wm}");
         if !wm.is_finite() {
             return 0.0;
         }
@@ -660,8 +659,7 @@ impl MicrosurfaceSlope for &TabulatedSlope {
     /// from the table (see the type's documentation); saturates to ±`f32::MAX` at ±0. Invalid input
     /// ([policy](crate#invalid-input)): a `w` that is not a unit direction gives NaN.
     #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         let lambda = (b / z.abs()).min(f64::from(f32::MAX)) as f32;
@@ -671,8 +669,7 @@ impl MicrosurfaceSlope for &TabulatedSlope {
     /// cos θ + B(cos θ) above the horizon, B(|cos θ|) below (B interpolated). Invalid input
     /// ([policy](crate#invalid-input)): a `w` that is not a unit direction gives NaN.
     #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let z = f64::from(w.z);
         let b = self.backface_at(z.abs());
         (if w.z >= 0.0 { z + b } else { b }) as f32
@@ -681,8 +678,7 @@ impl MicrosurfaceSlope for &TabulatedSlope {
     /// Exact for every ωi (see the type's documentation); +z for ωi = −z. Invalid
     /// input ([policy](crate#invalid-input)): a non-unit ωi or a uniform outside [0, 1] gives NaN.
     #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         self.sample_normal(wi, u1, u2)
     }
 }
@@ -757,14 +753,14 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
 
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
-        self.d64(wm.as_dvec3()) as f32
+        self.d64_unchecked(wm.as_dvec3()) as f32
     }
 
     /// P²²(x̃, ỹ)/cos⁴θm in f64; 0 for ωm.z ≤ 0, beyond the table and for a non-finite normal
     /// (a debug assertion).
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
+    fn d64_unchecked(&self, wm: DVec3) -> f64 {
+        debug_assert!(wm.is_finite(), "d64_unchecked: non-finite normal {wm}");
         if !wm.is_finite() || wm.z <= 0.0 {
             return 0.0;
         }
@@ -779,15 +775,13 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
     }
 
     #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
+    fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let (s, _) = self.stretch(w);
         (&self.table).lambda(s)
     }
 
     #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
+    fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let (s, len) = self.stretch(w);
         (len * f64::from((&self.table).projected_area(s))) as f32
     }
@@ -796,8 +790,7 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
     /// for ωi = −z. Invalid input ([policy](crate#invalid-input)): a non-unit ωi or a uniform
     /// outside [0, 1] gives NaN.
     #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
+    fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         let (s, len) = self.stretch(wi);
         if len <= 0.0 {
             return Vec3::Z;

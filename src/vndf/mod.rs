@@ -13,6 +13,7 @@
 //! probability).
 
 mod beckmann_newton;
+mod bounded_cap;
 mod disk_band;
 mod ggx_disk;
 mod smith;
@@ -20,6 +21,7 @@ mod spherical_cap;
 mod vcavity;
 
 pub use beckmann_newton::BeckmannNewton;
+pub use bounded_cap::GgxBoundedCap;
 pub use ggx_disk::GgxDisk;
 pub use smith::SmithVndf;
 pub use spherical_cap::GgxSphericalCap;

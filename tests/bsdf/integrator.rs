@@ -119,9 +119,16 @@ fn the_specular_limit_below_smooth_alpha() {
         assert_eq!(b.eval(wo, mirror).f, Vec3::ZERO);
         assert_eq!(b.pdf(wo, mirror), 0.0);
         // seen from below the shading hemisphere (a normal map) the rough lobe answers: its
-        // visible facets are the distribution's tails, which do not shrink as α → 0
-        let from_below = b.sample(-wo, 0.5, Vec2::splat(0.5));
-        assert!(from_below.is_none_or(|s| !s.flags.specular), "{tname}: {from_below:?}");
+        // visible facets are the distribution's tails, which do not shrink as α → 0; its
+        // samples are flagged specular (pdf 1), and eval and pdf stay 0, as the flags say
+        let from_below = b.sample(-wo, 0.5, Vec2::splat(0.5)).expect("the backfacing lobe reflects");
+        assert!(from_below.flags.specular && from_below.pdf == 1.0, "{tname}: {from_below:?}");
+        assert!(
+            from_below.weight.max_element() > 0.0 && from_below.flags.reflection,
+            "{tname}: {from_below:?}"
+        );
+        assert_eq!(b.eval(-wo, from_below.wi).f, Vec3::ZERO, "{tname}");
+        assert_eq!(b.pdf(-wo, from_below.wi), 0.0, "{tname}");
         // dielectric: reflection with probability F, refraction (Snell) otherwise
         let d = mf(ggx(below, below), dielectric()).with_technique(t);
         assert!(d.flags().specular && d.flags().transmission && d.flags().reflection, "{tname}");
@@ -213,9 +220,10 @@ fn roughness_above_the_walk_range_is_rejected() {
 }
 
 /// Single scattering uses the caller's uniforms directly: `u` is the visible-normal sample
-/// (`sample_d_wi(wo, u.x, u.y)`, the reflection about it) and `uc` the Fresnel event of a
-/// dielectric (reflection iff uc < F(wo·m)). Uniforms on the 2⁻²⁴ grid the crate draws on
-/// are passed through exactly.
+/// (a GGX conductor: the bounded cap's `GgxBoundedCap.sample(wo, [u.x, u.y, ·])`; a
+/// dielectric: `sample_d_wi(wo, u.x, u.y)`; the reflection about it) and `uc` the Fresnel
+/// event of a dielectric (reflection iff uc < F(wo·m)). Uniforms on the 2⁻²⁴ grid the crate
+/// draws on are passed through exactly.
 #[test]
 fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
     use microsurface::fresnel::fresnel_dielectric;
@@ -229,11 +237,21 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
         let wo = dir(1.4 * uniform64(&mut rng), 2.0 * PI * uniform64(&mut rng));
         let u = Vec2::new(grid(uniform32(&mut rng)), grid(uniform32(&mut rng)));
         let uc = grid(uniform32(&mut rng));
+        let m_gold = microsurface::vndf::VisibleNormalSampler::sample(
+            &microsurface::vndf::GgxBoundedCap(slope),
+            wo,
+            [u.x, u.y, 0.0],
+        );
+        let mirror_gold = 2.0 * wo.dot(m_gold) * m_gold - wo;
+        if let Some(s) = gold_b.sample(wo, uc, u) {
+            assert!(
+                (s.wi - mirror_gold).length() <= 1e-5,
+                "wo {wo}, u {u}: wi {} ≠ reflection {mirror_gold}",
+                s.wi
+            );
+        }
         let m = slope.sample_d_wi(wo, u.x, u.y);
         let mirror = 2.0 * wo.dot(m) * m - wo;
-        if let Some(s) = gold_b.sample(wo, uc, u) {
-            assert!((s.wi - mirror).length() <= 1e-5, "wo {wo}, u {u}: wi {} ≠ reflection {mirror}", s.wi);
-        }
         let f = fresnel_dielectric(wo.dot(m), ETA);
         if let Some(s) = glass_b.sample(wo, uc, u) {
             let reflected = s.wi.z > 0.0;
@@ -251,4 +269,24 @@ fn single_scattering_sample_is_driven_by_the_callers_uniforms() {
         }
     }
     assert!(reflections > 50 && refractions > 500, "{reflections} reflections, {refractions} refractions");
+}
+
+/// Single scattering is exact on conductors and dielectrics (deterministic: every key gives
+/// the same bits, `exact` is set) and stochastic on diffuse facets, as its documentation and
+/// flags say: an unbiased one-sample estimate whose value depends on the key.
+#[test]
+fn single_scattering_of_diffuse_facets_is_flagged_stochastic() {
+    let (wo, wi) = (dir(0.7, 0.2), dir(0.4, 2.5));
+    for (label, b, exact) in [
+        ("gold", &mf(ggx(0.5, 0.5), gold()).with_technique(Technique::SingleScattering) as &dyn Bsdf, true),
+        ("glass", &mf(ggx(0.5, 0.5), dielectric()).with_technique(Technique::SingleScattering), true),
+        ("diffuse", &mf(ggx(0.5, 0.5), diffuse()).with_technique(Technique::SingleScattering), false),
+    ] {
+        let values: Vec<BsdfValue> = (0..16).map(|key| b.eval_keyed(wo, wi, key)).collect();
+        assert!(values.iter().all(|v| v.exact == exact), "{label}: {values:?}");
+        let distinct = values.iter().filter(|v| v.f != values[0].f).count();
+        assert_eq!(distinct > 0, !exact, "{label}: {distinct} keys gave another value");
+        let s = b.sample(wo, 0.3, Vec2::new(0.6, 0.2)).expect("a sample");
+        assert_eq!(s.flags.exact_pdf, exact, "{label}: {s:?}");
+    }
 }

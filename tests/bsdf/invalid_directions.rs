@@ -70,11 +70,13 @@ pub(super) fn check_bad_input<B: Bsdf>(
         let both = &format!("{label}: eval_with_pdf(wi = {bad})");
         nothing_or_debug_panic(both, || b.eval_with_pdf(good_o, bad), |(v, p)| zero_f(v) && *p == 0.0);
     }
+    // (a uniform of exactly 1 is valid, taken as 1 − 2⁻²⁴: tests/invalid_input/renderer.rs)
+    let above_one = 1.0 + f32::EPSILON;
     for (uc, u) in [
-        (1.0, Vec2::new(0.5, 0.5)),
+        (above_one, Vec2::new(0.5, 0.5)),
         (-0.1, Vec2::new(0.5, 0.5)),
         (0.5, Vec2::new(f32::NAN, 0.5)),
-        (0.5, Vec2::new(0.5, 1.0)),
+        (0.5, Vec2::new(0.5, above_one)),
         (f32::INFINITY, Vec2::ZERO),
     ] {
         let s = &format!("{label}: sample(uc = {uc}, u = {u})");

@@ -39,5 +39,7 @@ mod integrator;
 mod invalid_directions;
 mod noncentral;
 mod reciprocity;
+mod roulette;
 mod shading_frame;
+mod sidedness;
 mod weights;

@@ -17,8 +17,8 @@ use microsurface::research::{Interaction, Side};
 use microsurface::research::{Material, MicrosurfaceGeometry, UniformHeight, orthonormal_basis};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
+    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope,
+    VisibleNormalSampler, smith_normalization,
 };
 use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
@@ -306,6 +306,7 @@ fn named_samplers_treat_negative_zero_like_positive_zero() {
                 c.vector1("GgxSphericalCap.sample", w, |w| {
                     GgxSphericalCap(ggx).sample(w, u).to_array().to_vec()
                 });
+                c.vector1("GgxBoundedCap.sample", w, |w| GgxBoundedCap(ggx).sample(w, u).to_array().to_vec());
                 c.vector1("GgxDisk.sample", w, |w| GgxDisk(ggx).sample(w, u).to_array().to_vec());
                 c.vector1("BeckmannNewton.sample", w, |w| {
                     BeckmannNewton(beckmann).sample(w, u).to_array().to_vec()
@@ -313,6 +314,7 @@ fn named_samplers_treat_negative_zero_like_positive_zero() {
             }
             for wm in directions() {
                 c.scalar2("GgxSphericalCap.pdf", w, wm, |a, b| GgxSphericalCap(ggx).pdf(a, b));
+                c.scalar2("GgxBoundedCap.pdf", w, wm, |a, b| GgxBoundedCap(ggx).pdf(a, b));
                 c.scalar2("GgxDisk.pdf", w, wm, |a, b| GgxDisk(ggx).pdf(a, b));
                 c.scalar2("BeckmannNewton.pdf", w, wm, |a, b| BeckmannNewton(beckmann).pdf(a, b));
             }

@@ -14,6 +14,7 @@ use glam::{DVec3, Vec2, Vec3};
 use microsurface::Elliptical;
 use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 use microsurface::leadr::Noncentral;
+use microsurface::research::Invariance;
 use microsurface::research::{
     Estimator, GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry,
     MicrosurfaceHeight, PhaseSample, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
@@ -22,8 +23,8 @@ use microsurface::research::{
 use microsurface::research::{Interaction, Side};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::vndf::{
-    BeckmannNewton, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope, VisibleNormalSampler,
-    smith_normalization,
+    BeckmannNewton, GgxBoundedCap, GgxDisk, GgxSphericalCap, SmithVndf, VCavity, VCavitySlope,
+    VisibleNormalSampler, smith_normalization,
 };
 use microsurface::{Beckmann, ComplexIor, Conductor, DIRECTION_TOLERANCE, Dielectric, Diffuse, Ggx};
 use rand::SeedableRng;
@@ -37,7 +38,7 @@ const MESSAGE: &str = "invalid input";
 
 /// Silences the panics of contract violations (they are expected by the thousand in debug
 /// builds); every other panic is reported by the default hook.
-fn quiet_violations() {
+pub(super) fn quiet_violations() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         let default = std::panic::take_hook();
@@ -57,7 +58,7 @@ fn quiet_violations() {
 
 /// The failures collected by a test, reported together at its end.
 #[derive(Default)]
-struct Report {
+pub(super) struct Report {
     checked: usize,
     failures: Vec<String>,
 }
@@ -66,11 +67,23 @@ impl Report {
     /// Checks one call with invalid input: in a debug build it must panic with the
     /// contract-violation message, in a release build it must return a value `is_nothing`
     /// accepts.
-    fn expect_nothing<T: Debug>(
+    pub(super) fn expect_nothing<T: Debug>(
         &mut self,
         label: &str,
         f: impl FnOnce() -> T,
         is_nothing: impl Fn(&T) -> bool,
+    ) {
+        self.expect_nothing_saying(label, f, is_nothing, &[]);
+    }
+
+    /// [`Report::expect_nothing`], and in a debug build the panic message must contain each of
+    /// `needles` (the argument's name and value).
+    pub(super) fn expect_nothing_saying<T: Debug>(
+        &mut self,
+        label: &str,
+        f: impl FnOnce() -> T,
+        is_nothing: impl Fn(&T) -> bool,
+        needles: &[&str],
     ) {
         self.checked += 1;
         if cfg!(debug_assertions) {
@@ -82,7 +95,7 @@ impl Report {
                         .cloned()
                         .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
                         .unwrap_or_default();
-                    if !text.starts_with(MESSAGE) {
+                    if !text.starts_with(MESSAGE) || !needles.iter().all(|n| text.contains(n)) {
                         self.failures.push(format!("{label}: panicked with an unexpected message: {text}"));
                     }
                 }
@@ -97,7 +110,12 @@ impl Report {
 
     /// Checks one call with valid input: it must not panic (in either mode) and its result must
     /// satisfy `ok`.
-    fn expect_valid<T: Debug>(&mut self, label: &str, f: impl FnOnce() -> T, ok: impl Fn(&T) -> bool) {
+    pub(super) fn expect_valid<T: Debug>(
+        &mut self,
+        label: &str,
+        f: impl FnOnce() -> T,
+        ok: impl Fn(&T) -> bool,
+    ) {
         self.checked += 1;
         match catch_unwind(AssertUnwindSafe(f)) {
             Ok(v) if ok(&v) => {}
@@ -106,7 +124,7 @@ impl Report {
         }
     }
 
-    fn finish(self, name: &str, at_least: usize) {
+    pub(super) fn finish(self, name: &str, at_least: usize) {
         println!("{name}: {} calls checked", self.checked);
         assert!(self.checked >= at_least, "{name}: only {} calls checked", self.checked);
         assert!(
@@ -312,6 +330,7 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
     let mut rng = rng();
     let surface = Microsurface::new(UniformHeight, s, m);
     let pf = |shadowing| PositionFree::new(s, m, shadowing);
+    let invariance = Invariance::new(s, m).ok();
     let all = ScatteringOrder::All;
     for b in bad_directions() {
         for (wi, wo, slot) in [(b, good(), "ωi"), (good(), b, "ωo")] {
@@ -358,6 +377,9 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
                 || surface.eval(wi, wo, ScatteringOrder::only(1).unwrap(), &mut rng),
                 zero,
             );
+            if let Some(inv) = &invariance {
+                r.expect_nothing(&format!("{l}: Invariance::eval"), || inv.eval(wi, wo, all, &mut rng), zero);
+            }
             r.expect_nothing(
                 &format!("{l}: Microsurface::eval_phase"),
                 || surface.eval_phase(wi, wo, &mut rng),
@@ -401,6 +423,13 @@ fn check_material<S: MicrosurfaceSlope, M: Material>(r: &mut Report, name: &str,
             || surface.sample(b, &mut rng),
             Option::is_none,
         );
+        if let Some(inv) = &invariance {
+            r.expect_nothing(
+                &format!("{l}: Invariance::sample"),
+                || inv.sample(b, &mut rng),
+                Option::is_none,
+            );
+        }
         r.expect_nothing(
             &format!("{l}: Microsurface::sample_phase"),
             || surface.sample_phase(b, &mut rng),
@@ -573,6 +602,7 @@ fn visible_normal_samplers() {
     check_sampler(&mut r, "SmithVndf<GGX>", SmithVndf(ggx));
     check_sampler(&mut r, "SmithVndf<Beckmann>", SmithVndf(beckmann));
     check_sampler(&mut r, "GgxSphericalCap", GgxSphericalCap(ggx));
+    check_sampler(&mut r, "GgxBoundedCap", GgxBoundedCap(ggx));
     check_sampler(&mut r, "GgxDisk", GgxDisk(ggx));
     check_sampler(&mut r, "BeckmannNewton", BeckmannNewton(beckmann));
     check_sampler(&mut r, "VCavity<GGX>", VCavity(ggx));

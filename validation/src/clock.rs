@@ -96,6 +96,17 @@ impl Measurement for Clock {
     }
 }
 
+/// The CPU time of the calling thread (Linux; the wall time since a fixed origin elsewhere):
+/// the clock of the report's efficiency table of the invariance-principle estimator, which
+/// leaves out the time the thread spends preempted on a shared machine.
+pub fn thread_time() -> Duration {
+    #[cfg(target_os = "linux")]
+    let clock = Clock::ThreadCpu;
+    #[cfg(not(target_os = "linux"))]
+    let clock = Clock::Wall;
+    clock.now()
+}
+
 /// Short runs: the matrix is large, and the whole suite should finish in a few minutes.
 pub fn config() -> Criterion<Clock> {
     Criterion::default()

@@ -17,7 +17,9 @@
 //! rectangles, the sphere, and the slope-space integrals of visible normals), one f64
 //! reference model ([`reference`](mod@reference)), one set of statistical assertions (seeded generators,
 //! Šidák-corrected z, mean within z·SE with SE small enough: the crate root), the pooling of
-//! low-expectation cells ([`chi2::pool`]), the stability study's configurations
+//! low-expectation cells ([`chi2::pool`]), the per-order albedos of the walk and the
+//! position-free models in closed form for GGX α = 1 ([`per_order`]), the stability study's
+//! configurations
 //! ([`stability`]), the LEADR validation ([`leadr`](mod@leadr)), and what the benches share
 //! (the measurement clock [`clock`], the pre-generated inputs [`inputs`], the research calls
 //! the renderer's techniques wrap [`research`]). The applications built on it (the report, the
@@ -42,6 +44,7 @@ pub mod chi2;
 pub mod clock;
 pub mod inputs;
 pub mod leadr;
+pub mod per_order;
 pub mod quadrature;
 pub mod reference;
 pub mod research;

@@ -5,7 +5,8 @@
 use glam::Vec3;
 use microsurface::Technique;
 use microsurface::research::{
-    Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, SingleScattering, UniformHeight,
+    Invariance, Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, SingleScattering,
+    UniformHeight,
 };
 use microsurface::slope::MicrosurfaceSlope;
 use rand_pcg::Pcg64Mcg;
@@ -39,6 +40,10 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
             Technique::PositionFree { estimator, shadowing } => {
                 self.pf(shadowing).eval(walk_in, walk_out, estimator, ScatteringOrder::All, rng)
             }
+            Technique::Invariance => match Invariance::new(*self.surface.slope(), *self.surface.material()) {
+                Ok(invariance) => invariance.eval(walk_in, walk_out, ScatteringOrder::All, rng),
+                Err(_) => self.surface.eval(walk_in, walk_out, ScatteringOrder::All, rng),
+            },
         }
     }
 
@@ -65,6 +70,10 @@ impl<S: MicrosurfaceSlope, M: Material> Research<S, M> {
             Technique::PositionFree { shadowing, .. } => {
                 self.pf(shadowing).sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0))
             }
+            Technique::Invariance => match Invariance::new(*self.surface.slope(), *self.surface.material()) {
+                Ok(invariance) => invariance.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
+                Err(_) => self.surface.sample(walk_in, rng).map(|s| (s.wo, s.weight, 0.0)),
+            },
         }
     }
 

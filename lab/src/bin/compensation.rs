@@ -750,7 +750,7 @@ fn main() -> std::io::Result<()> {
          runs; load average {}). The walk is the reference (error 0, its standard error is in the headers above); \
          PT and BDPT are the position-free model's estimators (Wang et al. 2022), a different model whose albedo \
          differs from the walk's by the entry. Glass: total albedo, importance transport, η = 1.5 from outside \
-         (Kulla–Conty: the walk-split KullaContyDielectric); then the larger error of R and T, views from both sides.\n",
+         (Kulla–Conty: the walk split); then the larger error of R and T, views from both sides.\n",
         s.mus,
         load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
     )

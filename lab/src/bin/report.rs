@@ -1,23 +1,25 @@
 //! The crate's main job: a report of every estimator's accuracy against run time, the lobes
 //! and energy per scattering order, and the cost of every model, measured on this machine.
 //!
-//! `cargo run --release -p lab --bin report -- [--quick] [--out DIR]` writes CSV files, SVG
-//! figures, `summary.md` and the page `index.html` into DIR (default `target/report`) and
-//! prints the summary. The stages (`lab::report`), one file each: `configure` (what and how much), `measure`
+//! `cargo run --release -p lab --bin report -- [--quick] [--out DIR] [--results FILE]` writes CSV
+//! files, SVG figures, `summary.md` and the page `index.html` into DIR (default
+//! `target/report`), prints the summary and, in a full run, rewrites the results page
+//! `docs/results.md` (or FILE) that the docs quote. The stages (`lab::report`), one file each: `configure` (what and how much), `measure`
 //! (per-sample values, timings, references, energy, lobes, cost), `reduce` (errors against
 //! time, efficiency ratios with confidence intervals, lobe panels), `plot` (SVG figures) and
 //! `write` (CSV, Markdown, HTML); `pipeline` runs them in order.
 
 use lab::report::{configure, pipeline};
 
-const USAGE: &str = "usage: cargo run --release -p lab --bin report -- [--quick] [--out DIR]
+const USAGE: &str = "usage: cargo run --release -p lab --bin report -- [--quick] [--out DIR] [--results FILE]
 
-  --quick    a small run (seconds instead of minutes)
-  --out DIR  output directory (default target/report)
-  --help     print this message
+  --quick         a small run (seconds instead of minutes); leaves the results page alone
+  --out DIR       output directory (default target/report)
+  --results FILE  where a full run writes the results page (default docs/results.md)
+  --help          print this message
 
-Writes CSV files, SVG figures, summary.md and index.html into DIR and prints the summary. A
-progress bar goes to stderr when it is a terminal.";
+Writes CSV files, SVG figures, summary.md and index.html into DIR, prints the summary and, in a
+full run, rewrites the results page. A progress bar goes to stderr when it is a terminal.";
 
 /// Prints the usage and the problem to stderr and exits with status 2.
 fn usage_error(problem: &str) -> ! {
@@ -34,12 +36,17 @@ fn options() -> Option<configure::Options> {
         out_dir: configure::default_out_dir(),
         threads: std::thread::available_parallelism().map_or(2, |n| n.get()),
         progress: std::io::stderr().is_terminal(),
+        results_page: None,
     };
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--quick" => opts.size = configure::RunSize::Quick,
             "--out" => {
                 opts.out_dir = args.next().unwrap_or_else(|| usage_error("--out needs a directory")).into()
+            }
+            "--results" => {
+                opts.results_page =
+                    Some(args.next().unwrap_or_else(|| usage_error("--results needs a file")).into())
             }
             "-h" | "--help" => {
                 println!("{USAGE}");

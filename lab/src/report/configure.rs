@@ -22,6 +22,8 @@ pub struct Options {
     pub threads: usize,
     /// Print a progress bar on stderr (`main` sets it only when stderr is a terminal).
     pub progress: bool,
+    /// Where a full run writes the results page (`None`: `docs/results.md`).
+    pub results_page: Option<PathBuf>,
 }
 
 /// How much a run computes.

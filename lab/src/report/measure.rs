@@ -144,7 +144,7 @@ fn table_errors(opts: &Options, budget: &Budget) -> Vec<TableCurve> {
 }
 
 /// Runs `jobs` on `threads` workers, reporting progress on stderr.
-fn parallel<T: Send, R: Send>(
+pub(crate) fn parallel<T: Send, R: Send>(
     label: &str,
     jobs: Vec<T>,
     opts: &Options,

@@ -6,12 +6,16 @@
 //! values, timings, references, energy, lobes, cost), [`reduce`] (errors against time,
 //! efficiency ratios with confidence intervals, lobe panels), [`tables`] (the albedo tables'
 //! interpolation error), [`plot`] (SVG figures) and
-//! [`write`](mod@write) (CSV, Markdown, HTML); [`pipeline`] runs them in order.
+//! [`write`](mod@write) (CSV, Markdown, HTML); [`pipeline`] runs them in order, then the
+//! efficiency table of the invariance-principle estimator ([`invariance`](mod@invariance)); a
+//! full run rewrites the results page `docs/results.md` ([`results_page`]).
 
 pub mod configure;
+pub mod invariance;
 pub mod measure;
 pub mod pipeline;
 pub mod plot;
 pub mod reduce;
+pub mod results_page;
 pub mod tables;
 pub mod write;

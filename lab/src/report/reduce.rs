@@ -127,7 +127,7 @@ impl Results {
 }
 
 /// The sample mean and variance.
-fn mean_and_variance(values: &[f32]) -> (f64, f64) {
+pub(crate) fn mean_and_variance(values: &[f32]) -> (f64, f64) {
     let n = values.len() as f64;
     let mean = values.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
     let var = values.iter().map(|&v| (f64::from(v) - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
@@ -137,7 +137,7 @@ fn mean_and_variance(values: &[f32]) -> (f64, f64) {
 /// The standard error of the sample variance: the standard deviation of the squared
 /// deviations (x − mean)² over √n (delta method; it needs a finite fourth moment, so for
 /// heavy-tailed estimators it is itself uncertain).
-fn variance_se(values: &[f32], mean: f64) -> f64 {
+pub(crate) fn variance_se(values: &[f32], mean: f64) -> f64 {
     let n = values.len() as f64;
     let sq: Vec<f64> = values.iter().map(|&v| (f64::from(v) - mean).powi(2)).collect();
     let m = sq.iter().sum::<f64>() / n;
@@ -207,7 +207,7 @@ pub fn reduce(m: Measurements) -> Results {
 }
 
 /// Relative variance of an estimate's value: (se/x)².
-fn rel2(x: f64, se: f64) -> f64 {
+pub(crate) fn rel2(x: f64, se: f64) -> f64 {
     if x != 0.0 { (se / x).powi(2) } else { 0.0 }
 }
 

@@ -241,7 +241,7 @@ fn lobe_table(results: &Results) -> Table {
 }
 
 /// (name, value) of the machine the report ran on.
-fn machine(threads: usize) -> Vec<(&'static str, String)> {
+pub(crate) fn machine(threads: usize) -> Vec<(&'static str, String)> {
     let read = |p: &str| std::fs::read_to_string(p).unwrap_or_default();
     let cpu = read("/proc/cpuinfo")
         .lines()

@@ -21,7 +21,7 @@ use glam::Vec3;
 
 /// The Halley–bisection iteration stops once its step is below this fraction of 1 + |x̃| (about
 /// the f32 resolution of x̃). The error after that step is of order C·step² or less, where C, the
-/// inverse of the lobe's width, reaches |cot θ| far below the horizon (see DESIGN.md for why not
+/// inverse of the lobe's width, reaches |cot θ| far below the horizon (see DESIGN.md, “Halley steps”, for why not
 /// looser).
 const HALLEY_TOLERANCE: f64 = 1e-7;
 /// Halley's step n/(1 − c) is taken only for |c| up to this (else Newton's step n): it then

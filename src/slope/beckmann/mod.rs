@@ -1,6 +1,6 @@
 //! The Beckmann slope distribution.
 
-use super::{MicrosurfaceSlope, check_roughness, is_direction, is_direction64, is_uniform};
+use super::{MicrosurfaceSlope, check_roughness, is_direction, is_uniform};
 use crate::constants::INV_SQRT_PI;
 use crate::error::Error;
 use crate::special::{
@@ -214,20 +214,8 @@ impl MicrosurfaceSlope for Beckmann {
     }
 
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        require!(is_direction64(wm), 0.0; wm);
-        self.d64_unchecked(wm)
-    }
-
-    #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
         self.d_double(wm)
-    }
-
-    #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.lambda_unchecked(w)
     }
 
     /// Formed from the fits of [`lambda_from_fits`] (within 0.51 f32 ulp of Λ, saturating at
@@ -265,12 +253,6 @@ impl MicrosurfaceSlope for Beckmann {
     }
 
     #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.projected_area_unchecked(w)
-    }
-
-    #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         self.projected_area_double(w) as f32
     }
@@ -287,12 +269,6 @@ impl MicrosurfaceSlope for Beckmann {
     fn d_wi(&self, wi: Vec3, wm: Vec3) -> f32 {
         require!(is_direction(wi) && is_direction(wm), 0.0; wi, wm);
         self.d_wi64_unchecked(wi, wm.as_dvec3()) as f32
-    }
-
-    #[inline]
-    fn d_wi64(&self, wi: Vec3, wm: DVec3) -> f64 {
-        require!(is_direction(wi) && is_direction64(wm), 0.0; wi, wm);
-        self.d_wi64_unchecked(wi, wm)
     }
 
     #[inline]
@@ -321,12 +297,6 @@ impl MicrosurfaceSlope for Beckmann {
     /// precision: far below the horizon the visible slopes lie within about 1/|cot θ| of it, so
     /// an f32 rounding of cot θ (relative 6e-8) would shift them by a visible fraction of
     /// their spread (5 % at |cot θ| = 480).
-    #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
-        self.sample_d_wi_unchecked(wi, u1, u2)
-    }
-
     #[inline]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_visible_normal(self, wi, u1, u2)

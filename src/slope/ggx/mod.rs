@@ -1,15 +1,16 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
 use super::{
-    MicrosurfaceSlope, check_roughness, is_direction, is_direction64, is_uniform, projected_roughness_sq,
-    reflection_density64, smith_d_wi64,
+    MicrosurfaceSlope, check_roughness, is_direction, is_uniform, projected_roughness_sq,
+    reflection_density64_over, smith_d_wi64,
 };
 use crate::error::Error;
 mod visible;
 
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
-use visible::{sample_spherical_cap, sample_visible_hemisphere};
+use visible::{bounded_area, sample_spherical_cap, sample_visible_hemisphere};
+pub(crate) use visible::{cap_bound, sample_bounded_cap};
 
 /// 1/(4π), the constant of the reflection density D(ωh)/(4 A(ωi)).
 const FRAC_1_4PI: f32 = 0.25 * FRAC_1_PI;
@@ -149,12 +150,6 @@ impl MicrosurfaceSlope for Ggx {
     }
 
     #[inline]
-    fn d64(&self, wm: DVec3) -> f64 {
-        require!(is_direction64(wm), 0.0; wm);
-        self.d64_unchecked(wm)
-    }
-
-    #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
         if wm.z <= 0.0 {
             return 0.0;
@@ -218,12 +213,6 @@ impl MicrosurfaceSlope for Ggx {
     }
 
     #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.lambda_unchecked(w)
-    }
-
-    #[inline]
     fn lambda_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         // Λ of the upper hemisphere at |cos θ|: z = −0 is the horizon seen from above, like +0
@@ -236,12 +225,6 @@ impl MicrosurfaceSlope for Ggx {
     /// equivalent αᵢ² sin²θ / (2(√(cos²θ + αᵢ² sin²θ) − cos θ)) below it, which has no
     /// cancellation there.
     #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        require!(is_direction(w), f32::NAN; w);
-        self.projected_area_unchecked(w)
-    }
-
-    #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         let root = (w.z * w.z + q).sqrt();
@@ -252,12 +235,6 @@ impl MicrosurfaceSlope for Ggx {
     /// spherical cap, unstretch (Dupuy and Benyoub 2023, with the cap z > −ωi.z, which is
     /// also valid for ωi.z < 0). The stretched ωi is not normalized: the cap is sampled at its
     /// scale (a square root, no division).
-    #[inline]
-    fn sample_d_wi(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        require!(is_direction(wi) && is_uniform(u1) && is_uniform(u2), Vec3::NAN; wi, u1, u2);
-        self.sample_d_wi_unchecked(wi, u1, u2)
-    }
-
     #[inline(always)]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_spherical_cap(self, wi, u1, u2)
@@ -274,17 +251,46 @@ impl MicrosurfaceSlope for Ggx {
     /// 2⁻¹⁰⁰ (subnormal terms) or the result is not a normal f32, the f64 form serves.
     #[inline(always)]
     fn reflection_density_unchecked(&self, wi: Vec3, wo: Vec3) -> f32 {
+        self.reflection_density_over(wi, wo, self.projected_area_unchecked(wi))
+    }
+
+    /// [`Self::reflection_density_unchecked`]'s f32 form with the given area.
+    #[inline(always)]
+    fn reflection_density_over_unchecked(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
+        self.reflection_density_over(wi, wo, area)
+    }
+
+    /// The bounded cap of Eto and Tokuyoshi 2023 ([`GgxBoundedCap`](crate::GgxBoundedCap)),
+    /// with its bounded projected area A_b = (L + k ωi.z)/2 (eq. 8).
+    #[inline(always)]
+    fn sample_mirror_normal_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        (sample_bounded_cap(self, wi, u1, u2), bounded_area(self, wi))
+    }
+
+    #[inline(always)]
+    fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
+        bounded_area(self, wi)
+    }
+}
+
+impl Ggx {
+    /// D(ωh)/(4 `area`) in f32 from the unnormalized sum h = ωi + ωo (see
+    /// [`MicrosurfaceSlope::reflection_density_unchecked`], which passes A(ωi); the bounded cap
+    /// passes its A_b), with the f64 form where a term is subnormal or the result is not a
+    /// normal f32.
+    #[inline(always)]
+    pub(crate) fn reflection_density_over(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
         let h = wi + wo;
         let (x, y) = (h.x / ax, h.y / ay);
         let t = x * x + y * y + h.z * h.z;
         let len_sq = h.length_squared();
         let ratio = len_sq / t;
-        let density = FRAC_1_4PI * (ratio * ratio) / (ax * ay * self.projected_area_unchecked(wi));
+        let density = FRAC_1_4PI * (ratio * ratio) / (ax * ay * area);
         if len_sq >= F32_DENSITY_MIN_SUM && t >= F32_DENSITY_MIN_SUM && density.is_normal() {
             density
         } else {
-            reflection_density64(self, wi, wo)
+            reflection_density64_over(self, wi, wo, area)
         }
     }
 }

@@ -4,10 +4,12 @@
 //! for instruction counts under `valgrind --tool=callgrind` (run it with two call counts and
 //! take the difference per call, which removes the start-up cost).
 //!
-//! `pt` and `bdpt` run the position-free estimators (correlated shadowing) on the same
-//! configuration instead; an optional last argument replaces α = 0.5.
+//! `eval_inside` evaluates with ωo at θ = π − 0.6, φ = 3.5 instead (the listing's dielectric
+//! transmission, `eval_inside` in the bench group). `pt` and `bdpt` run the position-free
+//! estimators (correlated shadowing) on the same configuration instead; an optional last
+//! argument replaces α = 0.5.
 //!
-//! Usage: `profile_listing {conductor|diffuse|dielectric} {ggx|beckmann} {eval|sample|pt|bdpt} calls [α]`
+//! Usage: `profile_listing {conductor|diffuse|dielectric} {ggx|beckmann} {eval|eval_inside|sample|pt|bdpt} calls [α]`
 
 use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
@@ -29,12 +31,18 @@ fn run<S: MicrosurfaceSlope, M: Material>(slope: S, material: M, what: &str, cal
     let surface = Microsurface::new(UniformHeight, slope, material);
     let position_free = PositionFree::new(slope, material, Shadowing::Correlated);
     let (wi, wo) = (spherical(0.5, 0.0), spherical(0.8, 3.5));
+    let wo_inside = spherical(2.541_592_653_589_793, 3.5);
     let mut rng = Pcg64Mcg::seed_from_u64(6000);
     let mut sum = 0.0f64;
     for _ in 0..calls {
         sum += f64::from(match what {
             "eval" => {
                 black_box(&surface).eval(black_box(wi), black_box(wo), ScatteringOrder::All, &mut rng).x
+            }
+            "eval_inside" => {
+                black_box(&surface)
+                    .eval(black_box(wi), black_box(wo_inside), ScatteringOrder::All, &mut rng)
+                    .x
             }
             "sample" => black_box(&surface).sample(black_box(wi), &mut rng).map_or(0.0, |s| s.weight.x),
             "pt" => {
@@ -59,7 +67,7 @@ fn main() {
         [_, m, s, w, c] => (m, s, w, c, 0.5),
         [_, m, s, w, c, a] => (m, s, w, c, a.parse().expect("a roughness")),
         _ => panic!(
-            "usage: profile_listing {{conductor|diffuse|dielectric}} {{ggx|beckmann}} {{eval|sample|pt|bdpt}} calls [α]"
+            "usage: profile_listing {{conductor|diffuse|dielectric}} {{ggx|beckmann}} {{eval|eval_inside|sample|pt|bdpt}} calls [α]"
         ),
     };
     let calls: u64 = calls.parse().expect("a call count");

@@ -365,13 +365,6 @@ pub(crate) fn renormalized(w: Vec3) -> Vec3 {
     if is_direction(w) { w } else { renormalize_drifted(w).unwrap_or(w) }
 }
 
-/// Whether a direction is accepted by the renderer layer (within [`BSDF_DIRECTION_TOLERANCE`]),
-/// without a debug assertion: for the wrappers that hand invalid input on to an inner lobe,
-/// whose own check reports it.
-#[inline(always)]
-pub(crate) fn valid_direction(w: Vec3) -> bool {
-    is_direction(w) || renormalize_drifted(w).is_some()
-}
 
 /// Whether the caller's uniforms all lie in [0, 1) (NaN fails): the fast path of
 /// [`unit_view!`].
@@ -408,9 +401,3 @@ fn clamp_ones(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
     })
 }
 
-/// Whether the caller's uniforms are accepted (in [0, 1]), without a debug assertion: for the
-/// wrappers that hand invalid input on to an inner lobe, whose own check reports it.
-#[inline(always)]
-pub(crate) fn valid_uniforms(uc: f32, u: Vec2) -> bool {
-    are_unit_uniforms(uc, u) || clamp_ones(uc, u).is_some()
-}

@@ -27,7 +27,7 @@ use super::compensated::{Compensated, Compensation, CompensatedMaterial};
 use super::conductor_tables::ConductorTables;
 use super::fresnel_average::fresnel_average;
 use super::shared::{Shared, mixture_sample};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, valid_direction, valid_uniforms};
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
 use crate::bsdf::MicrofacetBsdf;
 use crate::compensation::AlbedoTabulated;
 use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, ORDER_TABLE_SIZE, node_cell};
@@ -372,6 +372,9 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     }
 }
 
+/// The value of invalid arguments (the documented nothing of [`Bsdf::eval`]).
+const NOTHING: BsdfValue = BsdfValue { f: Vec3::ZERO, exact: true };
+
 impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
     #[inline]
     fn flags(&self) -> BsdfFlags {
@@ -380,10 +383,11 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
-        if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
-            return self.single.eval_keyed(wo, wi, key);
-        }
+        unit_directions!(wo, wi, NOTHING, self.eval_keyed(wo, wi, key));
         let v = self.single.eval_valid(wo, wi, key);
+        if self.single.is_specular() {
+            return v;
+        }
         let f = match self.scheme {
             Compensation::Turquin => v.f * self.lobes.turquin_factor(self.lobes.view_complement(wo)),
             scheme => v.f + self.lobes.added(scheme, wo.z, wi.z),
@@ -393,6 +397,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, key));
         let lobes = &self.lobes;
         if self.scheme == Compensation::Turquin {
             let mut s = self.single.sample_keyed(wo, uc, u, key)?;
@@ -401,7 +406,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
             }
             return if s.weight.is_finite() { Some(s) } else { None };
         }
-        if !self.mixes(wo) || !valid_direction(wo) || !valid_uniforms(uc, u) {
+        if !self.mixes(wo) {
             return self.single.sample_keyed(wo, uc, u, key);
         }
         let p = lobes.single_share(wo.z);
@@ -433,9 +438,9 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
 
     #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe,
-        // whose pdf validates the directions
-        if !self.mixes(wo) || !valid_direction(wo) || !valid_direction(wi) || wi.z <= 0.0 {
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
+        // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe
+        if !self.mixes(wo) || wi.z <= 0.0 {
             // (a light below the horizon: single scattering's density, 0 for a view from above
             // — the mixture's p·0 + q·0)
             return self.single.pdf(wo, wi);
@@ -449,8 +454,9 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        unit_directions!(wo, wi, (NOTHING, 0.0), self.eval_with_pdf_keyed(wo, wi, key));
         let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-        if self.single.is_specular() || !valid_direction(wo) || !valid_direction(wi) {
+        if self.single.is_specular() {
             return (v, pdf_ss);
         }
         let lobes = &self.lobes;

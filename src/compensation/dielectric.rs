@@ -49,8 +49,7 @@ use super::compensated::{Compensated, Compensation, CompensatedMaterial};
 use super::glass_tables::{GlassSide, GlassTables};
 use super::lobe_profile::mu_cell;
 use super::shared::{ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, valid_direction};
-use crate::bsdf::valid_uniforms;
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, unit_directions, unit_view};
 use crate::compensation::AlbedoTabulated;
 use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable, MAX_TABULATED_ETA,
@@ -383,7 +382,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
     /// horizon.
     #[inline(always)]
     fn compensates(&self, wo: Vec3, wi: Vec3) -> bool {
-        self.lobes.active && valid_direction(wo) && valid_direction(wi) && wo.z != 0.0 && wi.z != 0.0
+        self.lobes.active && wo.z != 0.0 && wi.z != 0.0
     }
 
     /// Turquin's factor 1/E(μo) for the view `wo` (1 on the horizon, where f_ss = 0).
@@ -413,6 +412,9 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
     }
 }
 
+/// The value of invalid arguments (the documented nothing of [`Bsdf::eval`]).
+const NOTHING: BsdfValue = BsdfValue { f: Vec3::ZERO, exact: true };
+
 impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
     #[inline]
     fn flags(&self) -> BsdfFlags {
@@ -421,22 +423,21 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
 
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
+        unit_directions!(wo, wi, NOTHING, self.eval_keyed(wo, wi, key));
         if self.scheme == Compensation::Turquin {
-            if !valid_direction(wo) || !valid_direction(wi) {
-                return self.single.eval_keyed(wo, wi, key);
-            }
             return Self::scaled(self.single.eval_valid(wo, wi, key), self.turquin_factor(wo));
         }
-        if !self.compensates(wo, wi) {
-            return self.single.eval_keyed(wo, wi, key);
-        }
         let v = self.single.eval_valid(wo, wi, key);
+        if !self.compensates(wo, wi) {
+            return v;
+        }
         let f = self.lobes.added(side_of(wo), crossing(wo, wi), wo.z.abs(), wi.z.abs());
         BsdfValue { f: v.f + Vec3::splat(f), exact: true }
     }
 
     #[inline]
     fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, key));
         if self.scheme == Compensation::Turquin {
             let s = self.single.sample_keyed(wo, uc, u, key)?;
             if s.flags.specular {
@@ -446,7 +447,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
             return weight.is_finite().then_some(BsdfSample { weight, ..s });
         }
         let lobes = &self.lobes;
-        if !lobes.active || !valid_direction(wo) || !valid_uniforms(uc, u) || wo.z == 0.0 {
+        if !lobes.active || wo.z == 0.0 {
             return self.single.sample_keyed(wo, uc, u, key);
         }
         let a = side_of(wo);
@@ -483,6 +484,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
 
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
         if self.scheme == Compensation::Turquin || !self.compensates(wo, wi) {
             return self.single.pdf(wo, wi);
         }
@@ -493,11 +495,9 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        unit_directions!(wo, wi, (NOTHING, 0.0), self.eval_with_pdf_keyed(wo, wi, key));
         let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
         if self.scheme == Compensation::Turquin {
-            if !valid_direction(wo) {
-                return (v, pdf_ss);
-            }
             return (Self::scaled(v, self.turquin_factor(wo)), pdf_ss);
         }
         if !self.compensates(wo, wi) {

@@ -172,7 +172,8 @@ fn average_albedo_matches_cosine_weighted_monte_carlo() {
 #[test]
 fn first_order_of_the_random_walk_equals_the_table() {
     // the walk's order-1 energy is the single-scattering albedo: an estimate by another model
-    let cases = [(0usize, 31usize, 31usize), (0, 12, 20), (1, 31, 16), (1, 6, 9)];
+    let last = ALBEDO_DIRECTIONS - 1;
+    let cases = [(0usize, last, ALBEDO_ROUGHNESSES - 1), (0, 36, 20), (1, last, 16), (1, 18, 9)];
     let z = family_z(FAMILY_ALPHA, cases.len());
     let results = par_map(&cases, |k, &(family, i, j)| {
         let (mu, alpha) = node_coordinates(i, j);

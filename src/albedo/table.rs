@@ -3,9 +3,9 @@
 use super::generated::conductor as data;
 
 /// Direction nodes of a roughness row of [`AlbedoTable`] (x = i/93).
-pub const ALBEDO_DIRECTIONS: usize = 32;
+pub const ALBEDO_DIRECTIONS: usize = 94;
 
-/// Roughness rows of [`AlbedoTable`] (r = √α = j/62), and nodes of its E_avg.
+/// Roughness rows of [`AlbedoTable`] (r = √α = j/31), and nodes of its E_avg.
 pub const ALBEDO_ROUGHNESSES: usize = 32;
 
 /// The largest roughness α the tables cover (their roughness axis is r = √α ∈ [0, 1]).
@@ -30,7 +30,7 @@ pub(crate) enum Family {
 /// G2 = 1/(1 + Λ(ωi) + Λ(ωo)) (Heitz 2014; the first order of the random walk of Heitz et al.
 /// 2016), and its cosine-weighted average E_avg(α) = 2 ∫₀¹ E(μ) μ dμ (Kulla and Conty 2017).
 ///
-/// **Axes.** Roughness r = √α ∈ [0, 1] (as in Cycles' tables), 62 equal steps. The direction
+/// **Axes.** Roughness r = √α ∈ [0, 1] (as in Cycles' tables), 31 equal steps. The direction
 /// axis is scale-invariant: node x ∈ [0, 1] holds μ = X α / (1 + α − X) with X = x², so that the
 /// sharp feature of E at μ ≈ α (E(0) = 1: a grazing ray sees the top of the surface, from
 /// which every reflection escapes, and E dips to ≈ 0.89 at μ ≈ α) is resolved at every α; the
@@ -115,7 +115,7 @@ impl AlbedoTable {
     }
 
     /// The raw node values of E, row-major with the roughness index slowest
-    /// (`values[j * 94 + i]` at x = i/93, r = j/62), for export to shaders.
+    /// (`values[j * 94 + i]` at x = i/93, r = j/31), for export to shaders.
     #[must_use]
     pub fn directional_nodes(&self) -> &'static [f32] {
         self.directional
@@ -138,14 +138,14 @@ impl AlbedoTable {
         self.family
     }
 
-    /// The raw node values of E_avg at r = j/62.
+    /// The raw node values of E_avg at r = j/31.
     #[must_use]
     pub fn average_nodes(&self) -> &'static [f32] {
         self.average
     }
 }
 
-/// Bilinear interpolation of the row-major grid at fractional indices (i, j) ∈ [0, 93] × [0, 62].
+/// Bilinear interpolation of the row-major grid at fractional indices (i, j) ∈ [0, 93] × [0, 31].
 #[inline(always)]
 fn bilinear(grid: &[f32; ALBEDO_DIRECTIONS * ALBEDO_ROUGHNESSES], i: f32, j: f32) -> f32 {
     let (i0, fi) = super::node_cell(i, ALBEDO_DIRECTIONS);

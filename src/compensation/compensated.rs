@@ -10,12 +10,24 @@ use crate::slope::MicrosurfaceSlope;
 
 /// How a [`Compensated`] BSDF restores the energy single scattering loses. Every scheme
 /// applies to conductors and to dielectrics; each is the same idea for both.
+///
+/// **The default** is [`Compensation::Walk`] for both materials, the scheme with the lowest
+/// measured error against the random walk (`lab --bin compensation`: GGX, albedo per RGB
+/// channel over 8 α × 8 μo, 10⁵ samples per cell, gold, copper, aluminium and F = 1):
+///
+/// | largest albedo error | `Walk` | `KullaConty` | `Turquin` |
+/// |---|---|---|---|
+/// | conductor, F = 1 | «WF1» | «KF1» | «TF1» |
+/// | coloured conductors, max / RMS | «WC» | «KC» | «TC» |
+/// | glass, R and T of either side | «WG» | (= `Walk`) | «TG» |
+///
+/// For F = 1 `Walk` and `KullaConty` are the same lobe. For coloured metals `Walk` follows the
+/// walk's split of the loss by order («WHI» at α ≥ 0.5, against «KHI» for `KullaConty`); both
+/// miss the grazing-facet Fresnel of the higher orders at small α and grazing views.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Compensation {
-    /// The random walk's higher orders, tabulated (the default: the lowest error against the
-    /// walk the crate measured, for coloured conductors and for glass alike;
-    /// `lab --bin compensation`), added as reciprocal separable lobes g(μo) g(μi)/(π ḡ) whose
-    /// albedo is the tabulated energy.
+    /// The random walk's higher orders, tabulated (the default), added as reciprocal separable
+    /// lobes g(μo) g(μi)/(π ḡ) whose albedo is the tabulated energy.
     ///
     /// Conductors: per RGB channel g(μ) = (1 − E(μ)) Σ_k φ_k(μ) F̄ᵏ, the single-scattering
     /// loss split over the orders k = 2 … 6 by the F = 1 walk's fractions φ_k
@@ -79,10 +91,12 @@ pub trait CompensatedMaterial: Material + SpecularLimit {
 ///
 /// **Built per hit.** Construction reads shared tables (the shipped albedo tables and what
 /// is derived from them once, on first use, per slope family) and computes a few per-hit
-/// scalars: no per-instance table, no heap allocation, a few tens of nanoseconds (`README.md`
-/// has the criterion figures against the calls of a prebuilt BSDF), so a renderer builds it at
-/// every hit from textured parameters, as pbrt-v4's `GetBxDF`. The type is `Copy` and small
-/// (`size_of`: 136 bytes for GGX gold, 208 for GGX glass, `tests/compensated_per_hit.rs`).
+/// scalars: no per-instance table, no heap allocation, so that a renderer builds it at
+/// every hit from textured parameters, as pbrt-v4's `GetBxDF` (the cost of construction
+/// against the calls of a prebuilt BSDF is in `DESIGN.md`, "Speed of the compensated lobes").
+/// The type is `Copy` and small: `size_of` is 224 bytes for a GGX conductor, 272 for GGX glass,
+/// 240 and 304 on Beckmann slopes (`tests/per_hit.rs`; the single-scattering
+/// [`MicrofacetBsdf`] inside takes 128, 40, 144 and «BD» of them).
 ///
 /// **Tables.** The tables are read at α = √(αx αy) (an anisotropic surface is compensated as
 /// the isotropic surface of the same slope area: an approximation that restores about half of

@@ -35,13 +35,12 @@ const N: usize = 32;
 /// Direction nodes of the conductor albedo table (x = i/93: every third one a node of the
 /// per-order tables).
 const NX: usize = 94;
-/// Roughness nodes of the conductor albedo table (r = j/62: every second one a row of the
-/// per-order tables).
-const NR: usize = 63;
+/// Roughness nodes of the conductor albedo table (r = j/31: the rows of the per-order tables).
+const NR: usize = 32;
 /// The roughness at which the r = 0 row (the α → 0 limit profile) is evaluated.
 const ALPHA_LIMIT: f64 = 1e-6;
 /// Quadrature panels per variable for the shipped values, and for the error estimate.
-const PANELS: usize = 12;
+const PANELS: usize = 8;
 const CHECK_PANELS: usize = 6;
 /// Largest accepted disagreement of the two resolutions.
 const MAX_QUADRATURE_ERROR: f64 = 1e-6;
@@ -198,13 +197,7 @@ fn interpolation_error(family: Family) -> Vec<(Probe, f64, f64, (f64, f64))> {
     }
     let errors = par_map(points.len(), &format!("{} interpolation", family.name()), |k| {
         let (_, x, r) = points[k];
-        let alpha = (r * r).max(ALPHA_LIMIT);
-        let mu = mu_of(x, alpha);
-        // the lookup at the f32 coordinates, the quadrature at the same (f32) values
-        let (mu32, alpha32) = (mu as f32, alpha as f32);
-        let exact = single_scattering_albedo(family, f64::from(mu32), f64::from(alpha32), CHECK_PANELS);
-        let e = (f64::from(table.directional(mu32, alpha32).expect("in range")) - exact).abs();
-        (e, (f64::from(mu32), f64::from(alpha32)))
+        probe_error(family, x, r)
     });
     [Probe::Centre, Probe::DirectionEdge, Probe::RoughnessEdge]
         .into_iter()
@@ -216,6 +209,30 @@ fn interpolation_error(family: Family) -> Vec<(Probe, f64, f64, (f64, f64))> {
             (probe, worst.0, rms, worst.1)
         })
         .collect()
+}
+
+/// The largest interpolation error of E the shipped tables' documentation states (cell centres
+/// and edge midpoints, from `--interpolation`): GGX, Beckmann. `--quick` checks probes against it.
+const STATED_E_ERROR: [f64; 2] = [STATED_GGX, STATED_BECKMANN];
+const STATED_GGX: f64 = 1.2e-3;
+const STATED_BECKMANN: f64 = 1.2e-3;
+/// Probes of the interpolation error recomputed by `--quick` per family.
+const QUICK_PROBES: usize = 12;
+
+/// Quadrature panels of the dense check's reference values (`--quick` measures their own error
+/// against [`CHECK_PANELS`] at its probes).
+const DENSE_PANELS: usize = 4;
+
+/// |E interpolated − E by quadrature| at the direction and roughness coordinates (x, r), and the
+/// (μ, α) of the point: the lookup at the f32 coordinates, the quadrature at the same values.
+fn probe_error(family: Family, x: f64, r: f64) -> (f64, (f64, f64)) {
+    let table = table_of(family);
+    let alpha = (r * r).max(ALPHA_LIMIT);
+    let mu = mu_of(x, alpha);
+    let (mu32, alpha32) = (mu as f32, alpha as f32);
+    let exact = single_scattering_albedo(family, f64::from(mu32), f64::from(alpha32), DENSE_PANELS);
+    let e = (f64::from(table.directional(mu32, alpha32).expect("in range")) - exact).abs();
+    (e, (f64::from(mu32), f64::from(alpha32)))
 }
 
 /// The interpolation error of E_avg at the midpoints between its nodes against quadrature.
@@ -278,11 +295,11 @@ fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result
 fn write_readme(dir: &std::path::Path) -> std::io::Result<()> {
     let mut readme = String::from(
         "Little-endian f32 arrays, no header.\n\n\
-         <family>_directional.f32: 63 x 94 values E[j][i], j (roughness) slowest.\n\
-         r = j/62, alpha = r^2 (row j = 0: the alpha -> 0 limit profile); x = i/93,\n\
+         <family>_directional.f32: 32 x 94 values E[j][i], j (roughness) slowest.\n\
+         r = j/31, alpha = r^2 (row j = 0: the alpha -> 0 limit profile); x = i/93,\n\
          mu = X alpha/(1 + alpha - X) with X = x^2. Lookup of (mu, alpha):\n\
-         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), bilinear in (x, r) at (93 x, 62 r).\n\
-         <family>_average.f32: 63 values E_avg[j] at r = j/62, linear in r.\n\n\
+         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), bilinear in (x, r) at (93 x, 31 r).\n\
+         <family>_average.f32: 32 values E_avg[j] at r = j/31, linear in r.\n\n\
          <family>_dielectric_<side>_<reflected|transmitted>.f32: 16 x 16 x 16 values V[l][j][i],\n\
          l (eta) slowest, i (direction) fastest: the single-scattering reflected / transmitted\n\
          (flux) albedo of a dielectric with light from <side> (outside: relative index eta;\n\
@@ -476,6 +493,7 @@ fn dielectric_export(
 fn quick() {
     let mut state = 0x9e37_79b9_7f4a_7c15_u64;
     let mut failures = 0;
+    let mut dense_reference: f64 = 0.0;
     for family in [Family::Ggx, Family::Beckmann] {
         let table = table_of(family);
         for _ in 0..QUICK_CELLS {
@@ -486,6 +504,25 @@ fn quick() {
             if value.to_bits() != shipped.to_bits() {
                 failures += 1;
                 println!("{} node {k}: recomputed {value:?}, shipped {shipped:?}", family.name());
+            }
+        }
+        // the dense check's probes: a cell centre or an edge midpoint of a pseudo-random cell
+        for _ in 0..QUICK_PROBES {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            let (i, j) = ((state >> 33) as usize % (NX - 1), (state >> 45) as usize % (NR - 1));
+            let (x, r) = match (state >> 60) % 3 {
+                0 => (i as f64 + 0.5, j as f64 + 0.5),
+                1 => (i as f64 + 0.5, j as f64),
+                _ => (i as f64, j as f64 + 0.5),
+            };
+            let (x, r) = (x / (NX - 1) as f64, r / (NR - 1) as f64);
+            let (e, (mu, alpha)) = probe_error(family, x, r);
+            let reference = |panels| single_scattering_albedo(family, mu, alpha, panels);
+            dense_reference = dense_reference.max((reference(DENSE_PANELS) - reference(CHECK_PANELS)).abs());
+            let stated = STATED_E_ERROR[usize::from(family == Family::Beckmann)];
+            if e > stated {
+                failures += 1;
+                println!("{} E at μ {mu:.5}, α {alpha:.5}: interpolation error {e:.2e} > {stated:.1e}", family.name());
             }
         }
         let j = (state >> 40) as usize % NR;
@@ -499,6 +536,11 @@ fn quick() {
             );
         }
     }
+    println!(
+        "conductor E: {} probes of the interpolation error within the stated bound; the dense check's \
+         {DENSE_PANELS}-panel reference within {dense_reference:.1e} of {CHECK_PANELS} panels there",
+        2 * QUICK_PROBES
+    );
     let mut dielectric_nodes = 0;
     for family in [Family::Ggx, Family::Beckmann] {
         let table = dielectric_table_of(family);

@@ -77,7 +77,8 @@ const BOUND_TOLERANCE: f64 = 1.0 / 1_048_576.0; // 2⁻²⁰
 ///
 /// # Examples
 /// ```
-/// use microsurface::{Ggx, GgxBoundedCap, GgxSphericalCap, VisibleNormalSampler};
+/// use microsurface::Ggx;
+/// use microsurface::vndf::{GgxBoundedCap, GgxSphericalCap, VisibleNormalSampler};
 /// use microsurface::glam::Vec3;
 /// let ggx = Ggx::isotropic(0.8)?;
 /// let (bounded, cap) = (GgxBoundedCap(ggx), GgxSphericalCap(ggx));

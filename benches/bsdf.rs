@@ -24,9 +24,9 @@
 //! `per_hit/{material} {technique}/{prebuilt|per-hit} {static|dyn}`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use microsurface::glam::Vec3;
 use microsurface::research::{Estimator, Material, Microsurface, Shadowing, SpecularLimit, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
-use microsurface::glam::Vec3;
 use microsurface::{
     Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique,
 };
@@ -276,7 +276,8 @@ fn compensated_glass(c: &mut Criterion<Clock>) {
         .expect("α ≤ MAX_WALK_ALPHA")
         .with_technique(Technique::SingleScattering);
     let kc = Compensated::new(slope, glass).expect("in the tables' range");
-    let turquin = Compensated::with_scheme(slope, glass, Compensation::Turquin).expect("in the tables' range");
+    let turquin =
+        Compensated::with_scheme(slope, glass, Compensation::Turquin).expect("in the tables' range");
     let x = inputs(true, 310);
     macro_rules! bench {
         ($g:expr, $name:expr, $model:expr, $call:ident) => {
@@ -413,22 +414,27 @@ fn per_hit(c: &mut Criterion<Clock>) {
     let glass = |k: usize| Dielectric::new(black_box(p.eta[k])).expect("η > 0");
     let (xg, xd) = (inputs(false, 410), inputs(true, 420));
     for (tname, technique) in TECHNIQUES {
-        let build = |k: usize| MicrofacetBsdf::new(slope(k), conductor(k)).expect("α ≤ 10").with_technique(technique);
+        let build =
+            |k: usize| MicrofacetBsdf::new(slope(k), conductor(k)).expect("α ≤ 10").with_technique(technique);
         per_hit_case(c, &format!("gold {tname}"), build, &xg);
     }
     for (tname, technique) in &TECHNIQUES[..2] {
         let technique = *technique;
-        let build = |k: usize| MicrofacetBsdf::new(slope(k), glass(k)).expect("α ≤ 10").with_technique(technique);
+        let build =
+            |k: usize| MicrofacetBsdf::new(slope(k), glass(k)).expect("α ≤ 10").with_technique(technique);
         per_hit_case(c, &format!("glass {tname}"), build, &xd);
     }
-    for (sname, scheme) in
-        [("walk", Compensation::Walk), ("kulla-conty", Compensation::KullaConty), ("turquin", Compensation::Turquin)]
-    {
+    for (sname, scheme) in [
+        ("walk", Compensation::Walk),
+        ("kulla-conty", Compensation::KullaConty),
+        ("turquin", Compensation::Turquin),
+    ] {
         let build = |k: usize| Compensated::with_scheme(slope(k), conductor(k), scheme).expect("α ≤ 1");
         per_hit_case(c, &format!("gold compensated {sname}"), build, &xg);
     }
     for (sname, scheme) in [("walk", Compensation::Walk), ("turquin", Compensation::Turquin)] {
-        let build = |k: usize| Compensated::with_scheme(slope(k), glass(k), scheme).expect("in the tables' range");
+        let build =
+            |k: usize| Compensated::with_scheme(slope(k), glass(k), scheme).expect("in the tables' range");
         per_hit_case(c, &format!("glass compensated {sname}"), build, &xd);
     }
 }

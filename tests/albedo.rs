@@ -5,8 +5,8 @@
 
 use glam::Vec3;
 use microsurface::compensation::{
-    ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, EtaRange,
-    ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable,
+    ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable,
+    EtaRange, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable,
 };
 use microsurface::research::{Microsurface, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
@@ -22,7 +22,7 @@ const SAMPLES: usize = 1 << 17;
 const MAX_SE: f64 = 2e-3;
 /// The interpolation errors the tables' documentation states (cell centres and edge
 /// midpoints, measured by the generator's dense check): GGX, Beckmann.
-const STATED_INTERPOLATION_ERROR: [f64; 2] = [5.4e-4, 1.3e-3];
+const STATED_INTERPOLATION_ERROR: [f64; 2] = [5.5e-4, 1.3e-3];
 /// The interpolation errors of E_avg the documentation states (midpoints between nodes): GGX,
 /// Beckmann.
 const STATED_AVERAGE_ERROR: [f64; 2] = [3.0e-4, 2.4e-4];
@@ -85,7 +85,11 @@ fn nodes_match_an_independent_monte_carlo_estimate() {
         .flat_map(|family| {
             (0..10)
                 .map(|_| {
-                    (family, pick.random_range(0..ALBEDO_DIRECTIONS), pick.random_range(0..ALBEDO_ROUGHNESSES))
+                    (
+                        family,
+                        pick.random_range(0..ALBEDO_DIRECTIONS),
+                        pick.random_range(0..ALBEDO_ROUGHNESSES),
+                    )
                 })
                 .collect::<Vec<_>>()
         })
@@ -333,7 +337,11 @@ fn order_tables_complete_the_single_scattering_albedo() {
         };
         for c in 0..n * n {
             let higher: f64 = (0..ORDER_TABLES).map(|k| f64::from(orders.directional_nodes(k)[c])).sum();
-            worst = worst.max(check(f64::from(ss.directional_nodes()[albedo_node(c)]), higher, &format!("node {c}")));
+            worst = worst.max(check(
+                f64::from(ss.directional_nodes()[albedo_node(c)]),
+                higher,
+                &format!("node {c}"),
+            ));
         }
         for j in 0..n {
             let higher: f64 = (0..ORDER_TABLES).map(|k| f64::from(orders.average_nodes(k)[j])).sum();

@@ -8,7 +8,9 @@ use microsurface::compensation::{
 };
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::research::Side;
-use microsurface::{Beckmann, Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, Transport};
+use microsurface::{
+    Beckmann, Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, Transport,
+};
 use validation::check::{assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw};
 use validation::chi2::{BsdfChi2, sampler_chi2};
 use validation::quadrature::{Domain, integrate_sphere};
@@ -215,8 +217,7 @@ fn per_order_lobe_has_the_model_albedo() {
                 } else {
                     (x2 * f64::from(alpha) / (1.0 + f64::from(alpha) - x2)) as f32
                 };
-                let b =
-                    Compensated::with_scheme(slope_of(alpha), conductor, Compensation::Walk).unwrap();
+                let b = Compensated::with_scheme(slope_of(alpha), conductor, Compensation::Walk).unwrap();
                 let got = b.multiple_scattering_albedo(mu).unwrap();
                 let node = j * n + i;
                 let e: Vec<f64> =
@@ -275,8 +276,7 @@ fn per_order_is_kulla_conty_for_f1() {
         for a in rows.chain([0.05f32, 0.3]) {
             let kc = Compensated::with_scheme(slope_of(a), Conductor::perfect(), Compensation::KullaConty)
                 .unwrap();
-            let po =
-                Compensated::with_scheme(slope_of(a), Conductor::perfect(), Compensation::Walk).unwrap();
+            let po = Compensated::with_scheme(slope_of(a), Conductor::perfect(), Compensation::Walk).unwrap();
             for _ in 0..100 {
                 let mut d = || {
                     let z = uniform32(&mut rng);
@@ -360,9 +360,8 @@ fn fresnel_average_is_accurate() {
 #[test]
 fn kulla_conty_is_reciprocal() {
     let mut rng = validation::rng(1800);
-    for (a, scheme) in [0.05f32, 0.3, 1.0]
-        .into_iter()
-        .flat_map(|a| [(a, Compensation::KullaConty), (a, Compensation::Walk)])
+    for (a, scheme) in
+        [0.05f32, 0.3, 1.0].into_iter().flat_map(|a| [(a, Compensation::KullaConty), (a, Compensation::Walk)])
     {
         let b = Compensated::with_scheme(beckmann(a), gold(), scheme).unwrap();
         for _ in 0..2000 {
@@ -573,8 +572,9 @@ fn dielectric_white_furnace_at_the_nodes() {
         worst: &mut f64,
     ) {
         let alpha = slope.alpha_x();
-        let imp =
-            Compensated::with_scheme(slope, glass(eta), Compensation::Turquin).unwrap().with_transport(Transport::Importance);
+        let imp = Compensated::with_scheme(slope, glass(eta), Compensation::Turquin)
+            .unwrap()
+            .with_transport(Transport::Importance);
         let rad = imp.with_transport(Transport::Radiance);
         for above in [true, false] {
             let mu = mus[usize::from(!above)];

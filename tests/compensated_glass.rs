@@ -10,7 +10,9 @@ use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::SeedableRng;
 use microsurface::research::{Microsurface, Side, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
-use microsurface::{Beckmann, Bsdf, Compensated, Compensation, Dielectric, Ggx, MicrofacetBsdf, Technique, Transport};
+use microsurface::{
+    Beckmann, Bsdf, Compensated, Compensation, Dielectric, Ggx, MicrofacetBsdf, Technique, Transport,
+};
 use validation::check::{
     EDGE_VIEW_COSINES, assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw, edge_view,
 };
@@ -90,9 +92,7 @@ fn sample_matches_pdf_and_weights_match_eval() {
         (
             "Beckmann η = 2.5 α = 0.5 θo = 1.2, importance".into(),
             Box::new(
-                Compensated::new(beckmann(0.5), glass(2.5))
-                    .unwrap()
-                    .with_transport(Transport::Importance),
+                Compensated::new(beckmann(0.5), glass(2.5)).unwrap().with_transport(Transport::Importance),
             ),
             1.2,
         ),
@@ -421,8 +421,7 @@ fn reciprocal_across_the_interface() {
     for (a, eta) in [(0.1f32, 1.5f32), (0.5, 1.5), (1.0, 1.33), (0.8, 2.5), (0.6, 1.0 / 1.5)] {
         let b = Compensated::new(ggx(a), glass(eta)).unwrap().with_transport(Transport::Importance);
         worst_mismatch = worst_mismatch.max(b.transmission_mismatch().abs());
-        let bb =
-            Compensated::new(beckmann(a), glass(eta)).unwrap().with_transport(Transport::Importance);
+        let bb = Compensated::new(beckmann(a), glass(eta)).unwrap().with_transport(Transport::Importance);
         worst_mismatch = worst_mismatch.max(bb.transmission_mismatch().abs());
         for &wo in &dirs {
             for &wi in &dirs {
@@ -476,10 +475,9 @@ fn constructor_range_and_smooth_limit() {
     for eta in [3.0f32, 1.0 / 3.0, 1.0, 1.0001] {
         assert!(Compensated::new(ggx(1.0), glass(eta)).is_ok(), "η = {eta}");
     }
-    for b in [
-        Compensated::new(ggx(1e-4), glass(1.5)).unwrap(),
-        Compensated::new(ggx(0.5), glass(1.0)).unwrap(),
-    ] {
+    for b in
+        [Compensated::new(ggx(1e-4), glass(1.5)).unwrap(), Compensated::new(ggx(0.5), glass(1.0)).unwrap()]
+    {
         assert!(b.flags().specular);
         let wo = dir(0.5, 0.0);
         assert_eq!(

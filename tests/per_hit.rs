@@ -9,7 +9,8 @@ use microsurface::glam::{Vec2, Vec3};
 use microsurface::research::{Estimator, Shadowing};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Beckmann, Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique,
+    Beckmann, Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf,
+    Technique,
 };
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -145,16 +146,20 @@ fn no_allocation_per_hit<S: microsurface::compensation::AlbedoTabulated + Copy>(
         let before = allocations();
         for h in if warm { &hits[..1] } else { &hits[..] } {
             for t in techniques {
-                let gold = MicrofacetBsdf::new(slope(h.alpha), Conductor::new(h.metal)).unwrap().with_technique(t);
+                let gold =
+                    MicrofacetBsdf::new(slope(h.alpha), Conductor::new(h.metal)).unwrap().with_technique(t);
                 sum += calls_sum(&gold, h) + calls_sum_dyn(&gold, h);
-                let glass =
-                    MicrofacetBsdf::new(slope(h.alpha), Dielectric::new(h.eta).unwrap()).unwrap().with_technique(t);
+                let glass = MicrofacetBsdf::new(slope(h.alpha), Dielectric::new(h.eta).unwrap())
+                    .unwrap()
+                    .with_technique(t);
                 sum += calls_sum(&glass, h) + calls_sum_dyn(&glass, h);
             }
             for scheme in SCHEMES {
-                let metal = Compensated::with_scheme(slope(h.alpha), Conductor::new(h.metal), scheme).unwrap();
+                let metal =
+                    Compensated::with_scheme(slope(h.alpha), Conductor::new(h.metal), scheme).unwrap();
                 sum += calls_sum(&metal, h) + calls_sum_dyn(&metal, h);
-                let glass = Compensated::with_scheme(slope(h.alpha), Dielectric::new(h.eta).unwrap(), scheme).unwrap();
+                let glass = Compensated::with_scheme(slope(h.alpha), Dielectric::new(h.eta).unwrap(), scheme)
+                    .unwrap();
                 sum += calls_sum(&glass, h) + calls_sum_dyn(&glass, h);
             }
         }
@@ -191,9 +196,11 @@ fn per_hit_equals_prebuilt() {
         let mut singles = Vec::new();
         for h in hits.iter().rev() {
             for scheme in SCHEMES {
-                metals.push(Compensated::with_scheme(slope(h.alpha), Conductor::new(h.metal), scheme).unwrap());
+                metals
+                    .push(Compensated::with_scheme(slope(h.alpha), Conductor::new(h.metal), scheme).unwrap());
                 glasses.push(
-                    Compensated::with_scheme(slope(h.alpha), Dielectric::new(h.eta).unwrap(), scheme).unwrap(),
+                    Compensated::with_scheme(slope(h.alpha), Dielectric::new(h.eta).unwrap(), scheme)
+                        .unwrap(),
                 );
             }
             singles.push(
@@ -206,12 +213,22 @@ fn per_hit_equals_prebuilt() {
         for (k, h) in hits.iter().enumerate() {
             let r = n - 1 - k;
             for (s, scheme) in SCHEMES.into_iter().enumerate() {
-                let metal = Compensated::with_scheme(slope(h.alpha), Conductor::new(h.metal), scheme).unwrap();
+                let metal =
+                    Compensated::with_scheme(slope(h.alpha), Conductor::new(h.metal), scheme).unwrap();
                 assert_eq!(metal, metals[3 * r + s], "{family} conductor {scheme:?} hit {k}");
-                assert_eq!(calls(&metal, h), calls(&metals[3 * r + s], h), "{family} conductor {scheme:?} hit {k}");
-                let glass = Compensated::with_scheme(slope(h.alpha), Dielectric::new(h.eta).unwrap(), scheme).unwrap();
+                assert_eq!(
+                    calls(&metal, h),
+                    calls(&metals[3 * r + s], h),
+                    "{family} conductor {scheme:?} hit {k}"
+                );
+                let glass = Compensated::with_scheme(slope(h.alpha), Dielectric::new(h.eta).unwrap(), scheme)
+                    .unwrap();
                 assert_eq!(glass, glasses[3 * r + s], "{family} glass {scheme:?} hit {k}");
-                assert_eq!(calls(&glass, h), calls(&glasses[3 * r + s], h), "{family} glass {scheme:?} hit {k}");
+                assert_eq!(
+                    calls(&glass, h),
+                    calls(&glasses[3 * r + s], h),
+                    "{family} glass {scheme:?} hit {k}"
+                );
             }
             let single = MicrofacetBsdf::new(slope(h.alpha), Conductor::new(h.metal))
                 .unwrap()

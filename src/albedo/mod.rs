@@ -16,13 +16,13 @@ mod orders;
 mod table;
 
 pub(crate) use axis::{DielectricDirection, floor_index, node_cell, scale_invariant_direction};
-pub(crate) use grid::{Grid, SideGrids};
 pub use dielectric::{DielectricAlbedo, DielectricAlbedoTable};
 pub use dielectric_walk::{DielectricWalkTable, HigherOrders, MAX_WALK_TABLE_SE, WALK_BATCH};
 pub use grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};
+pub(crate) use grid::{Grid, SideGrids};
 pub use orders::{
-    LAST_TABULATED_ORDER, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable,
-    TabulatedOrder,
+    LAST_TABULATED_ORDER, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES,
+    ScatteringOrderTable, TabulatedOrder,
 };
 pub(crate) use table::Family;
 pub use table::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, MAX_TABULATED_ALPHA};

@@ -1,8 +1,8 @@
 //! The per-order multiple-scattering energies of the F = 1 conductor, tabulated from the
 //! exact random walk, and their interpolation.
 
-use super::generated::orders as orders_data;
 use super::MAX_TABULATED_ALPHA;
+use super::generated::orders as orders_data;
 
 /// Nodes per axis of the per-order tables: 32 × 32 for e_k(μ, α), 32 for e_k,avg(α).
 pub const ORDER_TABLE_SIZE: usize = 32;

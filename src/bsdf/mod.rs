@@ -365,7 +365,6 @@ pub(crate) fn renormalized(w: Vec3) -> Vec3 {
     if is_direction(w) { w } else { renormalize_drifted(w).unwrap_or(w) }
 }
 
-
 /// Whether the caller's uniforms all lie in [0, 1) (NaN fails): the fast path of
 /// [`unit_view!`].
 #[inline(always)]
@@ -400,4 +399,3 @@ fn clamp_ones(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
         (uc, Vec2::new(x, y))
     })
 }
-

@@ -23,14 +23,14 @@
 //! same bits in `pdf`, `eval_with_pdf` and the sample. Turquin samples and has the density of
 //! the single-scattering lobe.
 
-use super::compensated::{Compensated, Compensation, CompensatedMaterial};
+use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::conductor_tables::ConductorTables;
 use super::fresnel_average::fresnel_average;
 use super::shared::{Shared, mixture_sample};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
-use crate::bsdf::MicrofacetBsdf;
-use crate::compensation::AlbedoTabulated;
 use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, ORDER_TABLE_SIZE, node_cell};
+use crate::bsdf::MicrofacetBsdf;
+use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
+use crate::compensation::AlbedoTabulated;
 use crate::error::Error;
 use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;

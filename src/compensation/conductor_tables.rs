@@ -123,8 +123,9 @@ impl ConductorTables {
             let alpha = (r * r).max(ALPHA_FLOOR);
             let f = s as f64 / SUBSTEPS as f64;
             let (lo, hi) = (row(j), row(j + 1));
-            let blended: [f32; ALBEDO_DIRECTIONS] =
-                core::array::from_fn(|i| (f64::from(lo[i]) + f * (f64::from(hi[i]) - f64::from(lo[i]))) as f32);
+            let blended: [f32; ALBEDO_DIRECTIONS] = core::array::from_fn(|i| {
+                (f64::from(lo[i]) + f * (f64::from(hi[i]) - f64::from(lo[i]))) as f32
+            });
             // the order rows around r, and the fraction between them
             let (jo, fo) = node_cell((r * (ORDER_TABLE_SIZE - 1) as f64) as f32, ORDER_TABLE_SIZE);
             let fo = f64::from(fo);

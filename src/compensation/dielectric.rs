@@ -45,16 +45,18 @@
 //! interpolation error relative to E. Near η = 1 at grazing views E → 0: where f_ss/E would not
 //! be a finite f32 the BSDF answers 0 (and `sample` `None`).
 
-use super::compensated::{Compensated, Compensation, CompensatedMaterial};
+use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::glass_tables::{GlassSide, GlassTables};
 use super::lobe_profile::mu_cell;
 use super::shared::{ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, unit_directions, unit_view};
-use crate::compensation::AlbedoTabulated;
 use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable, MAX_TABULATED_ETA,
-    node_cell,
+    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable,
+    MAX_TABULATED_ETA, node_cell,
 };
+use crate::bsdf::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, unit_directions, unit_view,
+};
+use crate::compensation::AlbedoTabulated;
 use crate::error::Error;
 use crate::material::{Dielectric, Side};
 use crate::single_scattering::SingleScattering;
@@ -290,8 +292,10 @@ impl CompensatedMaterial for Dielectric {
         let (m_out, m_in) = (averages[0].y, eta * eta * averages[1].y);
         let c = if m_out > 0.0 && m_in > 0.0 {
             let ratio = m_in / m_out;
-            let (v_out, v_in) =
-                (averages[0].z / (averages[0].y * averages[0].y), averages[1].z / (averages[1].y * averages[1].y));
+            let (v_out, v_in) = (
+                averages[0].z / (averages[0].y * averages[0].y),
+                averages[1].z / (averages[1].y * averages[1].y),
+            );
             let w = if v_out + v_in > 0.0 { v_out / (v_out + v_in) } else { 0.5 };
             lobes.mismatch = 1.0 / ratio - 1.0;
             let c_out = 1.0 + w * (ratio - 1.0);
@@ -328,13 +332,13 @@ impl DielectricLobes {
     /// and from inside η².
     fn with_transport(mut self, transport: Transport) -> Self {
         let eta = self.transmitted_eta[0];
-        let radiance = [1.0 / (eta * eta), eta * eta];
-        for view in 0..2 {
-            let factor = match transport {
-                Transport::Radiance => radiance[view],
-                Transport::Importance => 1.0,
-            };
-            self.scales[view][1] = self.transmitted_scale[view] * factor;
+        let factors = match transport {
+            Transport::Radiance => [1.0 / (eta * eta), eta * eta],
+            Transport::Importance => [1.0, 1.0],
+        };
+        for ((scales, transmitted), factor) in self.scales.iter_mut().zip(self.transmitted_scale).zip(factors)
+        {
+            scales[1] = transmitted * factor;
         }
         self
     }

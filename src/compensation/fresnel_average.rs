@@ -145,9 +145,11 @@ mod tests {
     /// a tenth with k = 0), by region.
     #[test]
     fn lookup_is_within_its_stated_error() {
-        let exact = |eta: Vec3, k: Vec3| Vec3::from_array(core::array::from_fn(|c| {
-            quadrature(f64::from(eta[c]), f64::from(k[c]), 64) as f32
-        }));
+        let exact = |eta: Vec3, k: Vec3| {
+            Vec3::from_array(core::array::from_fn(|c| {
+                quadrature(f64::from(eta[c]), f64::from(k[c]), 64) as f32
+            }))
+        };
         let mut presets: f32 = 0.0;
         for ior in [ComplexIor::GOLD, ComplexIor::COPPER, ComplexIor::ALUMINIUM, ComplexIor::SILVER] {
             presets = presets.max((fresnel_average(&ior) - exact(ior.eta(), ior.k())).abs().max_element());

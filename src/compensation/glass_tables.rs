@@ -88,9 +88,12 @@ impl GlassTables {
         static GGX: OnceLock<GlassTables> = OnceLock::new();
         static BECKMANN: OnceLock<GlassTables> = OnceLock::new();
         match family {
-            Family::Ggx => GGX.get_or_init(|| Self::build(&DielectricWalkTable::GGX, &DielectricAlbedoTable::GGX)),
-            Family::Beckmann => BECKMANN
-                .get_or_init(|| Self::build(&DielectricWalkTable::BECKMANN, &DielectricAlbedoTable::BECKMANN)),
+            Family::Ggx => {
+                GGX.get_or_init(|| Self::build(&DielectricWalkTable::GGX, &DielectricAlbedoTable::GGX))
+            }
+            Family::Beckmann => BECKMANN.get_or_init(|| {
+                Self::build(&DielectricWalkTable::BECKMANN, &DielectricAlbedoTable::BECKMANN)
+            }),
         }
     }
 

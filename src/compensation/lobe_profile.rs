@@ -134,7 +134,11 @@ const GL8: [(f64, f64); 4] = [
 /// row interpolated on a `cells + 1`-node axis, or on a coarser axis whose cells are unions of
 /// these): 8-point Gauss–Legendre per cell in u = √μ, where x(u²) is analytic and the measure
 /// 4u³ du smooth (exact to rounding for the piecewise-linear rows of [`profile_average`]).
-pub(crate) fn axis_average<const L: usize>(alpha: f64, cells: usize, g: impl Fn(f64) -> [f64; L]) -> [f64; L] {
+pub(crate) fn axis_average<const L: usize>(
+    alpha: f64,
+    cells: usize,
+    g: impl Fn(f64) -> [f64; L],
+) -> [f64; L] {
     let k = 1.0 + alpha;
     let mu_of = |x: f64| {
         let big_x = x * x;

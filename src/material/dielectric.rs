@@ -159,7 +159,7 @@ impl Dielectric {
         let len_sq = sum.length_squared();
         let degenerate = REFRACTION_DEGENERATE * eta.max(1.0);
         // NaN fails too
-        if !(len_sq > degenerate * degenerate) {
+        if len_sq.partial_cmp(&(degenerate * degenerate)) != Some(core::cmp::Ordering::Greater) {
             return 0.0;
         }
         let h = if sum.z > 0.0 { sum } else { -sum };

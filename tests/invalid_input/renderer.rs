@@ -13,8 +13,7 @@ use microsurface::leadr::{Noncentral, NoncentralBsdf};
 use microsurface::research::{Estimator, Shadowing};
 use microsurface::{
     BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    Compensated, Compensation, ComplexIor, Conductor, Dielectric, Diffuse,
-    Ggx, MicrofacetBsdf, Technique,
+    Compensated, Compensation, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, MicrofacetBsdf, Technique,
 };
 
 /// 1 − 2⁻²⁴, what a uniform of 1 stands for.
@@ -62,8 +61,16 @@ fn models() -> Vec<(String, Box<dyn Bsdf>, bool)> {
             false,
         ));
     }
-    v.push(("Turquin glass".into(), Box::new(Compensated::with_scheme(ggx, glass, Compensation::Turquin).unwrap()), false));
-    v.push(("Kulla-Conty glass".into(), Box::new(Compensated::with_scheme(ggx, glass, Compensation::Walk).unwrap()), false));
+    v.push((
+        "Turquin glass".into(),
+        Box::new(Compensated::with_scheme(ggx, glass, Compensation::Turquin).unwrap()),
+        false,
+    ));
+    v.push((
+        "Kulla-Conty glass".into(),
+        Box::new(Compensated::with_scheme(ggx, glass, Compensation::Walk).unwrap()),
+        false,
+    ));
     v
 }
 

@@ -581,7 +581,8 @@ fn main() -> std::io::Result<()> {
          the lower, the better the pdf follows f·cos), mean and max over the cells and RGB channels above:\n"
     )
     .unwrap();
-    writeln!(md, "| material |{}", TECHNIQUE_TITLES.map(|t| format!(" {t}: mean σ | max σ |")).concat()).unwrap();
+    writeln!(md, "| material |{}", TECHNIQUE_TITLES.map(|t| format!(" {t}: mean σ | max σ |")).concat())
+        .unwrap();
     writeln!(md, "|---|{}", "---|---|".repeat(TECHNIQUES.len())).unwrap();
     let n_albedo = (s.albedo_samples as f64).sqrt();
     for (name, _) in &mats {

@@ -20,10 +20,7 @@
 
 use glam::{Vec2, Vec3};
 use microsurface::research::{PositionFree, Shadowing};
-use microsurface::{
-    Bsdf, Compensated, Compensation, Conductor, Dielectric, Ggx,
-    MicrofacetBsdf,
-};
+use microsurface::{Bsdf, Compensated, Compensation, Conductor, Dielectric, Ggx, MicrofacetBsdf};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 

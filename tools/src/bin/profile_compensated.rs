@@ -14,8 +14,8 @@
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
-    MicrofacetBsdf, Technique,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, Compensated, Compensation, ComplexIor, Conductor, Dielectric,
+    Ggx, MicrofacetBsdf, Technique,
 };
 use std::hint::black_box;
 use validation::inputs::{Inputs, N, inputs};
@@ -150,7 +150,9 @@ fn main() {
                         .with_technique(Technique::SingleScattering);
                     run(&b, &x, what, calls)
                 }
-                "walk" | "kulla-conty" => run(&Compensated::new(slope, glass).expect("in range"), &x, what, calls),
+                "walk" | "kulla-conty" => {
+                    run(&Compensated::new(slope, glass).expect("in range"), &x, what, calls)
+                }
                 "turquin" => run(
                     &Compensated::with_scheme(slope, glass, Compensation::Turquin).expect("in range"),
                     &x,

@@ -12,8 +12,7 @@ use crate::label::{Align, BLACK, Canvas, Fonts, Rgb8, WHITE, Weight, srgb8};
 use glam::Vec3;
 use lab::tracer::{Camera, Environment, Light, Lighting, Material, RenderStats, Scene, Sphere, render};
 use microsurface::{
-    Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
-    MicrofacetBsdf, Technique,
+    Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique,
 };
 
 /// The roughnesses of the columns.
@@ -119,7 +118,8 @@ impl Row {
             (Substance::Glass, Method::Turquin) => {
                 let glass = Dielectric::new(GLASS_ETA).expect("valid η");
                 Box::new(
-                    Compensated::with_scheme(slope, glass, Compensation::Turquin).expect("α and η within the tables"),
+                    Compensated::with_scheme(slope, glass, Compensation::Turquin)
+                        .expect("α and η within the tables"),
                 )
             }
             (Substance::Glass, Method::KullaConty) => unreachable!("no Kulla–Conty dielectric row"),

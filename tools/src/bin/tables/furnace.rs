@@ -103,7 +103,8 @@ pub fn run() -> Vec<FurnacePoint> {
     }
     for family in [Family::Ggx, Family::Beckmann] {
         for side in [Side::Outside, Side::Inside] {
-            let of: Vec<&FurnacePoint> = out.iter().filter(|p| p.family == family && p.side == side).collect();
+            let of: Vec<&FurnacePoint> =
+                out.iter().filter(|p| p.family == family && p.side == side).collect();
             let max = of.iter().map(|p| p.error().abs()).fold(0.0, f64::max);
             let raw = of.iter().map(|p| (p.single + p.raw - 1.0).abs()).fold(0.0, f64::max);
             let rms = (of.iter().map(|p| p.error() * p.error()).sum::<f64>() / of.len() as f64).sqrt();

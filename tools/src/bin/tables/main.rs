@@ -214,7 +214,7 @@ fn interpolation_error(family: Family) -> Vec<(Probe, f64, f64, (f64, f64))> {
 /// The largest interpolation error of E the shipped tables' documentation states (cell centres
 /// and edge midpoints, from `--interpolation`): GGX, Beckmann. `--quick` checks probes against it.
 const STATED_E_ERROR: [f64; 2] = [STATED_GGX, STATED_BECKMANN];
-const STATED_GGX: f64 = 5.4e-4;
+const STATED_GGX: f64 = 5.5e-4;
 const STATED_BECKMANN: f64 = 1.3e-3;
 /// Probes of the interpolation error recomputed by `--quick` per family.
 const QUICK_PROBES: usize = 12;
@@ -522,7 +522,10 @@ fn quick() {
             let stated = STATED_E_ERROR[usize::from(family == Family::Beckmann)];
             if e > stated {
                 failures += 1;
-                println!("{} E at μ {mu:.5}, α {alpha:.5}: interpolation error {e:.2e} > {stated:.1e}", family.name());
+                println!(
+                    "{} E at μ {mu:.5}, α {alpha:.5}: interpolation error {e:.2e} > {stated:.1e}",
+                    family.name()
+                );
             }
         }
         let j = (state >> 40) as usize % NR;
@@ -731,7 +734,11 @@ fn main() {
                         family.name()
                     );
                 }
-                println!("{}: E_avg interpolation error, max {:.2e}", family.name(), average_interpolation_error(family));
+                println!(
+                    "{}: E_avg interpolation error, max {:.2e}",
+                    family.name(),
+                    average_interpolation_error(family)
+                );
             }
             if dielectric {
                 for side in [Side::Outside, Side::Inside] {

@@ -8,8 +8,8 @@
 //! the complements 1 − E of its nodes (exact in f64, rounded once), so that 1 − E keeps its
 //! relative precision where E → 1. The added lobes are normalized by the average of what they
 //! interpolate at this α (not the shipped E_avg table): 2∫(1 − E) μ dμ in closed form per cell,
-//! tabulated at 64 sub-steps of each roughness cell and interpolated linearly (within 1e-4
-//! relative at α ≥ 1e-3, 2e-5 at α ≥ 1e-2), so that the Kulla–Conty lobe integrates to
+//! tabulated at 64 sub-steps of each roughness cell and interpolated linearly (within 4e-4
+//! relative at α ≥ 1e-3, 4e-5 at α ≥ 1e-2), so that the Kulla–Conty lobe integrates to
 //! F_ms (1 − E(μo)) and the white furnace errs by the table's interpolation error alone.
 //!
 //! **Sampling** (Kulla–Conty and the walk's orders): with probability p = E(μo) (the lobes'
@@ -287,7 +287,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     }
 
     /// E_avg = 2∫₀¹ E(μ) μ dμ of the interpolated E (its closed form, tabulated at sub-steps
-    /// of the roughness cells: relative error of 1 − E_avg below 1e-4 at α ≥ 1e-3).
+    /// of the roughness cells: relative error of 1 − E_avg below 4e-4 at α ≥ 1e-3).
     pub fn average_albedo(&self) -> f32 {
         1.0 - self.lobes.complement_average
     }

@@ -204,8 +204,8 @@ mod tests {
 
     /// The averages: C at every sub-step equals its closed form and the quadrature of the
     /// order averages sums to it (Σ_k φ_k = 1), to 1e-6 relative; between the sub-steps the
-    /// linear interpolation of C is within 1e-4 (relative) of the closed form at α ≥ 1e-3 and
-    /// 2e-5 at α ≥ 1e-2, measured at the midpoints of every sub-step of both families.
+    /// linear interpolation of C is within 4e-4 (relative) of the closed form at α ≥ 1e-3 and
+    /// 4e-5 at α ≥ 1e-2, measured at the midpoints of every sub-step of both families.
     #[test]
     fn averages_are_exact_at_the_substeps_and_close_between() {
         for (family, albedo) in [(Family::Ggx, AlbedoTable::GGX), (Family::Beckmann, AlbedoTable::BECKMANN)] {
@@ -245,7 +245,7 @@ mod tests {
                  {worst_large:.1e} (α ≥ 1e-2)",
                 albedo.name()
             );
-            assert!(worst_sum <= 1e-6 && worst_small <= 1e-4 && worst_large <= 2e-5);
+            assert!(worst_sum <= 1e-6 && worst_small <= 4e-4 && worst_large <= 4e-5);
         }
     }
 }

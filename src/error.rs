@@ -25,6 +25,16 @@ pub enum Error {
         /// The materials it covers, in words.
         expected: &'static str,
     },
+    /// A slice of a batch call is not as long as the batch's first slice (the batch API,
+    /// [`BatchBsdf`](crate::BatchBsdf)): nothing was computed.
+    LengthMismatch {
+        /// Name of the slice (`"wi.x"`, `"pdf"`…).
+        name: &'static str,
+        /// The batch's length (that of its first direction slice).
+        expected: usize,
+        /// The slice's length.
+        found: usize,
+    },
 }
 
 impl Error {
@@ -64,6 +74,9 @@ impl fmt::Display for Error {
             }
             Error::UnsupportedMaterial { model, expected } => {
                 write!(f, "unsupported material for `{model}`: expected {expected}")
+            }
+            Error::LengthMismatch { name, expected, found } => {
+                write!(f, "batch slice `{name}` has {found} elements: expected {expected}")
             }
         }
     }

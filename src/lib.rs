@@ -111,7 +111,9 @@
 //! `data-driven` ([`tabulated`]). A renderer that needs only this page's types, the compensated
 //! lobes and the walk builds with `default-features = false`.
 
-#![forbid(unsafe_code)]
+// No unsafe code, except the runtime dispatch of the batch loops to their AVX2 build
+// (`lanes::dispatch`: a call of a `#[target_feature]` function after the CPU check).
+#![deny(unsafe_code)]
 #![deny(missing_docs)]
 // One allowance for the fitted coefficient tables of src/special (the erfcx pieces, the
 // Gaussian-quantile fits, the azimuth polynomials) and their reference values: they are written
@@ -130,6 +132,7 @@ mod error;
 mod height;
 #[cfg(feature = "invariance")]
 mod invariance;
+mod lanes;
 mod material;
 mod microsurface;
 #[cfg(feature = "leadr")]
@@ -141,6 +144,7 @@ mod rng;
 mod sampling;
 mod sealed;
 mod single_scattering;
+mod soa;
 mod vector;
 
 pub mod compensation;
@@ -155,9 +159,9 @@ pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.
 pub use bsdf::{
-    BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking,
-    ClassicNdf, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, ShadingFrame, Sidedness,
-    Technique, Transport,
+    BSDF_DIRECTION_TOLERANCE, BatchBsdf, Bsdf, BsdfFlags, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking,
+    ClassicNdf, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SampleFlags, SampleOutputs, ShadingFrame,
+    Sidedness, Technique, Transport,
 };
 #[cfg(feature = "mint")]
 pub use bsdf::{MintBsdf, MintSample};
@@ -167,6 +171,7 @@ pub use error::Error;
 pub use fresnel::ComplexIor;
 pub use material::{Conductor, Dielectric, Diffuse};
 pub use slope::{Beckmann, Elliptical, Ggx};
+pub use soa::{Channels, Directions};
 
 /// The vector library of the public API, re-exported so that users on another `glam` version
 /// can name the crate's types.
@@ -214,7 +219,8 @@ pub mod research {
     pub use crate::invariance::{Invariance, MIN_FIRST_RATE};
     pub use crate::material::{Event, Interaction, Material, PhaseSample, Side};
     pub use crate::microsurface::{
-        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkSample,
+        HeightSample, MAX_BOUNCES, Microsurface, MicrosurfaceGeometry, ScatteringOrder, WalkOutputs,
+        WalkSample,
     };
     pub use crate::path::Shadowing;
     #[cfg(feature = "position-free")]

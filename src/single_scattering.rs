@@ -12,7 +12,7 @@ use rand::Rng;
 
 /// An f32 value of ωi·(ωi + ωo) above this is positive in exact arithmetic (its rounding error
 /// is below 3 ulps of 2, 4e-7).
-const VISIBLE_SUM_MARGIN: f32 = 1e-6;
+pub(crate) const VISIBLE_SUM_MARGIN: f32 = 1e-6;
 
 /// An outgoing direction sampled from the single-scattering BSDF, with its weight and density.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,7 +6,7 @@ use glam::Vec3;
 
 /// An f32 dot product of two unit vectors above this is positive in exact arithmetic too
 /// (its rounding error is at most 3 ulp of 1 ≈ 1.8e-7).
-const VISIBLE_DOT_MARGIN: f32 = 1e-6;
+pub(crate) const VISIBLE_DOT_MARGIN: f32 = 1e-6;
 
 /// Largest number of halvings tried by [`ensure_visible`].
 const VISIBILITY_NUDGES: i32 = 24;

@@ -18,6 +18,7 @@
 //! convention instead: `eval(wi, wo)` with `wi` the direction light arrives from, returning
 //! f·|cos θo|, and `&mut impl Rng` arguments.)
 
+mod batch;
 mod classic;
 mod frame;
 mod microfacet;
@@ -27,6 +28,7 @@ mod seed;
 mod sidedness;
 mod specular;
 
+pub use batch::{BatchBsdf, SampleOutputs};
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use frame::ShadingFrame;
 pub use microfacet::{EnergyByOrder, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, Technique};

@@ -44,7 +44,7 @@ fn pair(a: f32, b: f32) -> u64 {
 /// float bits, wyhash-style: three independent folded products of the words (the processor
 /// runs them in parallel; the seed enters two of them) and one more product of their
 /// combination. About 12 cycles of latency (three dependent multiplications), against about
-/// 30 for the splitmix64-finalized form of session 5 and 70 for absorbing the six words one
+/// 30 for a splitmix64-finalized form and 70 for absorbing the six words one
 /// splitmix64 round after another; its avalanche through the generator's first output is
 /// measured by `one_input_bit_flips_half_the_output_bits`.
 #[derive(Debug, Clone, Copy)]

@@ -2,6 +2,7 @@
 
 use crate::contract::is_cosine;
 use crate::error::Error;
+use crate::lanes::Lanes;
 use glam::{Vec3, Vec3A};
 
 /// A complex index of refraction η + i k per RGB channel, relative to the outside medium.
@@ -101,18 +102,36 @@ pub(crate) fn conductor_reflectance(cos_theta_i: f32, ior: &ComplexIor) -> Vec3 
     }
     // the three channels in one SIMD register (Vec3A): one division and one square root
     // instruction per step for the three
-    let c = Vec3A::splat(cos_theta);
+    Vec3::from(reflectance_of(Vec3A::splat(cos_theta), ior.t0, ior.four_eta_k_sq))
+}
+
+/// The conductor's reflectance of [`conductor_reflectance`] for every lane type (the three
+/// channels of one cosine, or one channel of several), for cos θ = `c` ∈ (0, 1] (the caller
+/// handles grazing, where it is 1) and the channel's constants `t0` = η² − k² − 1 and
+/// `four_eta_k_sq` = 4η²k².
+#[must_use]
+#[inline(always)]
+pub(crate) fn reflectance_of<L: Lanes>(c: L, t0: L, four_eta_k_sq: L) -> L {
+    let (zero, one) = (L::lit(0.0), L::lit(1.0));
     let c2 = c * c;
-    let s2 = Vec3A::ONE - c2;
+    let s2 = one - c2;
     // t = η² − k² − sin²θ and a² + b² = √(t² + 4η²k²), from the index's constants
-    let t = ior.t0 + c2;
-    let a2b2 = (t * t + ior.four_eta_k_sq).sqrt();
-    let a = (0.5 * (a2b2 + t)).max(Vec3A::ZERO).sqrt();
+    let t = t0 + c2;
+    let a2b2 = (t * t + four_eta_k_sq).sqrt();
+    let a = (L::lit(0.5) * (a2b2 + t)).max(zero).sqrt();
     // Rs = (P − Q)/(P + Q) and Rp = Rs (R − S)/(R + S) with P = a² + b² + cos²θ, Q = 2a cos θ,
     // R = cos²θ (a² + b²) + s⁴, S = Q s²: (Rs + Rp)/2 = Rs R/(R + S), one division
     let p = a2b2 + c2;
-    let q = 2.0 * a * c;
+    let q = L::lit(2.0) * a * c;
     let r = c2 * a2b2 + s2 * s2;
     let f = (p - q) * r / ((p + q) * (r + q * s2));
-    Vec3::from(f.clamp(Vec3A::ZERO, Vec3A::ONE))
+    f.clamp(zero, one)
+}
+
+impl ComplexIor {
+    /// The per-channel constants of the Fresnel term (η² − k² − 1, 4η²k²), for the batch kernels.
+    #[inline(always)]
+    pub(crate) fn constants(&self) -> (Vec3A, Vec3A) {
+        (self.t0, self.four_eta_k_sq)
+    }
 }

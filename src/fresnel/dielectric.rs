@@ -1,6 +1,7 @@
 //! Fresnel reflectance of a dielectric interface.
 
 use crate::contract::{is_cosine, is_index};
+use crate::lanes::Lanes;
 
 /// Unpolarized Fresnel reflectance of a smooth dielectric interface, with total internal
 /// reflection.
@@ -43,10 +44,16 @@ pub(crate) fn dielectric_reflectance(cos_theta_i: f32, eta: f32) -> f32 {
 #[must_use]
 #[inline]
 pub(crate) fn fresnel_dielectric_cosines(c: f64, t: f64, eta: f64) -> f64 {
+    fresnel_dielectric_cosines_of(c, t, eta)
+}
+
+/// [`fresnel_dielectric_cosines`] for every lane type.
+#[must_use]
+#[inline(always)]
+pub(crate) fn fresnel_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) -> L {
     let (num_s, den_s) = (c - eta * t, c + eta * t);
     let (num_p, den_p) = (eta * c - t, eta * c + t);
-    if den_s <= 0.0 || den_p <= 0.0 {
-        return 1.0;
-    }
-    0.5 * ((num_s / den_s).powi(2) + (num_p / den_p).powi(2))
+    let zero = L::lit(0.0);
+    let (rs, rp) = (num_s / den_s, num_p / den_p);
+    L::select(den_s.le(zero) | den_p.le(zero), L::lit(1.0), L::lit(0.5) * (rs * rs + rp * rp))
 }

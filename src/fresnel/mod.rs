@@ -5,8 +5,10 @@ mod dielectric;
 mod presets;
 mod schlick;
 
-pub(crate) use conductor::conductor_reflectance;
 pub use conductor::{ComplexIor, fresnel_conductor};
+pub(crate) use conductor::{conductor_reflectance, reflectance_of};
 pub use dielectric::fresnel_dielectric;
-pub(crate) use dielectric::{dielectric_reflectance, fresnel_dielectric_cosines};
+pub(crate) use dielectric::{
+    dielectric_reflectance, fresnel_dielectric_cosines, fresnel_dielectric_cosines_of,
+};
 pub use schlick::fresnel_schlick;

@@ -1,8 +1,8 @@
 //! Conductor microfacets.
 
 use super::{
-    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
-    reflection_density, reflection_half_vector,
+    HalfSum, Interaction, LaneMaterial, Material, PhaseSample, Side, g2_reflection, phase_reflection,
+    reflect, reflection_density, reflection_half_vector,
 };
 use crate::contract::{is_cosine, is_direction};
 use crate::fresnel::{ComplexIor, conductor_reflectance};
@@ -113,6 +113,11 @@ impl Material for Conductor {
     const TRANSMITS: bool = false;
     const EXACT_PHASE_PDF: bool = true;
     const MIRROR_FACETS: bool = true;
+
+    #[inline]
+    fn lane_material(&self) -> LaneMaterial {
+        LaneMaterial::Conductor(self.ior.map(|ior| ior.constants()))
+    }
 
     #[inline]
     fn eval_phase_unchecked<S: MicrosurfaceSlope>(

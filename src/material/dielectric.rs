@@ -1,12 +1,13 @@
 //! Dielectric microfacets.
 
 use super::{
-    HalfSum, Interaction, Material, PhaseSample, Side, g2_reflection, phase_reflection, reflect,
-    reflection_half_vector,
+    HalfSum, Interaction, LaneMaterial, Material, PhaseSample, Side, g2_reflection, phase_reflection,
+    reflect, reflection_half_vector,
 };
 use crate::contract::is_direction;
 use crate::error::Error;
 use crate::fresnel::{dielectric_reflectance, fresnel_dielectric, fresnel_dielectric_cosines};
+use crate::lanes::Lanes;
 use crate::rng::{uniform, uniform_pair};
 use crate::slope::{MicrosurfaceSlope, renormalize};
 use crate::special::beta;
@@ -158,8 +159,7 @@ impl Dielectric {
         let sum = i + eta * o;
         let len_sq = sum.length_squared();
         let degenerate = REFRACTION_DEGENERATE * eta.max(1.0);
-        // NaN fails too
-        if len_sq.partial_cmp(&(degenerate * degenerate)) != Some(core::cmp::Ordering::Greater) {
+        if len_sq.is_nan() || len_sq <= degenerate * degenerate {
             return 0.0;
         }
         let h = if sum.z > 0.0 { sum } else { -sum };
@@ -233,19 +233,7 @@ impl Dielectric {
     /// cosine with l = 1.
     #[inline(always)]
     fn reflectance_scaled(&self, k: f64, l_sq: f64) -> (f64, f64) {
-        let eta = f64::from(self.eta);
-        let s_sq = k * k + (eta - 1.0) * (eta + 1.0) * l_sq;
-        if s_sq <= 0.0 {
-            return (1.0, 0.0);
-        }
-        let s = s_sq.sqrt();
-        let eta2_k = eta * eta * k;
-        let (den_s, den_p) = (k + s, eta2_k + s);
-        if den_s <= 0.0 || den_p <= 0.0 {
-            return (1.0, s);
-        }
-        let (rs, rp) = ((k - s) / den_s, (eta2_k - s) / den_p);
-        (0.5 * (rs * rs + rp * rp), s)
+        reflectance_scaled_of(f64::from(self.eta), k, l_sq)
     }
 
     /// The refraction of ωi through the facet ωm with c = ωi·ωm ≥ 0 and s = η cos θt
@@ -287,9 +275,29 @@ impl Dielectric {
     }
 }
 
+/// [`Dielectric`]'s `reflectance_scaled` for every lane type, with η = `eta`: (F, s) for
+/// cos θi = k/l, l² = `l_sq`, s = l η cos θt (F = 1, s = 0 under total internal reflection).
+#[inline(always)]
+pub(crate) fn reflectance_scaled_of<L: Lanes>(eta: L, k: L, l_sq: L) -> (L, L) {
+    let (zero, one) = (L::lit(0.0), L::lit(1.0));
+    let s_sq = k * k + (eta - one) * (eta + one) * l_sq;
+    let total = s_sq.le(zero);
+    let s = L::select(total, zero, s_sq.sqrt());
+    let eta2_k = eta * eta * k;
+    let (den_s, den_p) = (k + s, eta2_k + s);
+    let (rs, rp) = ((k - s) / den_s, (eta2_k - s) / den_p);
+    let f = L::select(total | den_s.le(zero) | den_p.le(zero), one, L::lit(0.5) * (rs * rs + rp * rp));
+    (f, s)
+}
+
 impl Material for Dielectric {
     const TRANSMITS: bool = true;
     const EXACT_PHASE_PDF: bool = true;
+
+    #[inline]
+    fn lane_material(&self) -> LaneMaterial {
+        LaneMaterial::Dielectric(self.eta)
+    }
 
     /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not
     /// transparent: from the denser side a ray below the critical angle, cos θ < √(2|η − 1|),
@@ -336,7 +344,7 @@ impl Material for Dielectric {
 
     // out of line: the walk instantiated with the renderer layer's primed generator inlined
     // it and ran 25 % slower than with the research layer's generator, which does not
-    // (DESIGN.md, “renderer trait speed, session 6”)
+    // (DESIGN.md, “Speed against the research calls”)
     #[inline(never)]
     fn sample_phase_unchecked<S: MicrosurfaceSlope>(
         &self,
@@ -351,8 +359,8 @@ impl Material for Dielectric {
 
     /// The visible normal's two uniforms from one 64-bit draw (the walks' stream). Out of
     /// line: inlined with the GGX visible normal into the walk's loop, the listing's GGX
-    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Integration,
-    /// session 6”).
+    /// `sample` took 80 ns against 65 ns (Beckmann 127 against 135 ns; DESIGN.md, “Speed against
+    /// the research calls”).
     #[inline(never)]
     fn sample_phase_walk_unchecked<S: MicrosurfaceSlope>(
         &self,

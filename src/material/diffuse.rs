@@ -107,7 +107,7 @@ const AREA_LOG_BELOW: f64 = 1e-280;
 /// (Beckmann, a = |cot θo|/α), and so is the exact density unless ωi is as far below; the
 /// constant 1/(8π) alone overstated it by up to e^{a²}, and the bidirectional estimator's
 /// balance weights gave the light sub-path's strategies a share of paths it practically never
-/// samples (a bias, DESIGN.md, “BDPT and diffuse facets lit from below”). The ratio is formed
+/// samples (a bias, DESIGN.md, “Paths from below”). The ratio is formed
 /// from ln Λ where an area underflows f64 (Beckmann, a > 26).
 #[inline(never)]
 fn pdf_below_horizon<S: MicrosurfaceSlope>(slope: &S, it: &Interaction) -> f32 {

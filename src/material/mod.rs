@@ -14,9 +14,23 @@ pub use interaction::{Event, Interaction};
 pub use side::Side;
 
 use crate::contract::is_direction;
+use crate::lanes::Lanes;
 use crate::slope::MicrosurfaceSlope;
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec3A};
 use rand::Rng;
+
+/// A material as the batch calls' lane kernels see it (crate-internal).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LaneMaterial {
+    /// Conductor facets: the per-channel constants (η² − k² − 1, 4η²k²) of their Fresnel
+    /// term, `None` for a perfect mirror.
+    Conductor(Option<(Vec3A, Vec3A)>),
+    /// Dielectric facets of relative index η.
+    Dielectric(f32),
+    /// No lane kernels.
+    Other,
+}
 
 /// An outgoing direction sampled from a phase function.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,6 +202,14 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     // the crate's walks call once or more per bounce with directions they produced
     // themselves (unit up to rounding).
 
+    /// What the batch calls' lane kernels need of the material ([`LaneMaterial`]); `Other`
+    /// for materials without lane kernels (their batch calls run the scalar ones lane by lane).
+    #[doc(hidden)]
+    #[inline]
+    fn lane_material(&self) -> LaneMaterial {
+        LaneMaterial::Other
+    }
+
     /// [`Material::eval_phase`] without the argument check (crate-internal hot path).
     #[doc(hidden)]
     #[must_use]
@@ -303,7 +325,7 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
 /// (ωo close to −ωi, c small) this dominates: from below a smooth surface (Beckmann α = 0.02
 /// at θi = 120°, c ≈ 1e-4) the plain sum lost the sign of ωi·ωh for about 1 % of the sampled
 /// directions (eval and pdf 0 where the sampler put mass) and was off by a median 5 %
-/// elsewhere (DESIGN.md, “BDPT from below at a = 28.9”).
+/// elsewhere (DESIGN.md, “Paths from below”).
 ///
 /// So where either direction is below the horizon, ωh is that of the directions the vectors
 /// represent, ωh ∝ ω̂i + ω̂o ∝ ωi + (|ωi|/|ωo|)ωo in f64: its direction is exact to 1e-16/c rad
@@ -394,7 +416,25 @@ pub(crate) fn g2_reflection<S: MicrosurfaceSlope>(slope: &S, wi: Vec3, wo: Vec3)
         return 0.0;
     }
     // in f64: the f32 Λ saturates at f32::MAX near grazing, where 1 + Λi + Λo would overflow
-    (1.0 / (1.0 + slope.lambda64(wi) + slope.lambda64(wo))) as f32
+    g2_reflection_of(slope.lambda64(wi), slope.lambda64(wo)) as f32
+}
+
+/// The height-correlated G2 = 1/(1 + Λ(ωi) + Λ(ωo)) of a reflection from Λ(ωi) and Λ(ωo) ≥ 0,
+/// for every lane type (in f32 lanes a saturated Λ gives 1/∞ = 0, the limit).
+#[inline(always)]
+pub(crate) fn g2_reflection_of<L: Lanes>(lambda_i: L, lambda_o: L) -> L {
+    L::lit(1.0) / (L::lit(1.0) + lambda_i + lambda_o)
+}
+
+/// G2/G1(ωi) = (1 + Λi)/(1 + Λi + Λo) of a reflection between directions above the horizon,
+/// from their projected areas A = (1 + Λ) cos θ and cosines z, for every lane type:
+/// Ai zo/(Ai zo + zi (Ao − zo)), one division. The rounding of Ao − zo = Λo zo, which cancels
+/// where Λo is small, is at most ε Ao, and relative to the denominator (at least
+/// zi zo max(1, Λo)) that is at most 3ε: the ratio keeps a few ulps.
+#[inline(always)]
+pub(crate) fn g2_over_g1_of<L: Lanes>(area_i: L, area_o: L, z_i: L, z_o: L) -> L {
+    let front = area_i * z_o;
+    front / (front + z_i * (area_o - z_o))
 }
 
 /// D_ωi(ωh)/(4 ωi·ωh) = D(ωh)/(4 A(ωi)) for a valid reflection half vector ωh (ωh.z > 0,

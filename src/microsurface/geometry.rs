@@ -3,6 +3,7 @@
 
 use crate::contract::{is_direction, is_uniform};
 use crate::height::MicrosurfaceHeight;
+use crate::lanes::Lanes;
 use crate::rng::cut_tails;
 use crate::slope::MicrosurfaceSlope;
 use crate::special::{ln_1m_exp_f32, ln_f32};
@@ -197,25 +198,32 @@ pub(crate) const MIN_HIT_DEPTH: f32 = f32::MIN_POSITIVE;
 pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32> {
     // tails cut and 1 − u: see `next_c1`
     let one_minus_u = 1.0 - cut_tails(u);
-    if z >= 0.0 {
-        let bound = lambda * ln_c1;
-        // −u′ = (1 − u) − 1 with u′ the uniform 1 − u stands for (exact for 1 − u ≥ ½;
-        // below, where the subtraction may round by 2⁻²⁵, ln(1 − u) < −u′ − 0.19): then
-        // ln(1 − u) ≤ −u′ ≤ Λ ln C¹, and the f32 logarithm (within 1e-10 of ln(1 − u),
-        // which is below −u′ by u′²/2 ≥ 2⁻⁴⁹ relative to u′) would round to at most the f32
-        // Λ ln C¹ too
-        if lambda == 0.0 || one_minus_u - 1.0 <= bound {
-            return None;
-        }
-        let ln_1mu = ln_f32(one_minus_u);
-        if ln_1mu <= bound {
-            return None;
-        }
-        return Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH));
+    if z >= 0.0 && escapes_without_log(lambda, ln_c1, one_minus_u) {
+        return None;
     }
     // the logarithm inline (`special::ln_f32`, correctly rounded but for 0.002 ulp)
-    let ln_1mu = ln_f32(one_minus_u);
-    Some((ln_c1 - ln_1mu / lambda).min(-MIN_HIT_DEPTH))
+    let (next, escapes) = step_ln_c1(z, lambda, ln_c1, ln_f32(one_minus_u));
+    if escapes { None } else { Some(next) }
+}
+
+/// Whether a ray going up (z ≥ 0) with Λ = `lambda` from ln C¹ = `ln_c1` escapes for the
+/// uniform 1 − u = `one_minus_u` without the logarithm (every lane type): Λ = 0, or
+/// −u′ = (1 − u) − 1 ≤ Λ ln C¹ with u′ the uniform 1 − u stands for (exact for 1 − u ≥ ½;
+/// below, where the subtraction may round by 2⁻²⁵, ln(1 − u) < −u′ − 0.19): then
+/// ln(1 − u) ≤ −u′ ≤ Λ ln C¹, and the f32 logarithm (within 1e-10 of ln(1 − u), which is below
+/// −u′ by u′²/2 ≥ 2⁻⁴⁹ relative to u′) would round to at most the f32 Λ ln C¹ too.
+#[inline(always)]
+pub(crate) fn escapes_without_log<L: Lanes>(lambda: L, ln_c1: L, one_minus_u: L) -> L::Mask {
+    lambda.eq(L::lit(0.0)) | (one_minus_u - L::lit(1.0)).le(lambda * ln_c1)
+}
+
+/// Algorithm 1's step in ln C¹ space from ln(1 − u) = `ln_1mu` (every lane type): the next
+/// ln C¹ = ln C¹ − ln(1 − u)/Λ (at most −[`MIN_HIT_DEPTH`]), and whether the ray escapes instead
+/// (it goes up, z ≥ 0, and ln(1 − u) ≤ Λ ln C¹).
+#[inline(always)]
+pub(crate) fn step_ln_c1<L: Lanes>(z: L, lambda: L, ln_c1: L, ln_1mu: L) -> (L, L::Mask) {
+    let escapes = z.ge(L::lit(0.0)) & ln_1mu.le(lambda * ln_c1);
+    ((ln_c1 - ln_1mu / lambda).min(L::lit(-MIN_HIT_DEPTH)), escapes)
 }
 
 /// ln C¹ of the first intersection of a ray arriving from below the macrosurface, for an
@@ -234,7 +242,7 @@ pub(crate) fn next_ln_c1(z: f32, lambda: f32, ln_c1: f32, u: f32) -> Option<f32>
 /// single-scattering term the full-spherical height-correlated one, E[C^{Λ(ωo)}] =
 /// Λ(−ωi)/(Λ(−ωi) + Λ(ωo)), i.e. G2 = 1/(Λ(−ωi) + Λ(ωo)) (Wang et al. 2022, eq. 17), and the
 /// first vertex the position-free model's vertex reached from below (see DESIGN.md,
-/// “Multiple scattering for views below the macrosurface”).
+/// “Views from below in the walk”).
 ///
 /// The result lies in [−f32::MAX, −f32::MIN_POSITIVE]. ln(1 − u)/Λ overflows only for
 /// Λ(−ωi) < 5e-38 (GGX: ωi within ~1e-19 rad of the nadir; Beckmann: a denormal Λ, smooth

@@ -3,11 +3,13 @@
 
 mod geometry;
 mod walk;
+mod walk_lanes;
 
 pub use geometry::{HeightSample, MicrosurfaceGeometry};
 #[cfg(feature = "invariance")]
 pub(crate) use walk::incident_area;
 pub use walk::{MAX_BOUNCES, ScatteringOrder, WalkSample};
+pub use walk_lanes::WalkOutputs;
 
 use crate::contract::is_direction;
 use crate::height::MicrosurfaceHeight;

@@ -93,7 +93,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// Whether the walks leave the depth undrawn while they can ([`Depth`]): for opaque
     /// materials. A dielectric's walk crosses the interface at most first hits (η = 1.5: 92 %
     /// at θi = 0.5), where the depth must be drawn anyway, and the measured cost of carrying
-    /// the undrawn state was higher than its gain there (DESIGN.md, “Walk speed, session 6”).
+    /// the undrawn state was higher than its gain there (DESIGN.md, “Walk speed”).
     const LAZY: bool = !M::TRANSMITS;
 
     /// The rate a of an undrawn depth ([`Depth`]), `None` for a drawn one (always, known at
@@ -132,7 +132,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     /// The next-event masking C¹^Λ(ωo) is replaced by its conditional expectation where that
     /// is known in closed form, a/(a + Λ(ωo)): at the first hit on ωi's side (a = 1 + Λ(ωi))
     /// and, for opaque materials, at every hit reached since by rays going up, whose height the
-    /// walk does not draw (its law stays a e^{aℓ}; see DESIGN.md, “Walk speed, session 6”).
+    /// walk does not draw (its law stays a e^{aℓ}; see DESIGN.md, “Walk speed”).
     /// The estimate stays unbiased and its variance drops; order 1 is the exact single
     /// scattering term. The next-event phase function of a reflection is formed from the
     /// unnormalized half vector in f64 (the same accuracy as [`Material::eval_phase`]).
@@ -176,7 +176,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
     ///
     /// For opaque materials the heights of hits reached by rays going up are not drawn: such a
     /// ray escapes with probability a/(a + Λ(ωr)), a = 1 + Λ(ωi), which is the walk's law
-    /// (DESIGN.md, “Walk speed, session 6”); a height is drawn when a ray goes down.
+    /// (DESIGN.md, “Walk speed”); a height is drawn when a ray goes down.
     ///
     /// Invalid input ([policy](crate#invalid-input)): a `wi` that is not a unit direction gives
     /// `None` (a debug assertion in debug builds).

@@ -14,11 +14,15 @@ pub use elliptical::{AxisAlignedSlope, Elliptical};
 pub use ggx::Ggx;
 
 pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
-pub(crate) use ggx::{cap_bound, sample_bounded_cap};
+pub(crate) use ggx::{
+    F32_DENSITY_MIN_SUM, bounded_area_of, cap_bound, d_of_sum, kappa_of, lambda_and_area_of,
+    reflection_density_of, sample_bounded_cap, sample_cap_of,
+};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
+use crate::lanes::Lanes;
 // the materials' import path of the vector kernels (src/material is another branch's; the
 // kernels live in `crate::vector`)
 use crate::sealed::Sealed;
@@ -55,6 +59,15 @@ use glam::{DVec3, Vec3};
 pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// Roughness along x.
     fn alpha_x(&self) -> f32;
+
+    /// (αx, αy) if this is the axis-aligned GGX distribution, whose lane kernels the batch
+    /// calls use ([`BatchBsdf`](crate::BatchBsdf)); `None` for every other distribution (their
+    /// batch calls run the scalar ones lane by lane).
+    #[doc(hidden)]
+    #[inline]
+    fn ggx_roughness(&self) -> Option<(f32, f32)> {
+        None
+    }
 
     /// Roughness along y.
     fn alpha_y(&self) -> f32;
@@ -344,7 +357,13 @@ pub(crate) fn reflection_density64_over<S: MicrosurfaceSlope>(
 /// q = αx² ω.x² + αy² ω.y² = (αᵢ sin θ)², the squared stretched horizontal extent of ω.
 #[inline(always)]
 pub(crate) fn projected_roughness_sq(alpha_x: f32, alpha_y: f32, w: Vec3) -> f32 {
-    let (x, y) = (alpha_x * w.x, alpha_y * w.y);
+    projected_roughness_sq_of(alpha_x, alpha_y, w.x, w.y)
+}
+
+/// [`projected_roughness_sq`] for every lane type.
+#[inline(always)]
+pub(crate) fn projected_roughness_sq_of<L: Lanes>(alpha_x: L, alpha_y: L, wx: L, wy: L) -> L {
+    let (x, y) = (alpha_x * wx, alpha_y * wy);
     x * x + y * y
 }
 

@@ -25,3 +25,4 @@ pub(crate) use gaussian::gaussian_integral_and_half;
 pub(crate) use ln::{exp_f32, ln_1m_exp_f32, ln_f32};
 pub(crate) use tail_ratio::tail_ratio;
 pub use trig::sin_cos_turns;
+pub(crate) use trig::sin_cos_turns_of;

@@ -1,5 +1,7 @@
 //! Sine and cosine of an angle given in turns, for sampling azimuths.
 
+use crate::lanes::Lanes;
+
 /// Taylor coefficients of sin(π f / 2) in f, for |f| ≤ ½ (truncation error ≤ 2e-9).
 const SIN: [f32; 5] =
     [core::f32::consts::FRAC_PI_2, -0.645_964_1, 0.079_692_63, -0.004_681_754, 0.000_160_441_18];
@@ -17,17 +19,25 @@ const COS: [f32; 6] = [1.0, -1.233_700_6, 0.253_669_5, -0.020_863_481, 0.000_919
 #[inline(always)]
 pub fn sin_cos_turns(u: f32) -> (f32, f32) {
     debug_assert!((0.0..=1.0).contains(&u), "u = {u} outside [0, 1]");
-    let t = 4.0 * u;
-    // t + ½ ≥ 0, so truncation is the floor: q = round(t)
-    let q = (t + 0.5) as i32;
-    let f = t - q as f32;
+    sin_cos_turns_of(u)
+}
+
+/// [`sin_cos_turns`] for every lane type (u ∈ [0, 1] in each lane): the quadrant's rotation as
+/// lane selects.
+#[must_use]
+#[inline(always)]
+pub(crate) fn sin_cos_turns_of<L: Lanes>(u: L) -> (L, L) {
+    let t = L::lit(4.0) * u;
+    // q = round(t) ∈ {0, …, 4}, with its two low bits
+    let (q, odd, half) = t.quadrant();
+    let f = t - q;
     let f2 = f * f;
-    let s = f * (SIN[0] + f2 * (SIN[1] + f2 * (SIN[2] + f2 * (SIN[3] + f2 * SIN[4]))));
-    let c = COS[0] + f2 * (COS[1] + f2 * (COS[2] + f2 * (COS[3] + f2 * (COS[4] + f2 * COS[5]))));
-    match q & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    let k = |c: f32| L::lit(c);
+    let s = f * (k(SIN[0]) + f2 * (k(SIN[1]) + f2 * (k(SIN[2]) + f2 * (k(SIN[3]) + f2 * k(SIN[4])))));
+    let c = k(COS[0])
+        + f2 * (k(COS[1]) + f2 * (k(COS[2]) + f2 * (k(COS[3]) + f2 * (k(COS[4]) + f2 * k(COS[5])))));
+    // q & 3 = 0: (s, c); 1: (c, −s); 2: (−s, −c); 3: (−c, s)
+    let (sin, cos) = (L::select(odd, c, s), L::select(odd, s, c));
+    let negate_cos = (odd & !half) | (!odd & half);
+    (L::select(half, -sin, sin), L::select(negate_cos, -cos, cos))
 }

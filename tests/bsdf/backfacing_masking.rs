@@ -5,7 +5,7 @@
 //! For a backfacing view ωv the incident masking is G1 = 1/Λ(−ωv) and the projected area
 //! A = Λ(−ωv)|cos θv|; for low roughness both are of order e^{−a²} (Beckmann, a = |cot θ|/αᵢ):
 //! an f32 subnormal from a ≈ 9.6, 0 in f64 from a ≈ 26.6. The weight of a perfect conductor
-//! is Λ(−ωv)/(Λ(−ωv) + Λ(ωl)), a ratio of two such numbers (issue 12, defect 2).
+//! is Λ(−ωv)/(Λ(−ωv) + Λ(ωl)), a ratio of two such numbers.
 
 use glam::{Vec2, Vec3};
 use microsurface::research::{Material, SpecularLimit};
@@ -182,8 +182,8 @@ fn backfacing_single_scattering_weights_match_down_to_the_smallest_roughness() {
 /// from the f64-normalized pair, within 1e-5 (independent f64 reference), and no sample is
 /// lost. Before the half vector was formed from the normalized directions, the sum of the
 /// unnormalized f32 vectors lost the sign of ωv·ωh for 0.3–0.7 % of these samples (pdf 0,
-/// sample dropped) and the rest had a pdf off by a median 5 % at a = 28.9 (DESIGN.md, “BDPT
-/// from below at a = 28.9”).
+/// sample dropped) and the rest had a pdf off by a median 5 % at a = 28.9 (DESIGN.md, “Paths from
+/// below”).
 #[test]
 fn near_forward_reflections_have_the_density_of_their_direction() {
     let n = 2000;

@@ -1,4 +1,4 @@
-//! Deep tails of the exact single-scattering technique (issue 12, defect 5): every sample's
+//! Deep tails of the exact single-scattering technique: every sample's
 //! weight equals f·|cos θi|/pdf at its direction to f32 precision, also for low roughness at
 //! grazing views and for the samples drawn from the most extreme uniforms, and no sample
 //! comes back with a subnormal pdf or BSDF value (whose precision is lost).

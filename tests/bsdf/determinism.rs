@@ -118,11 +118,10 @@ fn stratified_uniforms(side: usize, rng: &mut TestRng) -> Vec<(f32, Vec2)> {
 /// alone.
 #[test]
 fn hashed_eval_is_unbiased_over_many_pairs() {
-    // 320 000 since session 6 (was 80 000, SE 0.0013 at 0.63): after the merge that changed
-    // BDPT's random stream, uncorrelated BDPT gold at the first view read 3.65 SE high (z = 3.45);
-    // 24 independent seeds at 80 000 (SD of the means 0.00144) and 3 × 10⁶ samples (0.6296 ±
-    // 0.0002 against 0.6299) found no bias, so the test was made stronger (SE halved), not
-    // weaker (DESIGN.md, “Integration, session 6”)
+    // N = 320 000 (SE about 6.5e-4 at 0.63): at 80 000 uncorrelated BDPT gold at the first view
+    // once read 3.45 SE high; 24 independent seeds at 80 000 (SD of the means 0.00144) and
+    // 3 × 10⁶ samples (0.6296 ± 0.0002 against 0.6299) found no bias, so the test is the
+    // stronger one (SE halved), not a looser bound (DESIGN.md, “Determinism and the seed hash”)
     const N: usize = 320_000;
     let views = [dir(0.2, 0.3), dir(0.8, 1.0), dir(1.3, 4.0)];
     let techniques = [

@@ -1,4 +1,4 @@
-//! Negative zero is treated exactly like positive zero (issue 12, defect 1).
+//! Negative zero is treated exactly like positive zero.
 //!
 //! For every slope (GGX and Beckmann, isotropic and anisotropic) and every public function of
 //! the slopes, the visible-normal samplers, the V-cavity model, the geometry's masking, the

@@ -677,8 +677,8 @@ fn fresnel_and_frame_helpers() {
     r.finish("fresnel_and_frame_helpers", 60);
 }
 
-/// The cases the issue reported (issue 12, “Invalid input gives plausible numbers”): each gave
-/// a plausible number before the policy.
+/// Inputs outside the domain that a looser check would answer with a plausible number: each
+/// must get the documented nothing.
 #[test]
 fn the_reported_cases_return_nothing() {
     quiet_violations();
@@ -732,7 +732,7 @@ fn valid_edge_directions_pass_the_checks() {
     let pf = PositionFree::new(beckmann, Dielectric::new(1.5).unwrap(), Shadowing::Correlated);
     let finite = |v: &Vec3| v.is_finite() && v.min_element() >= 0.0;
     for w in edges {
-        // (Λ at z = −0 is issue 12's first numerical defect, fixed and tested separately)
+        // (Λ at z = −0 is tested separately, tests/invalid_input/negative_zero.rs)
         if w.z != 0.0 || w.z.is_sign_positive() {
             r.expect_valid(&format!("GGX lambda({w})"), || ggx.lambda(w), |x| x.is_finite());
         }

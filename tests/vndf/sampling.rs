@@ -344,7 +344,7 @@ fn chi2_rejects_wrong_samplers() {
     );
 }
 
-/// Beckmann cases for the tabulated-guess sampler (issue 17) beyond the 60 above: α down to
+/// Beckmann cases for the tabulated-guess sampler beyond the 60 above: α down to
 /// 0.01 and ωi far below the horizon (κ = cot θ/α from 0.01·… to −72.6 and −8.1).
 fn beckmann_deep_cases(full: bool) -> Vec<Case> {
     let configs: &[(f32, f64)] = if full {

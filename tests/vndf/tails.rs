@@ -1,5 +1,4 @@
-//! The extreme uniforms carry no more probability than the model gives them (issue 12,
-//! defect 3).
+//! The extreme uniforms carry no more probability than the model gives them.
 //!
 //! The crate's uniforms are multiples of 2⁻²⁴ in [0, 1 − 2⁻²⁴], each with probability 2⁻²⁴; a
 //! renderer's f32 uniform in [0, 1) is at most 1 − 2⁻²⁴ too. Every sampler cuts the tails of

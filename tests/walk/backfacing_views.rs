@@ -1,7 +1,7 @@
 //! Multiple scattering for views below the macrosurface (normal mapping): the random walk of
 //! Heitz et al. 2016 and the position-free estimators of Wang et al. 2022 for an opaque
-//! material lit from ωi with ωi.z < 0 (DESIGN.md, “Multiple scattering for views below the
-//! macrosurface”).
+//! material lit from ωi with ωi.z < 0 (DESIGN.md, “Views from below in
+//! the walk”).
 //!
 //! Configurations: conductor F = 1 and gold, white and coloured diffuse, over GGX and
 //! Beckmann, for ωi.z ∈ {−0.072, −0.3, −0.6} (just below the horizon to deep below).

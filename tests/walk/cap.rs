@@ -152,7 +152,7 @@ fn cap_removes_less_than_1e4_of_the_albedo() {
     );
 }
 
-/// Dielectrics within a few f32 ulps of η = 1 at grazing incidence (issue 12, defect 4): a
+/// Dielectrics within a few f32 ulps of η = 1 at grazing incidence: a
 /// grazing ray crosses the nearly index-matched interface about Λ(ωi) times before refraction
 /// turns it (GGX α = 1: ~500 crossings at cos θi = 1e-3), which the former cap of 1024 cut
 /// (1 − 1e-7 at cos θi = 1e-3: 85 % of the walks dropped). For the issue's configurations

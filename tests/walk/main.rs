@@ -4,5 +4,6 @@
 
 mod backfacing_views;
 mod cap;
+mod lanes;
 mod random_walk;
 mod stiff;

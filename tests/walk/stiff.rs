@@ -1,4 +1,4 @@
-//! Stiff walks (issue 4): white-furnace energy conservation with standard errors and bounded
+//! Stiff walks: white-furnace energy conservation with standard errors and bounded
 //! walk lengths for the Heitz et al. 2016 random walk and the position-free PT and BDPT
 //! estimators (both shadowing models), at α = 1e-3, α = 4, θi = 1.57 rad and for a dielectric
 //! (η = 1.5) lit from inside at the critical angle and ±0.02 rad around it.

@@ -2,10 +2,13 @@
 
 use super::{
     MicrosurfaceSlope, check_roughness, is_direction, is_uniform, projected_roughness_sq,
-    reflection_density64_over, smith_d_wi64,
+    projected_roughness_sq_of, reflection_density64_over, smith_d_wi64,
 };
 use crate::error::Error;
+use crate::lanes::{Lanes, V3};
 mod visible;
+
+pub(crate) use visible::{bounded_area_of, kappa_of, sample_cap_of};
 
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
@@ -17,7 +20,7 @@ const FRAC_1_4PI: f32 = 0.25 * FRAC_1_PI;
 
 /// The smallest |ωi + ωo|² and stretched t for which the f32 reflection density is used: above
 /// it no term of either sum is subnormal enough to matter (absolute error 2⁻¹⁴⁹ against 2⁻¹⁰⁰).
-const F32_DENSITY_MIN_SUM: f32 = 7.888_609_e-31; // 2⁻¹⁰⁰
+pub(crate) const F32_DENSITY_MIN_SUM: f32 = 7.888_609_e-31; // 2⁻¹⁰⁰
 
 /// Smallest cos θm kept when a sampled normal is turned into slopes (only
 /// [`Ggx::sample_p22_11`]; the sampled normals themselves are exact).
@@ -75,10 +78,77 @@ impl Ggx {
 
 /// Λ for the upper hemisphere from q = (αᵢ sin θ)² and z = cos θ ≥ 0 (+0 at the horizon: the
 /// caller passes |cos θ|), in the cancellation-free form q / (2z(z + √(z² + q))); saturates to
-/// `f32::MAX` at z = +0.
+/// `f32::MAX` at z = +0. One formula for every lane type (f32, f64, [`F32x8`](crate::lanes::F32x8)).
 #[inline(always)]
-fn lambda_up(q: f32, z: f32) -> f32 {
-    (q / (2.0 * z * (z + (z * z + q).sqrt()))).min(f32::MAX)
+pub(crate) fn lambda_up<L: Lanes>(q: L, z: L) -> L {
+    lambda_up_unsaturated(q, z).min(L::lit(f32::MAX))
+}
+
+/// [`lambda_up`] without the saturation: +∞ at z = +0 (the f64 Λ of the walks' shadowing).
+#[inline(always)]
+pub(crate) fn lambda_up_unsaturated<L: Lanes>(q: L, z: L) -> L {
+    q / (L::lit(2.0) * z * (z + (z * z + q).sqrt()))
+}
+
+/// The signed Λ on the whole sphere from q = (αᵢ sin θ)² and z = cos θ, given the upper
+/// hemisphere's Λ at |z| (`up`): `up` above the horizon, −1 − `up` below it (z = −0 is the
+/// horizon seen from above, like +0).
+#[inline(always)]
+pub(crate) fn lambda_signed<L: Lanes>(up: L, z: L) -> L {
+    L::select(z.ge(L::lit(0.0)), up, -L::lit(1.0) - up)
+}
+
+/// The projected area (1 + Λ) cos θ from q = (αᵢ sin θ)² and z = cos θ: ½(z + √(z² + q)) above
+/// the horizon (supplement §2.3) and the equivalent q / (2(√(z² + q) − z)) below it, which has
+/// no cancellation there.
+#[inline(always)]
+pub(crate) fn projected_area_of<L: Lanes>(q: L, z: L) -> L {
+    let root = (z * z + q).sqrt();
+    L::choose(z.ge(L::lit(0.0)), || L::lit(0.5) * (z + root), || q / (L::lit(2.0) * (root - z)))
+}
+
+/// D(ωm) = 1/(π αx αy t²), t = m.x²/αx² + m.y²/αy² + m.z², for m.z > 0 (the caller tests it):
+/// the slope form multiplied through by cos⁴θm, finite down to m.z = 0.
+#[inline(always)]
+pub(crate) fn d_of<L: Lanes>(ax: L, ay: L, m: V3<L>, frac_1_pi: L) -> L {
+    let (x, y) = (m.x / ax, m.y / ay);
+    let t = x * x + y * y + m.z * m.z;
+    frac_1_pi / (ax * ay * t * t)
+}
+
+/// |h|²/t with t = h.x²/αx² + h.y²/αy² + h.z², and |h|² and t themselves: D of the direction of
+/// an unnormalized h is (|h|²/t)²/(π αx αy) (D is homogeneous of degree 0). Sums of squares
+/// only: a few ulps of the lane type for every h.
+#[inline(always)]
+pub(crate) fn sum_ratio<L: Lanes>(ax: L, ay: L, h: V3<L>) -> (L, L, L) {
+    let (x, y) = (h.x / ax, h.y / ay);
+    let t = x * x + y * y + h.z * h.z;
+    let len_sq = h.length_squared();
+    (len_sq / t, len_sq, t)
+}
+
+/// D(ωh) of the direction of an unnormalized h: (|h|²/t)²/(π αx αy) ([`sum_ratio`]).
+#[inline(always)]
+pub(crate) fn d_of_sum<L: Lanes>(ax: L, ay: L, h: V3<L>, frac_1_pi: L) -> L {
+    let (ratio, _, _) = sum_ratio(ax, ay, h);
+    frac_1_pi * (ratio * ratio) / (ax * ay)
+}
+
+/// Λ(ω) on the whole sphere (saturated at ±`f32::MAX` in f32 lanes) and the projected area
+/// A(ω) of a direction, for every lane type.
+#[inline(always)]
+pub(crate) fn lambda_and_area_of<L: Lanes>(ax: L, ay: L, w: V3<L>) -> (L, L) {
+    let q = projected_roughness_sq_of(ax, ay, w.x, w.y);
+    (lambda_signed(lambda_up(q, w.z.abs()), w.z), projected_area_of(q, w.z))
+}
+
+/// The reflection density D(ωh)/(4 A(ωi)) = (|h|²/t)²/(4π αx αy A) of the unnormalized
+/// h = ωi + ωo with A = `area`, with |h|² and t (the caller checks their range): see
+/// [`Ggx`]'s `reflection_density_unchecked` for the bound.
+#[inline(always)]
+pub(crate) fn reflection_density_of<L: Lanes>(ax: L, ay: L, h: V3<L>, area: L) -> (L, L, L) {
+    let (ratio, len_sq, t) = sum_ratio(ax, ay, h);
+    (L::lit(FRAC_1_4PI) * (ratio * ratio) / (ax * ay * area), len_sq, t)
 }
 
 impl Ggx {
@@ -114,6 +184,11 @@ impl crate::sealed::Sealed for Ggx {}
 
 impl MicrosurfaceSlope for Ggx {
     #[inline]
+    fn ggx_roughness(&self) -> Option<(f32, f32)> {
+        Some((self.alpha_x, self.alpha_y))
+    }
+
+    #[inline]
     fn d_wi64_unchecked(&self, wi: Vec3, wm: DVec3) -> f64 {
         smith_d_wi64(self, wi, wm)
     }
@@ -144,9 +219,7 @@ impl MicrosurfaceSlope for Ggx {
         if wm.z <= 0.0 {
             return 0.0;
         }
-        let (x, y) = (wm.x / self.alpha_x, wm.y / self.alpha_y);
-        let t = x * x + y * y + wm.z * wm.z;
-        FRAC_1_PI / (self.alpha_x * self.alpha_y * t * t)
+        d_of(self.alpha_x, self.alpha_y, V3::of(wm), FRAC_1_PI)
     }
 
     #[inline]
@@ -155,9 +228,7 @@ impl MicrosurfaceSlope for Ggx {
             return 0.0;
         }
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
-        let (x, y) = (wm.x / ax, wm.y / ay);
-        let t = x * x + y * y + wm.z * wm.z;
-        core::f64::consts::FRAC_1_PI / (ax * ay * t * t)
+        d_of(ax, ay, V3::new(wm.x, wm.y, wm.z), core::f64::consts::FRAC_1_PI)
     }
 
     /// (|h|²/t)²/(π αx αy) with t = h.x²/αx² + h.y²/αy² + h.z²: [`Self::d64_unchecked`]'s
@@ -169,9 +240,7 @@ impl MicrosurfaceSlope for Ggx {
             return 0.0;
         }
         let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
-        let (x, y) = (h.x / ax, h.y / ay);
-        let ratio = h.length_squared() / (x * x + y * y + h.z * h.z);
-        core::f64::consts::FRAC_1_PI * (ratio * ratio) / (ax * ay)
+        d_of_sum(ax, ay, V3::new(h.x, h.y, h.z), core::f64::consts::FRAC_1_PI)
     }
 
     /// D(ĥ)/(4A) = (|h|²/t)²/(4π αx αy A) written with t′ = t αx²αy² = h.x²αy² + h.y²αx² +
@@ -198,18 +267,16 @@ impl MicrosurfaceSlope for Ggx {
     #[inline]
     fn lambda64(&self, w: Vec3) -> f64 {
         let (x, y) = (f64::from(self.alpha_x) * f64::from(w.x), f64::from(self.alpha_y) * f64::from(w.y));
-        let (q, z) = (x * x + y * y, f64::from(w.z).abs());
-        let up = q / (2.0 * z * (z + (z * z + q).sqrt()));
-        if w.z >= 0.0 { up } else { -1.0 - up }
+        let (q, z) = (x * x + y * y, f64::from(w.z));
+        // unsaturated: ±∞ at exactly grazing directions
+        lambda_signed(lambda_up_unsaturated(q, z.abs()), z)
     }
 
     /// The f32 forms of [`Self::projected_area`] in f64.
     #[inline]
     fn projected_area64(&self, w: Vec3) -> f64 {
         let (x, y) = (f64::from(self.alpha_x) * f64::from(w.x), f64::from(self.alpha_y) * f64::from(w.y));
-        let (q, z) = (x * x + y * y, f64::from(w.z));
-        let root = (z * z + q).sqrt();
-        if z >= 0.0 { 0.5 * (z + root) } else { q / (2.0 * (root - z)) }
+        projected_area_of(x * x + y * y, f64::from(w.z))
     }
 
     #[inline]
@@ -217,8 +284,7 @@ impl MicrosurfaceSlope for Ggx {
         let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
         // Λ of the upper hemisphere at |cos θ|: z = −0 is the horizon seen from above, like +0
         // (passing w.z itself gave lambda_up(q, −0) = q/(−0) = −∞)
-        let up = lambda_up(q, w.z.abs());
-        if w.z >= 0.0 { up } else { -1.0 - up }
+        lambda_signed(lambda_up(q, w.z.abs()), w.z)
     }
 
     /// ½(cos θ + √(cos²θ + αᵢ² sin²θ)) above the horizon (supplement §2.3) and the
@@ -226,9 +292,7 @@ impl MicrosurfaceSlope for Ggx {
     /// cancellation there.
     #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
-        let q = projected_roughness_sq(self.alpha_x, self.alpha_y, w);
-        let root = (w.z * w.z + q).sqrt();
-        if w.z >= 0.0 { 0.5 * (w.z + root) } else { q / (2.0 * (root - w.z)) }
+        projected_area_of(projected_roughness_sq(self.alpha_x, self.alpha_y, w), w.z)
     }
 
     /// Exact for every ωi: stretch ωi to α = 1, sample the visible hemisphere with the
@@ -281,12 +345,8 @@ impl Ggx {
     #[inline(always)]
     pub(crate) fn reflection_density_over(&self, wi: Vec3, wo: Vec3, area: f32) -> f32 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
-        let h = wi + wo;
-        let (x, y) = (h.x / ax, h.y / ay);
-        let t = x * x + y * y + h.z * h.z;
-        let len_sq = h.length_squared();
-        let ratio = len_sq / t;
-        let density = FRAC_1_4PI * (ratio * ratio) / (ax * ay * area);
+        let h = V3::of(wi + wo);
+        let (density, len_sq, t) = reflection_density_of(ax, ay, h, area);
         if len_sq >= F32_DENSITY_MIN_SUM && t >= F32_DENSITY_MIN_SUM && density.is_normal() {
             density
         } else {

@@ -4,10 +4,13 @@
 //! and Tokuyoshi 2023, “Bounded VNDF Sampling for Smith–GGX Reflections”, eqs. 5–8).
 
 use super::Ggx;
-use crate::rng::cut_tails;
+use crate::lanes::{Lanes, V3};
+use crate::rng::{TAIL_CUT, cut_tails};
 use crate::slope::MicrosurfaceSlope;
-use crate::special::sin_cos_turns;
-use crate::vector::{DIRECT_SCALE_RANGE, ensure_visible, normalize_fast, normalize_scaled};
+use crate::special::{sin_cos_turns, sin_cos_turns_of};
+use crate::vector::{
+    DIRECT_SCALE_RANGE, VISIBLE_DOT_MARGIN, ensure_visible, normalize_fast, normalize_scaled,
+};
 use glam::{DVec3, Vec3};
 
 /// A GGX visible normal for a unit ωi, exact for every ωi: stretch ωi to α = 1, sample the
@@ -41,13 +44,7 @@ impl CapBound {
     /// the whole cap of a view below the horizon.
     #[inline(always)]
     pub(crate) fn top(self, v: Vec3, len: f32) -> f32 {
-        if v.z < 0.0 {
-            (v.x * v.x + v.y * v.y) / (len - v.z)
-        } else if self.kappa >= 1.0 {
-            len + (self.kappa - 1.0) * v.z
-        } else {
-            (v.x * v.x + v.y * v.y) / (len + v.z) + self.kappa * v.z
-        }
+        top_of(self.kappa, V3::of(v), len)
     }
 
     /// [`Self::top`] in double precision (len = |v| in f64).
@@ -71,6 +68,24 @@ impl CapBound {
     }
 }
 
+/// [`CapBound::top`] for every lane type: len + (κ − 1) v.z for κ ≥ 1, |v_xy|²/(len + v.z) +
+/// κ v.z for κ < 1, |v_xy|²/(len − v.z) below the horizon (where κ is always 2).
+#[inline(always)]
+pub(crate) fn top_of<L: Lanes>(kappa: L, v: V3<L>, len: L) -> L {
+    let one = L::lit(1.0);
+    L::choose(
+        v.z.lt(L::lit(0.0)),
+        || (v.x * v.x + v.y * v.y) / (len - v.z),
+        || {
+            L::choose(
+                kappa.ge(one),
+                || len + (kappa - one) * v.z,
+                || (v.x * v.x + v.y * v.y) / (len + v.z) + kappa * v.z,
+            )
+        },
+    )
+}
+
 /// [`sample_spherical_cap`] with the cap bounded below by `bound`: stretch, sample the cap
 /// c.z ≥ −k v̂.z, unstretch. The same normalization as `sample_spherical_cap` (`bound` is
 /// relative to v̂, so it holds for the rescaled v of huge or tiny stretched views).
@@ -78,15 +93,54 @@ impl CapBound {
 #[inline(always)]
 pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
     let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
-    let stretched = Vec3::new(alpha_x * wi.x, alpha_y * wi.y, wi.z);
+    let stretched = stretch_of(alpha_x, alpha_y, V3::of(wi)).vec3();
     let len_sq = stretched.length_squared();
-    let (v, len) = if len_sq > DIRECT_SCALE_RANGE.0 && len_sq < DIRECT_SCALE_RANGE.1 {
+    let (v, len) = if in_direct_range(len_sq) {
         (stretched, len_sq.sqrt())
     } else {
         (normalize_scaled(stretched, Vec3::Z), 1.0)
     };
     let h = sample_visible_cap(v, len, bound, u1, u2);
-    ensure_visible(wi, normalize_fast(Vec3::new(alpha_x * h.x, alpha_y * h.y, h.z), Vec3::Z))
+    ensure_visible(wi, normalize_fast(stretch_of(alpha_x, alpha_y, V3::of(h)).vec3(), Vec3::Z))
+}
+
+/// (αx x, αy y, z): the stretch of ωi to the α = 1 configuration, and the unstretch of a
+/// sampled (unnormalized) normal back to (αx, αy).
+#[inline(always)]
+pub(crate) fn stretch_of<L: Lanes>(alpha_x: L, alpha_y: L, w: V3<L>) -> V3<L> {
+    V3::new(alpha_x * w.x, alpha_y * w.y, w.z)
+}
+
+/// Whether a squared length is normalized directly (`DIRECT_SCALE_RANGE`).
+#[inline(always)]
+pub(crate) fn in_direct_range<L: Lanes>(len_sq: L) -> L::Mask {
+    len_sq.gt(L::lit(DIRECT_SCALE_RANGE.0)) & len_sq.lt(L::lit(DIRECT_SCALE_RANGE.1))
+}
+
+/// The GGX visible normal of [`sample_stretched_cap`] for every lane type, on its common path,
+/// with the cap bounded by κ ([`kappa_of`]; 2 for the whole cap of [`sample_spherical_cap`]):
+/// the stretched ωi normalized directly, the cap point away from −v̂, the unstretched normal
+/// normalized directly and clearly visible. Returns the normal and the mask of the lanes where
+/// that path is the scalar sampler's, bit for bit; the others need the scalar sampler.
+#[inline(always)]
+pub(crate) fn sample_cap_of<L: Lanes>(
+    alpha_x: L,
+    alpha_y: L,
+    wi: V3<L>,
+    kappa: L,
+    u1: L,
+    u2: L,
+) -> (V3<L>, L::Mask) {
+    let v = stretch_of(alpha_x, alpha_y, wi);
+    let len_sq = v.length_squared();
+    let len = len_sq.sqrt();
+    let lift = (L::lit(2.0) - kappa) * v.z;
+    let (h, away) = cap_direct(v, len, top_of(kappa, v, len), lift, u1, u2);
+    let m = stretch_of(alpha_x, alpha_y, h);
+    let m_len_sq = m.length_squared();
+    let m = m.scale(L::lit(1.0) / m_len_sq.sqrt());
+    let visible = wi.dot(m).gt(L::lit(VISIBLE_DOT_MARGIN));
+    (m, in_direct_range(len_sq) & away & in_direct_range(m_len_sq) & visible)
 }
 
 /// Samples the normals of the unit upper hemisphere visible from the direction `v` of length
@@ -124,23 +178,35 @@ pub(crate) fn sample_visible_hemisphere(v: Vec3, len: f32, u1: f32, u2: f32) -> 
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_visible_cap(v: Vec3, len: f32, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
-    let u1 = cut_tails(u1);
+    debug_assert!((0.0..=1.0).contains(&u2), "u2 = {u2} outside [0, 1]");
+    let (h, away) = cap_direct(V3::of(v), len, bound.top(v, len), bound.lift(v), u1, u2);
+    if away {
+        return h.vec3();
+    }
+    cap_near_opposite(v, bound, cut_tails(u1), u2).unwrap_or(h.vec3())
+}
+
+/// The cap point h of [`sample_visible_cap`] in its direct form, for every lane type, given the
+/// cap's scaled height `top` and `lift` ([`CapBound::top`], [`CapBound::lift`]; the whole cap's
+/// for the lanes), with the mask of the lanes where it is away from −v̂ (|h| ≥ len/64: kept; the
+/// others are recomputed by [`cap_near_opposite`]).
+#[inline(always)]
+pub(crate) fn cap_direct<L: Lanes>(v: V3<L>, len: L, top: L, lift: L, u1: L, u2: L) -> (V3<L>, L::Mask) {
+    let u1 = u1.clamp(L::lit(TAIL_CUT), L::lit(1.0 - TAIL_CUT));
     // len·(c.z + v̂.z) = (1 − u1)(len + v.z), and len²(1 − c.z²) = len² − (len c.z)², whose
     // factor len − len c.z is exactly u1 (len + v.z): both without cancellation
     // len + v.z written as (v.x² + v.y²)/(len − v.z) below the horizon: for a backfacing ωi
     // of a low-roughness surface v̂ ≈ −z and the direct sum cancels (GGX α = 1e-4 at θ = 2.3:
     // it rounded to 0 and every sample became the fallback horizontal normal)
-    let top = bound.top(v, len);
-    let h_z = (1.0 - u1) * top + bound.lift(v);
+    let h_z = (L::lit(1.0) - u1) * top + lift;
     let z_scaled = h_z - v.z;
-    let r = (u1 * top * (len + z_scaled)).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = sin_cos_turns(u2);
-    let h = Vec3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
+    let r = (u1 * top * (len + z_scaled)).max(L::lit(0.0)).sqrt();
+    let (sin_phi, cos_phi) = sin_cos_turns_of(u2);
+    let h = V3::new(r * cos_phi + v.x, r * sin_phi + v.y, h_z);
     // |h| ≥ h.z: the height alone clears the test for all but the bottom of the cap
-    if h_z >= NEAR_OPPOSITE * len || h.length_squared() >= NEAR_OPPOSITE * NEAR_OPPOSITE * (len * len) {
-        return h;
-    }
-    cap_near_opposite(v, bound, u1, u2).unwrap_or(h)
+    let near = L::lit(NEAR_OPPOSITE);
+    let away = h_z.ge(near * len) | h.length_squared().ge(near * near * (len * len));
+    (h, away)
 }
 
 /// |h| below this fraction of len is recomputed by [`cap_near_opposite`].
@@ -211,22 +277,26 @@ pub(crate) fn cap_bound(ggx: &Ggx, wi: Vec3) -> CapBound {
     if wi.z <= 0.0 {
         return CapBound::FULL;
     }
-    let a = ggx.alpha_x().min(ggx.alpha_y());
-    let a_sq = (a * a).min(MAX_BOUND_ALPHA_SQ);
+    CapBound { kappa: kappa_of(ggx.alpha_x().min(ggx.alpha_y()), V3::of(wi)) }
+}
+
+/// κ of [`cap_bound`] for a view above the horizon, for every lane type; `alpha` = min(αx, αy).
+#[inline(always)]
+pub(crate) fn kappa_of<L: Lanes>(alpha: L, wi: V3<L>) -> L {
+    let one = L::lit(1.0);
+    let a_sq = (alpha * alpha).min(L::lit(MAX_BOUND_ALPHA_SQ));
     let t_sq = wi.x * wi.x + wi.y * wi.y;
     // sin θ = t/r with t = |ωi,xy| and r = |ωi|, which is 1 within 5e-4 (1 − 1e-3 ≤ r² ≤ 1 +
     // 1e-3, the crate's direction tolerance): r = (1 + r²)/2 to within (r² − 1)²/8 ≤ 1.3e-7
     // relative, without a square root. κ is written homogeneous in (t, r), with σ₊ = r + t
     // and σ₋ = r − t, whose cancellation near grazing costs at most ε r absolute in terms
     // that are at least r (a ≤ 1: σ₊ + a² σ₋) or a² r (a > 1), i.e. a few ulps of κ
-    let (t, r) = (t_sq.sqrt(), 0.5 * (1.0 + (t_sq + wi.z * wi.z)));
+    let (t, r) = (t_sq.sqrt(), L::lit(0.5) * (one + (t_sq + wi.z * wi.z)));
     let (plus, minus) = (r + t, r - t);
-    let (numerator, denominator) = if a_sq <= 1.0 {
-        (r + (1.0 - a_sq) * t, plus + a_sq * minus)
-    } else {
-        (minus + a_sq * t, minus + a_sq * plus)
-    };
-    CapBound { kappa: (2.0 * numerator / denominator * KAPPA_MARGIN).min(2.0) }
+    let smooth = a_sq.le(one);
+    let numerator = L::choose(smooth, || r + (one - a_sq) * t, || minus + a_sq * t);
+    let denominator = L::choose(smooth, || plus + a_sq * minus, || minus + a_sq * plus);
+    (L::lit(2.0) * numerator / denominator * L::lit(KAPPA_MARGIN)).min(L::lit(2.0))
 }
 
 /// A reflection normal from the bounded cap of ωi (unit), no argument check: the spherical
@@ -242,9 +312,15 @@ pub(crate) fn sample_bounded_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec3 
 #[must_use]
 #[inline(always)]
 pub(crate) fn bounded_area(ggx: &Ggx, wi: Vec3) -> f32 {
-    // L as the sampler forms it (`sample_stretched_cap`), so that the two share it
-    let v = Vec3::new(ggx.alpha_x() * wi.x, ggx.alpha_y() * wi.y, wi.z);
-    0.5 * cap_bound(ggx, wi).top(v, v.length_squared().sqrt())
+    bounded_area_of(ggx.alpha_x(), ggx.alpha_y(), V3::of(wi), cap_bound(ggx, wi).kappa)
+}
+
+/// [`bounded_area`] for every lane type, given κ: L as the sampler forms it
+/// ([`sample_stretched_cap`], [`sample_cap_of`]), so that the two share it.
+#[inline(always)]
+pub(crate) fn bounded_area_of<L: Lanes>(alpha_x: L, alpha_y: L, wi: V3<L>, kappa: L) -> L {
+    let v = stretch_of(alpha_x, alpha_y, wi);
+    L::lit(0.5) * top_of(kappa, v, v.length_squared().sqrt())
 }
 
 #[cfg(test)]

@@ -10,11 +10,10 @@
 
 use super::quadrature::Family;
 use super::{N, alpha_of_node, mu_of, par_map};
-use microsurface::glam::Vec3;
 use microsurface::rand::SeedableRng;
-use microsurface::research::{Microsurface, UniformHeight};
+use microsurface::research::{Microsurface, UniformHeight, WalkOutputs};
 use microsurface::slope::MicrosurfaceSlope;
-use microsurface::{Beckmann, Conductor, Ggx};
+use microsurface::{Beckmann, Channels, Conductor, Directions, Ggx};
 use std::fmt::Write as _;
 
 /// Walks per cell: 2¹⁶, so that every cell's standard error is at most 0.5/256 < 2e-3.
@@ -52,7 +51,9 @@ fn generator(seed: u64, family: Family, cell: usize) -> Pcg {
 }
 
 /// Counts of walks leaving after k = 2 … K bounces and after more, for `walks` walks with the
-/// incident cosine drawn by `mu` (fixed, or cosine-weighted).
+/// incident cosine drawn by `mu` (fixed, or cosine-weighted), walked in lanes
+/// ([`Microsurface::sample_batch`]: GGX in eight f32 lanes, Beckmann by the scalar walk) from a
+/// seed drawn after the cosines.
 fn count<S: MicrosurfaceSlope>(
     slope: S,
     walks: usize,
@@ -60,22 +61,53 @@ fn count<S: MicrosurfaceSlope>(
     mut mu: impl FnMut(&mut Pcg) -> f32,
 ) -> [u64; TABLES] {
     let surface = Microsurface::new(UniformHeight, slope, Conductor::perfect());
-    let mut counts = [0u64; TABLES];
-    for _ in 0..walks {
-        let m = mu(rng);
-        if m <= 0.0 {
-            // a grazing ray sees only the top of the surface: single scattering takes it all
-            continue;
+    BUFFERS.with_borrow_mut(|b| {
+        // a grazing ray sees only the top of the surface: single scattering takes it all
+        b.z.clear();
+        b.z.extend((0..walks).map(|_| mu(rng)).filter(|&m| m > 0.0));
+        let n = b.z.len();
+        b.x.clear();
+        b.x.extend(b.z.iter().map(|&m| (1.0 - m * m).max(0.0).sqrt()));
+        for v in [&mut b.y, &mut b.wx, &mut b.wy, &mut b.wz, &mut b.r, &mut b.g, &mut b.b] {
+            v.resize(n, 0.0);
         }
-        let wi = Vec3::new((1.0 - m * m).max(0.0).sqrt(), 0.0, m);
-        if let Some(s) = surface.sample(wi, rng) {
-            let k = s.bounces as usize;
+        b.bounces.resize(n, 0);
+        let seed = microsurface::rand::Rng::next_u64(rng);
+        let mut out = WalkOutputs {
+            wo: Channels::new(&mut b.wx, &mut b.wy, &mut b.wz),
+            weight: Channels::new(&mut b.r, &mut b.g, &mut b.b),
+            bounces: &mut b.bounces,
+        };
+        let wi = Directions::new(&b.x, &b.y, &b.z).expect("equal lengths");
+        surface.sample_batch(&wi, seed, &mut out).expect("equal lengths");
+        let mut counts = [0u64; TABLES];
+        for &k in &b.bounces {
+            let k = k as usize;
             if k >= 2 {
                 counts[(k - 2).min(TABLES - 1)] += 1;
             }
         }
-    }
-    counts
+        counts
+    })
+}
+
+/// The walks' inputs and outputs, kept per thread across cells.
+#[derive(Default)]
+struct Buffers {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    wx: Vec<f32>,
+    wy: Vec<f32>,
+    wz: Vec<f32>,
+    r: Vec<f32>,
+    g: Vec<f32>,
+    b: Vec<f32>,
+    bounces: Vec<u32>,
+}
+
+thread_local! {
+    static BUFFERS: std::cell::RefCell<Buffers> = std::cell::RefCell::new(Buffers::default());
 }
 
 /// The counts of one cell (direction cell or average cell) with `walks` walks from `seed`.

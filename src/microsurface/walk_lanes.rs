@@ -1,0 +1,415 @@
+//! The random walk in lanes: many walks of [`Microsurface::sample`] at once, eight in flight,
+//! each lane refilled with the next query when its walk ends (supplement §3.1, Algorithm 3).
+//!
+//! A lane carries one path: its ray, its height (ln C¹, or the undrawn rate of an opaque
+//! walk, `walk::Depth`), its weight, its bounce count, and its own generator. Every formula is
+//! the scalar walk's kernel: Λ ([`lambda_and_area_of`]), the height step
+//! ([`escapes_without_log`], [`step_ln_c1`], the logarithm `ln_f32` lane by lane), the
+//! spherical-cap visible normal ([`sample_cap_of`]), the reflection and its Newton
+//! renormalization, the Fresnel term ([`reflectance_of`]); the rare forms the scalar walk
+//! branches to (a cap point near −v̂, a Fresnel cosine below 0.05, a reflection far from unit
+//! length) are the scalar material's sampler for that lane. The lanes draw their uniforms from
+//! their own generators, so a walk in lanes is not the scalar walk's bits but the same
+//! distribution (two-sample tests per order in `tests/walk/lanes.rs`).
+
+use super::Microsurface;
+use super::geometry::{escapes_without_log, step_ln_c1};
+use super::walk::{MAX_BOUNCES, WalkSample};
+use crate::error::Error;
+use crate::fresnel::reflectance_of;
+use crate::height::MicrosurfaceHeight;
+use crate::lanes::{LaneLoop, V3, dispatch};
+use crate::material::{LaneMaterial, Material};
+use crate::rng::TAIL_CUT;
+use crate::slope::{MicrosurfaceSlope, lambda_and_area_of, sample_cap_of};
+use crate::soa::{Channels, Directions, check_len};
+use crate::special::ln_f32;
+use glam::{Vec3, Vec3A};
+use rand::SeedableRng;
+
+/// The outputs of [`Microsurface::sample_batch`], one element per query: the exit direction,
+/// the weight f·|cos θo|/pdf and the number of bounces, 0 where [`Microsurface::sample`]
+/// returns `None` (then the direction and the weight are 0).
+#[derive(Debug)]
+pub struct WalkOutputs<'a> {
+    /// The exit directions ωo.
+    pub wo: Channels<'a>,
+    /// The weights per RGB channel.
+    pub weight: Channels<'a>,
+    /// The bounces of each walk (0: no sample).
+    pub bounces: &'a mut [u32],
+}
+
+impl WalkOutputs<'_> {
+    fn check(&self, n: usize) -> Result<(), Error> {
+        self.wo.check("wo", n)?;
+        self.weight.check("weight", n)?;
+        check_len("bounces", n, self.bounces.len())
+    }
+
+    #[inline]
+    fn set(&mut self, i: usize, s: Option<WalkSample>) {
+        match s {
+            Some(s) => {
+                self.wo.set(i, s.wo);
+                self.weight.set(i, s.weight);
+                self.bounces[i] = s.bounces;
+            }
+            None => {
+                self.wo.set(i, Vec3::ZERO);
+                self.weight.set(i, Vec3::ZERO);
+                self.bounces[i] = 0;
+            }
+        }
+    }
+}
+
+/// The splitmix64 state of query `i`'s stream from `seed` (a lane's generator is reseeded with
+/// each query, so that query i's walk depends on (seed, i) only, not on the lane or the order
+/// in which the lanes finish).
+#[inline(always)]
+fn stream(seed: u64, i: usize) -> u64 {
+    mix64(seed ^ mix64((i as u64).wrapping_add(0x632b_e59b_d9b4_e019)))
+}
+
+/// The splitmix64 finalizer.
+#[inline(always)]
+fn mix64(z: u64) -> u64 {
+    let z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// 2⁻²⁴.
+const INV_2_POW_24: f32 = 1.0 / 16_777_216.0;
+
+/// The paths in flight: a multiple of the vector width, enough for the step's loop to run
+/// in full vectors most of the time while lanes finish and refill.
+const PATHS: usize = 64;
+
+/// xoshiro128++ (Blackman and Vigna 2018), one per path: 32-bit words, so that the step's
+/// loop draws its uniforms in eight-lane integer instructions.
+#[inline(always)]
+fn xoshiro(s: &mut [u32; 4]) -> u32 {
+    let out = s[0].wrapping_add(s[3]).rotate_left(7).wrapping_add(s[0]);
+    let t = s[1] << 9;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = s[3].rotate_left(11);
+    out
+}
+
+/// A uniform on the 2⁻²⁴ grid of `rng::uniform` from 32 random bits.
+#[inline(always)]
+fn uniform_of(bits: u32) -> f32 {
+    (bits >> 8) as f32 * INV_2_POW_24
+}
+
+/// ln(1 − cut_tails(u)) (the walks' logarithm, `ln_f32`) and 1 − cut_tails(u).
+#[inline(always)]
+fn ln_one_minus(u: f32) -> (f32, f32) {
+    let one_minus_u = 1.0 - u.clamp(TAIL_CUT, 1.0 - TAIL_CUT);
+    (ln_f32(one_minus_u), one_minus_u)
+}
+
+/// The state of the paths in flight, one array element per path.
+struct Paths {
+    /// The ray leaving the current point (−ωi at the start).
+    wr: [[f32; PATHS]; 3],
+    /// ln C¹ (≤ 0), or the rate of an undrawn depth (> 0); 0 above the surface.
+    depth: [f32; PATHS],
+    weight: [[f32; PATHS]; 3],
+    bounces: [u32; PATHS],
+    /// The query of each path; `usize::MAX` for an idle slot.
+    query: [usize; PATHS],
+    rng: [[u32; 4]; PATHS],
+    /// The step's verdict: 0 continues with the lanes' facet; otherwise the bits
+    /// [`ESCAPED`], [`SCALAR_FACET`], [`HEIGHT_STEP`], [`ENDED`].
+    status: [u8; PATHS],
+    /// The uniforms of the last step: the height's two and the facet's two.
+    u: [[f32; 4]; PATHS],
+    /// The ray and weight after the lanes' facet of the last step.
+    next_wr: [[f32; PATHS]; 3],
+    next_weight: [[f32; PATHS]; 3],
+}
+
+/// The ray escaped before the facet (its closed-form escape, or the height step's).
+const ESCAPED: u8 = 1;
+/// The facet is off the kernels' common path: the scalar sampler redoes it.
+const SCALAR_FACET: u8 = 2;
+/// The ray's height is stepped with logarithms (Algorithm 1), by the scalar kernels.
+const HEIGHT_STEP: u8 = 4;
+/// The walk ends without a sample (absorbed, or the bounce cap).
+const ENDED: u8 = 8;
+
+/// One step of one path of a GGX conductor walk (`Microsurface::next_hit` of an opaque walk,
+/// then the mirror facet of `Conductor::sample_mirror_unchecked`) on the lanes' common path:
+/// the ray's escape where it needs no logarithm (a first hit from above, the closed form of an
+/// undrawn depth seen from below it), the facet, the next depth, and the verdict bits.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn step(
+    ax: f32,
+    ay: f32,
+    fresnel: Option<(Vec3A, Vec3A)>,
+    w: V3<f32>,
+    depth: f32,
+    weight: [f32; 3],
+    rng: &mut [u32; 4],
+) -> (V3<f32>, f32, [f32; 3], u8, [f32; 4]) {
+    let (lambda, _) = lambda_and_area_of(ax, ay, w);
+    let (ua, ub) = (uniform_of(xoshiro(rng)), uniform_of(xoshiro(rng)));
+    let (u1, u2) = (uniform_of(xoshiro(rng)), uniform_of(xoshiro(rng)));
+    // the next intersection: a first hit from above is undrawn (rate −Λ = 1 + Λ(ωi)); an
+    // undrawn depth seen by a ray going up escapes with probability a/(a + Λ); every other
+    // ray's height is stepped with logarithms (`HEIGHT_STEP`)
+    let from_above = depth == 0.0 && w.z < 0.0;
+    let closed_form = depth > 0.0 && w.z > 0.0;
+    let escapes = closed_form && ua < depth / (depth + lambda);
+    let next_depth = if from_above { -lambda } else { depth };
+    // the facet: a visible normal of ωi = −ωr, the mirror reflection, its Fresnel weight
+    let wi = V3::new(-w.x, -w.y, -w.z);
+    let (m, cap_ok) = sample_cap_of(ax, ay, wi, 2.0, u1, u2);
+    let c = wi.dot(m);
+    let k = 2.0 * c;
+    let r = V3::new(k * m.x - wi.x, k * m.y - wi.y, k * m.z - wi.z);
+    let r_len_sq = r.length_squared();
+    let nearly_unit = (r_len_sq - 1.0).abs() <= 1.0 / 4096.0;
+    let wo = r.scale(1.5 - 0.5 * r_len_sq);
+    let (f, common) = match fresnel {
+        None => ([1.0; 3], cap_ok && nearly_unit),
+        Some((t0, m4)) => {
+            let cos = c.abs().min(1.0);
+            let f = |t: f32, q: f32| reflectance_of(cos, t, q);
+            ([f(t0.x, m4.x), f(t0.y, m4.y), f(t0.z, m4.z)], cap_ok && nearly_unit && c >= 0.05)
+        }
+    };
+    let status = u8::from(escapes) * ESCAPED
+        + u8::from(!common) * SCALAR_FACET
+        + u8::from(!from_above && !closed_form) * HEIGHT_STEP;
+    (wo, next_depth, [weight[0] * f[0], weight[1] * f[1], weight[2] * f[2]], status, [ua, ub, u1, u2])
+}
+
+/// The walks of a GGX conductor in lanes.
+struct WalkLoop<'s, 'a, 'b, H, S, M> {
+    surface: &'s Microsurface<H, S, M>,
+    ax: f32,
+    ay: f32,
+    fresnel: Option<(Vec3A, Vec3A)>,
+    wi: &'s Directions<'a>,
+    seed: u64,
+    out: &'s mut WalkOutputs<'b>,
+}
+
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, '_, H, S, M> {
+    /// The scalar walk for query `i` (outside the lanes' domain: a view from below, an invalid
+    /// direction), from its own generator.
+    #[inline(never)]
+    fn scalar(&mut self, i: usize) {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(stream(self.seed, i));
+        self.out.set(i, self.surface.sample(self.wi.get(i), &mut rng));
+    }
+
+    /// Fills slot `k` with the next query the lanes walk (answering the others with the scalar
+    /// walk), or leaves it idle.
+    #[inline(never)]
+    fn refill(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
+        p.query[k] = usize::MAX;
+        // an idle slot walks a harmless ray whose results are dropped
+        let mut wi = Vec3::Z;
+        while *next < self.wi.len() {
+            let i = *next;
+            *next += 1;
+            let w = self.wi.get(i);
+            // the lanes walk from above: a unit ωi with ωi.z > 0 (what `Microsurface::sample`
+            // walks itself; a view from below is its `sample_from_below`)
+            if crate::contract::is_direction(w) && w.z > 0.0 {
+                p.query[k] = i;
+                wi = w;
+                let s = stream(self.seed, i);
+                let (a, b) = (mix64(s), mix64(s ^ 0xd1b5_4a32_d192_ed03));
+                p.rng[k] = [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32 | 1];
+                break;
+            }
+            self.scalar(i);
+        }
+        for (c, v) in [-wi.x, -wi.y, -wi.z].into_iter().enumerate() {
+            p.wr[c][k] = v;
+            p.weight[c][k] = 1.0;
+        }
+        p.depth[k] = 0.0;
+        p.bounces[k] = 0;
+    }
+
+    /// The step of every path (a loop the compiler vectorizes), then the commit of the paths
+    /// that continue on the lanes' common path (another).
+    #[inline(always)]
+    fn step_all(&self, p: &mut Paths, fresnel: Option<(Vec3A, Vec3A)>) {
+        for k in 0..PATHS {
+            let w = V3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
+            let weight = [p.weight[0][k], p.weight[1][k], p.weight[2][k]];
+            let (wo, depth, weight, status, u) =
+                step(self.ax, self.ay, fresnel, w, p.depth[k], weight, &mut p.rng[k]);
+            for (c, v) in [wo.x, wo.y, wo.z].into_iter().enumerate() {
+                p.next_wr[c][k] = v;
+            }
+            for (c, v) in weight.into_iter().enumerate() {
+                p.next_weight[c][k] = v;
+            }
+            p.depth[k] = depth;
+            p.status[k] = status;
+            p.u[k] = u;
+        }
+        for k in 0..PATHS {
+            let go = p.status[k] == 0;
+            for c in 0..3 {
+                p.wr[c][k] = if go { p.next_wr[c][k] } else { p.wr[c][k] };
+                p.weight[c][k] = if go { p.next_weight[c][k] } else { p.weight[c][k] };
+            }
+            let bounces = p.bounces[k] + u32::from(go);
+            p.bounces[k] = bounces;
+            let absorbed = p.weight[0][k] == 0.0 && p.weight[1][k] == 0.0 && p.weight[2][k] == 0.0;
+            p.status[k] |= u8::from(go && (absorbed || bounces >= MAX_BOUNCES)) * ENDED;
+        }
+    }
+
+    /// The paths off the lanes' common path, one by one: their height step with the scalar
+    /// kernels (`next_ln_c1`'s, from the step's uniforms), the scalar facet, the exits, ends and
+    /// refills.
+    #[inline(never)]
+    fn finish(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
+        let Some(i) = Some(p.query[k]).filter(|&i| i != usize::MAX) else { return };
+        let status = p.status[k];
+        let mut escaped = status & ESCAPED != 0;
+        if status & HEIGHT_STEP != 0 {
+            let w = Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
+            let lambda = self.surface.slope().lambda_unchecked(w);
+            let [ua, ub, _, _] = p.u[k];
+            let depth = p.depth[k];
+            // an undrawn depth is drawn from a e^{aℓ} first (`walk::Depth::drawn`)
+            let drawn = if depth > 0.0 { step_ln_c1(-1.0, -depth, 0.0, ln_one_minus(ua).0).0 } else { depth };
+            let (ln_b, one_minus_b) = ln_one_minus(ub);
+            let quick = w.z >= 0.0 && escapes_without_log(lambda, drawn, one_minus_b);
+            let (stepped, escapes) = step_ln_c1(w.z, lambda, drawn, ln_b);
+            escaped = quick || escapes;
+            p.depth[k] = stepped;
+        }
+        if escaped {
+            let s = WalkSample {
+                wo: Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]),
+                weight: Vec3::new(p.weight[0][k], p.weight[1][k], p.weight[2][k]),
+                bounces: p.bounces[k],
+            };
+            self.out.set(i, Some(s));
+            self.refill(p, k, next);
+            return;
+        }
+        if status & ENDED == 0 && status != 0 {
+            // the facet of a path that continues: the lanes' or the scalar sampler's
+            if status & SCALAR_FACET != 0 {
+                let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
+                let [_, _, u1, u2] = p.u[k];
+                let wm = self.surface.slope().sample_d_wi_unchecked(wi, u1, u2);
+                let s = self.surface.material().mirror_reflection_unchecked(wi, wm);
+                for (c, (w, f)) in
+                    [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
+                {
+                    p.wr[c][k] = w;
+                    p.weight[c][k] *= f;
+                }
+            } else {
+                for c in 0..3 {
+                    p.wr[c][k] = p.next_wr[c][k];
+                    p.weight[c][k] = p.next_weight[c][k];
+                }
+            }
+            p.bounces[k] += 1;
+        }
+        let absorbed = (0..3).all(|c| p.weight[c][k] == 0.0);
+        if status & ENDED != 0 || absorbed || p.bounces[k] >= MAX_BOUNCES {
+            self.out.set(i, None);
+            self.refill(p, k, next);
+        }
+    }
+
+    /// Walks every query with the Fresnel term `fresnel` (fixed, so that the step's loop has
+    /// no branch on it).
+    #[inline(always)]
+    fn walk(&mut self, fresnel: Option<(Vec3A, Vec3A)>) {
+        let mut p = Paths {
+            wr: [[0.0; PATHS], [0.0; PATHS], [-1.0; PATHS]],
+            depth: [0.0; PATHS],
+            weight: [[1.0; PATHS]; 3],
+            bounces: [0; PATHS],
+            query: [usize::MAX; PATHS],
+            rng: [[1; 4]; PATHS],
+            status: [0; PATHS],
+            u: [[0.0; 4]; PATHS],
+            next_wr: [[0.0; PATHS]; 3],
+            next_weight: [[0.0; PATHS]; 3],
+        };
+        let mut next = 0;
+        for k in 0..PATHS {
+            self.refill(&mut p, k, &mut next);
+        }
+        while p.query.iter().any(|&q| q != usize::MAX) {
+            self.step_all(&mut p, fresnel);
+            let mut pending = 0u64;
+            for k in 0..PATHS {
+                pending |= u64::from(p.status[k] != 0) << k;
+            }
+            while pending != 0 {
+                let k = pending.trailing_zeros() as usize;
+                pending &= pending - 1;
+                self.finish(&mut p, k, &mut next);
+            }
+        }
+    }
+}
+
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> LaneLoop for WalkLoop<'_, '_, '_, H, S, M> {
+    #[inline(always)]
+    fn run(&mut self) {
+        match self.fresnel {
+            None => self.walk(None),
+            Some(f) => self.walk(Some(f)),
+        }
+    }
+}
+
+impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S, M> {
+    /// Samples one walk for each incident direction `wi[i]` (as [`Microsurface::sample`]), eight
+    /// at a time, each lane refilled with the next query when its walk ends; writes
+    /// [`WalkOutputs`]. Query i's walk is a function of (`seed`, i) only. The walks of GGX
+    /// conductors from above run in lanes; every other configuration and query (dielectrics,
+    /// other slopes, views from below, invalid directions) runs the scalar walk with a generator
+    /// seeded from (`seed`, i). Either way each walk has the distribution of
+    /// [`Microsurface::sample`] (not its bits: the lanes have their own generators).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] if an output slice is not as long as `wi`.
+    pub fn sample_batch(
+        &self,
+        wi: &Directions<'_>,
+        seed: u64,
+        out: &mut WalkOutputs<'_>,
+    ) -> Result<(), Error> {
+        out.check(wi.len())?;
+        let lanes = match (self.slope().ggx_roughness(), self.material().lane_material()) {
+            (Some((ax, ay)), LaneMaterial::Conductor(fresnel)) => Some((ax, ay, fresnel)),
+            _ => None,
+        };
+        let Some((ax, ay, fresnel)) = lanes else {
+            for i in 0..wi.len() {
+                let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(stream(seed, i));
+                out.set(i, self.sample(wi.get(i), &mut rng));
+            }
+            return Ok(());
+        };
+        dispatch(&mut WalkLoop { surface: self, ax, ay, fresnel, wi, seed, out });
+        Ok(())
+    }
+}

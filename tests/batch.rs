@@ -1,0 +1,345 @@
+//! The batch calls (`BatchBsdf`) against the scalar calls they stand for, query by query: over
+//! views and lights on the whole sphere (grazing down to cos θ = 1e-6, backfacing views), GGX
+//! roughness from 2e-3 to 10 (isotropic and anisotropic), gold, a perfect mirror and glass of
+//! η = 1.5, 1/1.5 and 1.33; invalid lanes mixed with valid ones; slices of unequal length.
+
+use microsurface::glam::{Vec2, Vec3};
+use microsurface::{
+    BatchBsdf, Beckmann, Bsdf, Channels, ComplexIor, Conductor, Dielectric, Directions, Error, Ggx,
+    MicrofacetBsdf, SampleOutputs, Technique,
+};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+/// Queries per configuration (not a multiple of 8: the scalar tail is exercised too).
+const N: usize = 4099;
+
+/// A direction: uniform on the sphere, or grazing (|cos θ| = 10⁻ᵏ, k = 1…6) one time in four.
+fn direction(rng: &mut Pcg64Mcg, upper: bool) -> Vec3 {
+    let z = if rng.random::<f32>() < 0.25 {
+        10f32.powi(-(1 + rng.random_range(0..6)))
+    } else {
+        1.0 - rng.random::<f32>()
+    };
+    let z = if !upper && rng.random::<bool>() { -z } else { z };
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = core::f32::consts::TAU * rng.random::<f32>();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+struct Soa {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+}
+
+impl Soa {
+    fn of(v: &[Vec3]) -> Self {
+        Self {
+            x: v.iter().map(|w| w.x).collect(),
+            y: v.iter().map(|w| w.y).collect(),
+            z: v.iter().map(|w| w.z).collect(),
+        }
+    }
+    fn dirs(&self) -> Directions<'_> {
+        Directions::new(&self.x, &self.y, &self.z).expect("equal lengths")
+    }
+}
+
+struct Out {
+    a: Vec<f32>,
+    b: Vec<f32>,
+    c: Vec<f32>,
+}
+
+impl Out {
+    fn new(n: usize) -> Self {
+        Self { a: vec![-1.0; n], b: vec![-1.0; n], c: vec![-1.0; n] }
+    }
+    fn channels(&mut self) -> Channels<'_> {
+        Channels::new(&mut self.a, &mut self.b, &mut self.c)
+    }
+    fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.a[i], self.b[i], self.c[i])
+    }
+}
+
+/// The largest relative error of `b` against `s` beyond an absolute allowance `abs` (per
+/// component), as (worst excess ratio, where).
+fn excess(b: Vec3, s: Vec3, rel: f32, abs: f32) -> f32 {
+    let mut worst = 0.0f32;
+    for k in 0..3 {
+        let (b, s) = (b[k], s[k]);
+        let bound = rel * s.abs() + abs;
+        worst = worst.max(if b == s { 0.0 } else { (b - s).abs() / bound });
+    }
+    worst
+}
+
+/// Views (upper or whole sphere) and lights (whole sphere).
+fn queries(seed: u64, views_upper: bool) -> (Vec<Vec3>, Vec<Vec3>) {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let wo = (0..N).map(|_| direction(&mut rng, views_upper)).collect();
+    let wi = (0..N).map(|_| direction(&mut rng, false)).collect();
+    (wo, wi)
+}
+
+/// Batch eval, pdf and eval_with_pdf against the scalar calls, with f within `rel`·|f| + `abs`·F
+/// (F the largest channel of the scalar f, so `abs` is relative to the lobe's size at that
+/// query) and the density within `pdf_rel`·pdf + `pdf_abs` (0, 0: bit for bit).
+fn check_eval<B: BatchBsdf>(
+    label: &str,
+    bsdf: &B,
+    seed: u64,
+    rel: f32,
+    abs: f32,
+    pdf_rel: f32,
+    pdf_abs: f32,
+) {
+    for views_upper in [true, false] {
+        let (wo, wi) = queries(seed, views_upper);
+        let (so, si) = (Soa::of(&wo), Soa::of(&wi));
+        let (mut f, mut f2, mut pdf, mut pdf2) = (Out::new(N), Out::new(N), vec![-1.0; N], vec![-1.0; N]);
+        bsdf.eval_batch(&so.dirs(), &si.dirs(), &mut f.channels()).expect("lengths");
+        bsdf.pdf_batch(&so.dirs(), &si.dirs(), &mut pdf).expect("lengths");
+        bsdf.eval_with_pdf_batch(&so.dirs(), &si.dirs(), &mut f2.channels(), &mut pdf2).expect("lengths");
+        let (mut worst_f, mut worst_pdf, mut nonzero) = (0.0f32, 0.0f32, 0);
+        for i in 0..N {
+            let value = bsdf.eval(wo[i], wi[i]).f;
+            let density = bsdf.pdf(wo[i], wi[i]);
+            let (value2, density2) = bsdf.eval_with_pdf(wo[i], wi[i]);
+            let scale = abs * value.max_element();
+            for (b, s) in [(f.get(i), value), (f2.get(i), value2.f)] {
+                let e = excess(b, s, rel, scale);
+                assert!(
+                    e <= 1.0,
+                    "{label}: f({}, {}) = {b} in the batch, {s} scalar (bound {rel}·|f| + {scale})",
+                    wo[i],
+                    wi[i]
+                );
+                worst_f = worst_f.max(if s == Vec3::ZERO {
+                    0.0
+                } else {
+                    ((b - s).abs() / s.max_element()).max_element()
+                });
+            }
+            for (b, s) in [(pdf[i], density), (pdf2[i], density2)] {
+                let bound = pdf_rel * s + pdf_abs;
+                assert!(
+                    b == s || (b - s).abs() <= bound,
+                    "{label}: pdf({}, {}) = {b} in the batch, {s} scalar",
+                    wo[i],
+                    wi[i]
+                );
+                worst_pdf = worst_pdf.max(if s > 0.0 { (b - s).abs() / s } else { 0.0 });
+            }
+            nonzero += usize::from(value != Vec3::ZERO);
+        }
+        eprintln!(
+            "{label} (views {}): f rel. error ≤ {worst_f:.2e}, pdf rel. error ≤ {worst_pdf:.2e}, {nonzero} of {N} nonzero",
+            if views_upper { "above" } else { "whole sphere" }
+        );
+        assert!(nonzero > N / 8, "{label}: only {nonzero} nonzero values compared");
+    }
+}
+
+/// Batch samples against the scalar samples, bit for bit (`exact`) or within `rel` for the
+/// weight and the density.
+fn check_sample<B: BatchBsdf>(label: &str, bsdf: &B, seed: u64, rel: f32) {
+    let (wo, _) = queries(seed, false);
+    let mut rng = Pcg64Mcg::seed_from_u64(seed + 7);
+    let uc: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let u1: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let u2: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let so = Soa::of(&wo);
+    let (mut w, mut weight, mut pdf, mut eta) = (Out::new(N), Out::new(N), vec![-1.0; N], vec![-1.0; N]);
+    let mut out = SampleOutputs { wi: w.channels(), weight: weight.channels(), pdf: &mut pdf, eta: &mut eta };
+    bsdf.sample_batch(&so.dirs(), &uc, &u1, &u2, &mut out).expect("lengths");
+    let mut some = 0;
+    for i in 0..N {
+        let s = bsdf.sample(wo[i], uc[i], Vec2::new(u1[i], u2[i]));
+        match s {
+            None => assert!(
+                pdf[i] == 0.0 && w.get(i) == Vec3::ZERO && weight.get(i) == Vec3::ZERO && eta[i] == 1.0,
+                "{label}: no scalar sample for {}, the batch has pdf {}",
+                wo[i],
+                pdf[i]
+            ),
+            Some(s) => {
+                some += 1;
+                let ok = w.get(i) == s.wi
+                    && eta[i] == s.eta
+                    && excess(weight.get(i), s.weight, rel, 0.0) <= 1.0
+                    && (pdf[i] - s.pdf).abs() <= rel * s.pdf;
+                assert!(
+                    ok,
+                    "{label}: sample of {} = {:?}, batch ({}, {}, {})",
+                    wo[i],
+                    s,
+                    w.get(i),
+                    weight.get(i),
+                    pdf[i]
+                );
+            }
+        }
+    }
+    assert!(some > N / 4, "{label}: only {some} samples compared");
+}
+
+fn single<
+    S: microsurface::slope::MicrosurfaceSlope,
+    M: microsurface::research::Material + microsurface::research::SpecularLimit,
+>(
+    slope: S,
+    material: M,
+) -> MicrofacetBsdf<S, M> {
+    MicrofacetBsdf::new(slope, material).expect("valid roughness").with_technique(Technique::SingleScattering)
+}
+
+/// Conductors: densities and samples bit for bit; f within 2e-5 relative plus 4e-6 of the
+/// value's largest channel (the scalar f forms D, Λ and G2 in f64, the lanes in f32).
+#[test]
+fn conductor_batches_are_the_scalar_calls() {
+    let gold = Conductor::new(ComplexIor::GOLD);
+    for (k, (ax, ay)) in [(2e-3f32, 2e-3f32), (0.05, 0.05), (0.5, 0.5), (0.3, 0.02), (2.0, 0.7), (10.0, 10.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let slope = Ggx::new(ax, ay).expect("valid roughness");
+        let seed = 100 + k as u64;
+        check_eval(&format!("gold GGX ({ax}, {ay})"), &single(slope, gold), seed, 4e-6, 1e-6, 0.0, 0.0);
+        check_eval(
+            &format!("mirror GGX ({ax}, {ay})"),
+            &single(slope, Conductor::perfect()),
+            seed,
+            4e-6,
+            1e-6,
+            0.0,
+            0.0,
+        );
+        check_sample(&format!("gold GGX ({ax}, {ay})"), &single(slope, gold), seed, 0.0);
+        check_sample(&format!("mirror GGX ({ax}, {ay})"), &single(slope, Conductor::perfect()), seed, 0.0);
+    }
+}
+
+/// Dielectrics: reflection f within 2e-5 relative plus 4e-6 of the value; densities within
+/// 1e-4 relative plus 1e-6 absolute; samples (the scalar calls) bit for bit.
+#[test]
+fn dielectric_batches_are_the_scalar_calls() {
+    for (k, eta) in [1.5f32, 1.0 / 1.5, 1.33].into_iter().enumerate() {
+        let glass = Dielectric::new(eta).expect("valid index");
+        for (j, (ax, ay)) in [(2e-3f32, 2e-3f32), (0.5, 0.5), (0.3, 0.02), (2.0, 0.7)].into_iter().enumerate()
+        {
+            let slope = Ggx::new(ax, ay).expect("valid roughness");
+            let seed = 200 + 10 * k as u64 + j as u64;
+            let bsdf = single(slope, glass);
+            check_eval(&format!("glass η = {eta}, GGX ({ax}, {ay})"), &bsdf, seed, 2e-5, 4e-6, 1e-4, 1e-6);
+            check_sample(&format!("glass η = {eta}, GGX ({ax}, {ay})"), &bsdf, seed, 0.0);
+        }
+    }
+}
+
+/// Configurations without lane kernels (Beckmann, the random walk) answer with the scalar calls.
+#[test]
+fn other_configurations_are_the_scalar_calls() {
+    let gold = Conductor::new(ComplexIor::GOLD);
+    let beckmann = single(Beckmann::isotropic(0.4).expect("valid roughness"), gold);
+    check_eval("gold Beckmann", &beckmann, 300, 0.0, 0.0, 0.0, 0.0);
+    check_sample("gold Beckmann", &beckmann, 300, 0.0);
+    let walk = MicrofacetBsdf::new(Ggx::isotropic(0.4).expect("valid roughness"), gold).expect("valid");
+    check_eval("gold walk", &walk, 301, 0.0, 0.0, 0.0, 0.0);
+}
+
+/// Slices of unequal length are rejected before anything is written.
+#[test]
+fn unequal_lengths_are_rejected() {
+    let gold = single(Ggx::isotropic(0.5).expect("valid roughness"), Conductor::new(ComplexIor::GOLD));
+    let (x, z) = (vec![0.0f32; 16], vec![1.0f32; 16]);
+    assert!(matches!(
+        Directions::new(&x, &x[..15], &z),
+        Err(Error::LengthMismatch { name: "y", expected: 16, found: 15 })
+    ));
+    let d = Directions::new(&x, &x, &z).expect("equal");
+    let short = Directions::new(&x[..8], &x[..8], &z[..8]).expect("equal");
+    let mut f = Out::new(16);
+    let mut pdf = vec![-1.0; 15];
+    assert!(matches!(gold.pdf_batch(&d, &d, &mut pdf), Err(Error::LengthMismatch { name: "pdf", .. })));
+    assert!(matches!(
+        gold.eval_batch(&d, &short, &mut f.channels()),
+        Err(Error::LengthMismatch { name: "wi", .. })
+    ));
+    assert!(pdf.iter().all(|&p| p == -1.0) && f.a.iter().all(|&v| v == -1.0), "a rejected call wrote");
+    let (mut w, mut weight, mut p, mut eta) = (Out::new(16), Out::new(16), vec![-1.0; 16], vec![-1.0; 16]);
+    let mut out = SampleOutputs { wi: w.channels(), weight: weight.channels(), pdf: &mut p, eta: &mut eta };
+    let u = vec![0.5f32; 16];
+    assert!(matches!(
+        gold.sample_batch(&d, &u, &u[..3], &u, &mut out),
+        Err(Error::LengthMismatch { name: "u1", .. })
+    ));
+    assert!(p.iter().all(|&v| v == -1.0));
+}
+
+/// Invalid lanes (NaN, zero, non-unit directions, uniforms outside [0, 1)) among valid ones get
+/// the scalar calls' nothing, and their neighbours their own values (release builds: the scalar
+/// calls assert in debug builds).
+#[cfg(not(debug_assertions))]
+#[test]
+fn invalid_lanes_get_nothing_and_do_not_poison_their_neighbours() {
+    let gold = single(Ggx::isotropic(0.5).expect("valid roughness"), Conductor::new(ComplexIor::GOLD));
+    let glass = single(Ggx::isotropic(0.5).expect("valid roughness"), Dielectric::new(1.5).expect("valid"));
+    let bad = [
+        Vec3::NAN,
+        Vec3::ZERO,
+        Vec3::new(0.0, 0.0, 2.0),
+        Vec3::new(f32::INFINITY, 0.0, 0.0),
+        Vec3::new(0.6, 0.0, 0.9),
+    ];
+    let (mut wo, mut wi) = queries(400, true);
+    for (k, b) in bad.iter().enumerate() {
+        wo[8 * k + 3] = *b;
+        wi[8 * k + 5] = *b;
+    }
+    check_lanes("gold", &gold, &wo, &wi);
+    check_lanes("glass", &glass, &wo, &wi);
+    let mut rng = Pcg64Mcg::seed_from_u64(401);
+    let mut u1: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let u2: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let uc = u2.clone();
+    for (k, u) in [f32::NAN, -0.1, 1.0, 3.0].into_iter().enumerate() {
+        u1[8 * k + 2] = u;
+    }
+    let so = Soa::of(&wo);
+    let (mut w, mut weight, mut pdf, mut eta) = (Out::new(N), Out::new(N), vec![-1.0; N], vec![-1.0; N]);
+    let mut out = SampleOutputs { wi: w.channels(), weight: weight.channels(), pdf: &mut pdf, eta: &mut eta };
+    gold.sample_batch(&so.dirs(), &uc, &u1, &u2, &mut out).expect("lengths");
+    for i in 0..N {
+        let s = gold.sample(wo[i], uc[i], Vec2::new(u1[i], u2[i]));
+        assert_eq!(s.map_or(0.0, |s| s.pdf), pdf[i], "sample {i}");
+        assert_eq!(s.map_or(Vec3::ZERO, |s| s.weight), weight.get(i), "sample {i}");
+    }
+}
+
+#[cfg(not(debug_assertions))]
+fn check_lanes<B: BatchBsdf>(label: &str, bsdf: &B, wo: &[Vec3], wi: &[Vec3]) {
+    let (so, si) = (Soa::of(wo), Soa::of(wi));
+    let (mut f, mut pdf) = (Out::new(N), vec![-1.0; N]);
+    bsdf.eval_with_pdf_batch(&so.dirs(), &si.dirs(), &mut f.channels(), &mut pdf).expect("lengths");
+    for i in 0..N {
+        let (v, p) = bsdf.eval_with_pdf(wo[i], wi[i]);
+        let close = excess(f.get(i), v.f, 2e-5, 4e-6 * v.f.max_element()) <= 1.0
+            && (pdf[i] - p).abs() <= 1e-4 * p + 1e-6;
+        assert!(
+            close,
+            "{label}: query {i} ({}, {}): batch ({}, {}), scalar ({}, {p})",
+            wo[i],
+            wi[i],
+            f.get(i),
+            pdf[i],
+            v.f
+        );
+        if !(wo[i].length_squared() - 1.0).abs().le(&1e-3) || !(wi[i].length_squared() - 1.0).abs().le(&1e-3)
+        {
+            assert!(f.get(i) == Vec3::ZERO && pdf[i] == 0.0, "{label}: invalid query {i} got a value");
+        }
+    }
+}

@@ -8,8 +8,10 @@
 //! Successive calls are independent, so the figure is the throughput cost of a call.
 //!
 //! Benchmark ids: `{slope}/{function}/a{α}/t{θ}` (θ in radians: the incident direction, or
-//! for `d` the direction the normals are visible from), and
-//! `{height}/sample_height/{slope}_a0.5/{case}` for the height sampling.
+//! for `d` the direction the normals are visible from),
+//! `{height}/sample_height/{slope}_a0.5/{case}` for the height sampling, and
+//! `data_driven/{function}/{slope}/t{θ}`: D and `sample_d_wi` of the tabulated slopes against
+//! the analytic GGX they tabulate (α = 0.5) in one group, so that their ratios come from one run.
 
 use core::f32::consts::TAU;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -158,6 +160,53 @@ fn slopes(c: &mut Criterion<Clock>) {
     });
 }
 
+/// The data-driven slopes against the GGX they tabulate (α = 0.5): `d` and `sample_d_wi` in one
+/// group, slope by slope for each θ, on the same inputs (normals sampled from GGX's D_ω).
+fn data_driven(c: &mut Criterion<Clock>) {
+    let a = 0.5f32;
+    let ggx = Ggx::isotropic(a).expect("valid roughness");
+    let table = TabulatedSlope::from_slope(&ggx, a, 256).expect("valid table");
+    let stretched = table.stretched(0.6, 1.4).expect("valid stretch");
+    let a64 = f64::from(a);
+    let grid = GridSlope::from_fn(a, a, 32, move |x: f64, y: f64| {
+        let t = 1.0 + (x * x + y * y) / (a64 * a64);
+        1.0 / (core::f64::consts::PI * a64 * a64 * t * t)
+    })
+    .expect("valid table");
+    let inputs: Vec<(f32, Inputs)> =
+        THETAS.iter().enumerate().map(|(k, &t)| (t, Inputs::new(&ggx, t, 3000 + k as u64))).collect();
+    let mut group = c.benchmark_group("data_driven");
+    fn both<S: MicrosurfaceSlope>(
+        group: &mut criterion::BenchmarkGroup<'_, Clock>,
+        name: &str,
+        slope: S,
+        inputs: &[(f32, Inputs)],
+    ) {
+        for (t, inputs) in inputs {
+            group.bench_function(format!("d/{name}/t{t:?}"), |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    black_box(slope).d(black_box(inputs.wm[k]))
+                })
+            });
+            group.bench_function(format!("sample_d_wi/{name}/t{t:?}"), |b| {
+                let mut i = 0;
+                b.iter(|| {
+                    let k = next(&mut i);
+                    let (u1, u2) = black_box(inputs.u[k]);
+                    black_box(slope).sample_d_wi(black_box(inputs.w[k]), u1, u2)
+                })
+            });
+        }
+    }
+    both(&mut group, "ggx", ggx, &inputs);
+    both(&mut group, "tabulated_ggx256", &table, &inputs);
+    both(&mut group, "stretched_ggx256", stretched, &inputs);
+    both(&mut group, "grid_ggx32", &grid, &inputs);
+    group.finish();
+}
+
 /// `sample_height` at α = 0.5: a ray arriving from above the surface (h0 = +∞, θ = 2.2 below
 /// the horizon, the first bounce of every walk), and rays leaving the surface from heights
 /// drawn from the height distribution at θ ∈ {0.3, 1.4, 2.2}.
@@ -202,6 +251,6 @@ fn heights(c: &mut Criterion<Clock>) {
 criterion_group! {
     name = benches;
     config = config();
-    targets = slopes, heights
+    targets = slopes, heights, data_driven
 }
 criterion_main!(benches);

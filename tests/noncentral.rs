@@ -256,7 +256,7 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
     let z = validation::family_z(0.01, tests);
     validation::par_map(&views, |i, &wi| {
         let mass = integrate_sphere(
-            &mut |wo| f64::from(s.pdf_single_scattering(wi, wo)),
+            &mut |wo| f64::from(s.pdf_single_scattering(&conductor, wi, wo)),
             24,
             48,
             Domain::UpperHemisphere,
@@ -267,22 +267,15 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
         chi2_test(
             &format!("single scattering from {wi}"),
             Chi2Grid { quad_tol: 1e-5, max_depth: 7, ..Chi2Grid::sphere(30, 40) },
-            |wo| f64::from(s.pdf_single_scattering(wi, wo)),
-            || {
-                s.sample_single_scattering(
-                    &conductor,
-                    wi,
-                    validation::uniform32(&mut rng),
-                    validation::uniform32(&mut rng),
-                )
-                .map(|x| x.wo)
-            },
+            |wo| f64::from(s.pdf_single_scattering(&conductor, wi, wo)),
+            || s.sample_single_scattering(&conductor, wi, &mut rng).map(|x| x.wo),
             N,
             alpha,
             mass,
         );
+        let mut unused = validation::rng(0);
         let albedo = integrate_sphere(
-            &mut |wo| f64::from(s.eval_single_scattering(&conductor, wi, wo).x),
+            &mut |wo| f64::from(s.eval_single_scattering(&conductor, wi, wo, &mut unused).x),
             24,
             48,
             Domain::UpperHemisphere,
@@ -292,12 +285,10 @@ fn single_scattering_sampler_matches_eval_and_pdf() {
         let mut rng = validation::rng(600 + i as u64);
         let mut weights = validation::Stats::default();
         for _ in 0..N {
-            let w = s.sample_single_scattering(
-                &conductor,
-                wi,
-                validation::uniform32(&mut rng),
-                validation::uniform32(&mut rng),
-            );
+            let w = s.sample_single_scattering(&conductor, wi, &mut rng);
+            if let Some(w) = w {
+                assert_eq!(w.pdf, s.pdf_single_scattering(&conductor, wi, w.wo), "the sample's density");
+            }
             weights.push(w.map_or(0.0, |w| f64::from(w.weight.x)));
         }
         // G1(ωo) > 1 away from the tilt makes the weights spread (σ̂ ≈ 1.2 at θ = 1.2): SE ≤ 5e-3

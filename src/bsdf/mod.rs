@@ -37,6 +37,11 @@ pub use mint::{MintBsdf, MintSample};
 pub use sidedness::Sidedness;
 pub use specular::{SpecularEvent, SpecularLimit};
 
+/// The deterministic randomness of the stochastic evaluations, for the renderer BSDFs of the
+/// layers above (the noncentral lobes).
+#[cfg(feature = "leadr")]
+pub(crate) use seed::{Hasher, PrimedRng};
+
 use glam::{Vec2, Vec3};
 
 /// Which quantity a path carries across a dielectric interface.

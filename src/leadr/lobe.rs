@@ -2,8 +2,7 @@
 
 use super::SlopeMoments;
 use crate::error::Error;
-use crate::material::Conductor;
-use crate::noncentral::{Noncentral, NoncentralBsdf};
+use crate::noncentral::{Noncentral, NoncentralBsdf, NoncentralMaterial};
 use crate::slope::{Beckmann, Elliptical};
 use glam::Vec2;
 
@@ -172,14 +171,19 @@ impl LeadrLobe {
         self.slope
     }
 
-    /// The lobe's single-scattering BSDF with `conductor`, for renderers: the
-    /// [`NoncentralBsdf`] of [`Self::slope`] (Dupuy 2015, §3.4: the filtered texel shaded with
-    /// the noncentral microfacet BRDF).
+    /// The lobe's single-scattering BSDF with `material` (a [`Conductor`](crate::Conductor),
+    /// a [`Dielectric`](crate::Dielectric) for filtered glass, or [`Diffuse`](crate::Diffuse)
+    /// facets), for renderers: the [`NoncentralBsdf`] of [`Self::slope`] (Dupuy 2015, §3.4: the
+    /// filtered texel shaded with the noncentral microfacet BSDF; the models are on
+    /// [`NoncentralMaterial`]).
     ///
     /// # Errors
     /// Those of [`NoncentralBsdf::new`] (a mean slope whose squared length overflows f32).
-    pub fn bsdf(&self, conductor: Conductor) -> Result<NoncentralBsdf<Elliptical<Beckmann>>, Error> {
-        NoncentralBsdf::new(self.slope(), conductor)
+    pub fn bsdf<M: NoncentralMaterial>(
+        &self,
+        material: M,
+    ) -> Result<NoncentralBsdf<Elliptical<Beckmann>, M>, Error> {
+        NoncentralBsdf::new(self.slope(), material)
     }
 
     /// The slope covariance Σ = ½ [[αx², ρ αx αy], [ρ αx αy, αy²]] as [Σxx, Σyy, Σxy].

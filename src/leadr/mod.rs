@@ -7,13 +7,21 @@
 //! Beckmann lobe of the same first and second moments ([`LeadrLobe`]). Beckmann only: GGX's
 //! second slope moments diverge.
 
+#[cfg(feature = "data-driven")]
+mod downsample;
+#[cfg(feature = "data-driven")]
+mod fft;
 mod height_map;
+mod histogram;
 mod lobe;
 mod map;
 mod moments;
 
 pub use crate::noncentral::{Noncentral, NoncentralBsdf, NoncentralMasking, NoncentralMaterial};
+#[cfg(feature = "data-driven")]
+pub use downsample::{Displacement, DownsampledSlope};
 pub use height_map::HeightMap;
+pub use histogram::{MAX_HISTOGRAM_BINS, SlopeHistogram};
 pub use lobe::{CovarianceTreatment, LeadrLobe, MIN_EIGENVALUE_RATIO, MIN_LEADR_ALPHA};
 pub use map::{LeadrMap, MomentLevel};
 pub use moments::SlopeMoments;

@@ -115,6 +115,21 @@ impl SlopeMoments {
         })
     }
 
+    /// The moments of the displacement alone: these moments less the base microsurface's
+    /// share, (E₁, E₂, E₃ − αx²/2, E₄ − αy²/2, E₅) (eqs. 3.5–3.9 with the base roughness
+    /// removed). For the moments of a [`LeadrMap`](crate::leadr::LeadrMap) built on the base
+    /// `base` (at any level: every texel carries the base's share once) they are the moments of
+    /// the displacement's slopes, the input of the downsampling operator, which combines the
+    /// displacement with any base material (Dupuy 2015, §5.1). The covariance may round to
+    /// slightly negative values where the displacement is flat (see
+    /// [`LeadrLobe::from_moments`](crate::leadr::LeadrLobe::from_moments)).
+    #[must_use]
+    pub fn without_base(&self, base: Beckmann) -> Self {
+        let (ax, ay) = (f64::from(base.alpha_x()), f64::from(base.alpha_y()));
+        let [e1, e2, e3, e4, e5] = self.to_array().map(f64::from);
+        Self::from_array64([e1, e2, e3 - 0.5 * ax * ax, e4 - 0.5 * ay * ay, e5])
+    }
+
     /// The moments of the union of equally weighted texels: their average, accumulated in f64
     /// (eqs. 3.10–3.14). `None` for an empty slice.
     #[must_use]

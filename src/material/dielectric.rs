@@ -20,14 +20,17 @@ const REFRACTION_DEGENERATE: f64 = 1e-6;
 
 /// A valid refraction ωi → ωo through the facet ωh, with its cosines in double precision.
 #[derive(Debug, Clone, Copy)]
-struct Refraction {
-    wh: DVec3,
-    cos_ih: f64,
-    cos_oh: f64,
+pub(crate) struct Refraction {
+    /// The refraction half vector (upper hemisphere, unit).
+    pub(crate) wh: DVec3,
+    /// ωi·ωh > 0.
+    pub(crate) cos_ih: f64,
+    /// ωo·ωh < 0.
+    pub(crate) cos_oh: f64,
     /// (ωi·ωh + η ωo·ωh)², the Jacobian's denominator.
-    denom_sq: f64,
+    pub(crate) denom_sq: f64,
     /// 1 − F from cos θi and the exact cos θt = −ωo·ωh.
-    transmittance: f64,
+    pub(crate) transmittance: f64,
 }
 
 /// Dielectric microfacets separating an outside (z > 0) from an inside medium with relative
@@ -93,7 +96,7 @@ impl Dielectric {
     /// from inside (Heitz et al. 2016, §3.4; the directions flip with
     /// `Interaction::seen_from_outside`).
     #[inline(always)]
-    fn seen_from(&self, side: Side) -> Self {
+    pub(crate) fn seen_from(&self, side: Side) -> Self {
         match side {
             Side::Outside => *self,
             Side::Inside => self.flipped(),
@@ -117,7 +120,7 @@ impl Dielectric {
     /// η = 1 and ωo = −ωi the transmission is a Dirac with no density to evaluate, and
     /// elsewhere this leaves out about 1e-12 sr.
     #[inline(always)]
-    fn refraction(&self, wi: Vec3, wo: Vec3) -> Option<Refraction> {
+    pub(crate) fn refraction(&self, wi: Vec3, wo: Vec3) -> Option<Refraction> {
         let (i, o, eta) = (wi.as_dvec3(), wo.as_dvec3(), f64::from(self.eta));
         let sum = i + eta * o;
         let len = sum.length();
@@ -232,7 +235,7 @@ impl Dielectric {
     /// estimate passes the half vector's unnormalized ωi·h and |h|², the sampler a facet's
     /// cosine with l = 1.
     #[inline(always)]
-    fn reflectance_scaled(&self, k: f64, l_sq: f64) -> (f64, f64) {
+    pub(crate) fn reflectance_scaled(&self, k: f64, l_sq: f64) -> (f64, f64) {
         reflectance_scaled_of(f64::from(self.eta), k, l_sq)
     }
 
@@ -244,7 +247,7 @@ impl Dielectric {
     /// critical path), with a full normalization where it is off by more than 2⁻¹². c − s is
     /// formed in f64 (it cancels near η = 1).
     #[inline(always)]
-    fn refract(&self, wi: Vec3, wm: Vec3, c: f64, s: f64) -> Vec3 {
+    pub(crate) fn refract(&self, wi: Vec3, wm: Vec3, c: f64, s: f64) -> Vec3 {
         renormalize(((c - s) as f32 * wm - wi) * self.inv_eta, -wm)
     }
 

@@ -74,7 +74,7 @@ impl Diffuse {
     /// A direction from the Lambertian lobe of the facet with normal `wm` (cosine-weighted
     /// about ωm), weighted by the albedo.
     #[inline(always)]
-    fn sample_at_facet(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
+    pub(crate) fn sample_at_facet(&self, wm: Vec3, rng: &mut impl Rng) -> PhaseSample {
         let local = cosine_hemisphere(uniform(rng), uniform(rng));
         let (t, b) = basis(wm);
         let wo = normalize_fast(local.x * t + local.y * b + local.z * wm, wm);

@@ -18,6 +18,9 @@ pub(crate) use ggx::{
     F32_DENSITY_MIN_SUM, bounded_area_of, cap_bound, d_of_sum, kappa_of, lambda_and_area_of,
     reflection_density_of, sample_bounded_cap, sample_cap_of,
 };
+// the spherical-cap kernels, for the tabulated slopes' tail (feature `data-driven`).
+#[cfg(feature = "data-driven")]
+pub(crate) use ggx::{sample_spherical_cap, sample_visible_hemisphere};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};

@@ -2,7 +2,8 @@
 //! thesis §4.2: the backscattering eigenproblem solved by power iteration, Algorithms 1–3).
 
 use super::grid::{GridSlope, boundaries};
-use super::radial::{TabulatedSlope, check_ring_count, disk_area};
+use super::radial::{TabulatedSlope, check_ring_count, grid_angle, is_isotropic};
+use super::rings::RingGrid;
 use crate::error::Error;
 use crate::slope::MicrosurfaceSlope;
 use core::f64::consts::PI;
@@ -38,17 +39,19 @@ pub struct Extraction {
 ///
 /// `backscatter[i]` is f_r(oᵢ, oᵢ) (the BRDF, not times a cosine) at the polar angle
 /// θᵢ = [`TabulatedSlope::ring_centre_angle`]`(scale, N, i)`, N = `backscatter.len()`. The slope
-/// distribution is the ring table of [`TabulatedSlope`] on the grid of `scale` with N rings,
-/// collocated at the ring centres: F0 pᵢ = Σⱼ Kᵢⱼ pⱼ with
-/// Kᵢⱼ = 4 f_r(oᵢ, oᵢ) cos⁵θᵢ · aⱼ(θᵢ), where aⱼ(θ) = ∫_ring j (cos θ − x̃ sin θ)₊ dx̃ dỹ
-/// (the projected area of ring j in closed form: the φh integral of eq. 4.14 done exactly for
-/// the piecewise-constant table; [`BackscatterShadowing::Monostatic`]) or
-/// ∫_ring j |cos θ − x̃ sin θ| dx̃ dỹ ([`BackscatterShadowing::HeightCorrelated`]). Starting
-/// from p = (1, …, 1), `iterations` multiplications by K (each normalized) give the Perron
-/// vector; the thesis uses four. Measured on the crate's single-scattering conductor (N = 128,
-/// s = α, `tests/tabulated/extraction.rs`): for Beckmann four are converged (residual ≤ 8e-5, F0 within
-/// 5e-4); for GGX the residual falls only by ×4–10 per iteration (heavy tail), and four leave
-/// F0 0.8 % and P 0.9 % off at α = 0.5–1, against 0.1–0.2 % after eight.
+/// distribution is the ring table of [`TabulatedSlope`] on the grid of `scale` with N rings
+/// (P²² = fⱼ·P_GGX(s) on ring j), collocated at the ring centres: with
+/// D(oᵢ) = fᵢ P_GGX(s)(tan θᵢ)/cos⁴θᵢ and G1 = cos θ/A, eq. 4.3 reads F0 fᵢ = Σⱼ Kᵢⱼ fⱼ with
+/// Kᵢⱼ = 4 f_r(oᵢ, oᵢ) cos⁵θᵢ aⱼ(θᵢ)/P_GGX(s)(tan θᵢ), where aⱼ(θ) = ∫_ring j (cos θ −
+/// x̃ sin θ)₊ P_GGX(s) dx̃ dỹ = cos θ·mⱼ + s sin θ·ΔSⱼ/π (the projected area of ring j in
+/// closed form: the φh integral of eq. 4.14 done exactly for the table, mⱼ the ring's GGX(s)
+/// mass and ΔSⱼ its back-face area; [`BackscatterShadowing::Monostatic`]) or the integral of
+/// |cos θ − x̃ sin θ|, cos θ·mⱼ + 2 s sin θ·ΔSⱼ/π ([`BackscatterShadowing::HeightCorrelated`]).
+/// Starting from f = (1, …, 1), `iterations` multiplications by K (each normalized) give the
+/// Perron vector; the thesis uses four. Measured on the crate's single-scattering conductor
+/// (`tests/tabulated/extraction.rs`, N = 128, s = α, eight iterations): F0 within 1e-4 and the
+/// ring values within 3e-4 for GGX and Beckmann at α = 0.2–1 (GGX at s = α is the start f = 1
+/// itself; Beckmann's residual falls ×10 per iteration at α = 1, four leave 3e-4).
 ///
 /// Cost: N² closed-form kernel entries and `iterations`·N² multiply-adds (N = 256: see the
 /// test `extraction_cost` in `tests/tabulated/extraction.rs`).
@@ -67,6 +70,32 @@ pub fn extract_isotropic(
     let s = f64::from(Error::check_positive("scale", scale)?);
     let n = backscatter.len();
     check_ring_count(n)?;
+    check_extraction(backscatter, iterations)?;
+    let grid = RingGrid::new(s, n);
+    let absolute = shadowing == BackscatterShadowing::HeightCorrelated;
+    // the kernel, row-major
+    let mut kernel = vec![0.0f64; n * n];
+    for (i, row) in kernel.chunks_exact_mut(n).enumerate() {
+        let theta = TabulatedSlope::ring_centre_angle(scale, n, i);
+        let (sin_t, cos_t) = theta.sin_cos();
+        // P_GGX(s)(tan θᵢ) = cos⁴θ′/(π s²), θ′ the ring centre's stretched angle
+        let cos_prime = grid_angle(i as f64 + 0.5, n).cos();
+        let row_scale = 4.0 * backscatter[i] * cos_t.powi(5) * PI * s * s / cos_prime.powi(4);
+        let back_scale = if absolute { 2.0 } else { 1.0 } * s * sin_t / PI;
+        grid.for_zones(cos_t / (s * sin_t), 0, |j, ds| {
+            if j < n {
+                row[j] = row_scale * (cos_t * grid.ggx_mass[j] + back_scale * ds);
+            }
+        });
+    }
+    let (f, lambda, residuals) = power_iteration(&kernel, n, iterations)?;
+    let slope = TabulatedSlope::from_factors(scale, f)?;
+    Ok(Extraction { slope, f0: lambda, residuals })
+}
+
+/// Checks the common input of the extractions: at least one iteration, and backscattering
+/// samples finite and ≥ 0.
+fn check_extraction(backscatter: &[f64], iterations: usize) -> Result<(), Error> {
     if iterations == 0 {
         return Err(Error::InvalidParameter { name: "iterations", value: 0.0, expected: "at least 1" });
     }
@@ -77,35 +106,7 @@ pub fn extract_isotropic(
             expected: "finite and >= 0",
         });
     }
-    let radii: Vec<f64> = (0..=n)
-        .map(|k| if k == 0 { 0.0 } else { s * super::radial::grid_angle(k as f64, n).tan() })
-        .collect();
-    // the kernel, row-major
-    let mut kernel = vec![0.0f64; n * n];
-    for i in 0..n {
-        let theta = TabulatedSlope::ring_centre_angle(scale, n, i);
-        let (sin_t, cos_t) = theta.sin_cos();
-        let c5 = cos_t.powi(5);
-        let row_scale = 4.0 * backscatter[i] * c5;
-        let mut prev = 0.0;
-        for j in 0..n {
-            let next = disk_area(radii[j + 1], cos_t, sin_t);
-            let visible = next - prev;
-            prev = next;
-            let entry = match shadowing {
-                BackscatterShadowing::Monostatic => visible,
-                BackscatterShadowing::HeightCorrelated => {
-                    // ∫|y| = 2∫y₊ − ∫y, and ∫_ring (cos θ − x̃ sin θ) = cos θ · area (∫x̃ = 0)
-                    let area = PI * (radii[j + 1] - radii[j]) * (radii[j + 1] + radii[j]);
-                    (2.0 * visible - cos_t * area).max(0.0)
-                }
-            };
-            kernel[i * n + j] = row_scale * entry;
-        }
-    }
-    let (p, lambda, residuals) = power_iteration(&kernel, n, iterations)?;
-    let slope = TabulatedSlope::from_ring_values(scale, p, None)?;
-    Ok(Extraction { slope, f0: lambda, residuals })
+    Ok(())
 }
 
 /// [`extract_isotropic`] from a backscattering function `f_r(θo)` (the BRDF at ωi = ωo with
@@ -131,16 +132,19 @@ pub fn extract_isotropic_fn(
 /// Extracts the Fresnel term F(θd) as the average ratio of the BRDF to the "ideal mirror"
 /// microfacet BRDF f_id = D(h) G(i, o)/(4 cos θi cos θo) over the configurations with
 /// i·h = cos θd (Dupuy 2015, eq. 4.11 and Algorithm 2), for `bins` values of θd at the bin
-/// centres (k + ½)(π/2)/`bins`.
+/// centres (k + ½)(π/2)/`bins`, for any slope distribution: a [`TabulatedSlope`] from
+/// [`extract_isotropic`], a [`GridSlope`] from [`extract_anisotropic`], or an analytic one.
 ///
-/// For each θd the average runs over a midpoint grid of `n_theta_h` × `n_phi` (θh, φd)
-/// (the azimuth φh is not sampled: the BRDF and the slope distribution are isotropic); the
-/// configurations with i or o at or below the horizon, or with f_id = 0, are skipped. G is
-/// the height-correlated 1/(1 + Λ(i) + Λ(o)) or, for [`BackscatterShadowing::Monostatic`],
-/// the separable G1(i)G1(o). `brdf(i, o)` is the BRDF (not times a cosine) in one channel.
-/// Returns `None` for a bin where no configuration is valid.
-pub fn extract_fresnel(
-    slope: &TabulatedSlope,
+/// For each θd the average runs over a midpoint grid of `n_theta_h` × `n_phi` (θh, φd), and,
+/// for an anisotropic slope, over `n_phi` azimuths φh of the half vector (an isotropic slope,
+/// αx = αy with the same projected roughness on the diagonal, has the same ratio at every φh
+/// for an isotropic BRDF: φh = 0 only); the configurations with i or o at or below the horizon,
+/// or with f_id = 0, are skipped. G is the height-correlated 1/(1 + Λ(i) + Λ(o)) or, for
+/// [`BackscatterShadowing::Monostatic`], the separable G1(i)G1(o). `brdf(i, o)` is the BRDF
+/// (not times a cosine) in one channel; a non-finite value skips the configuration (a MERL
+/// file's missing data). Returns `None` for a bin where no configuration is valid.
+pub fn extract_fresnel<S: MicrosurfaceSlope>(
+    slope: S,
     shadowing: BackscatterShadowing,
     bins: usize,
     n_theta_h: usize,
@@ -148,6 +152,7 @@ pub fn extract_fresnel(
     brdf: impl Fn(Vec3, Vec3) -> f64,
 ) -> Vec<Option<f64>> {
     let s = slope;
+    let n_phi_h = if is_isotropic(&s) { 1 } else { n_phi };
     (0..bins)
         .map(|b| {
             let theta_d = (b as f64 + 0.5) * 0.5 * PI / bins as f64;
@@ -156,31 +161,34 @@ pub fn extract_fresnel(
             for ih in 0..n_theta_h {
                 let theta_h = (ih as f64 + 0.5) * 0.5 * PI / n_theta_h as f64;
                 let (sh, ch) = theta_h.sin_cos();
-                // the half-vector frame: h = (sh, 0, ch), t = (ch, 0, −sh), b = y
-                let h = DVec3::new(sh, 0.0, ch);
-                let t = DVec3::new(ch, 0.0, -sh);
-                for ip in 0..n_phi {
-                    let phi = (ip as f64 + 0.5) * 2.0 * PI / n_phi as f64;
-                    let i = h * cd + (t * phi.cos() + DVec3::Y * phi.sin()) * sd;
-                    let o = 2.0 * i.dot(h) * h - i;
-                    if i.z <= 0.0 || o.z <= 0.0 {
-                        continue;
-                    }
-                    let (i32, o32) = (i.as_vec3(), o.as_vec3());
-                    let g = match shadowing {
-                        BackscatterShadowing::HeightCorrelated => {
-                            1.0 / (1.0 + f64::from(s.lambda(i32)) + f64::from(s.lambda(o32)))
+                for ia in 0..n_phi_h {
+                    // the half-vector frame: h, t = ∂h/∂θh, b = z × h/|…|
+                    let phi_h =
+                        if n_phi_h == 1 { 0.0 } else { (ia as f64 + 0.5) * 2.0 * PI / n_phi_h as f64 };
+                    let (sa, ca) = phi_h.sin_cos();
+                    let h = DVec3::new(sh * ca, sh * sa, ch);
+                    let t = DVec3::new(ch * ca, ch * sa, -sh);
+                    let bt = DVec3::new(-sa, ca, 0.0);
+                    for ip in 0..n_phi {
+                        let phi = (ip as f64 + 0.5) * 2.0 * PI / n_phi as f64;
+                        let i = h * cd + (t * phi.cos() + bt * phi.sin()) * sd;
+                        let o = 2.0 * i.dot(h) * h - i;
+                        if i.z <= 0.0 || o.z <= 0.0 {
+                            continue;
                         }
-                        BackscatterShadowing::Monostatic => {
-                            1.0 / ((1.0 + f64::from(s.lambda(i32))) * (1.0 + f64::from(s.lambda(o32))))
-                        }
-                    };
-                    let f_id = s.d64(h) * g / (4.0 * i.z * o.z);
-                    if f_id > 0.0 {
-                        let v = brdf(i32, o32);
-                        if v.is_finite() {
-                            sum += v / f_id;
-                            count += 1;
+                        let (i32, o32) = (i.as_vec3(), o.as_vec3());
+                        let (li, lo) = (s.lambda64(i32), s.lambda64(o32));
+                        let g = match shadowing {
+                            BackscatterShadowing::HeightCorrelated => 1.0 / (1.0 + li + lo),
+                            BackscatterShadowing::Monostatic => 1.0 / ((1.0 + li) * (1.0 + lo)),
+                        };
+                        let f_id = s.d64(h) * g / (4.0 * i.z * o.z);
+                        if f_id > 0.0 {
+                            let v = brdf(i32, o32);
+                            if v.is_finite() {
+                                sum += v / f_id;
+                                count += 1;
+                            }
                         }
                     }
                 }
@@ -267,16 +275,7 @@ pub fn extract_anisotropic(
             expected: "(2·half_cells)², half_cells ≤ 64",
         });
     }
-    if iterations == 0 {
-        return Err(Error::InvalidParameter { name: "iterations", value: 0.0, expected: "at least 1" });
-    }
-    if let Some(&bad) = backscatter.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-        return Err(Error::InvalidParameter {
-            name: "backscatter[i]",
-            value: bad as f32,
-            expected: "finite and >= 0",
-        });
-    }
+    check_extraction(backscatter, iterations)?;
     let (xs, ys) = (boundaries(sx, half_cells), boundaries(sy, half_cells));
     let n = m * m;
     let absolute = shadowing == BackscatterShadowing::HeightCorrelated;

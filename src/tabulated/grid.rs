@@ -4,6 +4,7 @@
 
 use super::radial::{check_ring_count, grid_angle};
 use crate::error::Error;
+use crate::rng::cut_tails64;
 use crate::slope::MicrosurfaceSlope;
 use crate::vector::{ensure_visible, normal_from_slopes};
 use glam::{DVec3, Vec2, Vec3};
@@ -15,6 +16,8 @@ const AREA_U: usize = 512;
 const AREA_PHI: usize = 128;
 /// The most rows a grid has (2 × the largest `half_cells`, 512).
 const MAX_ROWS: usize = 1024;
+/// The relative margin a sample keeps from a side of its cell beyond which P²² = 0.
+const GUARD: f64 = 1.0 / 1_048_576.0;
 /// Newton–bisection tolerance (relative to the interval) and iteration cap of the sampler.
 const SOLVE_TOLERANCE: f64 = 1e-13;
 const SOLVE_ITERATIONS: usize = 100;
@@ -379,8 +382,12 @@ impl GridSlope {
         self.backface_at(f64::from(w.z).abs(), phi)
     }
 
-    /// Samples visible slopes exactly for a unit ω; `None` if ω sees nothing.
+    /// Samples visible slopes exactly for a unit ω (uniforms cut at 2⁻²⁴, the crate's tail
+    /// policy); `None` if ω sees nothing.
     fn sample_slopes(&self, w: DVec3, u1: f64, u2: f64) -> Option<(f64, f64)> {
+        // the crate's tail policy: both quantiles cut at 2⁻²⁴ (u = 0 would put the sample on
+        // the visibility line or the grid's edge, where the model has no density)
+        let (u1, u2) = (cut_tails64(u1), cut_tails64(u2));
         let m = self.ys.len() - 1;
         // first pass: the row masses (on the stack: at most MAX_ROWS rows) and the total
         let mut masses = [0.0f64; MAX_ROWS];
@@ -470,7 +477,40 @@ impl GridSlope {
             let d = (c - x * w.x).max(0.0) * self.p[j * cols + cell_of(&self.xs, x)];
             (row_cdf(x), d)
         });
-        Some((x, y))
+        Some(self.clear_of_empty(i, j, x, y))
+    }
+
+    /// Keeps a sample (x, y) of cell (i, j) 2⁻²⁰ (relative to the cell or to the slope, the
+    /// larger) away from the sides of the cell beyond which P²² = 0 (the grid's edge, an empty
+    /// cell), so that the f32 normal of the slopes, within 2⁻²² of them, stays where the model
+    /// has density (a shift of the samples within that margin, below the f32 resolution of
+    /// the returned normal).
+    fn clear_of_empty(&self, i: usize, j: usize, x: f64, y: f64) -> (f64, f64) {
+        let m = self.xs.len() - 1;
+        let empty = |i: Option<usize>, j: Option<usize>| match (i, j) {
+            (Some(i), Some(j)) if i < m && j < m => self.p[j * m + i] <= 0.0,
+            _ => true,
+        };
+        let clear = |lo: f64, hi: f64, v: f64, below: bool, above: bool| {
+            let margin = (GUARD * (hi - lo).max(v.abs())).min(0.25 * (hi - lo));
+            let v = if below { v.max(lo + margin) } else { v };
+            if above { v.min(hi - margin) } else { v }
+        };
+        let x = clear(
+            self.xs[i],
+            self.xs[i + 1],
+            x,
+            empty(i.checked_sub(1), Some(j)),
+            empty(Some(i + 1), Some(j)),
+        );
+        let y = clear(
+            self.ys[j],
+            self.ys[j + 1],
+            y,
+            empty(Some(i), j.checked_sub(1)),
+            empty(Some(i), Some(j + 1)),
+        );
+        (x, y)
     }
 }
 
@@ -522,7 +562,7 @@ impl MicrosurfaceSlope for &GridSlope {
     /// P_ij/cos⁴θm (0 for ωm.z ≤ 0, outside the grid and for a non-finite normal).
     #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
-        debug_assert!(wm.is_finite(), "d64_unchecked: non-finite normal {wm}");
+        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
         if !wm.is_finite() || wm.z <= 0.0 {
             return 0.0;
         }

@@ -1,6 +1,10 @@
 //! The MERL isotropic BRDF binary format (Matusik, Pfister, Brand and McMillan 2003, "A
 //! Data-Driven Reflectance Model"), in which most measured BRDFs ship: a reader, a writer and a
-//! nearest-bin lookup, so that [`crate::tabulated::extract_isotropic`] can run on a measurement.
+//! nearest-bin lookup, so that the extractions run on a measurement: the backscattering
+//! ([`MerlBrdf::backscatter`] by polar angle for [`crate::tabulated::extract_isotropic_fn`],
+//! [`MerlBrdf::backscatter_toward`] by direction for [`crate::tabulated::extract_anisotropic_fn`]) gives
+//! the slope distribution, and [`MerlBrdf::eval`] the Fresnel term through
+//! [`crate::tabulated::extract_fresnel`], for a [`crate::tabulated::TabulatedSlope`] or a [`crate::tabulated::GridSlope`] alike.
 //!
 //! Layout (little-endian): three `i32` dimensions (90 θh bins, 90 θd bins, 180 φd bins), then
 //! 3 × 90·90·180 `f64` values, the red, green and blue blocks, each indexed by
@@ -224,6 +228,19 @@ impl MerlBrdf {
             return None;
         }
         Some(Vec3::new(rgb[0] as f32, rgb[1] as f32, rgb[2] as f32))
+    }
+
+    /// The backscattering f_r(o, o) toward the direction `o` (any length), the function
+    /// [`crate::tabulated::extract_anisotropic_fn`] samples: the file is isotropic, so that of the polar
+    /// angle of `o` ([`Self::backscatter`]). `None` for `o` at or below the horizon or not
+    /// finite, and as [`Self::backscatter`].
+    #[must_use]
+    pub fn backscatter_toward(&self, o: Vec3) -> Option<Vec3> {
+        if o.z <= 0.0 || !o.is_finite() {
+            return None;
+        }
+        let o = o.as_dvec3();
+        self.backscatter(o.x.hypot(o.y).atan2(o.z))
     }
 
     /// The backscattering f_r(o, o) at polar angle `theta` (θd = 0, θh = θ; φ irrelevant).

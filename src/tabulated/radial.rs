@@ -1,24 +1,18 @@
 //! A tabulated isotropic slope distribution (Dupuy 2015, thesis §4.2: data-driven
-//! microsurfaces), with exact visible-normal sampling on the whole sphere.
+//! microsurfaces): a GGX lobe modulated ring by ring, with an optional r⁻⁴ tail, exact
+//! visible-normal sampling on the whole sphere, and D, Λ and the sampler driven by tables
+//! built at construction.
 
+use super::rings::{RingGrid, RingLookup, back_area};
+use super::vndf::{Visible, VisibleSampler};
 use crate::error::Error;
-use crate::slope::{Azimuth, MicrosurfaceSlope};
+use crate::slope::{Ggx, MicrosurfaceSlope, sample_spherical_cap, sample_visible_hemisphere};
 use crate::vector::ensure_visible;
 use core::f64::consts::{FRAC_PI_2, PI};
 use glam::{DVec3, Vec2, Vec3};
 
-/// Largest number of rings a table may have (the sampler's cost grows linearly with it).
+/// Largest number of rings a table may have.
 pub const MAX_RINGS: usize = 4096;
-
-/// Intervals of the table of the back-face area B over u = |cos θ| ∈ [0, 1] (linear
-/// interpolation; its error is measured in `tests/tabulated/tabulated.rs`).
-const BACKFACE_INTERVALS: usize = 2048;
-
-/// B is summed exactly (instead of interpolated) when the visibility line cuts at most this
-/// many rings: near the poles, where B is small and has a kink at every ring the line
-/// crosses (at angles atan(1/Rₖ), ever closer for the outer rings), which no table in u
-/// resolves.
-const EXACT_RINGS: usize = 24;
 
 /// Gauss–Legendre nodes and weights on [−1, 1], 8 points (exact for polynomials of degree 15),
 /// used for the ring masses of [`TabulatedSlope::from_radial_fn`].
@@ -33,55 +27,104 @@ const GL8: [(f64, f64); 8] = [
     (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
 ];
 
-/// The safeguarded Newton iteration of the sampler stops when its step is below this fraction
-/// of the ring's outer radius (far below the f32 resolution of the returned slope).
-const NEWTON_TOLERANCE: f64 = 1e-13;
-/// A hard cap on the sampler's Newton–bisection iterations (bisection alone needs ~45 to reach
-/// [`NEWTON_TOLERANCE`]; Newton typically converges in 4–8).
-const MAX_ITERATIONS: usize = 100;
+/// Nodes of the back-face factor in all (at least two per group of rings; linear in c between
+/// them).
+const BACKFACE_NODES: usize = 2048;
+/// Groups of rings of the back-face factor at most (larger tables group several rings).
+const MAX_GROUPS: usize = 256;
+/// The outermost rings whose back-face area is summed exactly rather than interpolated: 16, or
+/// a quarter of the rings if fewer (a coarse table interpolates its inner rings too).
+const EXACT_OUTER_RINGS: usize = 16;
 
-/// An isotropic slope distribution given by a radial table: P²²(x̃, ỹ) = pₖ for slope radii
-/// r = √(x̃² + ỹ²) in the ring [Rₖ, Rₖ₊₁), k = 0 … N−1, and 0 beyond R_N.
+/// The model of a [`TabulatedSlope`] beyond its last ring, R > R_N.
+///
+/// # Examples
+/// ```
+/// use microsurface::Ggx;
+/// use microsurface::slope::MicrosurfaceSlope;
+/// use microsurface::tabulated::{TabulatedSlope, Tail};
+/// use microsurface::glam::Vec3;
+/// let ggx = Ggx::isotropic(0.5)?;
+/// let table = TabulatedSlope::from_slope(&ggx, 0.5, 256)?.with_tail(Tail::Continued);
+/// let w = Vec3::new(0.6, 0.0, 0.8);
+/// assert!(((&table).lambda(w) / ggx.lambda(w) - 1.0).abs() < 1e-4);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Tail {
+    /// No slopes beyond R_N: all the mass is in the rings (the constructors' default).
+    #[default]
+    Truncated,
+    /// The last ring's factor continued to every slope: P²² = f_{N−1}·P_GGX(s)(r) for
+    /// r ≥ R_N, an r⁻⁴ tail of mass f_{N−1} cos²θ′_N (θ′_N the last ring's stretched angle),
+    /// the rings rescaled so that the whole integrates to 1. Exact for GGX of roughness s; for
+    /// other data it assumes that beyond the table the density keeps the ratio to GGX(s) it
+    /// has in the last ring: a lighter tail (Beckmann) has a last factor of about 0 and gets
+    /// about no tail, a heavier one is cut to r⁻⁴.
+    Continued,
+}
+
+/// An isotropic slope distribution given by a radial table: a GGX lobe of roughness s (the
+/// table's scale) multiplied by a factor fₖ ≥ 0 constant on each ring of slope radius,
+/// P²²(r) = fₖ·s²/(π(s² + r²)²) for r in the ring [Rₖ, Rₖ₊₁), k = 0 … N − 1, and beyond R_N as
+/// the [`Tail`] says.
 ///
 /// # The table
-/// The ring boundaries are Rₖ = s·tan θ′ₖ for a slope scale s > 0, at the "stretched" normal
-/// angles θ′ₖ = (π/2)(1 − (1 − k/(N+1))²): steps of the angle atan(r/s) that are π/(N+1) at
-/// the centre and shrink towards the horizon, so that a lobe of roughness ≈ s is resolved and
-/// the table reaches the slope R_N = s·cot(π/(2(N+1)²)) ≈ 0.64 (N+1)² s (the mass beyond it is
-/// dropped: for GGX with s = α, the tail mass ≈ 2.5/(N+1)⁴ and the back-face area it would add,
-/// 2α²/(πR_N), are negligible at N = 256). The interpolation is **piecewise constant in slope
-/// space** (nearest ring), so D(ωm) = pₖ/cos⁴θm is piecewise smooth with jumps at the ring
-/// boundaries; the table is normalized so that ∫P²² = Σₖ pₖ π(Rₖ₊₁² − Rₖ²) = 1, i.e.
-/// ∫D cos θm dωm = 1 exactly for the stated interpolation. Tabulating a smooth radial P²² by
-/// ring averages gives a relative error of D of at most about ½ δθ′·|d ln P²²/dθ′| at the ring
-/// edges (δθ′ the ring's angular width); for GGX with s = α that is 2δθ′·r/α, e.g. 2.4 % at
-/// r = α with N = 256, and O(δθ′²) at the ring centres.
+/// The ring boundaries are Rₖ = s·tan θ′ₖ at the "stretched" normal angles
+/// θ′ₖ = (π/2)(1 − (1 − k/(N+1))²): steps of the angle atan(r/s) that are π/(N+1) at the centre
+/// and shrink towards the horizon, up to R_N ≈ 0.64 (N+1)² s. Stretched by 1/s, GGX(s) becomes
+/// the unit GGX lobe, whose density of normals is constant, D′ = 1/π: the table is the
+/// piecewise-constant density of normals D′ = fₖ/π on the zones θ′ₖ ≤ θ′ < θ′ₖ₊₁ of the
+/// stretched hemisphere, and D(ωm) = fₖ·D_GGX(s)(ωm). The factors are normalized so that
+/// Σₖ fₖ (cos²θ′ₖ − cos²θ′ₖ₊₁) = 1 (the zones' masses under GGX(s)), i.e. ∫D cos θm dωm = 1.
+/// A GGX of roughness s is reproduced exactly (every fₖ = 1, with [`Tail::Continued`]); any
+/// other profile is approximated ring by ring with its ring masses kept: within a ring the
+/// density follows the r⁻⁴ decay of GGX rather than a constant, which in the wide outer rings
+/// (radius ratios up to 4) is what keeps the first moment of a heavy tail, hence Λ, right.
+/// The relative error of D for a smooth profile is of the order of ½ δθ′·|d ln(P/P_GGX(s))/dθ′|
+/// at the ring edges (δθ′ ≤ π/(N+1) the ring's angular width).
 ///
 /// # Λ and the projected area
-/// The projected area of one ring seen from ω = (sin θ, 0, cos θ) has a closed form,
-/// ∫_{r<R} (cos θ − x̃ sin θ)₊ dx̃ dỹ = cos θ·(c w + R² acos(−c/R)) + ⅔ sin θ·w³ with
-/// c = cot θ, w = √(R² − c²) (for |c| < R; πR² cos θ or 0 otherwise), so the projected area of
-/// the table is an exact finite sum ([`TabulatedSlope::projected_area_exact`], cost O(N)). For
-/// speed, the trait's `lambda` and `projected_area` interpolate linearly a precomputed table
-/// of the back-face area B(u) = ∫⟨ω′, ωm⟩₊ D dωm, ω′.z = −u, over u ∈ [0, 1] (2049 nodes),
-/// except near the poles, where the visibility line cuts at most 24 rings and B is summed
-/// exactly (B is small there and has a kink at each ring boundary the line crosses):
-/// projected_area(ω) = cos θ + B(cos θ) above the horizon and B(|cos θ|) below, Λ = B/cos θ
-/// above and −1 − B/|cos θ| below. This keeps Λ(−ω) = −1 − Λ(ω) exact and Λ's relative
-/// error small near the zenith (where Λ = B/cos θ is small, B is small too).
+/// The back-face area B(ω) = ∫⟨ω, ωm⟩₋ D dωm of a zone has a closed form (the rings'
+/// module: with c = cot θ′ of the stretched direction, the unit lobe's
+/// S(R′, c) = k·atan(V/k) − c·atan(V/c) − (V − c·atan(V/c))/(1 + R′²), V = √(R′² − c²),
+/// k = √(1 + c²), rearranged or summed as a series where that cancels), so the projected area
+/// is an exact O(N) sum ([`TabulatedSlope::projected_area_exact`]). The trait's `lambda` and
+/// `projected_area` multiply the closed-form back-face area of GGX(s),
+/// s²h²/(2(√(z² + s²h²) + |z|)) (h = |ω_xy|, z = ω.z), by a factor ρ = B/B_GGX(s) tabulated at
+/// construction (2048 nodes, at least two per group of rings, linear in c = |z|/h between them,
+/// found by the constant-time ring lookup), except when the visibility line cuts only the 16
+/// outermost rings (a quarter of the rings if fewer; near the poles), where the sum is exact.
+/// ρ is a weighted mean of the factors fₖ of the rings beyond the visibility line: exactly 1
+/// for GGX(s), smooth otherwise (interpolation error 1.6e-7 relative for a mixture of two GGX
+/// lobes on 64 or 256 rings). Λ = B/cos θ above the horizon and −1 − B/|cos θ| below, so
+/// Λ(−ω) = −1 − Λ(ω) holds exactly. A GGX of roughness α tabulated on 256 rings at s = α with
+/// [`Tail::Continued`] has Λ within 2.3e-8 (relative) of the analytic one over the whole sphere,
+/// 1.2e-5 at s = 0.7 α; without the tail its Λ misses the tail's first moment, 4e-4 at θ = 0.3
+/// and more towards the poles (`tests/tabulated/tail.rs`).
 ///
 /// # Sampling
-/// Visible normals are sampled **exactly** (for the stated interpolation) by inversion, with
-/// the two uniforms only: in the slope frame aligned with ωi's azimuth, D_ωi dωm ∝
-/// (cos θi − x̃ sin θi)₊ P²² dx̃ dỹ, a mixture over rings of uniform annuli weighted by a
-/// linear function clipped to a half plane. The first uniform picks the ring by its exact
-/// visible mass (prefix sums for the rings entirely on the visible side, the closed form above
-/// for the others), then, rescaled, gives x̃ by a safeguarded Newton inversion of the closed-form
-/// marginal CDF of x̃ in that annulus; the second gives ỹ uniformly on the annulus' chord at x̃.
-/// The sampled density is the exact D_ωi of the table; [`MicrosurfaceSlope::d_wi`] divides by
-/// the interpolated projected area, whose relative error is measured in the tests. The cost is
-/// O(log N) plus O(number of rings cut by the visibility line x̃ = cot θi): all N for grazing
-/// and back-facing ωi.
+/// Visible normals are sampled **exactly** in the stretched hemisphere by a proposal tabulated
+/// at construction and corrected by rejection with the exact density ratio (the
+/// `vndf` module): majorants of ⟨ω, ωm⟩ per cell (zone × azimuth bin) tabulated at
+/// about 60 incident directions, interpolated between the two that bracket ω by the convexity
+/// of ⟨·, ωm⟩₊, picked in constant time (guide tables); from below, the cells above the
+/// visible region excluded and its top cell given its own proposal. 0.78 to 0.98 of the
+/// proposals are accepted for a tabulated GGX; the first proposal inverts the two uniforms, the
+/// acceptance test and any further proposal use uniforms hashed from their bits. Directions
+/// that see only the tail (within (π/2)/(N+1)² of the nadir, stretched) are sampled by GGX(s)'s
+/// spherical cap, exactly.
+///
+/// # Cost
+/// Construction is O(N²): the back-face factor's 2048 nodes, each an exact sum over the rings
+/// beyond it, and the sampler's tables (about 60 directions × the cells they see × 16 bins);
+/// 45 ms at N = 256, 0.7 s at N = 4096 (measured on one shared core). [`TabulatedSlope::heap_bytes`]
+/// reports the memory: 148 KB at N = 256 (176 KB with the tail), 1.9 MB at N = 4096; the struct
+/// itself is 536 bytes.
+/// `d` is a ring lookup (float bits of r² index a table of ring starts, then one or two exact
+/// boundary comparisons) and a few multiplications; `lambda` adds the closed form of GGX(s)
+/// and a linear interpolation; `sample_d_wi` is one proposal in general (a node pair, a guide
+/// table, 16 bin majorants, a square root and a hash).
 ///
 /// The crate's [`MicrosurfaceSlope`] trait requires `Copy`; it is implemented for
 /// `&TabulatedSlope`, so that the tables live once and the walks, estimators and BSDFs share
@@ -89,77 +132,76 @@ const MAX_ITERATIONS: usize = 100;
 ///
 /// Reference: Dupuy 2015, *Photorealistic Surface Rendering with Microfacet Theory*, §4.2–4.3
 /// (the tabulated slope distribution and its Smith Λ by quadrature).
+///
+/// # Examples
+/// ```
+/// use microsurface::Ggx;
+/// use microsurface::slope::MicrosurfaceSlope;
+/// use microsurface::tabulated::TabulatedSlope;
+/// use microsurface::glam::Vec3;
+/// // a mixture of two GGX lobes, tabulated on 128 rings at scale 0.3
+/// let p = |a: f64, r: f64| a * a / (std::f64::consts::PI * (a * a + r * r).powi(2));
+/// let table = TabulatedSlope::from_radial_fn(0.3, 128, |r| 0.5 * p(0.15, r) + 0.5 * p(0.7, r))?;
+/// let wi = Vec3::new(0.6, 0.0, 0.8);
+/// let wm = (&table).sample_d_wi(wi, 0.3, 0.7);
+/// assert!(wm.z > 0.0 && wi.dot(wm) > 0.0 && (&table).d_wi(wi, wm) > 0.0);
+/// # Ok::<(), microsurface::Error>(())
+/// ```
 #[derive(Clone)]
 pub struct TabulatedSlope {
-    /// The slope scale s of the ring grid.
-    scale: f64,
-    /// N + 1, the grid's divisor.
-    divisions: f64,
-    /// Ring boundaries R₀ = 0 < R₁ < … < R_N.
-    radii: Vec<f64>,
-    /// The normalized ring values pₖ (N of them).
-    p22: Vec<f64>,
-    /// Prefix masses Mₖ = Σ_{j<k} pⱼ π(Rⱼ₊₁² − Rⱼ²), M₀ = 0, M_N = 1.
-    mass_prefix: Vec<f64>,
-    /// The back-face area B at u = j/BACKFACE_INTERVALS.
-    backface: Vec<f64>,
-    /// The GGX-equivalent roughness 2 B(0).
+    /// The ring grid.
+    grid: RingGrid,
+    /// The normalized ring factors fₖ, k = 0 … N (the last one the tail's, 0 if truncated).
+    factors: Vec<f64>,
+    /// fₖ s²/π, k = 0 … N: D = that·(|m|²/(s²z² + h²))².
+    d_coef: Vec<f64>,
+    /// The ring averages of P²² (N of them).
+    ring_values: Vec<f64>,
+    /// The ring of a squared slope radius.
+    lookup: RingLookup,
+    /// The back-face factor ρ = B/B_GGX(s).
+    backface: BackfaceTable,
+    /// The visible-normal sampler's tables.
+    sampler: VisibleSampler,
+    /// The GGX-equivalent roughness 2 B(horizon).
     alpha: f32,
     /// The mass of the input before normalization (≠ 1 when the input was truncated at R_N).
     input_mass: f64,
+    /// The model beyond R_N.
+    tail: Tail,
+    /// GGX of roughness s (whose visible normals the directions that see only the tail see).
+    lobe: Ggx,
 }
 
 impl core::fmt::Debug for TabulatedSlope {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("TabulatedSlope")
-            .field("rings", &self.p22.len())
-            .field("scale", &self.scale)
+            .field("rings", &self.grid.rings)
+            .field("scale", &self.grid.scale)
             .field("alpha", &self.alpha)
+            .field("tail", &self.tail)
             .field("input_mass", &self.input_mass)
             .finish_non_exhaustive()
     }
 }
 
-/// The projected area of the uniform slope disk r < R (of density 1) seen from
-/// ω = (sin θ, 0, cos θ): ∫_{r<R} (cos θ − x̃ sin θ)₊ dx̃ dỹ, in closed form.
-#[inline]
-pub(super) fn disk_area(radius: f64, cos_t: f64, sin_t: f64) -> f64 {
-    if radius <= 0.0 {
-        return 0.0;
-    }
-    // visible where x̃ sin θ < cos θ, i.e. x̃ < c = cot θ
-    if cos_t >= radius * sin_t {
-        return PI * radius * radius * cos_t.max(0.0);
-    }
-    if cos_t <= -radius * sin_t {
-        return 0.0;
-    }
-    partial_disk_integral(radius, cos_t / sin_t, cos_t, sin_t)
-}
-
-/// ∫_{−R}^{x} (cos θ − s sin θ)·2√(R² − s²) ds for x ∈ [−R, R]: the projected area of the part
-/// x̃ < x of the disk r < R.
-#[inline]
-fn partial_disk_integral(radius: f64, x: f64, cos_t: f64, sin_t: f64) -> f64 {
-    let x = x.clamp(-radius, radius);
-    let w = ((radius - x) * (radius + x)).max(0.0).sqrt();
-    // ∫ 2√(R² − s²) ds = s√(R² − s²) + R² asin(s/R); from −R: + R²π/2 = R² acos(−s/R)
-    let chord_part = x * w + radius * radius * (-x / radius).clamp(-1.0, 1.0).acos();
-    // ∫ −2s√(R² − s²) ds = ⅔ (R² − s²)^{3/2}, zero at −R
-    cos_t * chord_part + sin_t * (2.0 / 3.0) * w * w * w
-}
-
-/// The chord length 2√(R² − x²)₊ of the disk r < R at x̃ = x.
-#[inline]
-fn chord(radius: f64, x: f64) -> f64 {
-    2.0 * ((radius - x) * (radius + x)).max(0.0).sqrt()
+/// The back-face factor ρ = B/B_GGX(s) at nodes of c² (see [`TabulatedSlope`]).
+#[derive(Debug, Clone)]
+struct BackfaceTable {
+    /// Rings per group, and nodes per group.
+    step: usize,
+    sub: usize,
+    /// The first ring summed exactly (a multiple of `step`; the groups cover the rings below).
+    exact_from: usize,
+    /// ρ at c = R_{g·step} + (i/sub)(R_{(g+1)step} − R_{g·step}), and at R_{exact_from}.
+    nodes: Vec<f64>,
 }
 
 impl TabulatedSlope {
-    /// A table from ring values of P²²: `values[k]` is P²² on the ring [Rₖ, Rₖ₊₁) of the grid
-    /// Rₖ = `scale`·tan(kπ/(2(N+1))), N = `values.len()` (a ring average, or a sample at the
-    /// ring's centre). The values are normalized to unit mass with the piecewise-constant
-    /// interpolation (see the type's documentation).
+    /// A table from ring values of P²²: `values[k]` is the mean of P²² over the ring
+    /// [Rₖ, Rₖ₊₁) of the grid of N = `values.len()` rings at scale `scale` (see the type's
+    /// documentation); the table keeps each ring's mass π(Rₖ₊₁² − Rₖ²)·`values[k]`, normalized
+    /// to unit total, and its factor fₖ is that mass over the ring's mass under GGX(`scale`).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] if `scale` is not finite and > 0, if `values` is empty or
@@ -167,43 +209,49 @@ impl TabulatedSlope {
     /// negative (`name = "values[k]"`, the offending value), or if the total mass is zero or not
     /// finite (`name = "total mass"`).
     pub fn from_p22(scale: f32, values: &[f32]) -> Result<Self, Error> {
-        let values: Vec<f64> = values.iter().map(|&v| f64::from(v)).collect();
-        Self::from_ring_values(scale, values, None)
+        let s = f64::from(Error::check_positive("scale", scale)?);
+        check_ring_count(values.len())?;
+        check_values(values.iter().map(|&v| f64::from(v)))?;
+        let grid = RingGrid::new(s, values.len());
+        let masses = values
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| f64::from(v) * PI * (grid.radii_sq[k + 1] - grid.radii_sq[k]))
+            .collect();
+        Self::from_masses(grid, masses, None)
     }
 
     /// A table from samples of D: `values[k]` is D at the normal angle of the centre of ring k,
-    /// θₖ = atan(`scale`·tan((k + ½)Δ)), converted to P²² = D cos⁴θₖ and then as
-    /// [`Self::from_p22`].
+    /// θₖ = atan(`scale`·tan θ′ₖ₊½) ([`Self::ring_centre_angle`]); ring k's factor is
+    /// `values[k]`/D_GGX(s)(θₖ), so that the table passes through the samples, then the factors
+    /// are normalized.
     ///
     /// # Errors
     /// As [`Self::from_p22`].
     pub fn from_d(scale: f32, values: &[f32]) -> Result<Self, Error> {
         let s = f64::from(Error::check_positive("scale", scale)?);
+        check_ring_count(values.len())?;
+        check_values(values.iter().map(|&v| f64::from(v)))?;
         let n = values.len();
-        let p: Vec<f64> = values
+        let grid = RingGrid::new(s, n);
+        let masses = values
             .iter()
             .enumerate()
             .map(|(k, &d)| {
-                let r = s * grid_angle(k as f64 + 0.5, n).tan();
-                let cos2 = 1.0 / (1.0 + r * r);
-                f64::from(d) * cos2 * cos2
+                // D_GGX(s)(θₖ) = cos⁴θ′/(π s² cos⁴θₖ) with tan θₖ = s tan θ′
+                let t = grid_angle(k as f64 + 0.5, n).tan();
+                let (cos2_prime, cos2) = (1.0 / (1.0 + t * t), 1.0 / (1.0 + s * s * t * t));
+                let factor = f64::from(d) * PI * s * s * cos2 * cos2 / (cos2_prime * cos2_prime);
+                factor * grid.ggx_mass[k]
             })
             .collect();
-        // validation of the values (sign, NaN) is done on the converted values, which keep
-        // the sign and NaN-ness of the inputs
-        Self::from_ring_values(scale, p, None).map_err(|e| match e {
-            Error::InvalidParameter { name: "values[k]", .. } => {
-                let bad = values.iter().copied().find(|v| !(v.is_finite() && *v >= 0.0)).unwrap_or(f32::NAN);
-                Error::InvalidParameter { name: "values[k]", value: bad, expected: "finite and >= 0" }
-            }
-            other => other,
-        })
+        Self::from_masses(grid, masses, None)
     }
 
     /// A table of `rings` rings of the radial slope density `p22(r)` (r ≥ 0 the slope radius),
-    /// by the exact ring averages pₖ = ∫_{Rₖ}^{Rₖ₊₁} p22(r) 2πr dr / (π(Rₖ₊₁² − Rₖ²)) (8-point
-    /// Gauss–Legendre in the stretched angle per ring), normalized. The mass beyond R_N is
-    /// dropped; [`Self::input_mass`] reports the mass that was tabulated.
+    /// by its exact ring masses ∫_{Rₖ}^{Rₖ₊₁} p22(r) 2πr dr (8-point Gauss–Legendre in the
+    /// stretched angle per ring), normalized. The mass beyond R_N is dropped
+    /// ([`Tail::Truncated`]); [`Self::input_mass`] reports the mass that was tabulated.
     ///
     /// # Errors
     /// As [`Self::from_p22`] (`rings` is `values.len()`); a NaN, infinite or negative value
@@ -211,7 +259,7 @@ impl TabulatedSlope {
     pub fn from_radial_fn(scale: f32, rings: usize, p22: impl Fn(f64) -> f64) -> Result<Self, Error> {
         let s = f64::from(Error::check_positive("scale", scale)?);
         check_ring_count(rings)?;
-        let mut values = Vec::with_capacity(rings);
+        let mut masses = Vec::with_capacity(rings);
         let mut input_mass = 0.0;
         for k in 0..rings {
             let (t0, t1) = (grid_angle(k as f64, rings), grid_angle((k + 1) as f64, rings));
@@ -232,12 +280,10 @@ impl TabulatedSlope {
                 let sec2 = 1.0 + t.tan() * t.tan();
                 mass += w * half * v * 2.0 * PI * r * s * sec2;
             }
-            let (r0, r1) = (s * t0.tan(), s * t1.tan());
-            let area = PI * (r1 - r0) * (r1 + r0);
             input_mass += mass;
-            values.push(mass / area);
+            masses.push(mass);
         }
-        Self::from_ring_values(scale, values, Some(input_mass))
+        Self::from_masses(RingGrid::new(s, rings), masses, Some(input_mass))
     }
 
     /// A table of an isotropic analytic slope distribution ([`crate::Ggx`], [`crate::Beckmann`],
@@ -248,12 +294,7 @@ impl TabulatedSlope {
     /// projected roughness on the diagonal that differs from αx, as for a correlated slope), else as
     /// [`Self::from_radial_fn`].
     pub fn from_slope<S: MicrosurfaceSlope>(slope: &S, scale: f32, rings: usize) -> Result<Self, Error> {
-        // αx = αy is not enough: a correlated (rotated elliptical) slope has equal marginals
-        // and a different αᵢ on the diagonals
-        let diagonal = Vec3::new(core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0);
-        if slope.alpha_x() != slope.alpha_y()
-            || (slope.alpha_i(diagonal) - slope.alpha_x()).abs() > 1e-6 * slope.alpha_x()
-        {
+        if !is_isotropic(slope) {
             return Err(Error::InvalidParameter {
                 name: "alpha_y",
                 value: slope.alpha_y(),
@@ -263,25 +304,19 @@ impl TabulatedSlope {
         Self::from_radial_fn(scale, rings, |r| f64::from(slope.p22(r as f32, 0.0)))
     }
 
-    pub(super) fn from_ring_values(
-        scale: f32,
-        mut values: Vec<f64>,
-        input_mass: Option<f64>,
-    ) -> Result<Self, Error> {
+    /// A table of ring factors fₖ (the extraction's eigenvector), normalized.
+    pub(super) fn from_factors(scale: f32, factors: Vec<f64>) -> Result<Self, Error> {
         let s = f64::from(Error::check_positive("scale", scale)?);
-        let n = values.len();
-        check_ring_count(n)?;
-        if let Some(&bad) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-            return Err(Error::InvalidParameter {
-                name: "values[k]",
-                value: bad as f32,
-                expected: "finite and >= 0",
-            });
-        }
-        let radii: Vec<f64> =
-            (0..=n).map(|k| if k == 0 { 0.0 } else { s * grid_angle(k as f64, n).tan() }).collect();
-        let ring_area = |k: usize| PI * (radii[k + 1] - radii[k]) * (radii[k + 1] + radii[k]);
-        let total: f64 = (0..n).map(|k| values[k] * ring_area(k)).sum();
+        check_ring_count(factors.len())?;
+        check_values(factors.iter().copied())?;
+        let grid = RingGrid::new(s, factors.len());
+        let masses = factors.iter().zip(&grid.ggx_mass).map(|(f, m)| f * m).collect();
+        Self::from_masses(grid, masses, None)
+    }
+
+    /// The table of the ring masses `masses` (validated ≥ 0), normalized, truncated.
+    fn from_masses(grid: RingGrid, masses: Vec<f64>, input_mass: Option<f64>) -> Result<Self, Error> {
+        let total: f64 = masses.iter().sum();
         if !(total.is_finite() && total > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "total mass",
@@ -289,58 +324,105 @@ impl TabulatedSlope {
                 expected: "finite and > 0 (a table with some mass)",
             });
         }
-        for v in &mut values {
-            *v /= total;
-        }
-        let mut mass_prefix = Vec::with_capacity(n + 1);
-        let mut acc = 0.0;
-        mass_prefix.push(0.0);
-        for (k, v) in values.iter().enumerate() {
-            acc += v * ring_area(k);
-            mass_prefix.push(acc);
-        }
-        let mut table = Self {
-            scale: s,
-            divisions: n as f64 + 1.0,
-            radii,
-            p22: values,
-            mass_prefix,
-            backface: Vec::new(),
-            alpha: 0.0,
-            input_mass: input_mass.unwrap_or(total),
+        let lobe = Ggx::isotropic(grid.scale as f32)?;
+        let mut factors: Vec<f64> = masses.iter().zip(&grid.ggx_mass).map(|(m, g)| m / total / g).collect();
+        factors.push(0.0);
+        Ok(Self::build(grid, factors, Tail::Truncated, input_mass.unwrap_or(total), lobe))
+    }
+
+    /// The same rings with the model `tail` beyond R_N (the factors rescaled so that the whole
+    /// integrates to 1); the derived tables are rebuilt (the cost of a construction).
+    #[must_use]
+    pub fn with_tail(self, tail: Tail) -> Self {
+        let n = self.grid.rings;
+        let mut factors = self.factors;
+        factors[n] = match tail {
+            Tail::Truncated => 0.0,
+            Tail::Continued => factors[n - 1],
         };
-        table.backface = (0..=BACKFACE_INTERVALS)
-            .map(|j| {
-                let u = j as f64 / BACKFACE_INTERVALS as f64;
-                table.area_exact(-u, (1.0 - u * u).max(0.0).sqrt())
-            })
+        let total: f64 = factors.iter().zip(&self.grid.ggx_mass).map(|(f, m)| f * m).sum();
+        for f in &mut factors {
+            *f /= total;
+        }
+        Self::build(self.grid, factors, tail, self.input_mass, self.lobe)
+    }
+
+    /// The derived tables of normalized factors.
+    fn build(grid: RingGrid, factors: Vec<f64>, tail: Tail, input_mass: f64, lobe: Ggx) -> Self {
+        let n = grid.rings;
+        let s = grid.scale;
+        let d_coef = factors.iter().map(|f| f * s * s / PI).collect();
+        let ring_values = (0..n)
+            .map(|k| factors[k] * grid.ggx_mass[k] / (PI * (grid.radii_sq[k + 1] - grid.radii_sq[k])))
             .collect();
-        table.alpha = (2.0 * table.backface[0]) as f32;
-        Ok(table)
+        let lookup = RingLookup::new(&grid.radii_sq);
+        let sampler = VisibleSampler::new(&grid, &factors);
+        let step = n.div_ceil(MAX_GROUPS).max(1);
+        let exact_from = n.saturating_sub(EXACT_OUTER_RINGS.min(n.div_ceil(4))) / step * step;
+        let sub = (BACKFACE_NODES / (exact_from / step).max(1)).max(2);
+        let mut table = Self {
+            grid,
+            factors,
+            d_coef,
+            ring_values,
+            lookup,
+            backface: BackfaceTable { step, sub, exact_from, nodes: Vec::new() },
+            sampler,
+            alpha: 0.0,
+            input_mass,
+            tail,
+            lobe,
+        };
+        let mut nodes = Vec::with_capacity(exact_from / step * sub + 1);
+        for g in 0..exact_from / step {
+            let (lo, hi) = (table.grid.radii[g * step], table.grid.radii[(g + 1) * step]);
+            for i in 0..sub {
+                nodes.push(table.back_factor_exact(lo + (hi - lo) * i as f64 / sub as f64));
+            }
+        }
+        if exact_from > 0 {
+            nodes.push(table.back_factor_exact(table.grid.radii[exact_from]));
+        }
+        table.backface.nodes = nodes;
+        table.alpha = (2.0 * table.backface_area(1.0, 0.0)) as f32;
+        table
     }
 
     /// The number of rings N.
     #[must_use]
     pub fn rings(&self) -> usize {
-        self.p22.len()
+        self.grid.rings
     }
 
-    /// The slope scale s of the ring grid.
+    /// The slope scale s of the ring grid (the roughness of the GGX lobe the rings modulate).
     #[must_use]
     pub fn scale(&self) -> f32 {
-        self.scale as f32
+        self.grid.scale as f32
     }
 
     /// The ring boundaries R₀ = 0 < … < R_N.
     #[must_use]
     pub fn radii(&self) -> &[f64] {
-        &self.radii
+        &self.grid.radii
     }
 
-    /// The normalized ring values pₖ of P²².
+    /// The normalized ring averages of P²², (mass of ring k)/(π(Rₖ₊₁² − Rₖ²)).
     #[must_use]
     pub fn ring_values(&self) -> &[f64] {
-        &self.p22
+        &self.ring_values
+    }
+
+    /// The normalized ring factors fₖ (P²² = fₖ·P_GGX(s) on ring k), k = 0 … N − 1, then the
+    /// tail's (0 for [`Tail::Truncated`]).
+    #[must_use]
+    pub fn ring_factors(&self) -> &[f64] {
+        &self.factors
+    }
+
+    /// The model beyond the last ring.
+    #[must_use]
+    pub fn tail(&self) -> Tail {
+        self.tail
     }
 
     /// The mass ∫P²² of the input before normalization (for [`Self::from_radial_fn`], the mass
@@ -348,6 +430,19 @@ impl TabulatedSlope {
     #[must_use]
     pub fn input_mass(&self) -> f64 {
         self.input_mass
+    }
+
+    /// The heap memory of the table's arrays, in bytes (the struct itself is
+    /// `size_of::<TabulatedSlope>()`).
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        let n = self.grid.rings;
+        // grid: radii, radii², stretched (N + 1 each), cos, sin (N + 2), masses (N + 1)
+        let grid = (6 * n + 8) * 8;
+        grid + (self.factors.len() + self.d_coef.len() + self.ring_values.len() + self.backface.nodes.len())
+            * 8
+            + self.lookup.heap_bytes()
+            + self.sampler.heap_bytes()
     }
 
     /// The GGX-equivalent roughness α = 2·projected_area(horizon) = E|x̃|: the GGX α with the
@@ -358,17 +453,19 @@ impl TabulatedSlope {
     }
 
     /// The Beckmann roughness with the same second moment, α = √E[x̃² + ỹ²] (E\[r²\] = α² for
-    /// Beckmann), computed exactly from the rings: E\[r²\] = Σₖ pₖ π(Rₖ₊₁⁴ − Rₖ⁴)/2 (Dupuy 2015,
+    /// Beckmann), computed exactly from the rings: ring k holds
+    /// fₖ s²(2 ln(cos θ′ₖ/cos θ′ₖ₊₁) − (cos²θ′ₖ − cos²θ′ₖ₊₁)) of E\[r²\] (Dupuy 2015,
     /// Listing 4.4, which converts a radial table to Beckmann roughness by its second moment).
+    /// Infinite with a [`Tail::Continued`] (the second moment of an r⁻⁴ tail diverges).
     #[must_use]
     pub fn beckmann_alpha(&self) -> f32 {
-        let m2: f64 = self
-            .p22
-            .iter()
-            .zip(self.radii.windows(2))
-            .map(|(p, r)| {
-                let (a, b) = (r[0] * r[0], r[1] * r[1]);
-                p * 0.5 * PI * (b - a) * (b + a)
+        let (g, n) = (&self.grid, self.grid.rings);
+        if self.factors[n] > 0.0 {
+            return f32::INFINITY;
+        }
+        let m2: f64 = (0..n)
+            .map(|k| {
+                self.factors[k] * g.scale * g.scale * (2.0 * (g.cos[k] / g.cos[k + 1]).ln() - g.ggx_mass[k])
             })
             .sum();
         m2.sqrt() as f32
@@ -381,27 +478,20 @@ impl TabulatedSlope {
         (f64::from(scale) * grid_angle(k as f64 + 0.5, rings).tan()).atan()
     }
 
-    /// The ring holding the slope radius r = `horizontal`/`z`, from the stretched angle.
-    #[inline]
-    fn ring_of(&self, horizontal: f64, z: f64) -> Option<usize> {
-        let angle = horizontal.atan2(self.scale * z);
-        // invert θ′ = (π/2)(1 − (1 − k/(N+1))²)
-        let k = ((1.0 - (1.0 - angle / FRAC_PI_2).max(0.0).sqrt()) * self.divisions) as usize;
-        (k < self.p22.len()).then_some(k)
-    }
-
-    /// The radial density P²² at slope radius `r` ≥ 0 (f64).
+    /// The radial density P²² at slope radius `r` ≥ 0 (f64; 0 for a NaN or negative r).
     #[must_use]
     pub fn p22_radial(&self, r: f64) -> f64 {
         if r.is_nan() || r < 0.0 {
             return 0.0;
         }
-        self.ring_of(r, 1.0).map_or(0.0, |k| self.p22[k])
+        let r2 = r * r;
+        let k = self.lookup.ring(r2, &self.grid.radii_sq);
+        let s2 = self.grid.scale * self.grid.scale;
+        self.d_coef[k] / ((s2 + r2) * (s2 + r2))
     }
 
-    /// The exact projected area ∫⟨ω, ωm⟩₊ D(ωm) dωm of the table for ω = (sin θ, 0, cos θ),
-    /// as the closed-form sum over rings (O(N), f64): the reference of the interpolated
-    /// [`MicrosurfaceSlope::projected_area`].
+    /// The exact projected area ∫⟨ω, ωm⟩₊ D(ωm) dωm of the table (O(N) closed-form sum, f64):
+    /// the reference of the interpolated [`MicrosurfaceSlope::projected_area`].
     #[must_use]
     pub fn projected_area_exact(&self, w: Vec3) -> f64 {
         let w = w.as_dvec3();
@@ -410,175 +500,137 @@ impl TabulatedSlope {
         if len.is_nan() || len <= 0.0 {
             return 0.0;
         }
-        self.area_exact(w.z / len, h / len)
-    }
-
-    fn area_exact(&self, cos_t: f64, sin_t: f64) -> f64 {
-        let n = self.p22.len();
-        // rings entirely on the visible side contribute cos θ times their mass
-        let full = self.fully_visible(cos_t, sin_t);
-        let mut area = cos_t.max(0.0) * self.mass_prefix[full];
-        let mut prev = disk_area(self.radii[full], cos_t, sin_t);
-        for k in full..n {
-            let next = disk_area(self.radii[k + 1], cos_t, sin_t);
-            area += self.p22[k] * (next - prev);
-            prev = next;
-        }
-        area
-    }
-
-    /// The number of rings entirely on the visible side x̃ < cot θ: the k with Rₖ·sin θ ≤ cos θ.
-    #[inline]
-    fn fully_visible(&self, cos_t: f64, sin_t: f64) -> usize {
-        if cos_t <= 0.0 {
-            return 0;
-        }
-        // radii[1..=n] are increasing: count the outer radii inside the visible half plane
-        self.radii[1..].partition_point(|&r| r * sin_t <= cos_t)
-    }
-
-    /// The back-face area B(u), u ∈ [0, 1]: the exact sum where the visibility line cuts at
-    /// most [`EXACT_RINGS`] rings, else interpolated linearly in u.
-    #[inline]
-    fn backface_at(&self, u: f64) -> f64 {
-        let u = u.clamp(0.0, 1.0);
-        let (cos_t, sin_t) = (-u, ((1.0 - u) * (1.0 + u)).sqrt());
-        // rings with Rₖ₊₁ sin θ ≤ u lie entirely on the invisible side
-        let first_cut = self.radii[1..].partition_point(|&r| r * sin_t <= u);
-        let n = self.p22.len();
-        if n - first_cut <= EXACT_RINGS {
-            let mut area = 0.0;
-            let mut prev = disk_area(self.radii[first_cut], cos_t, sin_t);
-            for k in first_cut..n {
-                let next = disk_area(self.radii[k + 1], cos_t, sin_t);
-                area += self.p22[k] * (next - prev);
-                prev = next;
-            }
-            return area;
-        }
-        let t = u * BACKFACE_INTERVALS as f64;
-        let j = (t as usize).min(BACKFACE_INTERVALS - 1);
-        let frac = t - j as f64;
-        self.backface[j] + frac * (self.backface[j + 1] - self.backface[j])
-    }
-
-    /// Samples visible slopes (x̃, ỹ) in the frame of ωi = (sin θ, 0, cos θ), exactly, from
-    /// two uniforms; `None` if ωi sees no microsurface.
-    fn sample_slopes(&self, cos_t: f64, sin_t: f64, u1: f64, u2: f64) -> Option<(f64, f64)> {
-        let n = self.p22.len();
-        let full = self.fully_visible(cos_t, sin_t);
-        let full_mass = cos_t.max(0.0) * self.mass_prefix[full];
-        // first pass: the exact total visible mass
-        let base = disk_area(self.radii[full], cos_t, sin_t);
-        let mut total = full_mass;
-        let mut prev = base;
-        for k in full..n {
-            let next = disk_area(self.radii[k + 1], cos_t, sin_t);
-            total += self.p22[k] * (next - prev);
-            prev = next;
-        }
-        if total.is_nan() || total <= 0.0 {
-            return None;
-        }
-        let target = u1 * total;
-        // the ring, and the uniform rescaled to it
-        let (ring, u) = if target < full_mass {
-            let m = target / cos_t;
-            let k = (self.mass_prefix[1..=full].partition_point(|&p| p <= m)).min(full - 1);
-            let ring_mass = self.mass_prefix[k + 1] - self.mass_prefix[k];
-            (k, ((m - self.mass_prefix[k]) / ring_mass).clamp(0.0, 1.0))
+        let (h, z) = (h / len, w.z / len);
+        let b = if h > 0.0 {
+            let c = z.abs() / (self.grid.scale * h);
+            self.grid.scale * h * self.back_sum(c) / PI
         } else {
-            let mut acc = full_mass;
-            let mut prev = base;
-            let mut chosen = None;
-            let mut last_positive = None;
-            for k in full..n {
-                let next = disk_area(self.radii[k + 1], cos_t, sin_t);
-                let m = self.p22[k] * (next - prev);
-                prev = next;
-                if m > 0.0 {
-                    last_positive = Some((k, acc, m));
-                    if target < acc + m {
-                        chosen = Some((k, ((target - acc) / m).clamp(0.0, 1.0)));
-                        break;
-                    }
-                }
-                acc += m;
-            }
-            // rounding can leave target ≥ the recomputed sum: the last ring with mass
-            chosen.or_else(|| last_positive.map(|(k, _, _)| (k, 1.0)))?
+            0.0
         };
-        let (r1, r2) = (self.radii[ring], self.radii[ring + 1]);
-        let x = self.invert_ring_marginal(r1, r2, cos_t, sin_t, u);
-        let lo = ((r1 - x.abs()).max(0.0) * (r1 + x.abs())).sqrt();
-        let hi = ((r2 - x.abs()).max(0.0) * (r2 + x.abs())).sqrt();
-        let s = 2.0 * u2 - 1.0;
-        let y = (lo + s.abs() * (hi - lo)).copysign(s);
-        Some((x, y))
+        z.max(0.0) + b
     }
 
-    /// The x̃ with F(x̃) = u·F(x_max) for the marginal F(x) = ∫_{−R₂}^{x} (cos θ − s sin θ)
-    /// (chord(R₂, s) − chord(R₁, s)) ds of the annulus R₁ ≤ r < R₂ on its visible side, by
-    /// Newton's method safeguarded by bisection.
-    fn invert_ring_marginal(&self, r1: f64, r2: f64, cos_t: f64, sin_t: f64, u: f64) -> f64 {
-        let x_max = if cos_t >= r2 * sin_t { r2 } else { cos_t / sin_t };
-        let cdf = |x: f64| {
-            let outer = partial_disk_integral(r2, x, cos_t, sin_t);
-            let inner = if r1 > 0.0 && x > -r1 { partial_disk_integral(r1, x, cos_t, sin_t) } else { 0.0 };
-            outer - inner
-        };
-        let target = u * cdf(x_max);
-        let (mut lo, mut hi) = (-r2, x_max);
-        let mut x = 0.5 * (lo + hi);
-        for _ in 0..MAX_ITERATIONS {
-            let f = cdf(x) - target;
-            if f > 0.0 {
-                hi = x;
-            } else {
-                lo = x;
-            }
-            let density = (cos_t - x * sin_t) * (chord(r2, x) - chord(r1, x));
-            let mut next = if density > 0.0 { x - f / density } else { f64::NAN };
-            if !(next > lo && next < hi) {
-                next = 0.5 * (lo + hi);
-            }
-            let done = (next - x).abs() <= NEWTON_TOLERANCE * r2;
-            x = next;
-            if done || hi - lo <= NEWTON_TOLERANCE * r2 {
-                break;
-            }
-        }
-        x
+    /// Σₖ fₖ ΔSₖ(c′) over the rings beyond the visibility line c′ (stretched): π B/(s h).
+    fn back_sum(&self, c: f64) -> f64 {
+        let first = self.lookup.ring((self.grid.scale * c).powi(2), &self.grid.radii_sq);
+        self.grid.back_sum(&self.factors, c, first)
     }
 
-    /// An exactly sampled visible normal for a unit `wi` (f64 inside).
-    fn sample_normal(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
-        let w = wi.as_dvec3();
-        let azimuth = Azimuth::of(w.x, w.y);
-        let h = azimuth.len_xy;
-        let len = (h * h + w.z * w.z).sqrt();
-        if len.is_nan() || len <= 0.0 {
-            return Vec3::Z;
-        }
-        let Some((x, y)) = self.sample_slopes(w.z / len, h / len, f64::from(u1), f64::from(u2)) else {
-            return Vec3::Z;
-        };
-        // the table is isotropic and unstretched: rotate only
-        ensure_visible(wi, azimuth.unstretched_normal(1.0, 1.0, x, y))
+    /// The back-face factor ρ = B/B_GGX(s) at the (unstretched) visibility line c = |z|/h,
+    /// summed exactly.
+    fn back_factor_exact(&self, c: f64) -> f64 {
+        let c = c / self.grid.scale;
+        self.back_sum(c) / back_area(f64::INFINITY, c)
     }
 
-    /// D in f64 for a normal with horizontal length `h` and height `z`.
+    /// The back-face area B for a direction of horizontal length `h` ≥ 0 and height ±`z`
+    /// (|z| is used): B_GGX(s) times the interpolated factor ρ (exact near the poles).
     #[inline]
-    fn d_from(&self, h: f64, z: f64) -> f64 {
-        if z.is_nan() || z <= 0.0 || !h.is_finite() {
+    fn backface_area(&self, h: f64, z: f64) -> f64 {
+        let z = z.abs();
+        let sh = self.grid.scale * h;
+        let ggx = sh * sh / (2.0 * ((sh * sh + z * z).sqrt() + z));
+        if ggx.is_nan() || ggx <= 0.0 {
             return 0.0;
         }
-        let Some(k) = self.ring_of(h, z) else { return 0.0 };
-        // D = P²²/cos⁴θm for a unit normal; for a non-unit one, cos θm = z/‖m‖
-        let len2 = h * h + z * z;
-        let c2 = z * z / len2;
-        self.p22[k] / (c2 * c2)
+        let c = z / h;
+        let k = self.lookup.ring(c * c, &self.grid.radii_sq);
+        let t = &self.backface;
+        let rho = if k < t.exact_from {
+            let g = k / t.step;
+            let (lo, hi) = (self.grid.radii[g * t.step], self.grid.radii[(g + 1) * t.step]);
+            let pos = ((c - lo) / (hi - lo)).clamp(0.0, 1.0) * t.sub as f64;
+            let i = (pos as usize).min(t.sub - 1);
+            let (a, b) = (t.nodes[g * t.sub + i], t.nodes[g * t.sub + i + 1]);
+            a + (pos - i as f64) * (b - a)
+        } else {
+            let c = z / sh;
+            self.grid.back_sum(&self.factors, c, k) / back_area(f64::INFINITY, c)
+        };
+        ggx * rho
     }
+
+    /// D in f64 for a normal with squared horizontal length `h2`, height `z` and squared
+    /// length `len2`: fₖ s²/π·(len2/(s²z² + h2))² (0 for z ≤ 0).
+    #[inline(always)]
+    fn d_of(&self, h2: f64, z: f64, len2: f64) -> f64 {
+        if !(z > 0.0 && h2.is_finite()) {
+            return 0.0;
+        }
+        let z2 = z * z;
+        let k = self.lookup.ring(h2 / z2, &self.grid.radii_sq);
+        let s = self.grid.scale;
+        let q = len2 / (s * s * z2 + h2);
+        self.d_coef[k] * q * q
+    }
+
+    /// The ring holding the visibility line c = |z|/h of a direction of horizontal length `h`
+    /// and height `z` (N beyond the last ring, and for h = 0).
+    #[inline(always)]
+    fn visibility_ring(&self, h: f64, z: f64) -> usize {
+        let c = z / h;
+        self.lookup.ring(c * c, &self.grid.radii_sq)
+    }
+
+    /// An exactly sampled visible normal for a unit `wi` (f64 inside); +z if ωi sees nothing.
+    fn sample_normal(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
+        let (x, y, z) = (f64::from(wi.x), f64::from(wi.y), f64::from(wi.z));
+        let h = (x * x + y * y).sqrt();
+        let s = self.grid.scale;
+        // the ring of the visibility line matters from below only
+        let ring = if z < 0.0 { self.visibility_ring(h, z) } else { 0 };
+        let m = match self.sampler.sample(s * h, z, ring, u1, u2) {
+            Visible::Normal(m) => m,
+            // the directions that see only the tail see GGX(s): its exact sampler
+            Visible::TailOnly => return sample_spherical_cap(&self.lobe, wi, u1, u2),
+            Visible::Nothing => return Vec3::Z,
+        };
+        // unstretch (the slopes scale by s) and rotate to the azimuth (x, y)/h of ωi, all
+        // times h (no division): h·(s R m_xy, m.z), R the rotation
+        let n = if h > 0.0 {
+            DVec3::new(s * (x * m.x - y * m.y), s * (y * m.x + x * m.y), h * m.z)
+        } else {
+            DVec3::new(s * m.x, s * m.y, m.z)
+        };
+        ensure_visible(wi, (n * n.length().recip()).as_vec3())
+    }
+
+    /// The fraction of visible-normal proposals accepted from the unit direction `w` (the
+    /// exact visible mass over the proposal's): a measurement of the sampler's efficiency
+    /// (1 where no rejection is used, near the nadir).
+    #[doc(hidden)]
+    #[must_use]
+    pub fn sampler_acceptance(&self, w: Vec3) -> f64 {
+        let w = w.as_dvec3();
+        let h = (w.x * w.x + w.y * w.y).sqrt();
+        match self.sampler.proposal_mass(self.grid.scale * h, w.z, self.visibility_ring(h, w.z)) {
+            Some(q) if q > 0.0 => self.projected_area_exact(w.as_vec3()) / (2.0 * q),
+            _ => 1.0,
+        }
+    }
+}
+
+/// Whether `slope` is isotropic to within 1e-6: αx = αy, and the same projected roughness on
+/// the diagonal (αx = αy is not enough: a correlated, rotated elliptical slope has equal
+/// marginals and a different αᵢ on the diagonals).
+pub(super) fn is_isotropic<S: MicrosurfaceSlope>(slope: &S) -> bool {
+    let diagonal = Vec3::new(core::f32::consts::FRAC_1_SQRT_2, core::f32::consts::FRAC_1_SQRT_2, 0.0);
+    slope.alpha_x() == slope.alpha_y()
+        && (slope.alpha_i(diagonal) - slope.alpha_x()).abs() <= 1e-6 * slope.alpha_x()
+}
+
+/// Checks that every value is finite and ≥ 0 (`values[k]`).
+fn check_values(values: impl Iterator<Item = f64>) -> Result<(), Error> {
+    for v in values {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "values[k]",
+                value: v as f32,
+                expected: "finite and >= 0",
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The stretched angle θ′ = (π/2)(1 − (1 − k/(N+1))²) of the (fractional) ring boundary `k` of
@@ -606,16 +658,26 @@ impl TabulatedSlope {
     /// `sample_d_wi` composed with this is exact; the override below skips the stretching.
     #[must_use]
     pub fn sample_p22_11(&self, cos_theta: f32, sin_theta: f32, u1: f32, u2: f32) -> Vec2 {
-        let a = f64::from(self.alpha);
-        let (sx, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));
-        let len = (sx * sx + z * z).sqrt();
-        if len.is_nan() || len <= 0.0 {
+        let (a, s) = (f64::from(self.alpha), self.grid.scale);
+        let (h, z) = (f64::from(sin_theta) / a, f64::from(cos_theta));
+        // the ring of the visibility line matters from below only
+        let ring = if z < 0.0 { self.visibility_ring(h, z) } else { 0 };
+        let m = match self.sampler.sample(s * h, z, ring, u1, u2) {
+            Visible::Normal(m) => m,
+            Visible::TailOnly => {
+                // the unit GGX lobe's visible normals from the stretched direction (s h, 0, z)
+                let len = (s * h).hypot(z);
+                let v = Vec3::new((s * h / len) as f32, 0.0, (z / len) as f32);
+                sample_visible_hemisphere(v, 1.0, u1, u2).as_dvec3()
+            }
+            Visible::Nothing => return Vec2::ZERO,
+        };
+        if m.z <= 0.0 {
             return Vec2::ZERO;
         }
-        match self.sample_slopes(z / len, sx / len, f64::from(u1), f64::from(u2)) {
-            Some((x, y)) => Vec2::new((x / a) as f32, (y / a) as f32),
-            None => Vec2::ZERO,
-        }
+        // slopes −s m.x/m.z, −s m.y/m.z, finite (a horizontal normal has the largest f32 slope)
+        let slope = |v: f64| (-s * v / (m.z * a)).clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32;
+        Vec2::new(slope(m.x), slope(m.y))
     }
 }
 
@@ -632,14 +694,15 @@ impl MicrosurfaceSlope for &TabulatedSlope {
         self.alpha
     }
 
-    /// The ring value pₖ of the slope radius (0 beyond R_N and for NaN slopes).
+    /// fₖ s²/(π(s² + r²)²) at the slope radius r (0 beyond R_N when truncated, and for NaN
+    /// slopes).
     #[inline]
     fn p22(&self, slope_x: f32, slope_y: f32) -> f32 {
         let (x, y) = (f64::from(slope_x), f64::from(slope_y));
         self.p22_radial((x * x + y * y).sqrt()) as f32
     }
 
-    /// pₖ/cos⁴θm in f64, rounded (0 for ωm.z ≤ 0 and beyond R_N, which bounds 1/cos θm).
+    /// fₖ D_GGX(s)(ωm) in f64, rounded (0 for ωm.z ≤ 0 and beyond R_N when truncated).
     #[inline]
     fn d(&self, wm: Vec3) -> f32 {
         self.d64_unchecked(wm.as_dvec3()) as f32
@@ -648,31 +711,47 @@ impl MicrosurfaceSlope for &TabulatedSlope {
     /// As `d`; 0 for a non-finite normal (a debug assertion in debug builds).
     #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
-        debug_assert!(wm.is_finite(), "d64_unchecked: non-finite normal {wm}");
+        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
         if !wm.is_finite() {
             return 0.0;
         }
-        self.d_from((wm.x * wm.x + wm.y * wm.y).sqrt(), wm.z)
+        let h2 = wm.x * wm.x + wm.y * wm.y;
+        self.d_of(h2, wm.z, h2 + wm.z * wm.z)
     }
 
-    /// B(cos θ)/cos θ above the horizon and −1 − B(|cos θ|)/|cos θ| below, B interpolated
-    /// from the table (see the type's documentation); saturates to ±`f32::MAX` at ±0. Invalid input
+    /// B/cos θ above the horizon and −1 − B/|cos θ| below, B interpolated (see the type's
+    /// documentation); saturates to ±`f32::MAX` at ±0. Invalid input
     /// ([policy](crate#invalid-input)): a `w` that is not a unit direction gives NaN.
     #[inline]
     fn lambda_unchecked(&self, w: Vec3) -> f32 {
-        let z = f64::from(w.z);
-        let b = self.backface_at(z.abs());
+        let (x, y, z) = (f64::from(w.x), f64::from(w.y), f64::from(w.z));
+        let b = self.backface_area((x * x + y * y).sqrt(), z);
         let lambda = (b / z.abs()).min(f64::from(f32::MAX)) as f32;
         if w.z >= 0.0 { lambda } else { -1.0 - lambda }
     }
 
-    /// cos θ + B(cos θ) above the horizon, B(|cos θ|) below (B interpolated). Invalid input
+    /// Λ in f64, unsaturated (±∞ at ±0).
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
+        let (x, y, z) = (f64::from(w.x), f64::from(w.y), f64::from(w.z));
+        let b = self.backface_area((x * x + y * y).sqrt(), z);
+        let l = b / z.abs();
+        if w.z >= 0.0 { l } else { -1.0 - l }
+    }
+
+    /// cos θ + B above the horizon, B below (B interpolated). Invalid input
     /// ([policy](crate#invalid-input)): a `w` that is not a unit direction gives NaN.
     #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
-        let z = f64::from(w.z);
-        let b = self.backface_at(z.abs());
-        (if w.z >= 0.0 { z + b } else { b }) as f32
+        self.projected_area64(w) as f32
+    }
+
+    /// The projected area in f64.
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        let (x, y, z) = (f64::from(w.x), f64::from(w.y), f64::from(w.z));
+        let b = self.backface_area((x * x + y * y).sqrt(), z);
+        if z >= 0.0 { z + b } else { b }
     }
 
     /// Exact for every ωi (see the type's documentation); +z for ωi = −z. Invalid
@@ -732,6 +811,15 @@ impl StretchedTabulated<'_> {
     }
 }
 
+impl StretchedTabulated<'_> {
+    /// The table's back-face area at the stretched direction (sx ω.x, sy ω.y, ω.z).
+    #[inline]
+    fn backface_area(&self, w: Vec3) -> f64 {
+        let (x, y) = (f64::from(self.sx) * f64::from(w.x), f64::from(self.sy) * f64::from(w.y));
+        self.table.backface_area((x * x + y * y).sqrt(), f64::from(w.z))
+    }
+}
+
 impl crate::sealed::Sealed for StretchedTabulated<'_> {}
 
 impl MicrosurfaceSlope for StretchedTabulated<'_> {
@@ -760,30 +848,45 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
     /// (a debug assertion).
     #[inline]
     fn d64_unchecked(&self, wm: DVec3) -> f64 {
-        debug_assert!(wm.is_finite(), "d64_unchecked: non-finite normal {wm}");
+        debug_assert!(wm.is_finite(), "d64: non-finite normal {wm}");
         if !wm.is_finite() || wm.z <= 0.0 {
             return 0.0;
         }
         let (sx, sy) = (f64::from(self.sx), f64::from(self.sy));
-        // the stretched normal (m.x/sx, m.y/sy, m.z) has the stretched slopes; D transforms
-        // with cos⁴: D(m) = D_table(m′) (cos θm′/cos θm)⁴ /(sx sy) for unit m, m′
-        let m = DVec3::new(wm.x / sx, wm.y / sy, wm.z);
-        let (lm, lw) = (m.length(), wm.length());
-        let d_table = self.table.d_from((m.x * m.x + m.y * m.y).sqrt(), m.z);
-        let ratio = (m.z / lm) / (wm.z / lw);
-        d_table * ratio.powi(4) / (sx * sy)
+        // the stretched normal m′ = (m.x/sx, m.y/sy, m.z) has the stretched slopes, and D
+        // transforms with cos⁴: D(m) = D_table(m′)(cos θm′/cos θm)⁴/(sx sy) =
+        // fₖ s²/π·(|m|²/(s² m.z² + |m′_xy|²))²/(sx sy), the table's form with |m|² for |m′|²
+        let (x, y) = (wm.x / sx, wm.y / sy);
+        self.table.d_of(x * x + y * y, wm.z, wm.length_squared()) / (sx * sy)
     }
 
+    /// The table's Λ at the stretched direction (the table's back-face area is homogeneous of
+    /// degree 1, so it is evaluated at (sx ω.x, sy ω.y, ω.z) directly, in f64); saturates to
+    /// ±`f32::MAX` at ±0. Invalid input ([policy](crate#invalid-input)): NaN.
     #[inline]
     fn lambda_unchecked(&self, w: Vec3) -> f32 {
-        let (s, _) = self.stretch(w);
-        (&self.table).lambda(s)
+        let lambda = (self.backface_area(w) / f64::from(w.z).abs()).min(f64::from(f32::MAX)) as f32;
+        if w.z >= 0.0 { lambda } else { -1.0 - lambda }
     }
 
+    /// Λ in f64, unsaturated.
+    #[inline]
+    fn lambda64(&self, w: Vec3) -> f64 {
+        let l = self.backface_area(w) / f64::from(w.z).abs();
+        if w.z >= 0.0 { l } else { -1.0 - l }
+    }
+
+    /// cos θ + B above the horizon, B below, B the table's back-face area at the stretched
+    /// direction. Invalid input ([policy](crate#invalid-input)): NaN.
     #[inline]
     fn projected_area_unchecked(&self, w: Vec3) -> f32 {
-        let (s, len) = self.stretch(w);
-        (len * f64::from((&self.table).projected_area(s))) as f32
+        self.projected_area64(w) as f32
+    }
+
+    /// The projected area in f64.
+    #[inline]
+    fn projected_area64(&self, w: Vec3) -> f64 {
+        f64::from(w.z).max(0.0) + self.backface_area(w)
     }
 
     /// Exact for every ωi: the table's visible slopes from ω_s/‖ω_s‖, scaled by (sx, sy); +z
@@ -796,6 +899,10 @@ impl MicrosurfaceSlope for StretchedTabulated<'_> {
             return Vec3::Z;
         }
         let m = (&self.table).sample_d_wi(s, u1, u2);
+        if m == Vec3::Z && wi.z <= 0.0 {
+            // the table sees nothing from the stretched ωi (as +z is not visible from ωi)
+            return Vec3::Z;
+        }
         // the table's normal m ∝ (−u, −v, 1): the slopes scale by (sx, sy)
         let stretched = Vec3::new(m.x * self.sx, m.y * self.sy, m.z);
         ensure_visible(wi, crate::vector::normalize_scaled(stretched, Vec3::Z))

@@ -31,10 +31,24 @@ pub(crate) fn chi2_exact<B: Bsdf>(
     z: f64,
     pdf_scale: f64,
 ) -> (f64, f64) {
+    chi2_exact_refined(label, b, wo, seed, z, pdf_scale, 0)
+}
+
+/// [`chi2_exact`] with the cells' quadrature split `min_depth` times before its adaptive test
+/// (`Chi2Grid::min_depth`): for densities with a jump along a curve the cells do not follow.
+pub(crate) fn chi2_exact_refined<B: Bsdf>(
+    label: &str,
+    b: &B,
+    wo: Vec3,
+    seed: u64,
+    z: f64,
+    pdf_scale: f64,
+    min_depth: u32,
+) -> (f64, f64) {
     let mut rng = validation::rng(seed);
     let mut eval_rng = validation::rng(seed + 7);
-    let settings =
-        BsdfChi2 { grid: chi2_grid(), mass: (16, 32, 1e-5, 7), n: CHI2_N, pdf_scale, pdf_consistency: None };
+    let grid = Chi2Grid { min_depth, ..chi2_grid() };
+    let settings = BsdfChi2 { grid, mass: (16, 32, 1e-5, 7), n: CHI2_N, pdf_scale, pdf_consistency: None };
     let out = bsdf_chi2(
         label,
         b,

@@ -23,8 +23,11 @@ pub(crate) const ETA: f32 = 1.5;
 /// Roughness of the multiple-scattering tests (enough for a visible second order).
 pub(crate) const ALPHA_MS: f32 = 0.6;
 /// The number of chi-square tests of this binary that must pass (the Šidák family): 33 of
-/// the microfacet (incl. elliptical) and classic models and those of `noncentral`.
-pub(crate) const CHI2_FAMILY: usize = 33 + super::noncentral::NONCENTRAL_CHI2_TESTS;
+/// the microfacet (incl. elliptical) and classic models and those of `noncentral` and
+/// `noncentral_materials`.
+pub(crate) const CHI2_FAMILY: usize = 33
+    + super::noncentral::NONCENTRAL_CHI2_TESTS
+    + super::noncentral_materials::NONCENTRAL_MATERIAL_CHI2_TESTS;
 /// Share of the single-bounce phase function in the proposal of the albedo estimates.
 pub(crate) const PHASE_SHARE: f64 = 0.7;
 

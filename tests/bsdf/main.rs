@@ -25,7 +25,8 @@
 //! modes), `shading_frame`, `energy_by_order`, `invalid_directions`, `classic` (ClassicBrdf
 //! specifics), `determinism` (object safety, determinism, decorrelation, stratified sampling),
 //! `integrator` (flags, η, the specular limit, the roughness range), `backfacing_masking` and
-//! `deep_tails`; `fixtures` holds what they share.
+//! `deep_tails`, `noncentral` and `noncentral_materials` (the sheared lobes of LEADR with
+//! conductors, glass and diffuse facets); `fixtures` holds what they share.
 
 mod backfacing_masking;
 mod classic;
@@ -38,6 +39,7 @@ mod fixtures;
 mod integrator;
 mod invalid_directions;
 mod noncentral;
+mod noncentral_materials;
 mod reciprocity;
 mod roulette;
 mod shading_frame;

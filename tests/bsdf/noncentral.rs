@@ -127,15 +127,17 @@ fn checked<S: MicrosurfaceSlope>(b: &NoncentralBsdf<S>, wo: Vec3, wi: Vec3) -> C
     let c = b.material();
     let v = b.eval(wo, wi);
     assert!(v.exact);
-    let f_research = s.eval_single_scattering(c, wo, wi) / wi.z;
-    let wh = (wo.as_dvec3() + wi.as_dvec3()).normalize();
-    let fresnel = c.fresnel(wi.as_dvec3().dot(wh) as f32);
+    let f_research = s.eval_single_scattering(c, wo, wi, &mut validation::rng(0)) / wi.z;
+    // the model takes unit directions: the f32 ones renormalized in f64
+    let (o, i) = (wo.as_dvec3().normalize(), wi.as_dvec3().normalize());
+    let wh = (o + i).normalize();
+    let fresnel = c.fresnel(i.dot(wh) as f32);
     let scalar = s.d64(wh) * f64::from(s.g1(wo)) * f64::from(s.g1(wi)) / (4.0 * f64::from(wo.z * wi.z));
     Checked {
         f: v.f,
         pdf: b.pdf(wo, wi),
         f_research,
-        pdf_research: s.pdf_single_scattering(wo, wi),
+        pdf_research: s.pdf_single_scattering(c, wo, wi),
         f_formula: fresnel.to_array().map(|x| f64::from(x) * scalar),
         f_swapped: b.eval(wi, wo).f,
         both: b.eval_with_pdf(wo, wi),

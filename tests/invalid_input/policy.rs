@@ -13,7 +13,7 @@
 use glam::{DVec3, Vec2, Vec3};
 use microsurface::Elliptical;
 use microsurface::fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
-use microsurface::leadr::Noncentral;
+use microsurface::leadr::{Noncentral, NoncentralMaterial};
 use microsurface::research::Invariance;
 use microsurface::research::{
     Estimator, GaussianHeight, HeightSample, Material, Microsurface, MicrosurfaceGeometry,
@@ -247,9 +247,8 @@ fn check_p22_11(r: &mut Report, name: &str, f: impl Fn(f32, f32, f32, f32) -> Ve
 }
 
 /// The inherent queries of a noncentral slope (Dupuy 2015, thesis §3.2): D, G1, D_ωi, the
-/// sampler and single scattering.
+/// sampler and single scattering with each material.
 fn check_noncentral<S: MicrosurfaceSlope>(r: &mut Report, name: &str, s: Noncentral<S>) {
-    let gold = Conductor::new(ComplexIor::GOLD);
     for b in bad_directions() {
         let l = format!("{name} ω = {b}");
         r.expect_nothing(&format!("{l}: d"), || s.d(b), zero32);
@@ -259,39 +258,47 @@ fn check_noncentral<S: MicrosurfaceSlope>(r: &mut Report, name: &str, s: Noncent
         r.expect_nothing(&format!("{l}: d_wi(bad, good)"), || s.d_wi(b, good()), zero32);
         r.expect_nothing(&format!("{l}: d_wi(good, bad)"), || s.d_wi(good(), b), zero32);
         r.expect_nothing(&format!("{l}: sample_d_wi"), || s.sample_d_wi(b, 0.5, 0.5), nan_vec);
-        for (wi, wo, slot) in [(b, good(), "ωi"), (good(), b, "ωo")] {
-            r.expect_nothing(
-                &format!("{l} {slot}: eval_single_scattering"),
-                || s.eval_single_scattering(&gold, wi, wo),
-                zero,
-            );
-            r.expect_nothing(
-                &format!("{l} {slot}: pdf_single_scattering"),
-                || s.pdf_single_scattering(wi, wo),
-                zero32,
-            );
-        }
-        r.expect_nothing(
-            &format!("{l}: sample_single_scattering"),
-            || s.sample_single_scattering(&gold, b, 0.5, 0.5),
-            Option::is_none,
-        );
     }
     for u in BAD_UNIFORMS {
         let l = format!("{name} u = {u}");
         r.expect_nothing(&format!("{l}: sample_d_wi u1"), || s.sample_d_wi(good(), u, 0.5), nan_vec);
         r.expect_nothing(&format!("{l}: sample_d_wi u2"), || s.sample_d_wi(good(), 0.5, u), nan_vec);
+    }
+    check_noncentral_material(r, &format!("{name} gold"), &s, &Conductor::new(ComplexIor::GOLD));
+    check_noncentral_material(r, &format!("{name} glass"), &s, &Dielectric::new(1.5).unwrap());
+    check_noncentral_material(r, &format!("{name} diffuse"), &s, &Diffuse::white());
+}
+
+/// Single scattering of a material on a noncentral slope with bad directions.
+fn check_noncentral_material<S: MicrosurfaceSlope, M: NoncentralMaterial>(
+    r: &mut Report,
+    name: &str,
+    s: &Noncentral<S>,
+    material: &M,
+) {
+    for b in bad_directions() {
+        let l = format!("{name} ω = {b}");
+        for (wi, wo, slot) in [(b, good(), "ωi"), (good(), b, "ωo")] {
+            r.expect_nothing(
+                &format!("{l} {slot}: eval_single_scattering"),
+                || s.eval_single_scattering(material, wi, wo, &mut Pcg64Mcg::seed_from_u64(1)),
+                zero,
+            );
+            r.expect_nothing(
+                &format!("{l} {slot}: pdf_single_scattering"),
+                || s.pdf_single_scattering(material, wi, wo),
+                zero32,
+            );
+        }
         r.expect_nothing(
-            &format!("{l}: sample_single_scattering u1"),
-            || s.sample_single_scattering(&gold, good(), u, 0.5),
-            Option::is_none,
-        );
-        r.expect_nothing(
-            &format!("{l}: sample_single_scattering u2"),
-            || s.sample_single_scattering(&gold, good(), 0.5, u),
+            &format!("{l}: sample_single_scattering"),
+            || s.sample_single_scattering(material, b, &mut Pcg64Mcg::seed_from_u64(2)),
             Option::is_none,
         );
     }
+    // valid directions below the base plane: the model's 0 or the dielectric's inside view
+    let f = s.eval_single_scattering(material, good_below(), good(), &mut Pcg64Mcg::seed_from_u64(3));
+    r.expect_valid(&format!("{name}: eval from below"), || f, |f| f.is_finite());
 }
 
 fn check_height<H: MicrosurfaceHeight>(r: &mut Report, name: &str, h: H) {

@@ -364,3 +364,51 @@ fn anisotropic_round_trip() {
     assert!(worst < 0.15, "Λ off by {worst:.3e}");
     assert!((s.alpha_x() / t.alpha_x() - 1.0).abs() < 3e-2 && (s.alpha_y() / t.alpha_y() - 1.0).abs() < 3e-2);
 }
+
+/// The Fresnel extraction (Algorithm 2) on the 2D grid, the anisotropic path written once with
+/// the isotropic one (`extract_fresnel` takes any slope and averages over the half vector's
+/// azimuth for an anisotropic one). With the exact slope, the analytic anisotropic GGX
+/// (0.3, 0.6), the crate's single-scattering gold conductor on it gives back gold's Fresnel
+/// (red channel) within 1e-6 for θd up to 75° (measured 2e-8: the BRDF is that model's own
+/// D G F/(4 cos cos)): the configurations and the average are right.
+/// Then the round trip: the grid extracted from that BRDF (2 × 24 cells per axis, eight
+/// iterations), F(θd) from the same BRDF on the grid within 3 % (measured 2.2 %: the grid's D
+/// and Λ at this resolution; 8 % at 2 × 16 cells), and the eigenvalue F0 within 2 % of F(0)
+/// (measured 1.0 %).
+#[test]
+fn grid_fresnel_round_trip() {
+    use microsurface::tabulated::extract_anisotropic_fn;
+    let ggx = Ggx::new(0.3, 0.6).unwrap();
+    let gold = ComplexIor::new(Vec3::new(0.143, 0.374, 1.442), Vec3::new(3.983, 2.385, 1.603)).unwrap();
+    let surface = Microsurface::new(UniformHeight, ggx, Conductor::new(gold));
+    let brdf = |i: Vec3, o: Vec3| {
+        let mut g = validation::rng(0);
+        f64::from(surface.eval_single_scattering(i, o, &mut g).x) / f64::from(o.z)
+    };
+    let hc = BackscatterShadowing::HeightCorrelated;
+    let bins = 8;
+    let worst_error = |fresnel: &[Option<f64>], label: &str| {
+        let mut worst = 0.0f64;
+        for (b, f) in fresnel.iter().enumerate() {
+            let theta_d = (b as f64 + 0.5) * FRAC_PI_2 / bins as f64;
+            let exact = f64::from(fresnel_conductor(theta_d.cos() as f32, &gold).x);
+            let f = f.expect("valid configurations");
+            println!("{label}, θd = {:.1}°: F extracted {f:.5}, exact {exact:.5}", theta_d.to_degrees());
+            if theta_d < 75f64.to_radians() {
+                worst = worst.max((f / exact - 1.0).abs());
+            }
+        }
+        worst
+    };
+    let exact_slope = worst_error(&extract_fresnel(ggx, hc, bins, 16, 16, brdf), "analytic GGX (0.3, 0.6)");
+    assert!(exact_slope < 1e-6, "F(θd) on the exact slope off by {exact_slope:.3e}");
+    let e = extract_anisotropic_fn(0.3, 0.6, 24, 8, hc, |o| brdf(o, o)).unwrap();
+    let worst = worst_error(&extract_fresnel(&e.slope, hc, bins, 16, 16, brdf), "grid 2 × 24");
+    let f_normal = f64::from(fresnel_conductor(1.0, &gold).x);
+    println!(
+        "grid gold: F0 extracted {:.5}, exact {f_normal:.5}; worst F(θd) relative error {worst:.3e} (exact slope {exact_slope:.1e})",
+        e.f0
+    );
+    assert!((e.f0 / f_normal - 1.0).abs() < 2e-2, "F0 = {} vs {f_normal}", e.f0);
+    assert!(worst < 3e-2, "F(θd) off by {worst:.3e}");
+}

@@ -123,7 +123,7 @@ fn sampler_chi2() {
     validation::par_map(&cases, |k, &(theta, phi)| {
         let mut g = rng(0x9d + k as u64);
         let wi = dir(theta, phi);
-        chi2_test(
+        let out = chi2_test(
             &format!("grid θi = {theta}, φi = {phi}"),
             grid,
             |m| f64::from(s.d_wi(wi, m)),
@@ -131,6 +131,10 @@ fn sampler_chi2() {
             50_000,
             alpha,
             1.0,
+        );
+        println!(
+            "grid θi = {theta}, φi = {phi}: χ² = {:.1}, dof = {}, p = {:.3}",
+            out.statistic, out.dof, out.p_value
         );
     });
 }

@@ -3,6 +3,8 @@
 //! (`extraction`) and the MERL file format (`merl`).
 
 mod extraction;
+mod fuzz;
 mod grid;
 mod merl;
 mod tabulated;
+mod tail;

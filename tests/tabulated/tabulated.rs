@@ -271,6 +271,10 @@ fn sampler_chi2() {
             alpha,
             1.0,
         );
+        println!(
+            "tabulated {label} θi = {theta}: χ² = {:.1}, dof = {}, p = {:.3}",
+            out.statistic, out.dof, out.p_value
+        );
         assert!(out.failures == 0);
     });
     let t = &coarse;

@@ -11,7 +11,9 @@
 //! distribution at a Šidák-corrected significance chosen by the caller.
 
 use crate::check::rel_close;
-use crate::quadrature::{CrossMap, Domain, integrate, integrate_sphere, uv_of, visible_frame};
+use crate::quadrature::{
+    CrossMap, Domain, integrate, integrate_refined, integrate_sphere, uv_of, visible_frame,
+};
 use glam::Vec3;
 use microsurface::{Bsdf, BsdfSample, BsdfValue};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -31,12 +33,16 @@ pub struct Chi2Grid {
     pub quad_tol: f64,
     /// Maximum depth of the adaptive quadrature per cell.
     pub max_depth: u32,
+    /// Splits of every cell before the adaptive test (see
+    /// [`integrate_refined`](crate::quadrature::integrate_refined)): 0 except for densities
+    /// with a jump along a curve that the cells do not follow.
+    pub min_depth: u32,
 }
 
 impl Chi2Grid {
     /// The whole sphere, `nz` × `nphi` equal-area cells.
     pub fn sphere(nz: usize, nphi: usize) -> Self {
-        Self { pole: Vec3::Z, cap_cos: -1.0, nz, nphi, quad_tol: 1e-7, max_depth: 10 }
+        Self { pole: Vec3::Z, cap_cos: -1.0, nz, nphi, quad_tol: 1e-7, max_depth: 10, min_depth: 0 }
     }
 
     /// A cap of angular radius `radius` (radians) around `pole`, plus the rest of the sphere.
@@ -48,6 +54,7 @@ impl Chi2Grid {
             nphi,
             quad_tol: 1e-7,
             max_depth: 10,
+            min_depth: 0,
         }
     }
 }
@@ -114,8 +121,16 @@ pub fn chi2_test(
         for ip in 0..grid.nphi {
             let p0 = std::f64::consts::TAU * ip as f64 / grid.nphi as f64;
             let p1 = std::f64::consts::TAU * (ip + 1) as f64 / grid.nphi as f64;
-            expected[iz * grid.nphi + ip] =
-                integrate(&mut g, z0, z1, p0, p1, grid.quad_tol / cells as f64, grid.max_depth);
+            expected[iz * grid.nphi + ip] = integrate_refined(
+                &mut g,
+                z0,
+                z1,
+                p0,
+                p1,
+                grid.quad_tol / cells as f64,
+                grid.min_depth,
+                grid.max_depth,
+            );
         }
     }
     if grid.cap_cos > -1.0 {
@@ -127,7 +142,16 @@ pub fn chi2_test(
             for q in 0..4 {
                 let p0 = std::f64::consts::TAU * q as f64 / 4.0;
                 let p1 = std::f64::consts::TAU * (q + 1) as f64 / 4.0;
-                outside += integrate(&mut g, z0, z1, p0, p1, grid.quad_tol / 64.0, grid.max_depth);
+                outside += integrate_refined(
+                    &mut g,
+                    z0,
+                    z1,
+                    p0,
+                    p1,
+                    grid.quad_tol / 64.0,
+                    grid.min_depth,
+                    grid.max_depth,
+                );
             }
         }
         expected[cells] = outside;

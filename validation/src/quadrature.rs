@@ -38,37 +38,47 @@ pub fn integrate(
     abs_tol: f64,
     max_depth: u32,
 ) -> f64 {
-    let whole = gauss(f, z0, z1, p0, p1);
-    refine(f, z0, z1, p0, p1, whole, abs_tol, max_depth)
+    integrate_refined(f, z0, z1, p0, p1, abs_tol, 0, max_depth)
 }
 
+/// [`integrate`] with every cell split `min_depth` times before the adaptive test: for
+/// integrands with a jump along a curve (the horizon of a density's support, a cut by a
+/// plane), where a thin sliver of a cell can hold the nonzero side while every Gauss node of the
+/// cell and its four children falls on the zero side, so that parent and children agree on a
+/// wrong value. Forced splits shrink the widest sliver that can be missed by 2^`min_depth`.
 #[allow(clippy::too_many_arguments)]
-fn refine(
+pub fn integrate_refined(
     f: &mut impl FnMut(f64, f64) -> f64,
     z0: f64,
     z1: f64,
     p0: f64,
     p1: f64,
+    abs_tol: f64,
+    min_depth: u32,
+    max_depth: u32,
+) -> f64 {
+    let whole = gauss(f, z0, z1, p0, p1);
+    refine(f, [z0, z1, p0, p1], whole, abs_tol, min_depth, max_depth.max(min_depth))
+}
+
+fn refine(
+    f: &mut impl FnMut(f64, f64) -> f64,
+    [z0, z1, p0, p1]: [f64; 4],
     whole: f64,
     abs_tol: f64,
+    min_depth: u32,
     depth: u32,
 ) -> f64 {
     let (zm, pm) = (0.5 * (z0 + z1), 0.5 * (p0 + p1));
-    let parts = [
-        gauss(f, z0, zm, p0, pm),
-        gauss(f, zm, z1, p0, pm),
-        gauss(f, z0, zm, pm, p1),
-        gauss(f, zm, z1, pm, p1),
-    ];
+    let cells = [[z0, zm, p0, pm], [zm, z1, p0, pm], [z0, zm, pm, p1], [zm, z1, pm, p1]];
+    let parts = cells.map(|[a, b, c, d]| gauss(f, a, b, c, d));
     let sum: f64 = parts.iter().sum();
-    if depth == 0 || (sum - whole).abs() <= abs_tol {
+    if depth == 0 || (min_depth == 0 && (sum - whole).abs() <= abs_tol) {
         return sum;
     }
     let t = 0.25 * abs_tol;
-    refine(f, z0, zm, p0, pm, parts[0], t, depth - 1)
-        + refine(f, zm, z1, p0, pm, parts[1], t, depth - 1)
-        + refine(f, z0, zm, pm, p1, parts[2], t, depth - 1)
-        + refine(f, zm, z1, pm, p1, parts[3], t, depth - 1)
+    let min_depth = min_depth.saturating_sub(1);
+    cells.iter().zip(parts).map(|(cell, part)| refine(f, *cell, part, t, min_depth, depth - 1)).sum()
 }
 
 /// ∫∫ f over [u_lo, u_hi] × [−π/2, π/2] as the sum of an `nu` × `nv` grid of cells, each

@@ -12,8 +12,8 @@ pub(crate) use visible::{bounded_area_of, kappa_of, sample_cap_of};
 
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
-use visible::{bounded_area, sample_spherical_cap, sample_visible_hemisphere};
-pub(crate) use visible::{cap_bound, sample_bounded_cap};
+use visible::bounded_area;
+pub(crate) use visible::{cap_bound, sample_bounded_cap, sample_spherical_cap, sample_visible_hemisphere};
 
 /// 1/(4π), the constant of the reflection density D(ωh)/(4 A(ωi)).
 const FRAC_1_4PI: f32 = 0.25 * FRAC_1_PI;

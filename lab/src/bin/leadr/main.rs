@@ -3,16 +3,17 @@
 //! plane receding to the horizon.
 //!
 //! `cargo run --release -p lab --bin leadr [-- --quick] [--out DIR]` (default `target/leadr`).
-//! Writes `leadr.png`: top row supersampled | LEADR | naive; bottom row the MIP level used per
-//! pixel (black 0, white the coarsest) | 2 × |LEADR − reference| | 2 × |naive − reference|
-//! (tone-mapped values).
+//! Writes `leadr.png` (mirror facets), `leadr_glass.png` (glass, η = 1.5: the LEADR-filtered
+//! noncentral dielectric) and `leadr_diffuse.png` (Lambertian facets): top row supersampled |
+//! LEADR | naive; bottom row the MIP level used per pixel (black 0, white the coarsest) |
+//! 2 × |LEADR − reference| | 2 × |naive − reference| (tone-mapped values).
 
 mod render;
 
 use glam::DVec3;
-use microsurface::Beckmann;
 use microsurface::leadr::LeadrMap;
-use render::Scene;
+use microsurface::{Beckmann, Dielectric, Diffuse};
+use render::{Facets, Scene};
 use validation::leadr::surface::{NormalMip, direction, procedural_height_map};
 use validation::leadr::validate::{filter_errors, texel_lobe};
 
@@ -41,18 +42,33 @@ fn main() {
     let leadr = LeadrMap::from_height_map(&map, Beckmann::isotropic(alpha as f32).expect("a roughness"))
         .expect("a map");
     let (width, height) = if quick { (160, 100) } else { (320, 200) };
-    let scene = Scene {
-        leadr: &leadr,
-        normals: &normals,
-        alpha,
-        size,
-        tile: 0.5,
-        // low sun ahead of the camera: a glint on the receding plane
-        light: DVec3::new(0.0, 0.95, 0.3).normalize(),
-        width,
-        height,
-        max_samples: if quick { 8 } else { 24 },
-    };
+    let facets = [
+        ("leadr.png", "mirror", Facets::Mirror),
+        ("leadr_glass.png", "glass η 1.5", Facets::Glass(Dielectric::new(1.5).expect("a valid η"))),
+        ("leadr_diffuse.png", "diffuse", Facets::Diffuse(Diffuse::white())),
+    ];
+    for (file, name, facets) in facets {
+        let scene = Scene {
+            leadr: &leadr,
+            normals: &normals,
+            alpha,
+            size,
+            tile: 0.5,
+            // low sun ahead of the camera: a glint on the receding plane
+            light: DVec3::new(0.0, 0.95, 0.3).normalize(),
+            width,
+            height,
+            max_samples: if quick { 8 } else { 24 },
+            facets,
+        };
+        picture(&scene, &leadr, name, &out.join(file));
+    }
+}
+
+/// Renders `scene`, prints the per-band error of LEADR and the naive MIP against the
+/// supersampled reference and writes the panels to `path`.
+fn picture(scene: &Scene, leadr: &LeadrMap, name: &str, path: &std::path::Path) {
+    let (width, height, alpha) = (scene.width, scene.height, scene.alpha);
     let panels = scene.render();
     let [reference, leadr_img, naive_img] = &panels.images;
     // exposure: the reference's mean radiance maps to 1 − 1/e
@@ -61,7 +77,7 @@ fn main() {
     let exposure = lit.len() as f64 / lit.iter().sum::<f64>();
     let tone = |v: f64| 1.0 - (-exposure * v).exp();
     println!(
-        "\npicture ({width} × {height} per panel, α = {alpha}): error of the tone-mapped pixels against the supersampled reference"
+        "\npicture, {name} ({width} × {height} per panel, α = {alpha}): error of the tone-mapped pixels against the supersampled reference"
     );
     println!("{:<28} {:>12} {:>12}", "rows (distance)", "LEADR", "naive");
     let bands = [(0.15, 0.25, "far (up to the horizon)"), (0.25, 0.45, "middle"), (0.45, 1.0, "near")];
@@ -99,8 +115,7 @@ fn main() {
     put(0, 1, &|i| if panels.lod[i].is_nan() { 0.0 } else { panels.lod[i] / top });
     put(1, 1, &|i| 2.0 * (tone(leadr_img[i]) - tone(reference[i])).abs());
     put(2, 1, &|i| 2.0 * (tone(naive_img[i]) - tone(reference[i])).abs());
-    let path = out.join("leadr.png");
-    let file = std::io::BufWriter::new(std::fs::File::create(&path).expect("create the PNG"));
+    let file = std::io::BufWriter::new(std::fs::File::create(path).expect("create the PNG"));
     let mut encoder = png::Encoder::new(file, (3 * width) as u32, (2 * height) as u32);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);

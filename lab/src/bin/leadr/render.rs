@@ -1,11 +1,27 @@
 //! A displacement-mapped plane receding to the horizon, shaded three ways: supersampled fine
 //! texels (the ground truth LEADR approximates), LEADR (trilinear moments), and the naive
-//! normal-map MIP with the base roughness.
+//! normal-map MIP with the base roughness; with mirror, glass or diffuse facets.
 
 use glam::{DVec2, DVec3, Vec2};
 use microsurface::leadr::{LeadrLobe, LeadrMap};
+use microsurface::{Bsdf, Dielectric, Diffuse};
 use validation::leadr::surface::NormalMip;
 use validation::leadr::validate::{f_cos, texel_lobe};
+
+/// The material of the facets.
+#[derive(Debug, Clone, Copy)]
+pub enum Facets {
+    /// A perfect mirror (F = 1).
+    Mirror,
+    /// Glass (its reflection of the light; the transmitted light leaves below the plane).
+    Glass(Dielectric),
+    /// Lambertian facets (the stochastic single scattering, averaged over `DIFFUSE_KEYS`
+    /// estimates per shading point).
+    Diffuse(Diffuse),
+}
+
+/// Estimates averaged per shading point of diffuse facets.
+const DIFFUSE_KEYS: u64 = 8;
 
 /// The scene.
 pub struct Scene<'a> {
@@ -27,6 +43,8 @@ pub struct Scene<'a> {
     pub height: usize,
     /// Largest supersampling grid per axis.
     pub max_samples: usize,
+    /// The facets' material.
+    pub facets: Facets,
 }
 
 /// One shaded panel set.
@@ -68,7 +86,21 @@ impl Scene<'_> {
         if view.z <= 0.0 {
             return 0.0;
         }
-        f_cos(lobe, self.light, view) / view.z * self.light.z
+        match self.facets {
+            Facets::Mirror => f_cos(lobe, self.light, view) / view.z * self.light.z,
+            Facets::Glass(glass) => self.shade_bsdf(&lobe.bsdf(glass).expect("a finite lobe"), view, 1),
+            Facets::Diffuse(diffuse) => {
+                self.shade_bsdf(&lobe.bsdf(diffuse).expect("a finite lobe"), view, DIFFUSE_KEYS)
+            }
+        }
+    }
+
+    /// f(view, light) cos θl of a renderer BSDF, averaged over `keys` keyed estimates (exact
+    /// BSDFs ignore the key).
+    fn shade_bsdf(&self, bsdf: &impl Bsdf, view: DVec3, keys: u64) -> f64 {
+        let (wo, wi) = (view.as_vec3().normalize(), self.light.as_vec3().normalize());
+        let sum: f64 = (0..keys).map(|k| f64::from(bsdf.eval_keyed(wo, wi, k).f.x)).sum();
+        sum / keys as f64 * self.light.z
     }
 
     /// Texture coordinates of a plane point.

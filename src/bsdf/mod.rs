@@ -365,8 +365,8 @@ fn renormalize_drifted(w: Vec3) -> Option<Vec3> {
     LENGTH_SQ_RANGE.contains(&len_sq).then(|| w / len_sq.sqrt())
 }
 
-/// A direction already accepted by [`valid_direction`], renormalized if it drifted (for the
-/// wrappers that validate once and call the inner lobe's `*_valid` methods).
+/// A direction already accepted by the entry checks (`unit_directions!`), renormalized if it
+/// drifted (for the wrappers that validate once and call the inner lobe's `*_valid` methods).
 #[inline(always)]
 pub(crate) fn renormalized(w: Vec3) -> Vec3 {
     if is_direction(w) { w } else { renormalize_drifted(w).unwrap_or(w) }

@@ -107,6 +107,7 @@ pub struct DielectricLobes {
 
 impl DielectricLobes {
     /// The lobes of a Dirac lobe: none.
+    #[inline(always)]
     fn none(tables: &'static GlassTables, eta: f32) -> Self {
         Self {
             tables: Shared(tables),
@@ -233,6 +234,7 @@ fn side_of(wo: Vec3) -> usize {
 }
 
 /// The cumulated probabilities of four corners with bilinear weights (fr, fu) and masses m.
+#[inline(always)]
 fn corner_probabilities(fr: f32, fu: f32, m: [f32; 4]) -> Vec4 {
     let w = Vec4::new((1.0 - fr) * (1.0 - fu), fr * (1.0 - fu), (1.0 - fr) * fu, fr * fu) * Vec4::from(m);
     let total = w.element_sum();
@@ -282,12 +284,14 @@ impl CompensatedMaterial for Dielectric {
         lobes.alpha = alpha;
         lobes.one_plus_alpha = 1.0 + alpha;
         // the averages [ΔR̄, ΔT̄, Var(ΔT̄)] of each view side, blended in u
-        let averages = [0, 1].map(|view| {
+        let average = |view: usize| {
             let side = lobes.side(view);
             let (a, b) = (side.averages_at(l, row), side.averages_at(l + 1, row));
             let mean = a.lerp(b, fu);
             Vec4::new(mean.x, mean.y, (1.0 - fu) * (1.0 - fu) * a.z + fu * fu * b.z, 0.0)
-        });
+        };
+        // (not `array::map`, whose closures are not inlined)
+        let averages = [average(0), average(1)];
         // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in (n_out = 1, n_in = η)
         let (m_out, m_in) = (averages[0].y, eta * eta * averages[1].y);
         let c = if m_out > 0.0 && m_in > 0.0 {
@@ -314,7 +318,7 @@ impl CompensatedMaterial for Dielectric {
         for view in 0..2 {
             for cross in 0..2 {
                 let rows = &lobes.side(view ^ cross).rows;
-                let m = [n, n + 1, n + N, n + N + 1].map(|k| rows[k].masses[cross]);
+                let m = [rows[n].masses[cross], rows[n + 1].masses[cross], rows[n + N].masses[cross], rows[n + N + 1].masses[cross]];
                 lobes.corners[view][cross] = corner_probabilities(row.1, fu, m);
             }
         }
@@ -330,6 +334,7 @@ impl CompensatedMaterial for Dielectric {
 impl DielectricLobes {
     /// The transmission scales for `transport`: (η_wo/η_wi)² for radiance, from outside 1/η²
     /// and from inside η².
+    #[inline(always)]
     fn with_transport(mut self, transport: Transport) -> Self {
         let eta = self.transmitted_eta[0];
         let factors = match transport {

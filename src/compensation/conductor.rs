@@ -59,8 +59,6 @@ pub struct ConductorLobes {
     /// Whether the sampler mixes in the added lobe (an additive scheme with energy on a rough
     /// surface).
     mixing: bool,
-    /// C = 1 − E_avg of the interpolated E at this α.
-    complement_average: f32,
     /// F̄ = F_avg per channel (Kulla–Conty and the walk's orders).
     fresnel_average: Vec3,
     /// Kulla–Conty: F_ms/(π C); the walk's orders: 1/(π ḡ) per channel; Turquin: F0.
@@ -78,7 +76,6 @@ impl ConductorLobes {
             order_row: (0, 0.0),
             upper: 0.0,
             mixing: false,
-            complement_average: 0.0,
             fresnel_average: Vec3::ZERO,
             scale: Vec3::ZERO,
         }
@@ -212,46 +209,39 @@ impl CompensatedMaterial for Conductor {
         let alpha = single.surface().slope().albedo_alpha();
         let r = alpha.sqrt();
         let row = node_cell(r * LAST_R, ALBEDO_ROUGHNESSES);
-        let order_row = node_cell(r * LAST_O, ORDER_TABLE_SIZE);
+        let lobes = ConductorLobes { alpha, one_plus_alpha: 1.0 + alpha, row, ..ConductorLobes::none(tables) };
+        if scheme == Compensation::Turquin {
+            // the view's 1 − E and F0: nothing else (the averages are the queries')
+            return Ok(ConductorLobes { scale: conductor.fresnel(1.0), ..lobes });
+        }
         let [a, b] = tables.averages_at(row);
         let c = a.x;
-        let (fresnel, scale) = match scheme {
-            Compensation::Turquin => (Vec3::ZERO, conductor.fresnel(1.0)),
+        let f = conductor.ior().map_or(Vec3::ONE, fresnel_average);
+        let scale = match scheme {
+            // no energy lost (every node of the row is 1): nothing to restore
+            _ if c <= 0.0 => Vec3::ZERO,
+            Compensation::KullaConty => {
+                // F_ms/(π C), F_ms = F̄² E_avg/(1 − F̄ C) (the denominator is ≥ E_avg > 0)
+                f * f * (1.0 - c) / ((Vec3::ONE - f * c) * (PI * c))
+            }
+            // 1/(π ḡ), ḡ = Σ_k F̄ᵏ m_k (> 0 for F̄ > 0: m_2 > 0 wherever C > 0)
             _ => {
-                let f = conductor.ior().map_or(Vec3::ONE, fresnel_average);
-                let scale = match scheme {
-                    // no energy lost (every node of the row is 1): nothing to restore
-                    _ if c <= 0.0 => Vec3::ZERO,
-                    Compensation::KullaConty => {
-                        // F_ms/(π C), F_ms = F̄² E_avg/(1 − F̄ C) (the denominator is ≥ E_avg > 0)
-                        f * f * (1.0 - c) / ((Vec3::ONE - f * c) * (PI * c))
-                    }
-                    // 1/(π ḡ), ḡ = Σ_k F̄ᵏ m_k (> 0 for F̄ > 0: m_2 > 0 wherever C > 0)
-                    _ => {
-                        let average = series(f, Vec4::new(a.y, a.z, a.w, b.x), Vec4::new(b.y, b.z, 0.0, 0.0));
-                        Vec3::select(average.cmpgt(Vec3::ZERO), (PI * average).recip(), Vec3::ZERO)
-                    }
-                };
-                (f, scale)
+                let average = series(f, Vec4::new(a.y, a.z, a.w, b.x), Vec4::new(b.y, b.z, 0.0, 0.0));
+                Vec3::select(average.cmpgt(Vec3::ZERO), (PI * average).recip(), Vec3::ZERO)
             }
         };
         // the profile mixture of the two rows, by blend weight × mass
         let rows = &tables.rows;
-        let (j, f) = row;
-        let (lower, upper) = ((1.0 - f) * rows[j].mass, f * rows[j + 1].mass);
+        let (j, fr) = row;
+        let (lower, upper) = ((1.0 - fr) * rows[j].mass, fr * rows[j + 1].mass);
         let total = lower + upper;
-        let mixing = scheme != Compensation::Turquin && c > 0.0 && total > 0.0;
         Ok(ConductorLobes {
-            tables: Shared(tables),
-            alpha,
-            one_plus_alpha: 1.0 + alpha,
-            row,
-            order_row,
+            order_row: node_cell(r * LAST_O, ORDER_TABLE_SIZE),
             upper: if total > 0.0 { upper / total } else { 0.0 },
-            mixing,
-            complement_average: c,
-            fresnel_average: fresnel,
+            mixing: c > 0.0 && total > 0.0,
+            fresnel_average: f,
             scale,
+            ..lobes
         })
     }
 
@@ -289,7 +279,12 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// E_avg = 2∫₀¹ E(μ) μ dμ of the interpolated E (its closed form, tabulated at sub-steps
     /// of the roughness cells: relative error of 1 − E_avg below 4e-4 at α ≥ 1e-3).
     pub fn average_albedo(&self) -> f32 {
-        1.0 - self.lobes.complement_average
+        1.0 - self.complement_average()
+    }
+
+    /// C = 1 − E_avg of the interpolated E at this α (0 for a Dirac mirror).
+    fn complement_average(&self) -> f32 {
+        if self.single.is_specular() { 0.0 } else { self.lobes.tables.0.complement_average(self.lobes.row) }
     }
 
     /// The albedo ∫ f_ms cos θi dωi of the additive lobe for a view at cos θo = μ, per RGB
@@ -327,7 +322,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// F = 1).
     pub fn fresnel_multiple_scattering(&self) -> Vec3 {
         let f = self.fresnel_average();
-        let c = self.lobes.complement_average;
+        let c = self.complement_average();
         f * f * (1.0 - c) / (Vec3::ONE - f * c)
     }
 

@@ -173,6 +173,13 @@ impl ConductorTables {
         [a[0].lerp(b[0], w), a[1].lerp(b[1], w)]
     }
 
+    /// C = 1 − E_avg at the roughness cell `(j, f)` of the albedo table: the first of
+    /// [`Self::averages_at`].
+    #[inline(always)]
+    pub(crate) fn complement_average(&self, row: (usize, f32)) -> f32 {
+        self.averages_at(row)[0].x
+    }
+
     /// 1 − E at the direction cell `(i, fx)` of the roughness cell `(j, fr)`, bilinear.
     #[inline(always)]
     pub(crate) fn complement_at(&self, (i, fx): (usize, f32), (j, fr): (usize, f32)) -> f32 {

@@ -11,19 +11,24 @@
 //! across iterations; the trait calls seed their own generators from the hash of their
 //! arguments (that cost is part of what is measured) and take the counter as key.
 //!
+//! Per hit (`per_hit` group): construction from per-hit parameters (roughness, complex index or
+//! relative index varying per call) plus `sample` and `eval_with_pdf`, against the same two
+//! calls on a BSDF built once, for every renderer type, static and dynamic dispatch.
+//!
 //! Benchmark ids: `{material}/{technique}/{eval|pdf|sample}/{research|static|dyn}`,
 //! `{material}/{walk|pt|bdpt}/sample/research+pdf` (the research sample and the density of its
 //! direction, what the trait's sample computes),
 //! `{material}/single/eval_with_pdf/{research|static|dyn}` (the research call is
-//! `SingleScattering::eval_with_pdf`; its `sample` returns the density too), and
-//! `gold/single/sample-vs-vndf/{sample_d_wi|bounded_cap|static}`.
+//! `SingleScattering::eval_with_pdf`; its `sample` returns the density too),
+//! `gold/single/sample-vs-vndf/{sample_d_wi|bounded_cap|static}`, and
+//! `per_hit/{material} {technique}/{prebuilt|per-hit} {static|dyn}`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use microsurface::glam::Vec3;
 use microsurface::research::{Estimator, Material, Microsurface, Shadowing, SpecularLimit, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
-    KullaContyDielectric, MicrofacetBsdf, Technique,
+    Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique,
 };
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -213,18 +218,18 @@ fn sample_vs_vndf(c: &mut Criterion<Clock>) {
     g.finish();
 }
 
-/// The energy-compensated gold (`CompensatedConductor`, Kulla–Conty, Turquin, per-order) against the
-/// single-scattering gold it is built on, static dispatch (the target: at most 1.3× its cost).
-/// Ids `gold/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin|per-order}`.
+/// The energy-compensated gold (`Compensated`: Kulla–Conty, Turquin, the walk's orders) against
+/// the single-scattering gold it is built on, static dispatch. Ids
+/// `gold/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin|walk}`.
 fn compensated(c: &mut Criterion<Clock>) {
     let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
     let gold = Conductor::new(ComplexIor::GOLD);
     let single = MicrofacetBsdf::new(slope, gold)
         .expect("α ≤ MAX_WALK_ALPHA")
         .with_technique(Technique::SingleScattering);
-    let kc = CompensatedConductor::new(slope, gold, Compensation::KullaConty).expect("α ≤ 1");
-    let turquin = CompensatedConductor::new(slope, gold, Compensation::Turquin).expect("α ≤ 1");
-    let per_order = CompensatedConductor::new(slope, gold, Compensation::PerOrder).expect("α ≤ 1");
+    let kc = Compensated::with_scheme(slope, gold, Compensation::KullaConty).expect("α ≤ 1");
+    let turquin = Compensated::with_scheme(slope, gold, Compensation::Turquin).expect("α ≤ 1");
+    let per_order = Compensated::with_scheme(slope, gold, Compensation::Walk).expect("α ≤ 1");
     let x = inputs(false, 300);
     macro_rules! bench {
         ($g:expr, $name:expr, $model:expr, $call:ident) => {
@@ -244,34 +249,35 @@ fn compensated(c: &mut Criterion<Clock>) {
     bench!(g, "single", &single, eval);
     bench!(g, "kulla-conty", &kc, eval);
     bench!(g, "turquin", &turquin, eval);
-    bench!(g, "per-order", &per_order, eval);
+    bench!(g, "walk", &per_order, eval);
     g.finish();
     let mut g = c.benchmark_group("gold/compensated/pdf");
     bench!(g, "single", &single, pdf);
     bench!(g, "kulla-conty", &kc, pdf);
     bench!(g, "turquin", &turquin, pdf);
-    bench!(g, "per-order", &per_order, pdf);
+    bench!(g, "walk", &per_order, pdf);
     g.finish();
     let mut g = c.benchmark_group("gold/compensated/sample");
     bench!(g, "single", &single, sample);
     bench!(g, "kulla-conty", &kc, sample);
     bench!(g, "turquin", &turquin, sample);
-    bench!(g, "per-order", &per_order, sample);
+    bench!(g, "walk", &per_order, sample);
     g.finish();
 }
 
-/// The energy-compensated glass (η = 1.5: `KullaContyDielectric`, the walk's higher orders as
-/// reflection and transmission lobes, and Turquin's `CompensatedDielectric`) against the
-/// single-scattering glass, static dispatch, views above the surface and light directions on
-/// the whole sphere. Ids `glass/compensated/{eval|pdf|sample}/{single|kulla-conty|turquin}`.
+/// The energy-compensated glass (η = 1.5, `Compensated`: the walk's higher orders as reflection
+/// and transmission lobes, and Turquin's scaling) against the single-scattering glass, static
+/// dispatch, views above the surface and light directions on the whole sphere. Ids
+/// `glass/compensated/{eval|pdf|sample}/{single|walk|turquin}`.
 fn compensated_glass(c: &mut Criterion<Clock>) {
     let slope = Ggx::isotropic(ALPHA).expect("valid roughness");
     let glass = Dielectric::new(1.5).expect("valid index");
     let single = MicrofacetBsdf::new(slope, glass)
         .expect("α ≤ MAX_WALK_ALPHA")
         .with_technique(Technique::SingleScattering);
-    let kc = KullaContyDielectric::new(slope, glass).expect("in the tables' range");
-    let turquin = CompensatedDielectric::new(slope, glass).expect("in the tables' range");
+    let kc = Compensated::new(slope, glass).expect("in the tables' range");
+    let turquin =
+        Compensated::with_scheme(slope, glass, Compensation::Turquin).expect("in the tables' range");
     let x = inputs(true, 310);
     macro_rules! bench {
         ($g:expr, $name:expr, $model:expr, $call:ident) => {
@@ -289,22 +295,152 @@ fn compensated_glass(c: &mut Criterion<Clock>) {
     }
     let mut g = c.benchmark_group("glass/compensated/eval");
     bench!(g, "single", &single, eval);
-    bench!(g, "kulla-conty", &kc, eval);
+    bench!(g, "walk", &kc, eval);
     bench!(g, "turquin", &turquin, eval);
     g.finish();
     let mut g = c.benchmark_group("glass/compensated/pdf");
     bench!(g, "single", &single, pdf);
-    bench!(g, "kulla-conty", &kc, pdf);
+    bench!(g, "walk", &kc, pdf);
     bench!(g, "turquin", &turquin, pdf);
     g.finish();
     let mut g = c.benchmark_group("glass/compensated/sample");
     bench!(g, "single", &single, sample);
-    bench!(g, "kulla-conty", &kc, sample);
+    bench!(g, "walk", &kc, sample);
     bench!(g, "turquin", &turquin, sample);
     g.finish();
 }
 
+/// The per-hit parameters: roughness α ∈ [0.05, 1], a conductor index between gold and copper,
+/// a relative index η ∈ [1.2, 2.2], `N` of each from a fixed seed.
+struct HitParameters {
+    alpha: Vec<f32>,
+    ior: Vec<(Vec3, Vec3)>,
+    eta: Vec<f32>,
+}
+
+fn hit_parameters(seed: u64) -> HitParameters {
+    use rand::RngExt;
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let (gold, copper) = (ComplexIor::GOLD, ComplexIor::COPPER);
+    let mut alpha = Vec::with_capacity(N);
+    let mut ior = Vec::with_capacity(N);
+    let mut eta = Vec::with_capacity(N);
+    for _ in 0..N {
+        alpha.push(0.05 + 0.95 * rng.random::<f32>());
+        let t: f32 = rng.random();
+        ior.push((gold.eta().lerp(copper.eta(), t), gold.k().lerp(copper.k(), t)));
+        eta.push(1.2 + rng.random::<f32>());
+    }
+    HitParameters { alpha, ior, eta }
+}
+
+/// `sample` + `eval_with_pdf` at input k (the light direction of the eval is the sample's, or
+/// the input's where the sample fails).
+#[inline(always)]
+fn calls(b: &dyn Bsdf, x: &validation::inputs::Inputs, k: usize, i: usize) -> f32 {
+    let wo = black_box(x.wo[k]);
+    let s = b.sample(wo, black_box(x.uc[k]), black_box(x.u[k]));
+    let wi = s.map_or(x.wi[k], |s| s.wi);
+    let (f, pdf) = b.eval_with_pdf_keyed(wo, wi, i as u64);
+    f.f.x + pdf + s.map_or(0.0, |s| s.pdf)
+}
+
+/// [`calls`] with static dispatch.
+#[inline(always)]
+fn calls_static<B: Bsdf>(b: &B, x: &validation::inputs::Inputs, k: usize, i: usize) -> f32 {
+    let wo = black_box(x.wo[k]);
+    let s = b.sample(wo, black_box(x.uc[k]), black_box(x.u[k]));
+    let wi = s.map_or(x.wi[k], |s| s.wi);
+    let (f, pdf) = b.eval_with_pdf_keyed(wo, wi, i as u64);
+    f.f.x + pdf + s.map_or(0.0, |s| s.pdf)
+}
+
+/// One renderer type per hit: `prebuilt` (the two calls on the BSDF of the hit's parameters,
+/// built ahead of time: one per input) and `per-hit` (`build` from the hit's parameters, then
+/// the two calls), static and `dyn`. The difference of the two is the construction alone.
+fn per_hit_case<B: Bsdf + 'static>(
+    c: &mut Criterion<Clock>,
+    name: &str,
+    build: impl Fn(usize) -> B,
+    x: &validation::inputs::Inputs,
+) {
+    let prebuilt: Vec<B> = (0..N).map(&build).collect();
+    let mut g = c.benchmark_group(format!("per_hit/{name}"));
+    g.bench_function("prebuilt static", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            calls_static(black_box(&prebuilt[k]), x, k, i)
+        })
+    });
+    g.bench_function("per-hit static", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            let bsdf = build(k);
+            calls_static(&bsdf, x, k, i)
+        })
+    });
+    g.bench_function("prebuilt dyn", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            let d: &dyn Bsdf = &prebuilt[k];
+            calls(black_box(d), x, k, i)
+        })
+    });
+    g.bench_function("per-hit dyn", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            let k = next(&mut i);
+            let bsdf = build(k);
+            calls(black_box(&bsdf as &dyn Bsdf), x, k, i)
+        })
+    });
+    g.finish();
+}
+
+/// Every renderer type built per hit (`per_hit/…`): single scattering, the random walk and the
+/// position-free PT and BDPT, and every compensated scheme (a dielectric's Kulla–Conty is its
+/// walk split), gold-to-copper conductors and glass of η ∈ [1.2, 2.2], GGX α ∈ [0.05, 1]; the
+/// prebuilt BSDFs have the same parameters per input.
+fn per_hit(c: &mut Criterion<Clock>) {
+    let p = hit_parameters(400);
+    let slope = |k: usize| Ggx::isotropic(black_box(p.alpha[k])).expect("α in (0, 1]");
+    let conductor = |k: usize| {
+        let (eta, kappa) = black_box(p.ior[k]);
+        Conductor::new(ComplexIor::new(eta, kappa).expect("a metal's index"))
+    };
+    let glass = |k: usize| Dielectric::new(black_box(p.eta[k])).expect("η > 0");
+    let (xg, xd) = (inputs(false, 410), inputs(true, 420));
+    for (tname, technique) in TECHNIQUES {
+        let build =
+            |k: usize| MicrofacetBsdf::new(slope(k), conductor(k)).expect("α ≤ 10").with_technique(technique);
+        per_hit_case(c, &format!("gold {tname}"), build, &xg);
+    }
+    for (tname, technique) in &TECHNIQUES[..2] {
+        let technique = *technique;
+        let build =
+            |k: usize| MicrofacetBsdf::new(slope(k), glass(k)).expect("α ≤ 10").with_technique(technique);
+        per_hit_case(c, &format!("glass {tname}"), build, &xd);
+    }
+    for (sname, scheme) in [
+        ("walk", Compensation::Walk),
+        ("kulla-conty", Compensation::KullaConty),
+        ("turquin", Compensation::Turquin),
+    ] {
+        let build = |k: usize| Compensated::with_scheme(slope(k), conductor(k), scheme).expect("α ≤ 1");
+        per_hit_case(c, &format!("gold compensated {sname}"), build, &xg);
+    }
+    for (sname, scheme) in [("walk", Compensation::Walk), ("turquin", Compensation::Turquin)] {
+        let build =
+            |k: usize| Compensated::with_scheme(slope(k), glass(k), scheme).expect("in the tables' range");
+        per_hit_case(c, &format!("glass compensated {sname}"), build, &xd);
+    }
+}
+
 fn bsdfs(c: &mut Criterion<Clock>) {
+    per_hit(c);
     compensated(c);
     compensated_glass(c);
     sample_vs_vndf(c);

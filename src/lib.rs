@@ -12,7 +12,7 @@
 //! | you want | start at |
 //! |---|---|
 //! | a BSDF in a renderer | [`Bsdf`], [`MicrofacetBsdf`], [`ShadingFrame`] (this page) |
-//! | energy-conserving lobes at single-scattering cost | [`CompensatedConductor`], [`KullaContyDielectric`], [`compensation`] |
+//! | energy-conserving lobes at single-scattering cost | [`Compensated`], [`Compensation`], [`compensation`] |
 //! | the papers' models for references and experiments | [`research`] |
 //! | slope distributions and visible normals | [`slope`], [`vndf`] |
 //! | measured materials, data-driven slopes | [`tabulated`] (feature `data-driven`) |
@@ -165,7 +165,7 @@ pub use bsdf::{
 };
 #[cfg(feature = "mint")]
 pub use bsdf::{MintBsdf, MintSample};
-pub use compensation::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
+pub use compensation::{Compensated, Compensation};
 pub use contract::DIRECTION_TOLERANCE;
 pub use error::Error;
 pub use fresnel::ComplexIor;

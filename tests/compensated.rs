@@ -1,16 +1,15 @@
-//! Energy-compensated conductors (`CompensatedConductor`): the sampler against its density
+//! Energy-compensated conductors and dielectrics (`Compensated`): the sampler against its density
 //! (chi-square), the sample weights against eval·cos/pdf, the white furnace (F = 1) within the
 //! albedo tables' interpolation error, the normalization of the Kulla–Conty lobe, its
 //! reciprocity, and the constructor's range.
 
 use microsurface::compensation::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, AlbedoTabulated, LAST_TABULATED_ORDER, ORDER_TABLES,
+    ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, AlbedoTabulated, ORDER_TABLE_SIZE, ORDER_TABLES,
 };
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::research::Side;
 use microsurface::{
-    Beckmann, Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor,
-    Dielectric, Ggx, Transport,
+    Beckmann, Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, Transport,
 };
 use validation::check::{assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw};
 use validation::chi2::{BsdfChi2, sampler_chi2};
@@ -47,14 +46,14 @@ fn chi2_cases() -> Vec<(String, Box<dyn Bsdf>, f64)> {
     for (a, theta, scheme) in [(0.3f32, 0.5f64, kc), (1.0, 1.3, Compensation::Turquin)] {
         v.push((
             format!("{scheme:?} GGX gold α = {a} θo = {theta}"),
-            Box::new(CompensatedConductor::new(ggx(a), gold(), scheme).unwrap()),
+            Box::new(Compensated::with_scheme(ggx(a), gold(), scheme).unwrap()),
             theta,
         ));
     }
     for (a, theta) in [(0.08f32, 1.4f64), (1.0, 0.3)] {
         v.push((
             format!("KullaConty Beckmann gold α = {a} θo = {theta}"),
-            Box::new(CompensatedConductor::new(beckmann(a), gold(), kc).unwrap()),
+            Box::new(Compensated::with_scheme(beckmann(a), gold(), kc).unwrap()),
             theta,
         ));
     }
@@ -62,20 +61,20 @@ fn chi2_cases() -> Vec<(String, Box<dyn Bsdf>, f64)> {
     let copper = Conductor::new(ComplexIor::COPPER);
     let aluminium = Conductor::new(ComplexIor::ALUMINIUM);
     v.push((
-        "PerOrder GGX copper α = 0.8 θo = 0.7".into(),
-        Box::new(CompensatedConductor::new(ggx(0.8), copper, Compensation::PerOrder).unwrap()),
+        "Walk GGX copper α = 0.8 θo = 0.7".into(),
+        Box::new(Compensated::with_scheme(ggx(0.8), copper, Compensation::Walk).unwrap()),
         0.7,
     ));
     v.push((
-        "PerOrder Beckmann aluminium α = 0.4 θo = 1.2".into(),
-        Box::new(CompensatedConductor::new(beckmann(0.4), aluminium, Compensation::PerOrder).unwrap()),
+        "Walk Beckmann aluminium α = 0.4 θo = 1.2".into(),
+        Box::new(Compensated::with_scheme(beckmann(0.4), aluminium, Compensation::Walk).unwrap()),
         1.2,
     ));
     // anisotropic slopes (the tables at √(αx αy)): the sampler is still exact
     v.push((
         "KullaConty GGX gold αx = 0.2, αy = 0.8".into(),
         Box::new(
-            CompensatedConductor::new(Ggx::new(0.2, 0.8).unwrap(), gold(), Compensation::KullaConty).unwrap(),
+            Compensated::with_scheme(Ggx::new(0.2, 0.8).unwrap(), gold(), Compensation::KullaConty).unwrap(),
         ),
         0.9,
     ));
@@ -127,9 +126,9 @@ fn white_furnace_within_table_error() {
     ) {
         let alpha = slope.alpha_x();
         for scheme in [Compensation::KullaConty, Compensation::Turquin] {
-            let b = CompensatedConductor::new(slope, Conductor::perfect(), scheme).unwrap();
+            let b = Compensated::with_scheme(slope, Conductor::perfect(), scheme).unwrap();
             let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-            let mut rng = validation::rng(seed + scheme as u64);
+            let mut rng = validation::rng(seed + u64::from(scheme == Compensation::Turquin));
             let mut stats = Stats::default();
             for _ in 0..n {
                 stats.push(draw(&b, wo, &mut rng).map_or(0.0, |s| f64::from(s.weight.x)));
@@ -137,7 +136,7 @@ fn white_furnace_within_table_error() {
             let e_table = f64::from(table.directional(mu, alpha).unwrap());
             let tol = match scheme {
                 // (the per-order lobe is Kulla–Conty's for F = 1: `per_order_is_kulla_conty_for_f1`)
-                Compensation::KullaConty | Compensation::PerOrder => eps,
+                Compensation::KullaConty | Compensation::Walk => eps,
                 Compensation::Turquin => eps / e_table,
             };
             let label = format!("white furnace {} {scheme:?} α = {alpha} μo = {mu}", table.name());
@@ -166,7 +165,7 @@ fn white_furnace_within_table_error() {
 fn kulla_conty_lobe_is_normalized() {
     for (a, mu) in [(0.1f32, 0.3f32), (0.5, 0.8), (1.0, 0.05), (1.0, 1.0)] {
         for (name, conductor) in [("gold", gold()), ("F = 1", Conductor::perfect())] {
-            let b = CompensatedConductor::new(ggx(a), conductor, Compensation::KullaConty).unwrap();
+            let b = Compensated::with_scheme(ggx(a), conductor, Compensation::KullaConty).unwrap();
             let ss = *b.single_scattering();
             let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
             // the channels' sum (each channel's F_ms comes from the same formula)
@@ -192,13 +191,12 @@ fn kulla_conty_lobe_is_normalized() {
     }
 }
 
-/// The per-order lobe's albedo at a node (μ at x = i/31, α at r = j/31, where the
-/// constructor's interpolation is exact) is the documented model
-/// g = (1 − E) Σ_k e_k F̄^k/Σ_k e_k (tail: e_6 F̄⁶ ρF̄/(1 − ρF̄), ρ = e_tail/(e_6 + e_tail)),
-/// computed here from the raw nodes of the tables (relative 1e-4: the f32 round trip of μ), and
-/// the lobe f_ms = f − f_ss integrates to it (adaptive quadrature of the channels weighted
-/// 1, 2, 4; 2e-5 relative + 1e-6),
-/// for gold and aluminium, GGX and Beckmann.
+/// The per-order lobe's albedo at a node of the order tables (μ at x = i/31, α at r = j/31,
+/// also a node of the albedo table, where the lobe's interpolation is exact) is the documented
+/// model g = (1 − E) Σ_k e_k F̄^k/Σ_k e_k (the orders above 6 placed at order 7), computed here
+/// from the raw nodes of the tables (relative 1e-4: the f32 round trip of μ), and the lobe
+/// f_ms = f − f_ss integrates to it (adaptive quadrature of the channels weighted 1, 2, 4;
+/// 2e-5 relative + 1e-6), for gold and aluminium, GGX and Beckmann.
 #[test]
 fn per_order_lobe_has_the_model_albedo() {
     fn run<S: AlbedoTabulated>(
@@ -206,7 +204,9 @@ fn per_order_lobe_has_the_model_albedo() {
         table: AlbedoTable,
         orders: microsurface::compensation::ScatteringOrderTable,
     ) {
-        let n = ALBEDO_TABLE_SIZE;
+        let n = ORDER_TABLE_SIZE;
+        // the albedo table's node of an order node: x = i/31 = (i·93/31)/93, r = j/31 = (j·62/31)/62
+        let (sx, sr) = ((ALBEDO_DIRECTIONS - 1) / (n - 1), (ALBEDO_ROUGHNESSES - 1) / (n - 1));
         for (name, conductor) in [("gold", gold()), ("aluminium", Conductor::new(ComplexIor::ALUMINIUM))] {
             for (i, j) in [(8usize, 31usize), (20, 17), (29, 25), (31, 10)] {
                 let r = j as f64 / (n - 1) as f64;
@@ -217,25 +217,18 @@ fn per_order_lobe_has_the_model_albedo() {
                 } else {
                     (x2 * f64::from(alpha) / (1.0 + f64::from(alpha) - x2)) as f32
                 };
-                let b =
-                    CompensatedConductor::new(slope_of(alpha), conductor, Compensation::PerOrder).unwrap();
+                let b = Compensated::with_scheme(slope_of(alpha), conductor, Compensation::Walk).unwrap();
                 let got = b.multiple_scattering_albedo(mu).unwrap();
                 let node = j * n + i;
                 let e: Vec<f64> =
                     (0..ORDER_TABLES).map(|t| f64::from(orders.directional_nodes(t)[node])).collect();
                 let total: f64 = e.iter().sum();
-                let c = 1.0 - f64::from(table.directional_nodes()[node]);
+                let c = 1.0 - f64::from(table.directional_nodes()[j * sr * ALBEDO_DIRECTIONS + i * sx]);
                 let f_avg = b.fresnel_average();
                 for ch in 0..3 {
                     let fb = f64::from(f_avg[ch]);
-                    let mut w: f64 = (0..ORDER_TABLES - 1).map(|t| e[t] * fb.powi(t as i32 + 2)).sum();
-                    let (last, tail) = (e[ORDER_TABLES - 2], e[ORDER_TABLES - 1]);
-                    if last > 0.0 {
-                        let rho = tail / (last + tail);
-                        w += last * fb.powi(LAST_TABULATED_ORDER as i32) * rho * fb / (1.0 - rho * fb);
-                    } else {
-                        w += tail * fb.powi(LAST_TABULATED_ORDER as i32 + 1);
-                    }
+                    // orders 2 … 6, and the tail at order 7
+                    let w: f64 = (0..ORDER_TABLES).map(|t| e[t] * fb.powi(t as i32 + 2)).sum();
                     let expected = if total > 0.0 { c * w / total } else { c * fb * fb };
                     let g = f64::from(got[ch]);
                     assert!(
@@ -271,20 +264,19 @@ fn per_order_lobe_has_the_model_albedo() {
 
 /// For F = 1 (F̄ = 1) the per-order lobe is the Kulla–Conty lobe: the same f to relative 1e-5
 /// (their arithmetic differs in rounding only), on random pairs at every roughness row of the
-/// order tables (α = (j/31)², where the lobe is built from one row alone, so that a node the
-/// walk recorded as e₆ = 0 with a tail > 0 is met as it is) and between rows, GGX and
-/// Beckmann.
+/// albedo table (α = (j/62)², every second one a row of the order tables, where the lobe is
+/// built from one row alone, so that a node the walk recorded as e₆ = 0 with a tail > 0 is met
+/// as it is) and between rows, GGX and Beckmann.
 #[test]
 fn per_order_is_kulla_conty_for_f1() {
     fn run<S: AlbedoTabulated>(name: &str, slope_of: impl Fn(f32) -> S, seed: u64) {
         let mut rng = validation::rng(seed);
-        let last = (ALBEDO_TABLE_SIZE - 1) as f32;
-        let rows = (1..ALBEDO_TABLE_SIZE).map(|j| (j as f32 / last).powi(2));
+        let last = (ALBEDO_ROUGHNESSES - 1) as f32;
+        let rows = (1..ALBEDO_ROUGHNESSES).map(|j| (j as f32 / last).powi(2));
         for a in rows.chain([0.05f32, 0.3]) {
-            let kc = CompensatedConductor::new(slope_of(a), Conductor::perfect(), Compensation::KullaConty)
+            let kc = Compensated::with_scheme(slope_of(a), Conductor::perfect(), Compensation::KullaConty)
                 .unwrap();
-            let po =
-                CompensatedConductor::new(slope_of(a), Conductor::perfect(), Compensation::PerOrder).unwrap();
+            let po = Compensated::with_scheme(slope_of(a), Conductor::perfect(), Compensation::Walk).unwrap();
             for _ in 0..100 {
                 let mut d = || {
                     let z = uniform32(&mut rng);
@@ -305,15 +297,15 @@ fn per_order_is_kulla_conty_for_f1() {
 }
 
 /// No non-finite value from any compensated conductor on a roughness scan: every row of the
-/// tables, α = (j/31)², where a lobe is built from one row's nodes alone, and 64 roughnesses
-/// between and across them; five metals (F = 1 among them), all three schemes, GGX and
-/// Beckmann, 40 random pairs each. (The per-order lobe of F = 1 was NaN over three bands of
-/// α with the regenerated GGX order table: DESIGN.md, “Per-order conductor tables”.)
+/// albedo table, α = (j/62)², where a lobe is built from one row's nodes alone, and 64
+/// roughnesses between and across them; five metals (F = 1 among them), all three schemes, GGX
+/// and Beckmann, 40 random pairs each (a node of the order tables with e₆ = 0 and a tail once
+/// made the per-order lobe of F = 1 NaN: DESIGN.md, “Per-order conductor tables”).
 #[test]
 fn every_compensated_conductor_is_finite_on_a_roughness_scan() {
     let mut rng = validation::rng(1852);
-    let last = (ALBEDO_TABLE_SIZE - 1) as f32;
-    let alphas: Vec<f32> = (1..ALBEDO_TABLE_SIZE)
+    let last = (ALBEDO_ROUGHNESSES - 1) as f32;
+    let alphas: Vec<f32> = (1..ALBEDO_ROUGHNESSES)
         .map(|j| (j as f32 / last).powi(2))
         .chain((1..=64).map(|k| (k as f32 / 64.0).powi(2)))
         .collect();
@@ -326,23 +318,24 @@ fn every_compensated_conductor_is_finite_on_a_roughness_scan() {
     ];
     for &a in &alphas {
         for (name, c) in metals {
-            for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
-                let b = CompensatedConductor::new(ggx(a), c, scheme).unwrap();
+            for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::Walk] {
+                let b = Compensated::with_scheme(ggx(a), c, scheme).unwrap();
                 assert_finite_on_sphere(&b, 40, &mut rng, &format!("GGX {name} {scheme:?} α = {a}"));
-                let b = CompensatedConductor::new(beckmann(a), c, scheme).unwrap();
+                let b = Compensated::with_scheme(beckmann(a), c, scheme).unwrap();
                 assert_finite_on_sphere(&b, 40, &mut rng, &format!("Beckmann {name} {scheme:?} α = {a}"));
             }
         }
     }
 }
 
-/// F_avg by the constructor's 4 panels of Gauss–Legendre equals a 2000-panel midpoint rule to
-/// 1e-6 for the metal presets.
+/// F_avg from its table over the complex index equals a 20 000-step midpoint rule to 1e-6 for
+/// the metal presets (the table's stated error; `fresnel_average.rs` measures it against a
+/// 1024-point quadrature over the whole index plane).
 #[test]
 fn fresnel_average_is_accurate() {
     for ior in [ComplexIor::GOLD, ComplexIor::COPPER, ComplexIor::ALUMINIUM, ComplexIor::SILVER] {
         let c = Conductor::new(ior);
-        let b = CompensatedConductor::new(ggx(0.5), c, Compensation::KullaConty).unwrap();
+        let b = Compensated::with_scheme(ggx(0.5), c, Compensation::KullaConty).unwrap();
         let n = 20_000;
         let mut reference = [0.0f64; 3];
         for k in 0..n {
@@ -367,11 +360,10 @@ fn fresnel_average_is_accurate() {
 #[test]
 fn kulla_conty_is_reciprocal() {
     let mut rng = validation::rng(1800);
-    for (a, scheme) in [0.05f32, 0.3, 1.0]
-        .into_iter()
-        .flat_map(|a| [(a, Compensation::KullaConty), (a, Compensation::PerOrder)])
+    for (a, scheme) in
+        [0.05f32, 0.3, 1.0].into_iter().flat_map(|a| [(a, Compensation::KullaConty), (a, Compensation::Walk)])
     {
-        let b = CompensatedConductor::new(beckmann(a), gold(), scheme).unwrap();
+        let b = Compensated::with_scheme(beckmann(a), gold(), scheme).unwrap();
         for _ in 0..2000 {
             let mut d = || {
                 let z = uniform32(&mut rng);
@@ -396,17 +388,17 @@ fn kulla_conty_is_reciprocal() {
 #[test]
 fn constructor_range_and_smooth_limit() {
     for (ax, ay) in [(1.01f32, 1.01f32), (2.0, 0.6), (5.0, 5.0)] {
-        let r = CompensatedConductor::new(Ggx::new(ax, ay).unwrap(), gold(), Compensation::KullaConty);
+        let r = Compensated::with_scheme(Ggx::new(ax, ay).unwrap(), gold(), Compensation::KullaConty);
         assert!(
             matches!(r, Err(microsurface::Error::InvalidParameter { name: "alpha", .. })),
             "αx = {ax}, αy = {ay}: {r:?}"
         );
     }
-    assert!(CompensatedConductor::new(ggx(1.0), gold(), Compensation::Turquin).is_ok());
+    assert!(Compensated::with_scheme(ggx(1.0), gold(), Compensation::Turquin).is_ok());
     let aniso =
-        CompensatedConductor::new(Ggx::new(2.0, 0.25).unwrap(), gold(), Compensation::KullaConty).unwrap();
+        Compensated::with_scheme(Ggx::new(2.0, 0.25).unwrap(), gold(), Compensation::KullaConty).unwrap();
     assert!((aniso.table_alpha() - 0.5f32.sqrt()).abs() < 1e-6);
-    let smooth = CompensatedConductor::new(ggx(1e-4), gold(), Compensation::KullaConty).unwrap();
+    let smooth = Compensated::with_scheme(ggx(1e-4), gold(), Compensation::KullaConty).unwrap();
     assert!(smooth.flags().specular);
     let wo = dir(0.5, 0.0);
     assert_eq!(
@@ -420,7 +412,7 @@ fn constructor_range_and_smooth_limit() {
 /// single-scattering lobe, bit for bit.
 #[test]
 fn backfacing_views_are_single_scattering() {
-    let b = CompensatedConductor::new(ggx(0.4), gold(), Compensation::KullaConty).unwrap();
+    let b = Compensated::with_scheme(ggx(0.4), gold(), Compensation::KullaConty).unwrap();
     let ss = *b.single_scattering();
     let wo = dir(1.8, 0.3);
     let mut rng = validation::rng(1900);
@@ -440,8 +432,8 @@ fn backfacing_views_are_single_scattering() {
 fn invalid_input_gives_nothing() {
     let ok = dir(0.5, 0.2);
     let bad = [Vec3::NAN, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0)];
-    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
-        let b = CompensatedConductor::new(ggx(0.4), gold(), scheme).unwrap();
+    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::Walk] {
+        let b = Compensated::with_scheme(ggx(0.4), gold(), scheme).unwrap();
         let check = |label: &str, call: &dyn Fn() -> bool| {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(call));
             if cfg!(debug_assertions) {
@@ -471,7 +463,7 @@ fn invalid_input_gives_nothing() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Compensated dielectrics (`CompensatedDielectric`, Turquin scaling)
+// Compensated dielectrics with Turquin's scaling
 // ---------------------------------------------------------------------------------------------
 
 /// The dielectric tables' measured interpolation error of R + T (max at 256 random points,
@@ -522,18 +514,18 @@ fn dielectric_sample_matches_pdf_and_weights_match_eval() {
     let cases: Vec<(String, Box<dyn Bsdf>, f64)> = vec![
         (
             "GGX glass η = 1.5 α = 0.3 θo = 0.5".into(),
-            Box::new(CompensatedDielectric::new(ggx(0.3), glass(1.5)).unwrap()),
+            Box::new(Compensated::with_scheme(ggx(0.3), glass(1.5), Compensation::Turquin).unwrap()),
             0.5,
         ),
         (
             "GGX glass η = 1.5 α = 0.8 θo = 2.2 (inside)".into(),
-            Box::new(CompensatedDielectric::new(ggx(0.8), glass(1.5)).unwrap()),
+            Box::new(Compensated::with_scheme(ggx(0.8), glass(1.5), Compensation::Turquin).unwrap()),
             2.2,
         ),
         (
             "Beckmann η = 2.5 α = 0.5 θo = 1.2, importance".into(),
             Box::new(
-                CompensatedDielectric::new(beckmann(0.5), glass(2.5))
+                Compensated::with_scheme(beckmann(0.5), glass(2.5), Compensation::Turquin)
                     .unwrap()
                     .with_transport(Transport::Importance),
             ),
@@ -580,8 +572,9 @@ fn dielectric_white_furnace_at_the_nodes() {
         worst: &mut f64,
     ) {
         let alpha = slope.alpha_x();
-        let imp =
-            CompensatedDielectric::new(slope, glass(eta)).unwrap().with_transport(Transport::Importance);
+        let imp = Compensated::with_scheme(slope, glass(eta), Compensation::Turquin)
+            .unwrap()
+            .with_transport(Transport::Importance);
         let rad = imp.with_transport(Transport::Radiance);
         for above in [true, false] {
             let mu = mus[usize::from(!above)];
@@ -652,9 +645,10 @@ fn dielectric_white_furnace_between_the_nodes() {
     for (family, err) in [(0usize, DIELECTRIC_TABLE_ERROR[0]), (1, DIELECTRIC_TABLE_ERROR[1])] {
         for a in [0.1f32, 0.5] {
             for mu in [0.3f32, 0.8] {
-                let b: CompensatedDielectric<Ggx> = CompensatedDielectric::new(ggx(a), glass(1.5)).unwrap();
-                let bb: CompensatedDielectric<Beckmann> =
-                    CompensatedDielectric::new(beckmann(a), glass(1.5)).unwrap();
+                let b: Compensated<Ggx, Dielectric> =
+                    Compensated::with_scheme(ggx(a), glass(1.5), Compensation::Turquin).unwrap();
+                let bb: Compensated<Beckmann, Dielectric> =
+                    Compensated::with_scheme(beckmann(a), glass(1.5), Compensation::Turquin).unwrap();
                 for above in [true, false] {
                     let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, if above { mu } else { -mu });
                     let mut rng = validation::rng(seed);
@@ -689,20 +683,20 @@ fn dielectric_white_furnace_between_the_nodes() {
 #[test]
 fn dielectric_constructor_range_and_smooth_limit() {
     for (ax, ay) in [(1.01f32, 1.01f32), (2.0, 0.6)] {
-        let r = CompensatedDielectric::new(Ggx::new(ax, ay).unwrap(), glass(1.5));
+        let r = Compensated::with_scheme(Ggx::new(ax, ay).unwrap(), glass(1.5), Compensation::Turquin);
         assert!(matches!(r, Err(microsurface::Error::InvalidParameter { name: "alpha", .. })), "{r:?}");
     }
     for eta in [3.01f32, 0.33, 10.0] {
-        let r = CompensatedDielectric::new(ggx(0.5), glass(eta));
+        let r = Compensated::with_scheme(ggx(0.5), glass(eta), Compensation::Turquin);
         assert!(
             matches!(r, Err(microsurface::Error::InvalidParameter { name: "eta", .. })),
             "η = {eta}: {r:?}"
         );
     }
     for eta in [3.0f32, 1.0 / 3.0, 1.0, 1.0001] {
-        assert!(CompensatedDielectric::new(ggx(1.0), glass(eta)).is_ok(), "η = {eta}");
+        assert!(Compensated::with_scheme(ggx(1.0), glass(eta), Compensation::Turquin).is_ok(), "η = {eta}");
     }
-    let smooth = CompensatedDielectric::new(ggx(1e-4), glass(1.5)).unwrap();
+    let smooth = Compensated::with_scheme(ggx(1e-4), glass(1.5), Compensation::Turquin).unwrap();
     assert!(smooth.flags().specular);
     let wo = dir(0.5, 0.0);
     assert_eq!(
@@ -717,7 +711,7 @@ fn dielectric_constructor_range_and_smooth_limit() {
 fn dielectric_edges_are_finite() {
     for eta in [1.0001f32, 1.01, 1.0 / 1.01, 3.0, 1.0 / 3.0] {
         for a in [1e-3f32, 0.1, 1.0] {
-            let b = CompensatedDielectric::new(ggx(a), glass(eta)).unwrap();
+            let b = Compensated::with_scheme(ggx(a), glass(eta), Compensation::Turquin).unwrap();
             let wis = [Vec3::Z, -Vec3::Z, dir(1.5, 1.0), dir(1.7, 0.0)];
             assert_finite_at_edges(&b, &wis, &format!("η = {eta} α = {a}"));
         }

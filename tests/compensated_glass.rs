@@ -1,16 +1,17 @@
-//! Glass compensated with the random walk's higher orders (`KullaContyDielectric`, tables
+//! Glass compensated with the random walk's higher orders (`Compensated` with
+//! `Compensation::Walk`, tables
 //! `DielectricWalkTable`): the sampler against its density (chi-square, both sides, reflection
 //! and transmission), weights = eval·|cos|/pdf, the added lobes' normalization (quadrature),
 //! the white furnace, per-side R and T against the walk, reciprocity across the interface, an
 //! independent recomputation of table cells, the constructor's range and finite edges.
 
-use microsurface::compensation::{DielectricWalkTable, EtaRange, MAX_WALK_TABLE_SE, WalkTabulated};
+use microsurface::compensation::{AlbedoTabulated, DielectricWalkTable, EtaRange, MAX_WALK_TABLE_SE};
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::SeedableRng;
 use microsurface::research::{Microsurface, Side, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Beckmann, Bsdf, Dielectric, Ggx, KullaContyDielectric, MicrofacetBsdf, Technique, Transport,
+    Beckmann, Bsdf, Compensated, Compensation, Dielectric, Ggx, MicrofacetBsdf, Technique, Transport,
 };
 use validation::check::{
     EDGE_VIEW_COSINES, assert_finite_at_edges, assert_finite_on_sphere, assert_side_flags, draw, edge_view,
@@ -80,31 +81,29 @@ fn sample_matches_pdf_and_weights_match_eval() {
     let cases: Vec<(String, Box<dyn Bsdf>, f64)> = vec![
         (
             "GGX η = 1.5 α = 0.3 θo = 0.5".into(),
-            Box::new(KullaContyDielectric::new(ggx(0.3), glass(1.5)).unwrap()),
+            Box::new(Compensated::new(ggx(0.3), glass(1.5)).unwrap()),
             0.5,
         ),
         (
             "GGX η = 1.5 α = 0.8 θo = 2.2 (inside)".into(),
-            Box::new(KullaContyDielectric::new(ggx(0.8), glass(1.5)).unwrap()),
+            Box::new(Compensated::new(ggx(0.8), glass(1.5)).unwrap()),
             2.2,
         ),
         (
             "Beckmann η = 2.5 α = 0.5 θo = 1.2, importance".into(),
             Box::new(
-                KullaContyDielectric::new(beckmann(0.5), glass(2.5))
-                    .unwrap()
-                    .with_transport(Transport::Importance),
+                Compensated::new(beckmann(0.5), glass(2.5)).unwrap().with_transport(Transport::Importance),
             ),
             1.2,
         ),
         (
             "GGX η = 1/1.33 α = 1 θo = 1.45".into(),
-            Box::new(KullaContyDielectric::new(ggx(1.0), glass(1.0 / 1.33)).unwrap()),
+            Box::new(Compensated::new(ggx(1.0), glass(1.0 / 1.33)).unwrap()),
             1.45,
         ),
         (
             "Beckmann η = 1.2 α = 0.9 θo = 2.0 (inside), anisotropic 0.6 × 1".into(),
-            Box::new(KullaContyDielectric::new(Beckmann::new(0.6, 1.0).unwrap(), glass(1.2)).unwrap()),
+            Box::new(Compensated::new(Beckmann::new(0.6, 1.0).unwrap(), glass(1.2)).unwrap()),
             2.0,
         ),
     ];
@@ -136,13 +135,13 @@ fn sample_matches_pdf_and_weights_match_eval() {
 }
 
 /// The added lobes integrate to exactly the energies they restore: ∫ (f − f_ss)|cos θi| dωi over
-/// the view's hemisphere is ΔR(μo) and over the other one c ΔT(μo) ([`KullaContyDielectric::higher_orders`]),
+/// the view's hemisphere is ΔR(μo) and over the other one c ΔT(μo) ([`Compensated::higher_orders`]),
 /// by adaptive quadrature (requested 2e-6; asserted within 2e-5: the f32 arithmetic of the
 /// lobes, relative ~1e-6 of values ≤ 1, and the quadrature), importance transport.
 #[test]
 fn added_lobes_are_normalized() {
     for (a, eta) in [(0.05f32, 1.5f32), (1.0, 1.5), (0.7, 2.8), (0.3, 1.0 / 1.33)] {
-        let b = KullaContyDielectric::new(ggx(a), glass(eta)).unwrap().with_transport(Transport::Importance);
+        let b = Compensated::new(ggx(a), glass(eta)).unwrap().with_transport(Transport::Importance);
         let ss = *b.single_scattering();
         for mu in [0.02f32, 0.6] {
             for above in [true, false] {
@@ -177,8 +176,8 @@ fn added_lobes_are_normalized() {
 /// R_ss + T_ss + ΔR + c ΔT = 1 − (the tables' errors): the single-scattering nodes' error, the
 /// walk nodes' noise (SE of ΔR plus SE of ΔT, a bound for any correlation, at `z`) and the
 /// reciprocity factor's shift (c − 1) ΔT.
-fn furnace_allowance<S: WalkTabulated + Copy>(
-    b: &KullaContyDielectric<S>,
+fn furnace_allowance<S: AlbedoTabulated + Copy>(
+    b: &Compensated<S, Dielectric>,
     above: bool,
     k: usize,
     mu: f32,
@@ -206,9 +205,9 @@ fn white_furnace_at_the_nodes() {
     let n = 40_000;
     let mut worst: f64 = 0.0;
     let mut seed = 16_700;
-    fn run<S: WalkTabulated + Copy>(slope: S, k: usize, n: usize, z: f64, seed: u64, worst: &mut f64) {
+    fn run<S: AlbedoTabulated + Copy>(slope: S, k: usize, n: usize, z: f64, seed: u64, worst: &mut f64) {
         let (mu, alpha, eta) = node(k % 16, (k / 16) % 16, k / 256);
-        let imp = KullaContyDielectric::new(slope, glass(eta)).unwrap().with_transport(Transport::Importance);
+        let imp = Compensated::new(slope, glass(eta)).unwrap().with_transport(Transport::Importance);
         let rad = imp.with_transport(Transport::Radiance);
         for above in [true, false] {
             let wo = view(mu, above);
@@ -275,9 +274,9 @@ fn reflection_and_transmission_match_the_walk() {
         }
         out
     }
-    fn run<S: WalkTabulated + Copy>(slope: S, k: usize, n: usize, z: f64, seed: u64, worst: &mut [f64; 2]) {
+    fn run<S: AlbedoTabulated + Copy>(slope: S, k: usize, n: usize, z: f64, seed: u64, worst: &mut [f64; 2]) {
         let (mu, alpha, eta) = node(k % 16, (k / 16) % 16, k / 256);
-        let kc = KullaContyDielectric::new(slope, glass(eta)).unwrap().with_transport(Transport::Importance);
+        let kc = Compensated::new(slope, glass(eta)).unwrap().with_transport(Transport::Importance);
         let walk = MicrofacetBsdf::new(slope, glass(eta))
             .unwrap()
             .with_technique(Technique::RandomWalk)
@@ -420,10 +419,9 @@ fn reciprocal_across_the_interface() {
     let dirs = [dir(0.3, 0.1), dir(1.0, 2.0), dir(1.45, -0.7), dir(2.0, 0.4), dir(2.7, 1.9), dir(1.6, 3.0)];
     let mut worst_mismatch: f32 = 0.0;
     for (a, eta) in [(0.1f32, 1.5f32), (0.5, 1.5), (1.0, 1.33), (0.8, 2.5), (0.6, 1.0 / 1.5)] {
-        let b = KullaContyDielectric::new(ggx(a), glass(eta)).unwrap().with_transport(Transport::Importance);
+        let b = Compensated::new(ggx(a), glass(eta)).unwrap().with_transport(Transport::Importance);
         worst_mismatch = worst_mismatch.max(b.transmission_mismatch().abs());
-        let bb =
-            KullaContyDielectric::new(beckmann(a), glass(eta)).unwrap().with_transport(Transport::Importance);
+        let bb = Compensated::new(beckmann(a), glass(eta)).unwrap().with_transport(Transport::Importance);
         worst_mismatch = worst_mismatch.max(bb.transmission_mismatch().abs());
         for &wo in &dirs {
             for &wi in &dirs {
@@ -453,7 +451,7 @@ fn reciprocal_across_the_interface() {
     // where the transmitted higher orders are large (GGX, α ≥ 0.4) the walk's tables satisfy the
     // relation to the noise of their averages (measured ≤ 2 %; DESIGN.md has the table)
     for (a, eta) in [(0.4f32, 1.2f32), (0.6, 1.5), (0.8, 2.0), (1.0, 1.33), (1.0, 2.5), (0.6, 1.0 / 1.5)] {
-        let m = KullaContyDielectric::new(ggx(a), glass(eta)).unwrap().transmission_mismatch();
+        let m = Compensated::new(ggx(a), glass(eta)).unwrap().transmission_mismatch();
         assert!(m.abs() <= 0.03, "GGX α = {a} η = {eta}: mismatch {m}");
     }
 }
@@ -464,23 +462,22 @@ fn reciprocal_across_the_interface() {
 #[test]
 fn constructor_range_and_smooth_limit() {
     for (ax, ay) in [(1.01f32, 1.01f32), (2.0, 0.6)] {
-        let r = KullaContyDielectric::new(Ggx::new(ax, ay).unwrap(), glass(1.5));
+        let r = Compensated::new(Ggx::new(ax, ay).unwrap(), glass(1.5));
         assert!(matches!(r, Err(microsurface::Error::InvalidParameter { name: "alpha", .. })), "{r:?}");
     }
     for eta in [3.01f32, 0.33, 10.0] {
-        let r = KullaContyDielectric::new(ggx(0.5), glass(eta));
+        let r = Compensated::new(ggx(0.5), glass(eta));
         assert!(
             matches!(r, Err(microsurface::Error::InvalidParameter { name: "eta", .. })),
             "η = {eta}: {r:?}"
         );
     }
     for eta in [3.0f32, 1.0 / 3.0, 1.0, 1.0001] {
-        assert!(KullaContyDielectric::new(ggx(1.0), glass(eta)).is_ok(), "η = {eta}");
+        assert!(Compensated::new(ggx(1.0), glass(eta)).is_ok(), "η = {eta}");
     }
-    for b in [
-        KullaContyDielectric::new(ggx(1e-4), glass(1.5)).unwrap(),
-        KullaContyDielectric::new(ggx(0.5), glass(1.0)).unwrap(),
-    ] {
+    for b in
+        [Compensated::new(ggx(1e-4), glass(1.5)).unwrap(), Compensated::new(ggx(0.5), glass(1.0)).unwrap()]
+    {
         assert!(b.flags().specular);
         let wo = dir(0.5, 0.0);
         assert_eq!(
@@ -496,7 +493,7 @@ fn constructor_range_and_smooth_limit() {
 fn edges_are_finite() {
     for eta in [1.0001f32, 1.01, 1.0 / 1.01, 3.0, 1.0 / 3.0] {
         for a in [1e-3f32, 0.1, 1.0] {
-            let b = KullaContyDielectric::new(ggx(a), glass(eta)).unwrap();
+            let b = Compensated::new(ggx(a), glass(eta)).unwrap();
             let wis = [Vec3::Z, -Vec3::Z, dir(1.5, 1.0), dir(1.7, 0.0), Vec3::X];
             assert_finite_at_edges(&b, &wis, &format!("η = {eta} α = {a}"));
             for z in EDGE_VIEW_COSINES {
@@ -516,15 +513,15 @@ fn edges_are_finite() {
 /// The alpha the tables read for an anisotropic slope is √(αx αy).
 #[test]
 fn anisotropic_slopes_read_the_geometric_mean() {
-    let b = KullaContyDielectric::new(Ggx::new(0.2, 0.8).unwrap(), glass(1.5)).unwrap();
+    let b = Compensated::new(Ggx::new(0.2, 0.8).unwrap(), glass(1.5)).unwrap();
     assert!((b.table_alpha() - 0.4).abs() <= 1e-6);
     assert!(b.single_scattering().surface().slope().alpha_x() == 0.2);
 }
 
 /// No non-finite value from the compensated glass lobes on an (α, η) scan: 48 roughnesses
 /// (k/48)², the η nodes of the tables' axis η = 1 + 2u³ (u = i/15) seen from outside and
-/// from inside (1/η) plus 1.5 and 1/1.5, `KullaContyDielectric` for GGX and Beckmann and
-/// Turquin's `CompensatedDielectric` for GGX, 20 random pairs of directions on the sphere each
+/// from inside (1/η) plus 1.5 and 1/1.5, the walk's lobes (`Compensation::Walk`) for GGX and Beckmann and
+/// Turquin's scaling for GGX, 20 random pairs of directions on the sphere each
 /// (the scan that found the per-order conductor lobe's NaN bands, `tests/compensated.rs`).
 #[test]
 fn every_compensated_glass_is_finite_on_a_roughness_and_eta_scan() {
@@ -538,12 +535,12 @@ fn every_compensated_glass_is_finite_on_a_roughness_and_eta_scan() {
         let a = (k as f32 / 48.0).powi(2);
         for &eta in &etas {
             let label = |name: &str| format!("{name} α = {a} η = {eta}");
-            let b = KullaContyDielectric::new(ggx(a), glass(eta)).unwrap();
-            assert_finite_on_sphere(&b, 20, &mut rng, &label("KullaContyDielectric GGX"));
-            let b = KullaContyDielectric::new(beckmann(a), glass(eta)).unwrap();
-            assert_finite_on_sphere(&b, 20, &mut rng, &label("KullaContyDielectric Beckmann"));
-            let b = microsurface::CompensatedDielectric::new(ggx(a), glass(eta)).unwrap();
-            assert_finite_on_sphere(&b, 20, &mut rng, &label("CompensatedDielectric GGX"));
+            let b = Compensated::new(ggx(a), glass(eta)).unwrap();
+            assert_finite_on_sphere(&b, 20, &mut rng, &label("Walk GGX"));
+            let b = Compensated::new(beckmann(a), glass(eta)).unwrap();
+            assert_finite_on_sphere(&b, 20, &mut rng, &label("Walk Beckmann"));
+            let b = Compensated::with_scheme(ggx(a), glass(eta), Compensation::Turquin).unwrap();
+            assert_finite_on_sphere(&b, 20, &mut rng, &label("Turquin GGX"));
         }
     }
 }

@@ -358,17 +358,17 @@ fn isotropic_table_rejects_a_correlated_slope() {
 /// directions (its tables are read at √(α₁ α₂), not at the marginals' √(αx αy)).
 #[test]
 fn compensated_conductor_is_rotation_invariant() {
-    use microsurface::{Bsdf, CompensatedConductor, Compensation};
+    use microsurface::{Bsdf, Compensated, Compensation};
     let (a1, a2, phi) = (0.5f32, 0.15f32, 0.9f32);
     let conductor = Conductor::new(ComplexIor::GOLD);
-    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
-        let e = CompensatedConductor::new(
+    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::Walk] {
+        let e = Compensated::with_scheme(
             Elliptical::<Ggx>::from_ellipse(a1, a2, phi).unwrap(),
             conductor,
             scheme,
         )
         .unwrap();
-        let a = CompensatedConductor::new(Ggx::new(a1, a2).unwrap(), conductor, scheme).unwrap();
+        let a = Compensated::with_scheme(Ggx::new(a1, a2).unwrap(), conductor, scheme).unwrap();
         for k in 0..50 {
             let (t_o, p_o, t_i, p_i) =
                 (1.5 * k as f64 / 50.0, 0.9 * k as f64, 1.4 * (k as f64 * 0.37).fract(), 2.1 * k as f64);

@@ -744,7 +744,7 @@ fn check_flags(r: &mut FlagsReport, label: &str, b: &dyn Bsdf, rng: &mut Rng) {
 /// fuzz: every case counts, none may fail.
 #[test]
 fn flags_agree_with_every_call() {
-    use microsurface::{CompensatedConductor, CompensatedDielectric, Compensation, KullaContyDielectric};
+    use microsurface::{Compensated, Compensation};
     use rand::RngExt;
     const CONFIGS: usize = 48;
     const CASES: usize = 40;
@@ -812,15 +812,15 @@ fn flags_agree_with_every_call() {
             ClassicBrdf::new(Vec3::splat(0.3), Vec3::splat(0.5), ClassicNdf::Ggx(ax), ClassicMasking::Exact)
                 .unwrap();
         run(&mut r, &format!("classic α {ax}"), &classic, &mut rng);
-        for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
-            if let Ok(b) = CompensatedConductor::new(ggx, gold, scheme) {
+        for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::Walk] {
+            if let Ok(b) = Compensated::with_scheme(ggx, gold, scheme) {
                 run(&mut r, &format!("compensated gold {scheme:?} α ({ax}, {ay})"), &b, &mut rng);
             }
         }
-        if let Ok(b) = CompensatedDielectric::new(ggx, dielectric) {
+        if let Ok(b) = Compensated::with_scheme(ggx, dielectric, Compensation::Turquin) {
             run(&mut r, &format!("Turquin glass α ({ax}, {ay}) η {eta}"), &b, &mut rng);
         }
-        if let Ok(b) = KullaContyDielectric::new(ggx, dielectric) {
+        if let Ok(b) = Compensated::with_scheme(ggx, dielectric, Compensation::Walk) {
             run(&mut r, &format!("Kulla-Conty glass α ({ax}, {ay}) η {eta}"), &b, &mut rng);
         }
         #[cfg(feature = "leadr")]

@@ -162,27 +162,23 @@ impl DielectricAlbedoTable {
 }
 
 impl DielectricAlbedoTable {
-    /// R and T at the 16 direction nodes x = i/15 for roughness α and the relative index η
-    /// seen by the light, blended bilinearly in (r, u) as [`Self::albedo`] interpolates, and
-    /// the direction axis of η (the run-time lookup of a compensated lobe then interpolates
-    /// linearly in x only). `None` outside the tables' range.
-    pub(crate) fn direction_row(
-        &self,
-        alpha: f32,
-        eta: f32,
-    ) -> Option<([f32; DIELECTRIC_TABLE_SIZE], [f32; DIELECTRIC_TABLE_SIZE], DielectricDirection)> {
-        if !(alpha > 0.0
-            && alpha <= MAX_TABULATED_ALPHA
-            && (1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta))
-        {
-            return None;
+    /// The fractional roughness node r·15 of α ∈ (0, 1].
+    #[inline(always)]
+    pub(crate) fn roughness_node(alpha: f32) -> f32 {
+        roughness_coordinate(alpha) * LAST
+    }
+
+    /// The fractional index node u·15 of η ≥ 1.
+    #[inline(always)]
+    pub(crate) fn eta_node(eta_at_least_one: f32) -> f32 {
+        eta_coordinate(eta_at_least_one) * LAST
+    }
+
+    /// The (reflected, transmitted) grids of one side.
+    pub(crate) fn grids(&self, range: EtaRange) -> [&'static super::grid::Grid; 2] {
+        match range {
+            EtaRange::AtLeastOne => self.grids.outside,
+            EtaRange::AtMostOne => self.grids.inside,
         }
-        let (_, eta_ge_1) = self.grids.of(eta);
-        let (r, t) = self.grids.direction_row(
-            eta,
-            roughness_coordinate(alpha) * LAST,
-            eta_coordinate(eta_ge_1) * LAST,
-        );
-        Some((r, t, DielectricDirection::of(eta)))
     }
 }

@@ -1,7 +1,7 @@
 //! The random walk's higher-order energies of dielectric microsurfaces, split into reflection
 //! and transmission, and their interpolation.
 
-use super::axis::{node_cell, scale_invariant_direction};
+use super::axis::scale_invariant_direction;
 use super::generated::dielectric_walk as data;
 use super::grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA, NODES, SideGrids};
 use super::table::MAX_TABULATED_ALPHA;
@@ -47,7 +47,7 @@ pub struct HigherOrders {
 /// for one slope family and both sides of the interface. The walk's order 1 is the
 /// single-scattering model of [`crate::compensation::DielectricAlbedoTable`], and the walk conserves
 /// energy, so R_ss + T_ss + ΔR + ΔT = 1 up to the tables' errors: the higher orders that a
-/// compensated lobe ([`crate::KullaContyDielectric`]) restores, with their split between the
+/// compensated lobe ([`crate::Compensated`] with [`crate::Compensation::Walk`]) restores, with their split between the
 /// two sides.
 ///
 /// **Axes** (those of [`crate::compensation::DielectricAlbedoTable`]): relative index η ∈ [1, 3] seen from
@@ -149,48 +149,32 @@ impl DielectricWalkTable {
         let se = |p: f32| if n == 0 { 0.0 } else { (p * (1.0 - p) / n as f32).max(0.0).sqrt() };
         Some((se(r[k]), se(t[k])))
     }
-
-    /// ΔR and ΔT at the 16 direction nodes x = i/15 for roughness α and the relative index η
-    /// seen by the light, blended bilinearly in (r, u) as [`Self::energy`] interpolates.
-    /// `None` outside the tables' range.
-    pub(crate) fn direction_row(
-        &self,
-        alpha: f32,
-        eta: f32,
-    ) -> Option<([f32; DIELECTRIC_TABLE_SIZE], [f32; DIELECTRIC_TABLE_SIZE])> {
-        if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA && in_eta_range(eta)) {
-            return None;
-        }
-        let (_, eta_ge_1) = self.grids.of(eta);
-        Some(self.grids.direction_row(eta, alpha.sqrt() * LAST, eta_coordinate(eta_ge_1) * LAST))
-    }
 }
 
 impl DielectricWalkTable {
-    /// The variance of ΔT at the 16 direction nodes as [`Self::direction_row`] blends it: the
-    /// squared bilinear weights times the nodes' squared standard errors (independent
-    /// walks). `None` outside the tables' range.
-    pub(crate) fn transmitted_row_variance(
-        &self,
-        alpha: f32,
-        eta: f32,
-    ) -> Option<[f32; DIELECTRIC_TABLE_SIZE]> {
-        if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA && in_eta_range(eta)) {
-            return None;
+    /// The fractional roughness node r·15 of α ∈ (0, 1] (r = √α).
+    #[inline(always)]
+    pub(crate) fn roughness_node(alpha: f32) -> f32 {
+        alpha.sqrt() * LAST
+    }
+
+    /// The fractional index node u·15 of η ≥ 1.
+    #[inline(always)]
+    pub(crate) fn eta_node(eta_at_least_one: f32) -> f32 {
+        eta_coordinate(eta_at_least_one) * LAST
+    }
+
+    /// The (reflected, transmitted) grids of one side.
+    pub(crate) fn grids(&self, range: EtaRange) -> [&'static super::grid::Grid; 2] {
+        match range {
+            EtaRange::AtLeastOne => self.grids.outside,
+            EtaRange::AtMostOne => self.grids.inside,
         }
-        let range = EtaRange::of(eta);
-        let eta_ge_1 = if eta >= 1.0 { eta } else { 1.0 / eta };
-        let (j, fj) = node_cell(alpha.sqrt() * LAST, DIELECTRIC_TABLE_SIZE);
-        let (l, fl) = node_cell(eta_coordinate(eta_ge_1) * LAST, DIELECTRIC_TABLE_SIZE);
-        let var = |k: usize| self.standard_errors(range, k).map_or(0.0, |(_, t)| t * t);
-        let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
-        for (i, o) in out.iter_mut().enumerate() {
-            let at = |jj: usize, ll: usize| var(SideGrids::index(i, jj, ll));
-            let (a, b) = ((1.0 - fj) * (1.0 - fl), fj * (1.0 - fl));
-            let (c, d) = ((1.0 - fj) * fl, fj * fl);
-            *o = a * a * at(j, l) + b * b * at(j + 1, l) + c * c * at(j, l + 1) + d * d * at(j + 1, l + 1);
-        }
-        Some(out)
+    }
+
+    /// The slope family.
+    pub(crate) fn family(&self) -> super::Family {
+        if self.name == "ggx" { super::Family::Ggx } else { super::Family::Beckmann }
     }
 }
 

@@ -76,31 +76,6 @@ impl SideGrids {
         (trilinear(grids[0], at), trilinear(grids[1], at))
     }
 
-    /// Both quantities of the side of η at the 16 direction nodes x = i/15, blended bilinearly
-    /// at the fractional roughness and index nodes `r` and `u` ∈ [0, 15] (as [`Self::at`]
-    /// interpolates).
-    pub(crate) fn direction_row(
-        &self,
-        eta: f32,
-        r: f32,
-        u: f32,
-    ) -> ([f32; DIELECTRIC_TABLE_SIZE], [f32; DIELECTRIC_TABLE_SIZE]) {
-        let (grids, _) = self.of(eta);
-        let (j, fj) = node_cell(r, DIELECTRIC_TABLE_SIZE);
-        let (l, fl) = node_cell(u, DIELECTRIC_TABLE_SIZE);
-        let blend = |grid: &Grid| {
-            let mut out = [0.0; DIELECTRIC_TABLE_SIZE];
-            for (i, o) in out.iter_mut().enumerate() {
-                let at = |jj: usize, ll: usize| grid[ll * ROW + jj * DIELECTRIC_TABLE_SIZE + i];
-                let near = at(j, l) + fj * (at(j + 1, l) - at(j, l));
-                let far = at(j, l + 1) + fj * (at(j + 1, l + 1) - at(j, l + 1));
-                *o = near + fl * (far - near);
-            }
-            out
-        };
-        (blend(grids[0]), blend(grids[1]))
-    }
-
     /// The node index of (i, j, l).
     #[inline(always)]
     pub(crate) fn index(i: usize, j: usize, l: usize) -> usize {

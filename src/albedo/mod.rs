@@ -19,7 +19,10 @@ pub(crate) use axis::{DielectricDirection, floor_index, node_cell, scale_invaria
 pub use dielectric::{DielectricAlbedo, DielectricAlbedoTable};
 pub use dielectric_walk::{DielectricWalkTable, HigherOrders, MAX_WALK_TABLE_SE, WALK_BATCH};
 pub use grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};
+pub(crate) use grid::{Grid, SideGrids};
 pub use orders::{
-    LAST_TABULATED_ORDER, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable, TabulatedOrder,
+    LAST_TABULATED_ORDER, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES,
+    ScatteringOrderTable, TabulatedOrder,
 };
-pub use table::{ALBEDO_TABLE_SIZE, AlbedoTable, MAX_TABULATED_ALPHA};
+pub(crate) use table::Family;
+pub use table::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, MAX_TABULATED_ALPHA};

@@ -1,8 +1,11 @@
 //! The per-order multiple-scattering energies of the F = 1 conductor, tabulated from the
 //! exact random walk, and their interpolation.
 
+use super::MAX_TABULATED_ALPHA;
 use super::generated::orders as orders_data;
-use super::{ALBEDO_TABLE_SIZE, MAX_TABULATED_ALPHA};
+
+/// Nodes per axis of the per-order tables: 32 × 32 for e_k(μ, α), 32 for e_k,avg(α).
+pub const ORDER_TABLE_SIZE: usize = 32;
 
 /// The last scattering order with a table of its own: orders 2 … 6 are tabulated one by one,
 /// the orders above 6 together (the tail).
@@ -16,7 +19,7 @@ pub const ORDER_TABLES: usize = LAST_TABULATED_ORDER;
 pub const ORDER_TABLE_MAX_STANDARD_ERROR: f32 = 1.96e-3;
 
 /// The last node index, as a float.
-const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
+const LAST: f32 = (ORDER_TABLE_SIZE - 1) as f32;
 
 /// Which scattering orders a per-order table holds.
 ///
@@ -64,9 +67,10 @@ impl TabulatedOrder {
 /// needs, since each further bounce multiplies it by a Fresnel term (Kulla and Conty 2017;
 /// Hill's suggestion of E_F ≈ E_ss,F + Σ_k e_k F̄^k per RGB channel).
 ///
-/// **Axes** as [`super::AlbedoTable`]: r = √α in 32 equal steps (row 0 at α = 1e-6), direction
-/// node x ∈ [0, 1] at μ = X α/(1 + α − X), X = x²; bilinear in (x, r). Column x = 0 (μ = 0) is
-/// 0: a grazing ray sees only the top of the surface and leaves after one bounce.
+/// **Axes** those of [`super::AlbedoTable`] at a third of its direction resolution (every node
+/// here is a node there): r = √α in 31 equal steps (row 0 at α = 1e-6), direction node
+/// x = i/31 at μ = X α/(1 + α − X), X = x²; bilinear in (x, r). Column x = 0 (μ = 0) is 0: a
+/// grazing ray sees only the top of the surface and leaves after one bounce.
 ///
 /// **Accuracy.** Every node is the mean of 2¹⁶ walks of its own seeded generator: standard
 /// error √(e (1 − e)/2¹⁶) ≤ [`ORDER_TABLE_MAX_STANDARD_ERROR`] per node (and per average
@@ -89,8 +93,8 @@ impl TabulatedOrder {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScatteringOrderTable {
     name: &'static str,
-    directional: &'static [[f32; ALBEDO_TABLE_SIZE * ALBEDO_TABLE_SIZE]; ORDER_TABLES],
-    average: &'static [[f32; ALBEDO_TABLE_SIZE]; ORDER_TABLES],
+    directional: &'static [[f32; ORDER_TABLE_SIZE * ORDER_TABLE_SIZE]; ORDER_TABLES],
+    average: &'static [[f32; ORDER_TABLE_SIZE]; ORDER_TABLES],
 }
 
 impl ScatteringOrderTable {
@@ -125,13 +129,13 @@ impl ScatteringOrderTable {
             return None;
         }
         let x = super::scale_invariant_direction(mu, alpha) * LAST;
-        let (i, fi) = super::node_cell(x, ALBEDO_TABLE_SIZE);
-        let (j, fj) = super::node_cell(alpha.sqrt() * LAST, ALBEDO_TABLE_SIZE);
+        let (i, fi) = super::node_cell(x, ORDER_TABLE_SIZE);
+        let (j, fj) = super::node_cell(alpha.sqrt() * LAST, ORDER_TABLE_SIZE);
         let g = &self.directional[t];
-        let row = j * ALBEDO_TABLE_SIZE + i;
+        let row = j * ORDER_TABLE_SIZE + i;
         let lower = g[row] + fi * (g[row + 1] - g[row]);
         let upper =
-            g[row + ALBEDO_TABLE_SIZE] + fi * (g[row + ALBEDO_TABLE_SIZE + 1] - g[row + ALBEDO_TABLE_SIZE]);
+            g[row + ORDER_TABLE_SIZE] + fi * (g[row + ORDER_TABLE_SIZE + 1] - g[row + ORDER_TABLE_SIZE]);
         Some(lower + fj * (upper - lower))
     }
 
@@ -144,13 +148,13 @@ impl ScatteringOrderTable {
         if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA) {
             return None;
         }
-        let (j, f) = super::node_cell(alpha.sqrt() * LAST, ALBEDO_TABLE_SIZE);
+        let (j, f) = super::node_cell(alpha.sqrt() * LAST, ORDER_TABLE_SIZE);
         let a = &self.average[t];
         Some(a[j] + f * (a[j + 1] - a[j]))
     }
 
     /// The raw nodes of table `t` (0 for order 2 … [`ORDER_TABLES`] − 1 for the tail),
-    /// row-major with the roughness index slowest, as [`super::AlbedoTable::directional_nodes`].
+    /// row-major with the roughness index slowest (`values[j * 32 + i]` at x = i/31, r = j/31).
     ///
     /// # Panics
     /// If t ≥ [`ORDER_TABLES`].

@@ -2,14 +2,26 @@
 
 use super::generated::conductor as data;
 
-/// Nodes per axis of the tables: 32 × 32 for E(μ, α), 32 for E_avg(α).
-pub const ALBEDO_TABLE_SIZE: usize = 32;
+/// Direction nodes of a roughness row of [`AlbedoTable`] (x = i/93).
+pub const ALBEDO_DIRECTIONS: usize = 94;
+
+/// Roughness rows of [`AlbedoTable`] (r = √α = j/31), and nodes of its E_avg.
+pub const ALBEDO_ROUGHNESSES: usize = 32;
 
 /// The largest roughness α the tables cover (their roughness axis is r = √α ∈ [0, 1]).
 pub const MAX_TABULATED_ALPHA: f32 = 1.0;
 
-/// The last node index, as a float.
-const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
+/// The last direction node index, as a float.
+const LAST_X: f32 = (ALBEDO_DIRECTIONS - 1) as f32;
+/// The last roughness node index, as a float.
+const LAST_R: f32 = (ALBEDO_ROUGHNESSES - 1) as f32;
+
+/// The slope family of a table (which shared tables a compensated lobe reads).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Family {
+    Ggx,
+    Beckmann,
+}
 
 /// The single-scattering albedo of an isotropic microfacet conductor with F = 1 and
 /// height-correlated Smith masking-shadowing, tabulated for one slope family:
@@ -18,17 +30,22 @@ const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
 /// G2 = 1/(1 + Λ(ωi) + Λ(ωo)) (Heitz 2014; the first order of the random walk of Heitz et al.
 /// 2016), and its cosine-weighted average E_avg(α) = 2 ∫₀¹ E(μ) μ dμ (Kulla and Conty 2017).
 ///
-/// **Axes.** Roughness r = √α ∈ [0, 1] (as in Cycles' tables), 32 equal steps. The direction
+/// **Axes.** Roughness r = √α ∈ [0, 1] (as in Cycles' tables), 31 equal steps. The direction
 /// axis is scale-invariant: node x ∈ [0, 1] holds μ = X α / (1 + α − X) with X = x², so that the
 /// sharp feature of E at μ ≈ α (E(0) = 1: a grazing ray sees the top of the surface, from
 /// which every reflection escapes, and E dips to ≈ 0.89 at μ ≈ α) is resolved at every α; the
 /// row r = 0 holds the α → 0 limit of that profile (evaluated at α = 1e-6). A query (μ, α)
-/// maps to x = √(μ (1 + α)/(μ + α)) and is interpolated bilinearly in (x, r).
+/// maps to x = √(μ (1 + α)/(μ + α)) and is interpolated bilinearly in (x, r), with 93 equal
+/// steps of x ([`ALBEDO_DIRECTIONS`] × [`ALBEDO_ROUGHNESSES`] nodes).
 ///
-/// **Accuracy** (measured by the generator, see `DESIGN.md`): every node is within 1e-6 of the
-/// exact integral (two quadrature resolutions agree to that); bilinear interpolation errs by at
-/// most 1.2e-3 (GGX) and 3.7e-3 (Beckmann) at the cell centres, RMS 2.9e-4 and 5.3e-4. A
-/// uniform μ axis of the same size errs by up to 7.4e-2.
+/// **Accuracy** (measured by the generator, `tables --interpolation --only conductor`, see
+/// `DESIGN.md`): every node is within 1e-6 of the exact integral (two quadrature resolutions
+/// agree to that). Bilinear interpolation, measured against quadrature at every cell centre and
+/// at the midpoint of every cell edge (where a bilinear interpolant is farthest from its
+/// nodes), errs by at most 5.5e-4 for GGX (cell centres 5.2e-4, edge midpoints along x 1.2e-4,
+/// along r 5.42e-4; RMS ≤ 1.2e-4) and 1.3e-3 for Beckmann (centres 8.6e-4, edges along x 6.7e-4,
+/// along r 1.29e-3 at μ = 1, α ≈ 0.48; RMS ≤ 1.3e-4). A uniform μ axis of 32 nodes errs by up
+/// to 7.4e-2.
 ///
 /// # Examples
 /// ```
@@ -43,18 +60,24 @@ const LAST: f32 = (ALBEDO_TABLE_SIZE - 1) as f32;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlbedoTable {
     name: &'static str,
-    directional: &'static [f32; ALBEDO_TABLE_SIZE * ALBEDO_TABLE_SIZE],
-    average: &'static [f32; ALBEDO_TABLE_SIZE],
+    family: Family,
+    directional: &'static [f32; ALBEDO_DIRECTIONS * ALBEDO_ROUGHNESSES],
+    average: &'static [f32; ALBEDO_ROUGHNESSES],
 }
 
 impl AlbedoTable {
     /// The GGX (Trowbridge–Reitz) tables.
-    pub const GGX: AlbedoTable =
-        AlbedoTable { name: "ggx", directional: &data::GGX_DIRECTIONAL, average: &data::GGX_AVERAGE };
+    pub const GGX: AlbedoTable = AlbedoTable {
+        name: "ggx",
+        family: Family::Ggx,
+        directional: &data::GGX_DIRECTIONAL,
+        average: &data::GGX_AVERAGE,
+    };
 
     /// The Beckmann tables.
     pub const BECKMANN: AlbedoTable = AlbedoTable {
         name: "beckmann",
+        family: Family::Beckmann,
         directional: &data::BECKMANN_DIRECTIONAL,
         average: &data::BECKMANN_AVERAGE,
     };
@@ -76,7 +99,7 @@ impl AlbedoTable {
             return None;
         }
         let x = super::scale_invariant_direction(mu, alpha);
-        Some(bilinear(self.directional, x * LAST, alpha.sqrt() * LAST))
+        Some(bilinear(self.directional, x * LAST_X, alpha.sqrt() * LAST_R))
     }
 
     /// E_avg(α) = 2 ∫₀¹ E(μ, α) μ dμ, interpolated linearly in r = √α. Its nodes are exact to
@@ -90,17 +113,32 @@ impl AlbedoTable {
         if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA) {
             return None;
         }
-        let t = alpha.sqrt() * LAST;
-        let j = (t as usize).min(ALBEDO_TABLE_SIZE - 2);
-        let f = t - j as f32;
+        let (j, f) = super::node_cell(alpha.sqrt() * LAST_R, ALBEDO_ROUGHNESSES);
         Some(self.average[j] + f * (self.average[j + 1] - self.average[j]))
     }
 
     /// The raw node values of E, row-major with the roughness index slowest
-    /// (`values[j * 32 + i]` at x = i/31, r = j/31), for export to shaders.
+    /// (`values[j * 94 + i]` at x = i/93, r = j/31), for export to shaders.
     #[must_use]
     pub fn directional_nodes(&self) -> &'static [f32] {
         self.directional
+    }
+
+    /// The number of direction nodes of a roughness row.
+    #[must_use]
+    pub fn direction_nodes(&self) -> usize {
+        ALBEDO_DIRECTIONS
+    }
+
+    /// The number of roughness rows.
+    #[must_use]
+    pub fn roughness_nodes(&self) -> usize {
+        ALBEDO_ROUGHNESSES
+    }
+
+    /// The slope family.
+    pub(crate) fn family(&self) -> Family {
+        self.family
     }
 
     /// The raw node values of E_avg at r = j/31.
@@ -110,14 +148,14 @@ impl AlbedoTable {
     }
 }
 
-/// Bilinear interpolation of a row-major 32 × 32 grid at fractional indices (i, j) ∈ [0, 31]².
+/// Bilinear interpolation of the row-major grid at fractional indices (i, j) ∈ [0, 93] × [0, 31].
 #[inline(always)]
-fn bilinear(grid: &[f32; ALBEDO_TABLE_SIZE * ALBEDO_TABLE_SIZE], i: f32, j: f32) -> f32 {
-    let (i0, j0) = ((i as usize).min(ALBEDO_TABLE_SIZE - 2), (j as usize).min(ALBEDO_TABLE_SIZE - 2));
-    let (fi, fj) = (i - i0 as f32, j - j0 as f32);
-    let row = j0 * ALBEDO_TABLE_SIZE + i0;
+fn bilinear(grid: &[f32; ALBEDO_DIRECTIONS * ALBEDO_ROUGHNESSES], i: f32, j: f32) -> f32 {
+    let (i0, fi) = super::node_cell(i, ALBEDO_DIRECTIONS);
+    let (j0, fj) = super::node_cell(j, ALBEDO_ROUGHNESSES);
+    let row = j0 * ALBEDO_DIRECTIONS + i0;
     let (a, b) = (grid[row], grid[row + 1]);
-    let (c, d) = (grid[row + ALBEDO_TABLE_SIZE], grid[row + ALBEDO_TABLE_SIZE + 1]);
+    let (c, d) = (grid[row + ALBEDO_DIRECTIONS], grid[row + ALBEDO_DIRECTIONS + 1]);
     let lower = a + fi * (b - a);
     let upper = c + fi * (d - c);
     lower + fj * (upper - lower)

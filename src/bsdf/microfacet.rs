@@ -544,7 +544,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             flags,
         })
     }
-    /// [`Bsdf::eval_keyed`] for directions the caller has validated (`valid_direction`, and
+    /// [`Bsdf::eval_keyed`] for directions the caller has validated (`unit_directions!`, and
     /// renormalized here if they drifted): the compensated lobes validate once for both their
     /// own term and this one.
     #[inline(always)]

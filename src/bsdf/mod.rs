@@ -365,19 +365,11 @@ fn renormalize_drifted(w: Vec3) -> Option<Vec3> {
     LENGTH_SQ_RANGE.contains(&len_sq).then(|| w / len_sq.sqrt())
 }
 
-/// A direction already accepted by [`valid_direction`], renormalized if it drifted (for the
-/// wrappers that validate once and call the inner lobe's `*_valid` methods).
+/// A direction already accepted by the entry checks (`unit_directions!`), renormalized if it
+/// drifted (for the wrappers that validate once and call the inner lobe's `*_valid` methods).
 #[inline(always)]
 pub(crate) fn renormalized(w: Vec3) -> Vec3 {
     if is_direction(w) { w } else { renormalize_drifted(w).unwrap_or(w) }
-}
-
-/// Whether a direction is accepted by the renderer layer (within [`BSDF_DIRECTION_TOLERANCE`]),
-/// without a debug assertion: for the wrappers that hand invalid input on to an inner lobe,
-/// whose own check reports it.
-#[inline(always)]
-pub(crate) fn valid_direction(w: Vec3) -> bool {
-    is_direction(w) || renormalize_drifted(w).is_some()
 }
 
 /// Whether the caller's uniforms all lie in [0, 1) (NaN fails): the fast path of
@@ -413,11 +405,4 @@ fn clamp_ones(uc: f32, u: Vec2) -> Option<(f32, Vec2)> {
         let [uc, x, y] = all.map(|x| x.min(ONE_MINUS_EPSILON));
         (uc, Vec2::new(x, y))
     })
-}
-
-/// Whether the caller's uniforms are accepted (in [0, 1]), without a debug assertion: for the
-/// wrappers that hand invalid input on to an inner lobe, whose own check reports it.
-#[inline(always)]
-pub(crate) fn valid_uniforms(uc: f32, u: Vec2) -> bool {
-    are_unit_uniforms(uc, u) || clamp_ones(uc, u).is_some()
 }

@@ -41,18 +41,6 @@ impl<const N: usize> DirectionAxis<N> {
         Self::split((mu * self.scale / (mu + self.alpha)).min(Self::LAST * Self::LAST).sqrt())
     }
 
-    /// The cells of two cosines sharing one division: t² = μo s (μi + α)/((μo + α)(μi + α)) and
-    /// likewise for μi (s = (N − 1)²(1 + α); a few ulps from [`Self::cell`]).
-    #[inline(always)]
-    pub(crate) fn cells(&self, mu_o: f32, mu_i: f32) -> ((usize, f32), (usize, f32)) {
-        let (so, si) = (mu_o + self.alpha, mu_i + self.alpha);
-        let inv = self.scale / (so * si);
-        let top = Self::LAST * Self::LAST;
-        let to = (mu_o * si * inv).min(top).sqrt();
-        let ti = (mu_i * so * inv).min(top).sqrt();
-        (Self::split(to), Self::split(ti))
-    }
-
     /// The cell and fraction of the fractional node t ∈ [0, N − 1].
     #[inline(always)]
     fn split(t: f32) -> (usize, f32) {
@@ -131,6 +119,48 @@ pub(crate) fn profile_average<const N: usize>(g: &[f32; N], alpha: f32) -> f64 {
             prim.mass((xa, f64::from(g[i])), (xb, f64::from(g[i + 1])), xa, xb)
         })
         .sum()
+}
+
+/// 8-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; symmetric).
+const GL8: [(f64, f64); 4] = [
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
+    (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
+    (0.960_289_856_497_536_2, 0.101_228_536_290_376_3),
+];
+
+/// 2∫₀¹ g(x(μ)) μ dμ of a vector function g of the direction coordinate x = √(μ (1 + α)/(μ + α))
+/// at roughness α > 0, for g smooth on each of the `cells` equal cells of x (the pieces of a
+/// row interpolated on a `cells + 1`-node axis, or on a coarser axis whose cells are unions of
+/// these): 8-point Gauss–Legendre per cell in u = √μ, where x(u²) is analytic and the measure
+/// 4u³ du smooth (exact to rounding for the piecewise-linear rows of [`profile_average`]).
+pub(crate) fn axis_average<const L: usize>(
+    alpha: f64,
+    cells: usize,
+    g: impl Fn(f64) -> [f64; L],
+) -> [f64; L] {
+    let k = 1.0 + alpha;
+    let mu_of = |x: f64| {
+        let big_x = x * x;
+        if big_x >= 1.0 { 1.0 } else { alpha * big_x / (k - big_x) }
+    };
+    let mut out = [0.0; L];
+    for i in 0..cells {
+        let (ua, ub) = (mu_of(i as f64 / cells as f64).sqrt(), mu_of((i + 1) as f64 / cells as f64).sqrt());
+        let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
+        for &(t, w) in &GL8 {
+            for u in [mid - half * t, mid + half * t] {
+                let mu = u * u;
+                let x = (mu * k / (mu + alpha)).min(1.0).sqrt();
+                let v = g(x);
+                let weight = w * half * 4.0 * u * u * u;
+                for (o, v) in out.iter_mut().zip(v) {
+                    *o += weight * v;
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Cells of the uniform μ axis: cell k holds μ ∈ [k/M, (k + 1)/M) (μ = 1 the last).
@@ -331,27 +361,6 @@ impl MuProfile {
         let sin_theta = (1.0 - mu_sq).max(0.0).sqrt();
         let (sin_phi, cos_phi) = sin_cos_turns(u.y);
         (mu > 0.0).then(|| Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, mu))
-    }
-}
-
-/// Lobe probabilities of a sampling mixture, piecewise constant on the uniform μ axis of the
-/// view's cosine: any positive probabilities give an exact mixture density, so these need not
-/// follow the lobes' energies closely, only keep the weights near them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct MixtureTable<const L: usize> {
-    cells: [[f32; L]; MU_CELLS],
-}
-
-impl<const L: usize> MixtureTable<L> {
-    /// The table whose cell k has the probabilities `of(k)`.
-    pub(crate) fn new(of: impl Fn(usize) -> [f32; L]) -> Self {
-        Self { cells: core::array::from_fn(of) }
-    }
-
-    /// The probabilities for a view with |cos θo| = μ: one multiply and one truncation.
-    #[inline(always)]
-    pub(crate) fn at(&self, mu: f32) -> &[f32; L] {
-        &self.cells[mu_cell(mu)]
     }
 }
 

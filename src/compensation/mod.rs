@@ -1,19 +1,23 @@
 //! Energy compensation: the single-scattering lobe plus the energy of the higher orders restored
-//! from tabulated albedos of the exact model (Kulla and Conty 2017; Turquin 2019), with
-//! deterministic evaluation, exact densities and samplers; and the tables themselves.
+//! from tabulated albedos of the exact model (Kulla and Conty 2017; Turquin 2019; the random
+//! walk's own higher orders), with deterministic evaluation, exact densities and samplers,
+//! built per hit from tables shared by every instance; and the tables themselves.
 
+mod albedo_tabulated;
+mod compensated;
 mod conductor;
-mod kulla_conty_dielectric;
+mod conductor_tables;
+mod dielectric;
+mod fresnel_average;
+mod glass_tables;
 mod lobe_profile;
 mod shared;
-mod turquin_dielectric;
 
 pub use crate::albedo::{
-    ALBEDO_TABLE_SIZE, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo, DielectricAlbedoTable,
-    DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER, MAX_TABULATED_ALPHA,
-    MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLES, ScatteringOrderTable,
-    TabulatedOrder, WALK_BATCH,
+    ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo,
+    DielectricAlbedoTable, DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER,
+    MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR,
+    ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable, TabulatedOrder, WALK_BATCH,
 };
-pub use conductor::{AlbedoTabulated, CompensatedConductor, Compensation};
-pub use kulla_conty_dielectric::{KullaContyDielectric, WalkTabulated};
-pub use turquin_dielectric::CompensatedDielectric;
+pub use albedo_tabulated::AlbedoTabulated;
+pub use compensated::{Compensated, CompensatedMaterial, Compensation};

@@ -1,7 +1,6 @@
-//! What the energy-compensated BSDFs share: the tables' range check of their constructors and
-//! the final filter of a sample drawn from a sampling mixture.
+//! What the energy-compensated BSDFs share: the error of an index beyond the tables, the
+//! reference to shared tables, and the final filter of a sample drawn from a sampling mixture.
 
-use crate::albedo::{MAX_TABULATED_ALPHA, MAX_TABULATED_ETA};
 use crate::bsdf::{BsdfSample, SampleFlags};
 use crate::error::Error;
 use glam::Vec3;
@@ -9,50 +8,36 @@ use glam::Vec3;
 /// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
 pub(crate) const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// `Ok` if the roughness `alpha` = √(αx αy) lies within the albedo tables' range
-/// (≤ [`MAX_TABULATED_ALPHA`]) and, for a dielectric, its relative index `eta` within
-/// [1/[`MAX_TABULATED_ETA`], [`MAX_TABULATED_ETA`]]; otherwise [`Error::InvalidParameter`] naming
-/// `"alpha"` or `"eta"`, with `tables` (the tables' name) in its `expected`.
-pub(crate) fn check_tabulated(alpha: f32, eta: Option<f32>, tables: Tables) -> Result<(), Error> {
-    if alpha > MAX_TABULATED_ALPHA {
-        return Err(Error::InvalidParameter { name: "alpha", value: alpha, expected: tables.alpha() });
-    }
-    match eta {
-        Some(eta) if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) => {
-            Err(tables.eta_error(eta))
-        }
-        _ => Ok(()),
+/// The error of a relative index `value` outside the dielectric tables' range.
+pub(crate) fn eta_error(value: f32) -> Error {
+    Error::InvalidParameter {
+        name: "eta",
+        value,
+        expected: "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric compensation tables' range",
     }
 }
 
-/// Which tables a compensated BSDF reads (for the message of a rejected parameter).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Tables {
-    /// The single-scattering albedo tables.
-    Albedo,
-    /// The random walk's dielectric tables.
-    Walk,
+/// A reference to tables shared by every instance of a compensated BSDF: compared by address,
+/// printed by name.
+pub(crate) struct Shared<T: 'static>(pub(crate) &'static T);
+
+impl<T> Clone for Shared<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
 }
 
-impl Tables {
-    fn alpha(self) -> &'static str {
-        match self {
-            Self::Albedo => "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the albedo tables' range",
-            Self::Walk => "√(αx αy) at most 1 (MAX_TABULATED_ALPHA), the walk tables' range",
-        }
-    }
+impl<T> Copy for Shared<T> {}
 
-    /// The error of a relative index `value` outside the tables' range.
-    pub(crate) fn eta_error(self, value: f32) -> Error {
-        let expected = match self {
-            Self::Albedo => {
-                "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric albedo tables' range"
-            }
-            Self::Walk => {
-                "a relative index in [1/3, 3] (MAX_TABULATED_ETA), the dielectric walk tables' range"
-            }
-        };
-        Error::InvalidParameter { name: "eta", value, expected }
+impl<T> PartialEq for Shared<T> {
+    fn eq(&self, other: &Self) -> bool {
+        core::ptr::eq(self.0, other.0)
+    }
+}
+
+impl<T> core::fmt::Debug for Shared<T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "Shared<{}>({:p})", core::any::type_name::<T>(), self.0)
     }
 }
 

@@ -61,6 +61,12 @@ impl Conductor {
         Self { ior: Some(ior) }
     }
 
+    /// The complex index (`None` for the perfect mirror, F = 1).
+    #[inline(always)]
+    pub(crate) fn ior(&self) -> Option<&ComplexIor> {
+        self.ior.as_ref()
+    }
+
     /// The vertex term F(ωi·ωh) D(ωh)/(4 |cos θi|) of a valid reflection half vector with
     /// D(ωh) = `d`; 0 for ωi on the horizon.
     #[inline(always)]

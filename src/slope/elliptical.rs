@@ -64,7 +64,7 @@ impl AxisAlignedSlope for Beckmann {
 /// αy; [`MicrosurfaceSlope::alpha_i`] includes the correlation,
 /// αᵢ² = αx² cos²φ + 2ρ αx αy cos φ sin φ + αy² sin²φ. The walks, the position-free estimators,
 /// single scattering and [`MicrofacetBsdf`](crate::MicrofacetBsdf) accept it as any other slope
-/// (they reflect in real microfacet space), and [`CompensatedConductor`](crate::CompensatedConductor)
+/// (they reflect in real microfacet space), and [`Compensated`](crate::Compensated)
 /// reads its albedo tables at √(α₁ α₂) (the rotation-invariant geometric mean, what √(αx αy) is
 /// for an axis-aligned slope); `MicrofacetBsdf`'s smooth and walk-length limits compare
 /// [`MicrosurfaceSlope::alpha_max`] = max(α₁, α₂), the same for every φα, against their

@@ -97,16 +97,18 @@ fn elliptical_weight_matches_albedo() {
 /// The compensated lobes accept correlated slopes (their tables are read at √(α₁ α₂)).
 #[test]
 fn compensated_lobes_accept_elliptical_slopes() {
-    use microsurface::{CompensatedConductor, CompensatedDielectric, Compensation};
-    for scheme in [Compensation::KullaConty, Compensation::Turquin] {
-        let c = CompensatedConductor::new(elliptical_ggx(), gold(), scheme).unwrap();
+    use microsurface::{Compensated, Compensation};
+    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::Walk] {
+        let c = Compensated::with_scheme(elliptical_ggx(), gold(), scheme).unwrap();
         let v = c.eval(dir(0.6, 0.3), dir(0.8, 2.0));
         assert!(v.f.is_finite() && v.f.min_element() > 0.0, "{scheme:?} conductor GGX: {}", v.f);
-        let c = CompensatedConductor::new(elliptical_beckmann(), gold(), scheme).unwrap();
+        let c = Compensated::with_scheme(elliptical_beckmann(), gold(), scheme).unwrap();
         assert!(c.eval(dir(0.6, 0.3), dir(0.8, 2.0)).f.min_element() > 0.0, "{scheme:?} conductor Beckmann");
     }
-    let d = CompensatedDielectric::new(elliptical_ggx(), dielectric());
-    assert!(d.is_ok(), "dielectric GGX: {d:?}");
-    let d = CompensatedDielectric::new(elliptical_beckmann(), dielectric());
-    assert!(d.is_ok(), "dielectric Beckmann: {d:?}");
+    for scheme in [Compensation::Turquin, Compensation::Walk] {
+        let d = Compensated::with_scheme(elliptical_ggx(), dielectric(), scheme);
+        assert!(d.is_ok(), "{scheme:?} dielectric GGX: {d:?}");
+        let d = Compensated::with_scheme(elliptical_beckmann(), dielectric(), scheme);
+        assert!(d.is_ok(), "{scheme:?} dielectric Beckmann: {d:?}");
+    }
 }

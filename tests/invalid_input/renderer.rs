@@ -13,8 +13,7 @@ use microsurface::leadr::{Noncentral, NoncentralBsdf};
 use microsurface::research::{Estimator, Shadowing};
 use microsurface::{
     BSDF_DIRECTION_TOLERANCE, Bsdf, BsdfSample, BsdfValue, ClassicBrdf, ClassicMasking, ClassicNdf,
-    CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Diffuse,
-    Ggx, KullaContyDielectric, MicrofacetBsdf, Technique,
+    Compensated, Compensation, ComplexIor, Conductor, Dielectric, Diffuse, Ggx, MicrofacetBsdf, Technique,
 };
 
 /// 1 − 2⁻²⁴, what a uniform of 1 stands for.
@@ -55,15 +54,23 @@ fn models() -> Vec<(String, Box<dyn Bsdf>, bool)> {
     v.push(("classic".into(), Box::new(classic.unwrap()), true));
     let noncentral = NoncentralBsdf::new(Noncentral::new(ggx, Vec2::new(0.2, -0.1)).unwrap(), gold).unwrap();
     v.push(("noncentral".into(), Box::new(noncentral), true));
-    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::PerOrder] {
+    for scheme in [Compensation::KullaConty, Compensation::Turquin, Compensation::Walk] {
         v.push((
             format!("compensated gold {scheme:?}"),
-            Box::new(CompensatedConductor::new(ggx, gold, scheme).unwrap()),
+            Box::new(Compensated::with_scheme(ggx, gold, scheme).unwrap()),
             false,
         ));
     }
-    v.push(("Turquin glass".into(), Box::new(CompensatedDielectric::new(ggx, glass).unwrap()), false));
-    v.push(("Kulla-Conty glass".into(), Box::new(KullaContyDielectric::new(ggx, glass).unwrap()), false));
+    v.push((
+        "Turquin glass".into(),
+        Box::new(Compensated::with_scheme(ggx, glass, Compensation::Turquin).unwrap()),
+        false,
+    ));
+    v.push((
+        "Kulla-Conty glass".into(),
+        Box::new(Compensated::with_scheme(ggx, glass, Compensation::Walk).unwrap()),
+        false,
+    ));
     v
 }
 

@@ -1,5 +1,5 @@
-//! Measures the error of the energy-compensated conductors (`CompensatedConductor`:
-//! Kulla–Conty, Turquin and the per-order lobe from the walk's tables) and of plain single scattering against the exact multiple-scattering
+//! Measures the error of the energy-compensated conductors (`Compensated`: Kulla–Conty, Turquin
+//! and the walk's per-order lobe) and of plain single scattering against the exact multiple-scattering
 //! model (the random walk of Heitz et al. 2016), GGX:
 //!
 //! * directional albedo error A_technique(μ) − A_walk(μ) per RGB channel, max and RMS over a
@@ -8,7 +8,7 @@
 //!   Σ|h − h_walk| / Σ h_walk (F = 1), per α ∈ {0.1, 0.3, 0.6, 1} and θo ∈ {0, 1, 1.4}, with
 //!   the noise floor of the estimate (the same distance between two independent walk runs);
 //! * the albedo error of anisotropic GGX (F = 1) compensated at α = √(αx αy);
-//! * glass (`CompensatedDielectric`, Turquin scaling; `KullaContyDielectric`, the walk's
+//! * glass (`Compensated` with Turquin's scaling, and with the walk's
 //!   higher orders as separable reflection and transmission lobes; and single scattering): the
 //!   reflected, transmitted and total albedo against the walk's (importance transport: flux),
 //!   max and RMS over μ, α and η ∈ {1.33, 1.5, 2} seen from outside and from inside (1/η), and
@@ -31,8 +31,8 @@ use microsurface::rand::{RngExt, SeedableRng};
 use microsurface::research::{Estimator, Microsurface, Shadowing, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
 use microsurface::{
-    Bsdf, CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
-    KullaContyDielectric, MicrofacetBsdf, Technique, Transport,
+    Bsdf, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique,
+    Transport,
 };
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -74,9 +74,9 @@ fn technique(name: &str, slope: Ggx, c: Conductor) -> Box<dyn Bsdf> {
         "single" => {
             Box::new(MicrofacetBsdf::new(slope, c).unwrap().with_technique(Technique::SingleScattering))
         }
-        "kulla-conty" => Box::new(CompensatedConductor::new(slope, c, Compensation::KullaConty).unwrap()),
-        "turquin" => Box::new(CompensatedConductor::new(slope, c, Compensation::Turquin).unwrap()),
-        "per-order" => Box::new(CompensatedConductor::new(slope, c, Compensation::PerOrder).unwrap()),
+        "kulla-conty" => Box::new(Compensated::with_scheme(slope, c, Compensation::KullaConty).unwrap()),
+        "turquin" => Box::new(Compensated::with_scheme(slope, c, Compensation::Turquin).unwrap()),
+        "per-order" => Box::new(Compensated::with_scheme(slope, c, Compensation::Walk).unwrap()),
         _ => unreachable!(),
     }
 }
@@ -158,8 +158,12 @@ fn glass_models(slope: Ggx, material: Dielectric) -> [Box<dyn Bsdf>; 4] {
     [
         Box::new(mf.with_technique(Technique::RandomWalk)),
         Box::new(mf.with_technique(Technique::SingleScattering)),
-        Box::new(CompensatedDielectric::new(slope, material).unwrap().with_transport(Transport::Importance)),
-        Box::new(KullaContyDielectric::new(slope, material).unwrap().with_transport(Transport::Importance)),
+        Box::new(
+            Compensated::with_scheme(slope, material, Compensation::Turquin)
+                .unwrap()
+                .with_transport(Transport::Importance),
+        ),
+        Box::new(Compensated::new(slope, material).unwrap().with_transport(Transport::Importance)),
     ]
 }
 
@@ -404,14 +408,16 @@ fn glass_cost(alpha: f32, mus: &[f32], n: usize) -> [f64; 4] {
     [
         time_samples(&mf.with_technique(Technique::SingleScattering), &wos, n, 30_020),
         time_samples(
-            &CompensatedDielectric::new(slope, material).unwrap().with_transport(Transport::Importance),
+            &Compensated::with_scheme(slope, material, Compensation::Turquin)
+                .unwrap()
+                .with_transport(Transport::Importance),
             &wos,
             n,
             30_021,
         ),
         time_samples(&mf.with_technique(Technique::RandomWalk), &wos, n / 10, 30_022),
         time_samples(
-            &KullaContyDielectric::new(slope, material).unwrap().with_transport(Transport::Importance),
+            &Compensated::new(slope, material).unwrap().with_transport(Transport::Importance),
             &wos,
             n,
             30_023,
@@ -571,6 +577,30 @@ fn main() -> std::io::Result<()> {
     }
     writeln!(
         md,
+        "\nSampling quality: the standard deviation σ of one sample's weight (the one-sample albedo estimate; \
+         the lower, the better the pdf follows f·cos), mean and max over the cells and RGB channels above:\n"
+    )
+    .unwrap();
+    writeln!(md, "| material |{}", TECHNIQUE_TITLES.map(|t| format!(" {t}: mean σ | max σ |")).concat())
+        .unwrap();
+    writeln!(md, "|---|{}", "---|---|".repeat(TECHNIQUES.len())).unwrap();
+    let n_albedo = (s.albedo_samples as f64).sqrt();
+    for (name, _) in &mats {
+        write!(md, "| {name} |").unwrap();
+        for k in 0..TECHNIQUES.len() {
+            let sigmas: Vec<f64> = cells
+                .iter()
+                .filter(|c| c.material == *name)
+                .flat_map(|c| (0..3).map(move |ch| c.techniques[k].se[ch] * n_albedo))
+                .collect();
+            let max = sigmas.iter().fold(0.0f64, |m, &e| m.max(e));
+            let mean = sigmas.iter().sum::<f64>() / sigmas.len() as f64;
+            write!(md, " {mean:.4} | {max:.4} |").unwrap();
+        }
+        md.push('\n');
+    }
+    writeln!(
+        md,
         "\nAnisotropic GGX, F = 1, compensated at α = √(αx αy): albedo error over μo (as above) and \
          φo ∈ {{0, π/4, π/2}}:\n"
     )
@@ -632,6 +662,23 @@ fn main() -> std::io::Result<()> {
                 write!(md, " {max:.4} | {rms:.4} |").unwrap();
             }
             md.push('\n');
+        }
+    }
+    writeln!(
+        md,
+        "\nGlass sampling quality: σ of one sample's total (R + T) weight, mean and max over the cells above:\n"
+    )
+    .unwrap();
+    writeln!(md, "| technique | side | mean σ | max σ |").unwrap();
+    writeln!(md, "|---|---|---|---|").unwrap();
+    for (m, name) in [(1usize, "single"), (2, "Turquin"), (3, "Kulla–Conty (walk split)")] {
+        for inside in [false, true] {
+            let sigmas: Vec<f64> =
+                glass.iter().filter(|c| c.inside == inside).map(|c| c.albedo[m].se[2] * n_albedo).collect();
+            let max = sigmas.iter().fold(0.0f64, |x, &e| x.max(e));
+            let mean = sigmas.iter().sum::<f64>() / sigmas.len() as f64;
+            writeln!(md, "| {name} | {} | {mean:.4} | {max:.4} |", if inside { "inside" } else { "outside" })
+                .unwrap();
         }
     }
     writeln!(
@@ -704,7 +751,7 @@ fn main() -> std::io::Result<()> {
          runs; load average {}). The walk is the reference (error 0, its standard error is in the headers above); \
          PT and BDPT are the position-free model's estimators (Wang et al. 2022), a different model whose albedo \
          differs from the walk's by the entry. Glass: total albedo, importance transport, η = 1.5 from outside \
-         (Kulla–Conty: the walk-split KullaContyDielectric); then the larger error of R and T, views from both sides.\n",
+         (Kulla–Conty: the walk split); then the larger error of R and T, views from both sides.\n",
         s.mus,
         load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
     )

@@ -10,7 +10,7 @@
 //! 0.8 × the single-bounce phase density + 0.2 × a cosine lobe), which dielectrics keep as
 //! `Bsdf::pdf`; `Bsdf::pdf` the stochastic techniques' density of `MicrofacetBsdf`; for
 //! conductors (F = 1, whose walk exits with the density f·cos of the energy-conserving
-//! model): `kulla-conty` the F = 1 Kulla–Conty BRDF × cos (`CompensatedConductor`, which
+//! model): `kulla-conty` the F = 1 Kulla–Conty BRDF × cos (`Compensated` conductor, which
 //! integrates to 1; `Bsdf::pdf` is this density for tabulated conductors), `per-order` the
 //! per-order lobe, `mixture` the compensated conductor's sampling density; for glass
 //! (non-absorbing): the Kulla–Conty dielectric's f·|cos| and its mixture density.
@@ -20,10 +20,7 @@
 
 use glam::{Vec2, Vec3};
 use microsurface::research::{PositionFree, Shadowing};
-use microsurface::{
-    Bsdf, CompensatedConductor, Compensation, Conductor, Dielectric, Ggx, KullaContyDielectric,
-    MicrofacetBsdf,
-};
+use microsurface::{Bsdf, Compensated, Compensation, Conductor, Dielectric, Ggx, MicrofacetBsdf};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -127,8 +124,8 @@ fn main() {
         let ggx = Ggx::isotropic(alpha).expect("valid α");
         let walk = MicrofacetBsdf::new(ggx, Conductor::perfect()).expect("α ≤ 10");
         let kc =
-            CompensatedConductor::new(ggx, Conductor::perfect(), Compensation::KullaConty).expect("α ≤ 1");
-        let po = CompensatedConductor::new(ggx, Conductor::perfect(), Compensation::PerOrder).expect("α ≤ 1");
+            Compensated::with_scheme(ggx, Conductor::perfect(), Compensation::KullaConty).expect("α ≤ 1");
+        let po = Compensated::with_scheme(ggx, Conductor::perfect(), Compensation::Walk).expect("α ≤ 1");
         let research = PositionFree::new(ggx, Conductor::perfect(), Shadowing::Correlated);
         for t in thetas {
             let r = t.to_radians();
@@ -162,7 +159,7 @@ fn main() {
         let ggx = Ggx::isotropic(alpha).expect("valid α");
         let glass = Dielectric::new(1.5).expect("valid η");
         let walk = MicrofacetBsdf::new(ggx, glass).expect("α ≤ 10");
-        let kc = KullaContyDielectric::new(ggx, glass).expect("tabulated η");
+        let kc = Compensated::with_scheme(ggx, glass, Compensation::Walk).expect("tabulated η");
         for t in thetas {
             let r = t.to_radians();
             let wo = Vec3::new(r.sin(), 0.0, r.cos());

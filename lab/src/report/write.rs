@@ -387,7 +387,7 @@ const RENDERS: [(&str, &str); 2] = [
         "GGX roughness sweep rendered by the example path tracer (next-event estimation, MIS, Russian roulette): \
          columns α = 0.05 … 1, rows gold (complex IOR per RGB) with single scattering, the exact Heitz walk, Kulla–Conty and Turquin \
          compensation from the crate's albedo tables, then glass (η = 1.5) with single scattering, the walk and Turquin \
-         compensation (`CompensatedDielectric`, reflection and transmission, both sides); a sky, a ground colour below the horizon and a spherical light; 64 samples per pixel, sRGB, \
+         compensation (`Compensated` with `Compensation::Turquin`, reflection and transmission, both sides); a sky, a ground colour below the horizon and a spherical light; 64 samples per pixel, sRGB, \
          clamped to [0, 1]. Single scattering darkens with α: it loses the energy of the higher orders.",
     ),
     (

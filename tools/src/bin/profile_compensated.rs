@@ -14,8 +14,8 @@
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    Bsdf, BsdfFlags, BsdfSample, BsdfValue, CompensatedConductor, CompensatedDielectric, Compensation,
-    ComplexIor, Conductor, Dielectric, Ggx, KullaContyDielectric, MicrofacetBsdf, Technique,
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, Compensated, Compensation, ComplexIor, Conductor, Dielectric,
+    Ggx, MicrofacetBsdf, Technique,
 };
 use std::hint::black_box;
 use validation::inputs::{Inputs, N, inputs};
@@ -122,7 +122,7 @@ fn main() {
             let scheme = match technique.as_str() {
                 "kulla-conty" => Some(Compensation::KullaConty),
                 "turquin" => Some(Compensation::Turquin),
-                "per-order" => Some(Compensation::PerOrder),
+                "walk" | "per-order" => Some(Compensation::Walk),
                 _ => None,
             };
             match (technique.as_str(), scheme) {
@@ -134,7 +134,7 @@ fn main() {
                     run(&b, &x, what, calls)
                 }
                 (_, Some(scheme)) => {
-                    run(&CompensatedConductor::new(slope, gold, scheme).expect("α ≤ 1"), &x, what, calls)
+                    run(&Compensated::with_scheme(slope, gold, scheme).expect("α ≤ 1"), &x, what, calls)
                 }
                 _ => panic!("unknown technique {technique}"),
             }
@@ -150,12 +150,15 @@ fn main() {
                         .with_technique(Technique::SingleScattering);
                     run(&b, &x, what, calls)
                 }
-                "kulla-conty" => {
-                    run(&KullaContyDielectric::new(slope, glass).expect("in range"), &x, what, calls)
+                "walk" | "kulla-conty" => {
+                    run(&Compensated::new(slope, glass).expect("in range"), &x, what, calls)
                 }
-                "turquin" => {
-                    run(&CompensatedDielectric::new(slope, glass).expect("in range"), &x, what, calls)
-                }
+                "turquin" => run(
+                    &Compensated::with_scheme(slope, glass, Compensation::Turquin).expect("in range"),
+                    &x,
+                    what,
+                    calls,
+                ),
                 _ => panic!("unknown technique {technique}"),
             }
         }

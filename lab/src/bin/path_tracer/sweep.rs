@@ -12,8 +12,7 @@ use crate::label::{Align, BLACK, Canvas, Fonts, Rgb8, WHITE, Weight, srgb8};
 use glam::Vec3;
 use lab::tracer::{Camera, Environment, Light, Lighting, Material, RenderStats, Scene, Sphere, render};
 use microsurface::{
-    CompensatedConductor, CompensatedDielectric, Compensation, ComplexIor, Conductor, Dielectric, Ggx,
-    MicrofacetBsdf, Technique,
+    Compensated, Compensation, ComplexIor, Conductor, Dielectric, Ggx, MicrofacetBsdf, Technique,
 };
 
 /// The roughnesses of the columns.
@@ -111,14 +110,17 @@ impl Row {
                 } else {
                     Compensation::Turquin
                 };
-                Box::new(CompensatedConductor::new(slope, conductor, scheme).expect("α within the tables"))
+                Box::new(Compensated::with_scheme(slope, conductor, scheme).expect("α within the tables"))
             }
             (Substance::Gold, _) => Box::new(
                 MicrofacetBsdf::new(slope, conductor).expect("α ≤ MAX_WALK_ALPHA").with_technique(technique),
             ),
             (Substance::Glass, Method::Turquin) => {
                 let glass = Dielectric::new(GLASS_ETA).expect("valid η");
-                Box::new(CompensatedDielectric::new(slope, glass).expect("α and η within the tables"))
+                Box::new(
+                    Compensated::with_scheme(slope, glass, Compensation::Turquin)
+                        .expect("α and η within the tables"),
+                )
             }
             (Substance::Glass, Method::KullaConty) => unreachable!("no Kulla–Conty dielectric row"),
             (Substance::Glass, _) => {

@@ -33,6 +33,17 @@ pub struct Axes {
     pub roughness: Roughness,
     /// The direction axis below the knee (from inside).
     pub below_knee: BelowKnee,
+    /// The direction axis of each side: outside, inside.
+    pub direction: [Direction; 2],
+}
+
+/// The direction axis of one side of a design.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    /// B(μ) from outside, the knee axis from inside.
+    Blend,
+    /// The conductor's scale-invariant x = √(μ (1 + α)/(μ + α)).
+    ScaleInvariant,
 }
 
 /// The roughness axis of a design.
@@ -60,6 +71,7 @@ pub const SHIPPED: Axes = Axes {
     eta_power: 3.0,
     roughness: Roughness::Blend,
     below_knee: BelowKnee::Symmetric,
+    direction: [Direction::Blend, Direction::Blend],
 };
 
 /// B(μ) ∈ [0, 1].
@@ -132,7 +144,10 @@ impl Axes {
 
     /// The direction coordinate x ∈ [0, 1] of μ on the table of `side` for light seeing η
     /// (inside: η ≤ 1 and the knee axis at μc = √(1 − η²)).
-    pub fn direction(&self, mu: f64, eta_seen: f64, side: Side) -> f64 {
+    pub fn direction(&self, mu: f64, alpha: f64, eta_seen: f64, side: Side) -> f64 {
+        if self.direction[side as usize] == Direction::ScaleInvariant {
+            return (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
+        }
         if side == Side::Outside {
             return blend(mu);
         }
@@ -146,7 +161,11 @@ impl Axes {
     }
 
     /// μ of direction coordinate x (the inverse of [`Self::direction`]; μf-floored).
-    pub fn mu_of(&self, x: f64, eta_seen: f64, side: Side) -> f64 {
+    pub fn mu_of(&self, x: f64, alpha: f64, eta_seen: f64, side: Side) -> f64 {
+        if self.direction[side as usize] == Direction::ScaleInvariant {
+            let big_x = x * x;
+            return if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
+        }
         if side == Side::Outside {
             return blend_inverse(x);
         }
@@ -187,7 +206,7 @@ impl Axes {
         let alpha = self.alpha_of_node(j);
         let eta = self.eta_of(l as f64 / self.last());
         let eta_seen = if side == Side::Inside { 1.0 / eta } else { eta };
-        (self.mu_of(i as f64 / self.last(), eta_seen, side), alpha, eta_seen)
+        (self.mu_of(i as f64 / self.last(), alpha, eta_seen, side), alpha, eta_seen)
     }
 
     /// The fractional node coordinates (x, r, u)·(nodes − 1) of a lookup at (μ, α, η seen).
@@ -196,7 +215,7 @@ impl Axes {
         let eta_ge_1 = if side == Side::Inside { 1.0 / eta_seen } else { eta_seen };
         let l = self.last();
         [
-            self.direction(mu, eta_seen, side).clamp(0.0, 1.0) * l,
+            self.direction(mu, alpha, eta_seen, side).clamp(0.0, 1.0) * l,
             if self.roughness == Roughness::Blend { blend(alpha.min(1.0)) } else { alpha.sqrt().min(1.0) }
                 * l,
             self.eta_coordinate(eta_ge_1) * l,

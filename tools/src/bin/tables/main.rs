@@ -18,6 +18,7 @@
 
 mod dielectric;
 mod dielectric_axes;
+mod furnace;
 mod orders;
 mod quadrature;
 mod walk_dielectric;
@@ -29,12 +30,17 @@ use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Nodes per axis (as `microsurface::compensation::ALBEDO_TABLE_SIZE`).
-const N: usize = microsurface::compensation::ALBEDO_TABLE_SIZE;
+/// Nodes per axis of the per-order tables (as `microsurface::compensation::ORDER_TABLE_SIZE`).
+const N: usize = 32;
+/// Direction nodes of the conductor albedo table (x = i/93: every third one a node of the
+/// per-order tables).
+const NX: usize = 94;
+/// Roughness nodes of the conductor albedo table (r = j/31: the rows of the per-order tables).
+const NR: usize = 32;
 /// The roughness at which the r = 0 row (the α → 0 limit profile) is evaluated.
 const ALPHA_LIMIT: f64 = 1e-6;
 /// Quadrature panels per variable for the shipped values, and for the error estimate.
-const PANELS: usize = 12;
+const PANELS: usize = 8;
 const CHECK_PANELS: usize = 6;
 /// Largest accepted disagreement of the two resolutions.
 const MAX_QUADRATURE_ERROR: f64 = 1e-6;
@@ -43,10 +49,20 @@ const AVERAGE_PANELS: usize = 12;
 /// Cells recomputed by `--quick`.
 const QUICK_CELLS: usize = 24;
 
-/// The α of roughness node j.
-fn alpha_of_node(j: usize) -> f64 {
-    let r = j as f64 / (N - 1) as f64;
+/// The α of roughness node j of an axis r = √α with `nodes` nodes.
+fn alpha_at(j: usize, nodes: usize) -> f64 {
+    let r = j as f64 / (nodes - 1) as f64;
     (r * r).max(ALPHA_LIMIT)
+}
+
+/// The α of roughness node j of the per-order tables.
+fn alpha_of_node(j: usize) -> f64 {
+    alpha_at(j, N)
+}
+
+/// The α of roughness row j of the conductor albedo table.
+fn alpha_of_row(j: usize) -> f64 {
+    alpha_at(j, NR)
 }
 
 /// μ of direction coordinate x at roughness α: μ = X α/(1 + α − X), X = x².
@@ -55,10 +71,10 @@ fn mu_of(x: f64, alpha: f64) -> f64 {
     if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) }
 }
 
-/// E at node (i, j).
+/// E at node (i, j) of the conductor albedo table.
 fn node(family: Family, i: usize, j: usize, panels: usize) -> f64 {
-    let alpha = alpha_of_node(j);
-    single_scattering_albedo(family, mu_of(i as f64 / (N - 1) as f64, alpha), alpha, panels)
+    let alpha = alpha_of_row(j);
+    single_scattering_albedo(family, mu_of(i as f64 / (NX - 1) as f64, alpha), alpha, panels)
 }
 
 /// Below this μ the E_avg integrand is dropped: ∫₀^μ E μ dμ ≤ μ²/2 = 5e-15.
@@ -119,8 +135,8 @@ struct Tables {
 
 fn build(family: Family) -> Tables {
     let name = family.name();
-    let cells = par_map(N * N, &format!("{name} E(mu, alpha)"), |k| {
-        let (i, j) = (k % N, k / N);
+    let cells = par_map(NX * NR, &format!("{name} E(mu, alpha)"), |k| {
+        let (i, j) = (k % NX, k / NX);
         let fine = node(family, i, j, PANELS);
         let coarse = node(family, i, j, CHECK_PANELS);
         (fine, (fine - coarse).abs())
@@ -131,8 +147,8 @@ fn build(family: Family) -> Tables {
         worst <= MAX_QUADRATURE_ERROR,
         "{name}: quadrature error estimate {worst:.2e} > {MAX_QUADRATURE_ERROR:e}"
     );
-    let averages = par_map(N, &format!("{name} E_avg(alpha)"), |j| {
-        let alpha = alpha_of_node(j);
+    let averages = par_map(NR, &format!("{name} E_avg(alpha)"), |j| {
+        let alpha = alpha_of_row(j);
         let fine = average(family, alpha, AVERAGE_PANELS, PANELS);
         (fine, (fine - average(family, alpha, AVERAGE_PANELS / 2, CHECK_PANELS)).abs())
     });
@@ -145,26 +161,90 @@ fn build(family: Family) -> Tables {
     }
 }
 
-/// The interpolation error of the shipped lookups at the cell centres (and segment midpoints
-/// for E_avg) against direct quadrature: (max, RMS, max for E_avg).
-fn interpolation_error(family: Family) -> (f64, f64, f64) {
+/// Where an interpolated value is checked against quadrature, relative to the table's cells.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Probe {
+    /// The centre of a cell (both coordinates halfway between nodes).
+    Centre,
+    /// The midpoint of a cell edge along the direction axis (on a roughness row).
+    DirectionEdge,
+    /// The midpoint of a cell edge along the roughness axis (on a direction column).
+    RoughnessEdge,
+}
+
+/// The dense check of the conductor table: the interpolated E against direct quadrature at
+/// every cell centre and every midpoint of a cell edge (both kinds), where a bilinear
+/// interpolant is farthest from its nodes. Per probe kind: (max, RMS, (μ, α) of the max).
+fn interpolation_error(family: Family) -> Vec<(Probe, f64, f64, (f64, f64))> {
     let table = table_of(family);
-    let errors = par_map((N - 1) * (N - 1), &format!("{} interpolation", family.name()), |k| {
-        let (x, r) =
-            (((k % (N - 1)) as f64 + 0.5) / (N - 1) as f64, ((k / (N - 1)) as f64 + 0.5) / (N - 1) as f64);
-        let alpha = r * r;
-        let mu = mu_of(x, alpha);
-        let exact = single_scattering_albedo(family, mu, alpha, CHECK_PANELS);
-        (f64::from(table.directional(mu as f32, alpha as f32).expect("in range")) - exact).abs()
+    let (nx, nr) = (table.direction_nodes(), table.roughness_nodes());
+    let (lx, lr) = ((nx - 1) as f64, (nr - 1) as f64);
+    let mut points = Vec::new();
+    for j in 0..nr {
+        for i in 0..nx {
+            let (x, r) = (i as f64 / lx, j as f64 / lr);
+            let (xc, rc) = ((i as f64 + 0.5) / lx, (j as f64 + 0.5) / lr);
+            if i + 1 < nx && j + 1 < nr {
+                points.push((Probe::Centre, xc, rc));
+            }
+            if i + 1 < nx {
+                points.push((Probe::DirectionEdge, xc, r));
+            }
+            if j + 1 < nr {
+                points.push((Probe::RoughnessEdge, x, rc));
+            }
+        }
+    }
+    let errors = par_map(points.len(), &format!("{} interpolation", family.name()), |k| {
+        let (_, x, r) = points[k];
+        probe_error(family, x, r)
     });
-    let max = errors.iter().copied().fold(0.0, f64::max);
-    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-    let avg_errors = par_map(N - 1, &format!("{} E_avg interpolation", family.name()), |j| {
-        let r = (j as f64 + 0.5) / (N - 1) as f64;
+    [Probe::Centre, Probe::DirectionEdge, Probe::RoughnessEdge]
+        .into_iter()
+        .map(|probe| {
+            let of: Vec<&(f64, (f64, f64))> =
+                points.iter().zip(&errors).filter(|(p, _)| p.0 == probe).map(|(_, e)| e).collect();
+            let worst = of.iter().fold(&(0.0, (0.0, 0.0)), |w, e| if e.0 > w.0 { e } else { w });
+            let rms = (of.iter().map(|e| e.0 * e.0).sum::<f64>() / of.len() as f64).sqrt();
+            (probe, worst.0, rms, worst.1)
+        })
+        .collect()
+}
+
+/// The largest interpolation error of E the shipped tables' documentation states (cell centres
+/// and edge midpoints, from `--interpolation`): GGX, Beckmann. `--quick` checks probes against it.
+const STATED_E_ERROR: [f64; 2] = [STATED_GGX, STATED_BECKMANN];
+const STATED_GGX: f64 = 5.5e-4;
+const STATED_BECKMANN: f64 = 1.3e-3;
+/// Probes of the interpolation error recomputed by `--quick` per family.
+const QUICK_PROBES: usize = 12;
+
+/// Quadrature panels of the dense check's reference values (`--quick` measures their own error
+/// against [`CHECK_PANELS`] at its probes).
+const DENSE_PANELS: usize = 4;
+
+/// |E interpolated − E by quadrature| at the direction and roughness coordinates (x, r), and the
+/// (μ, α) of the point: the lookup at the f32 coordinates, the quadrature at the same values.
+fn probe_error(family: Family, x: f64, r: f64) -> (f64, (f64, f64)) {
+    let table = table_of(family);
+    let alpha = (r * r).max(ALPHA_LIMIT);
+    let mu = mu_of(x, alpha);
+    let (mu32, alpha32) = (mu as f32, alpha as f32);
+    let exact = single_scattering_albedo(family, f64::from(mu32), f64::from(alpha32), DENSE_PANELS);
+    let e = (f64::from(table.directional(mu32, alpha32).expect("in range")) - exact).abs();
+    (e, (f64::from(mu32), f64::from(alpha32)))
+}
+
+/// The interpolation error of E_avg at the midpoints between its nodes against quadrature.
+fn average_interpolation_error(family: Family) -> f64 {
+    let table = table_of(family);
+    let nr = table.roughness_nodes();
+    let avg_errors = par_map(nr - 1, &format!("{} E_avg interpolation", family.name()), |j| {
+        let r = (j as f64 + 0.5) / (nr - 1) as f64;
         let exact = average(family, r * r, AVERAGE_PANELS / 2, CHECK_PANELS);
         (f64::from(table.average((r * r) as f32).expect("in range")) - exact).abs()
     });
-    (max, rms, avg_errors.iter().copied().fold(0.0, f64::max))
+    avg_errors.iter().copied().fold(0.0, f64::max)
 }
 
 fn table_of(family: Family) -> microsurface::compensation::AlbedoTable {
@@ -183,13 +263,13 @@ fn source(tables: &[(Family, Tables)]) -> String {
     for (family, t) in tables {
         let upper = family.name().to_uppercase();
         let _ = writeln!(s, "/// E(μ, α) of {}, row-major, roughness slowest.", family.name());
-        let _ = writeln!(s, "pub(crate) static {upper}_DIRECTIONAL: [f32; {}] = [", N * N);
+        let _ = writeln!(s, "pub(crate) static {upper}_DIRECTIONAL: [f32; {}] = [", NX * NR);
         for row in t.directional.chunks(8) {
             let _ =
                 writeln!(s, "    {},", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "));
         }
         let _ = writeln!(s, "];\n/// E_avg(α) of {}.", family.name());
-        let _ = writeln!(s, "pub(crate) static {upper}_AVERAGE: [f32; {N}] = [");
+        let _ = writeln!(s, "pub(crate) static {upper}_AVERAGE: [f32; {NR}] = [");
         for row in t.average.chunks(8) {
             let _ =
                 writeln!(s, "    {},", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "));
@@ -215,10 +295,10 @@ fn export(tables: &[(Family, Tables)], dir: &std::path::Path) -> std::io::Result
 fn write_readme(dir: &std::path::Path) -> std::io::Result<()> {
     let mut readme = String::from(
         "Little-endian f32 arrays, no header.\n\n\
-         <family>_directional.f32: 32 x 32 values E[j][i], j (roughness) slowest.\n\
-         r = j/31, alpha = r^2 (row j = 0: the alpha -> 0 limit profile); x = i/31,\n\
+         <family>_directional.f32: 32 x 94 values E[j][i], j (roughness) slowest.\n\
+         r = j/31, alpha = r^2 (row j = 0: the alpha -> 0 limit profile); x = i/93,\n\
          mu = X alpha/(1 + alpha - X) with X = x^2. Lookup of (mu, alpha):\n\
-         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), bilinear in (x, r) at (31 x, 31 r).\n\
+         x = sqrt(mu (1 + alpha)/(mu + alpha)), r = sqrt(alpha), bilinear in (x, r) at (93 x, 31 r).\n\
          <family>_average.f32: 32 values E_avg[j] at r = j/31, linear in r.\n\n\
          <family>_dielectric_<side>_<reflected|transmitted>.f32: 16 x 16 x 16 values V[l][j][i],\n\
          l (eta) slowest, i (direction) fastest: the single-scattering reflected / transmitted\n\
@@ -413,20 +493,43 @@ fn dielectric_export(
 fn quick() {
     let mut state = 0x9e37_79b9_7f4a_7c15_u64;
     let mut failures = 0;
+    let mut dense_reference: f64 = 0.0;
     for family in [Family::Ggx, Family::Beckmann] {
         let table = table_of(family);
         for _ in 0..QUICK_CELLS {
             state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            let k = (state >> 33) as usize % (N * N);
-            let value = node(family, k % N, k / N, PANELS) as f32;
+            let k = (state >> 33) as usize % (NX * NR);
+            let value = node(family, k % NX, k / NX, PANELS) as f32;
             let shipped = table.directional_nodes()[k];
             if value.to_bits() != shipped.to_bits() {
                 failures += 1;
                 println!("{} node {k}: recomputed {value:?}, shipped {shipped:?}", family.name());
             }
         }
-        let j = (state >> 40) as usize % N;
-        let value = average(family, alpha_of_node(j), AVERAGE_PANELS, PANELS) as f32;
+        // the dense check's probes: a cell centre or an edge midpoint of a pseudo-random cell
+        for _ in 0..QUICK_PROBES {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            let (i, j) = ((state >> 33) as usize % (NX - 1), (state >> 45) as usize % (NR - 1));
+            let (x, r) = match (state >> 60) % 3 {
+                0 => (i as f64 + 0.5, j as f64 + 0.5),
+                1 => (i as f64 + 0.5, j as f64),
+                _ => (i as f64, j as f64 + 0.5),
+            };
+            let (x, r) = (x / (NX - 1) as f64, r / (NR - 1) as f64);
+            let (e, (mu, alpha)) = probe_error(family, x, r);
+            let reference = |panels| single_scattering_albedo(family, mu, alpha, panels);
+            dense_reference = dense_reference.max((reference(DENSE_PANELS) - reference(CHECK_PANELS)).abs());
+            let stated = STATED_E_ERROR[usize::from(family == Family::Beckmann)];
+            if e > stated {
+                failures += 1;
+                println!(
+                    "{} E at μ {mu:.5}, α {alpha:.5}: interpolation error {e:.2e} > {stated:.1e}",
+                    family.name()
+                );
+            }
+        }
+        let j = (state >> 40) as usize % NR;
+        let value = average(family, alpha_of_row(j), AVERAGE_PANELS, PANELS) as f32;
         if value.to_bits() != table.average_nodes()[j].to_bits() {
             failures += 1;
             println!(
@@ -436,6 +539,11 @@ fn quick() {
             );
         }
     }
+    println!(
+        "conductor E: {} probes of the interpolation error within the stated bound; the dense check's \
+         {DENSE_PANELS}-panel reference within {dense_reference:.1e} of {CHECK_PANELS} panels there",
+        2 * QUICK_PROBES
+    );
     let mut dielectric_nodes = 0;
     for family in [Family::Ggx, Family::Beckmann] {
         let table = dielectric_table_of(family);
@@ -534,6 +642,45 @@ fn main() {
         walk_dielectric::probe();
         return;
     }
+    if args.iter().any(|a| a == "--furnace") {
+        furnace::run();
+        return;
+    }
+    if let Some(k) = args.iter().position(|a| a == "--furnace-design") {
+        // --furnace-design NODES [ETA_POWER] [sqrt] [scale-invariant-outside] [scale-invariant-inside]
+        let nodes = args.get(k + 1).and_then(|v| v.parse::<usize>().ok()).unwrap_or(16);
+        let eta_power = args.get(k + 2).and_then(|v| v.parse::<f64>().ok()).unwrap_or(3.0);
+        let si = |name: &str| {
+            if args.iter().any(|a| a == name) {
+                dielectric_axes::Direction::ScaleInvariant
+            } else {
+                dielectric_axes::Direction::Blend
+            }
+        };
+        let axes = Axes {
+            nodes,
+            knee: (7 * (nodes - 1)).div_ceil(15),
+            eta_power,
+            roughness: if args.iter().any(|a| a == "sqrt") { Roughness::Sqrt } else { Roughness::Blend },
+            direction: [si("scale-invariant-outside"), si("scale-invariant-inside")],
+            ..dielectric_axes::SHIPPED
+        };
+        for family in [Family::Ggx, Family::Beckmann] {
+            for side in [Side::Outside, Side::Inside] {
+                let mut at = Vec::new();
+                for &alpha in &furnace::ALPHAS {
+                    for &eta in &furnace::ETAS {
+                        for &mu in &furnace::MUS {
+                            at.push((mu, alpha, if side == Side::Outside { eta } else { 1.0 / eta }));
+                        }
+                    }
+                }
+                let [_, _, (em, er)] = design_error_at(family, side, axes, &at);
+                println!("{} {} {axes:?}: R + T max {em:.2e}, RMS {er:.2e}", family.name(), side.name());
+            }
+        }
+        return;
+    }
     if args.iter().any(|a| a == "--quick") {
         quick();
         return;
@@ -551,6 +698,7 @@ fn main() {
             below_knee: num(6).map_or(dielectric_axes::SHIPPED.below_knee, |v| {
                 if v == 0.0 { BelowKnee::Blend } else { BelowKnee::Symmetric }
             }),
+            direction: dielectric_axes::SHIPPED.direction,
         };
         let points = num(4).map_or(INTERPOLATION_POINTS, |v| v as usize);
         let uniform = args.iter().any(|a| a == "--uniform");
@@ -579,10 +727,17 @@ fn main() {
     if args.iter().any(|a| a == "--interpolation") {
         for family in [Family::Ggx, Family::Beckmann] {
             if conductor {
-                let (max, rms, avg) = interpolation_error(family);
+                for (probe, max, rms, (mu, alpha)) in interpolation_error(family) {
+                    println!(
+                        "{}: interpolation error of E at {probe:?} probes: max {max:.2e} (μ {mu:.4}, α {alpha:.4}), \
+                         RMS {rms:.2e}",
+                        family.name()
+                    );
+                }
                 println!(
-                    "{}: interpolation error at cell centres: E max {max:.2e}, RMS {rms:.2e}; E_avg max {avg:.2e}",
-                    family.name()
+                    "{}: E_avg interpolation error, max {:.2e}",
+                    family.name(),
+                    average_interpolation_error(family)
                 );
             }
             if dielectric {
@@ -686,10 +841,17 @@ type Located = ((f64, f64, f64), [(usize, f64); 3]);
 /// `--design`: the interpolation error of a table design (axes) at `points` measurement points,
 /// computing only the nodes at the corners of the points' cells: (max, RMS) of R, T, R + T.
 fn design_error(family: Family, side: Side, axes: Axes, points: usize, uniform: bool) -> [(f64, f64); 3] {
+    let at: Vec<(f64, f64, f64)> = (0..points).map(|k| measurement_point(k, side, uniform)).collect();
+    design_error_at(family, side, axes, &at)
+}
+
+/// [`design_error`] at the given points (μ, α, η seen).
+fn design_error_at(family: Family, side: Side, axes: Axes, at: &[(f64, f64, f64)]) -> [(f64, f64); 3] {
+    let points = at.len();
     let last = axes.nodes - 1;
-    let located: Vec<Located> = (0..points)
-        .map(|k| {
-            let p = measurement_point(k, side, uniform);
+    let located: Vec<Located> = at
+        .iter()
+        .map(|&p| {
             let at = axes.coordinates(p.0, p.1, p.2);
             (
                 p,

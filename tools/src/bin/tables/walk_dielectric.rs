@@ -247,7 +247,7 @@ pub fn export(tables: &[(Family, Side, Vec<Cell>)], dir: &std::path::Path) -> st
          [1, 3]; r = j/15, alpha = r^2; x = i/15, mu = X alpha/(1 + alpha - X) with X = x^2 (node\n\
          x = 0 estimated at mu = 1e-7). Lookup of (mu, alpha, eta): x = sqrt(mu (1 + alpha)/(mu +\n\
          alpha)), r = sqrt(alpha), u = sqrt((eta - 1)/2), trilinear in (x, r, u) at (15 x, 15 r, 15 u).\n\
-         See microsurface::compensation::DielectricWalkTable and microsurface::KullaContyDielectric.\n",
+         See microsurface::compensation::DielectricWalkTable and microsurface::Compensated.\n",
     )?;
     Ok(())
 }

@@ -1,0 +1,522 @@
+//! The compensated dielectric: the single-scattering microfacet BSDF (reflection and
+//! transmission) plus the energy of the higher orders, built per hit from shared tables
+//! ([`GlassTables`]).
+//!
+//! **The walk's split** ([`Compensation::Walk`], and [`Compensation::KullaConty`], which is the
+//! same for a dielectric): two separable lobes,
+//!
+//! f = f_ss + f_R + f_T,
+//! f_R(ωo, ωi) = ΔR_a(μo) ΔR_a(μi) / (π ΔR̄_a)                (ωi on the view's side a),
+//! f_T(ωo, ωi) = c_a ΔT_a(μo) · ΔT_b(μi) / (π ΔT̄_b)          (ωi on the other side b),
+//!
+//! with ΔR_s, ΔT_s the walk's reflected and transmitted energy of orders ≥ 2 for light from
+//! side s ([`super::DielectricWalkTable`]: the walk of Heitz et al. 2016, supplement §3.4),
+//! ḡ = 2∫₀¹ g(μ) μ dμ of the interpolated row, and μ = |cos θ|: Kulla and Conty's separable
+//! lobe (2017) applied to each side's reflected and transmitted higher orders.
+//!
+//! **Energy** (importance transport, the flux): ∫ f_R cos dωi = ΔR_a(μo) and
+//! ∫ f_T |cos| dωi = c_a ΔT_a(μo) for every view, so the albedo is
+//! R_ss + T_ss + ΔR + c_a ΔT = 1 up to the tables' errors and the factor c_a.
+//!
+//! **Reciprocity.** Detailed balance in a medium of index n (equilibrium radiance ∝ n²) makes
+//! the flux BSDF of a transmission satisfy n_a² f(ωa, ωb) = n_b² f(ωb, ωa) (Veach 1997, §5.2,
+//! in importance form): the rank-1 f_T satisfies it if and only if
+//! n_a² c_a ΔT̄_a = n_b² c_b ΔT̄_b, which the walk's own higher orders satisfy up to the tables'
+//! noise and interpolation. The factors c enforce it exactly: with R = η² ΔT̄_in/ΔT̄_out and
+//! w = v_out/(v_out + v_in), the share of the relative variance v = Var(ΔT̄)/ΔT̄² of the outside
+//! average (from the nodes' standard errors), c_out = 1 + w (R − 1) and c_in = c_out/R: the
+//! noisier side absorbs more of the residual. The albedo from side a errs by (c_a − 1) ΔT_a(μo)
+//! for it; [`Compensated::transmission_mismatch`] reports 1/R − 1.
+//!
+//! **Sampling.** A mixture chosen by the view's energies: per cell of a uniform μ axis of the
+//! view (32 cells) the probabilities of the single-scattering sample, the reflection lobe and
+//! the transmission lobe are E_ss : ΔR_a : ΔT_a at the cell's centre (E_ss = 1 − ΔR − ΔT, at
+//! least 1e-3 of the total), blended bilinearly between the four (roughness, index) rows of
+//! the tables around the hit; each lobe samples its light profile g(μi) μi on its hemisphere as
+//! the mixture of the four rows' profiles (each at its row's α, chosen with probability
+//! ∝ blend weight × mass), each a density continuous and linear in μi² on the cells of the
+//! uniform μ axis (alias method). `pdf` is the exact mixture density, and a sample's weight is
+//! f·|cos θi|/pdf at its direction.
+//!
+//! **Turquin** ([`Compensation::Turquin`]): f = f_ss/E(μo), E = R + T of the single-scattering
+//! dielectric tables ([`super::DielectricAlbedoTable`]) on the view's side, interpolated
+//! trilinearly at (μo, α, η); `pdf` and `sample` are those of single scattering. With
+//! [`Transport::Importance`] the expected sample weight is 1 for every view, up to the table's
+//! interpolation error relative to E. Near η = 1 at grazing views E → 0: where f_ss/E would not
+//! be a finite f32 the BSDF answers 0 (and `sample` `None`).
+
+use super::compensated::{Compensated, CompensatedMaterial, Compensation};
+use super::glass_tables::{GlassSide, GlassTables};
+use super::lobe_profile::mu_cell;
+use super::shared::{ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
+use crate::albedo::{
+    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable,
+    MAX_TABULATED_ETA, node_cell,
+};
+use crate::bsdf::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, unit_directions, unit_view,
+};
+use crate::compensation::AlbedoTabulated;
+use crate::error::Error;
+use crate::material::{Dielectric, Side};
+use crate::single_scattering::SingleScattering;
+use crate::slope::MicrosurfaceSlope;
+use core::f32::consts::PI;
+use glam::{Vec2, Vec3, Vec4};
+
+/// Nodes per axis of the dielectric tables.
+const N: usize = DIELECTRIC_TABLE_SIZE;
+/// The last node index, as a float.
+const LAST: f32 = (N - 1) as f32;
+
+/// The per-hit state of a compensated dielectric.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DielectricLobes {
+    tables: Shared<GlassTables>,
+    /// Whether the lobes answer (a rough surface and η ≠ 1).
+    active: bool,
+    /// The table side (0: η ≥ 1, 1: η ≤ 1) of a view from outside (0) and inside (1).
+    table_side: [usize; 2],
+    /// η_wi/η_wo of a transmission from outside (η) and from inside (1/η).
+    transmitted_eta: [f32; 2],
+    /// The walk tables' cell: the row index l·16 + j of the lower (roughness, index) corner,
+    /// the roughness cell and its fraction, and the index fraction.
+    corner: usize,
+    walk_row: (usize, f32),
+    walk_u: f32,
+    /// α of the walk tables' direction axis, and 1 + α.
+    alpha: f32,
+    one_plus_alpha: f32,
+    /// The added lobes' scales per view side: [1/(π ΔR̄_a), c_a/(π ΔT̄_b) × transport].
+    scales: [[f32; 2]; 2],
+    /// [c_a/(π ΔT̄_b)] before the transport factor, per view side.
+    transmitted_scale: [f32; 2],
+    /// c_a per view side.
+    c: [f32; 2],
+    /// Per view side and crossing: the probabilities of the four rows' profiles (lower
+    /// corner, +r, +u, +r +u) in the light's sampler, cumulated.
+    corners: [[Vec4; 2]; 2],
+    /// 1/R − 1, the tables' reciprocity residual.
+    mismatch: f32,
+    /// Turquin: the single-scattering tables' cell (node of the lower corner, roughness and
+    /// index fractions) and each view side's direction axis.
+    single_base: usize,
+    single_f: (f32, f32),
+    single_axis: [DielectricDirection; 2],
+}
+
+impl DielectricLobes {
+    /// The lobes of a Dirac lobe: none.
+    #[inline(always)]
+    fn none(tables: &'static GlassTables, eta: f32) -> Self {
+        Self {
+            tables: Shared(tables),
+            active: false,
+            table_side: [0, 1],
+            transmitted_eta: [eta, 1.0 / eta],
+            corner: 0,
+            walk_row: (0, 0.0),
+            walk_u: 0.0,
+            alpha: 1.0,
+            one_plus_alpha: 2.0,
+            scales: [[0.0; 2]; 2],
+            transmitted_scale: [0.0; 2],
+            c: [1.0; 2],
+            corners: [[Vec4::ONE; 2]; 2],
+            mismatch: 0.0,
+            single_base: 0,
+            single_f: (0.0, 0.0),
+            single_axis: [DielectricDirection::Outside; 2],
+        }
+    }
+
+    /// The tables of the table side of a view side.
+    #[inline(always)]
+    fn side(&self, view: usize) -> &GlassSide {
+        &self.tables.0.sides[self.table_side[view]]
+    }
+
+    /// The direction coordinates of two cosines in [0, 1] from one division.
+    #[inline(always)]
+    fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
+        let (so, si) = (mu_o + self.alpha, mu_i + self.alpha);
+        let inv = self.one_plus_alpha / (so * si);
+        ((mu_o * si * inv).min(1.0).sqrt(), (mu_i * so * inv).min(1.0).sqrt())
+    }
+
+    /// The walk table's value of quantity q (ΔR, ΔT) of view side `view` at direction
+    /// coordinate x: trilinear at this hit's (roughness, index) cell.
+    #[inline(always)]
+    fn walk(&self, view: usize, q: usize, x: f32) -> f32 {
+        let grid = self.side(view).walk[q];
+        let (i, fx) = node_cell(x * LAST, N);
+        let base = self.corner * N + i;
+        let (fr, fu) = (self.walk_row.1, self.walk_u);
+        let at = |k: usize| grid[k] + fx * (grid[k + 1] - grid[k]);
+        let near = at(base) + fr * (at(base + N) - at(base));
+        let far = at(base + N * N) + fr * (at(base + N * N + N) - at(base + N * N));
+        near + fu * (far - near)
+    }
+
+    /// The added lobe f_R or f_T for a view on side `a` and a light crossing (`c` = 1) or not,
+    /// both off the horizon.
+    #[inline(always)]
+    fn added(&self, a: usize, c: usize, mu_o: f32, mu_i: f32) -> f32 {
+        let (xo, xi) = self.coordinates(mu_o, mu_i);
+        // the light's factor: ΔR of the view's side, or ΔT of the other side
+        let light = self.walk(a ^ c, c, xi);
+        self.walk(a, c, xo) * light * self.scales[a][c]
+    }
+
+    /// The mixture's probabilities (single, reflection, transmission) of a view on side `a`
+    /// with |cos θo| = `mu_o`: bilinear in the tables' rows at the centre of its μ cell.
+    #[inline(always)]
+    fn mixture(&self, a: usize, mu_o: f32) -> Vec4 {
+        let rows = &self.side(a).rows;
+        let k = mu_cell(mu_o);
+        let n = self.corner;
+        let (fr, fu) = (self.walk_row.1, self.walk_u);
+        let near = rows[n].mixture[k].lerp(rows[n + 1].mixture[k], fr);
+        let far = rows[n + N].mixture[k].lerp(rows[n + N + 1].mixture[k], fr);
+        near.lerp(far, fu)
+    }
+
+    /// The density of the light's profile for a view on side `a` and a light crossing (`c`)
+    /// or not, at |cos θi| = `mu_i`.
+    #[inline(always)]
+    fn profile_pdf(&self, a: usize, c: usize, mu_i: f32) -> f32 {
+        let rows = &self.side(a ^ c).rows;
+        let n = self.corner;
+        let cum = self.corners[a][c];
+        let w = Vec4::new(cum.x, cum.y - cum.x, cum.z - cum.y, cum.w - cum.z);
+        let p = Vec4::new(
+            rows[n].profiles[c].pdf(mu_i),
+            rows[n + 1].profiles[c].pdf(mu_i),
+            rows[n + N].profiles[c].pdf(mu_i),
+            rows[n + N + 1].profiles[c].pdf(mu_i),
+        );
+        w.dot(p)
+    }
+
+    /// The mixture density at wi (off the horizon) for a view on side `a` with probabilities
+    /// `p` and single scattering's density `pdf_ss`.
+    #[inline(always)]
+    fn mixture_pdf(&self, a: usize, p: Vec4, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        let c = crossing(wo, wi);
+        p.x * pdf_ss + p[1 + c] * self.profile_pdf(a, c, wi.z.abs())
+    }
+
+    /// E = R + T of the single-scattering tables for a view on side `a` at |cos θo| = `mu`.
+    #[inline(always)]
+    fn single_albedo(&self, a: usize, mu: f32) -> f32 {
+        let grid = &self.side(a).single;
+        let x = self.single_axis[a].coordinate(mu);
+        let (i, fx) = node_cell(x * LAST, N);
+        let base = self.single_base + i;
+        let (fr, fu) = self.single_f;
+        let at = |k: usize| grid[k] + fx * (grid[k + 1] - grid[k]);
+        let near = at(base) + fr * (at(base + N) - at(base));
+        let far = at(base + N * N) + fr * (at(base + N * N + N) - at(base + N * N));
+        near + fu * (far - near)
+    }
+}
+
+/// Whether the light crosses the interface (1) or stays on the view's side (0).
+#[inline(always)]
+fn crossing(wo: Vec3, wi: Vec3) -> usize {
+    usize::from((wi.z > 0.0) != (wo.z > 0.0))
+}
+
+/// The index of the view's side: outside (0), inside (1).
+#[inline(always)]
+fn side_of(wo: Vec3) -> usize {
+    usize::from(wo.z < 0.0)
+}
+
+/// The cumulated probabilities of four corners with bilinear weights (fr, fu) and masses m.
+#[inline(always)]
+fn corner_probabilities(fr: f32, fu: f32, m: [f32; 4]) -> Vec4 {
+    let w = Vec4::new((1.0 - fr) * (1.0 - fu), fr * (1.0 - fu), (1.0 - fr) * fu, fr * fu) * Vec4::from(m);
+    let total = w.element_sum();
+    if total > 0.0 {
+        let w = w / total;
+        Vec4::new(w.x, w.x + w.y, w.x + w.y + w.z, 1.0)
+    } else {
+        Vec4::ONE
+    }
+}
+
+impl CompensatedMaterial for Dielectric {
+    type Lobes = DielectricLobes;
+
+    fn lobes<S: AlbedoTabulated>(
+        single: &MicrofacetBsdf<S, Self>,
+        scheme: Compensation,
+    ) -> Result<DielectricLobes, Error> {
+        let eta = single.surface().material().eta();
+        if !(1.0 / MAX_TABULATED_ETA..=MAX_TABULATED_ETA).contains(&eta) {
+            return Err(eta_error(eta));
+        }
+        let tables = GlassTables::of(S::DIELECTRIC_WALK.family());
+        let mut lobes = DielectricLobes::none(tables, eta);
+        // a Dirac lobe is not compensated (and √(αx αy) may underflow to 0 there)
+        if single.is_specular() {
+            return Ok(lobes);
+        }
+        lobes.active = true;
+        let alpha = single.surface().slope().albedo_alpha();
+        let eta_ge_1 = eta.max(1.0 / eta);
+        // the table side seen from outside (η) and from inside (1/η)
+        lobes.table_side = if eta >= 1.0 { [0, 1] } else { [1, 0] };
+        if scheme == Compensation::Turquin {
+            let (j, fr) = node_cell(DielectricAlbedoTable::roughness_node(alpha), N);
+            let (l, fu) = node_cell(DielectricAlbedoTable::eta_node(eta_ge_1), N);
+            lobes.single_base = (l * N + j) * N;
+            lobes.single_f = (fr, fu);
+            lobes.single_axis = [DielectricDirection::of(eta), DielectricDirection::of(1.0 / eta)];
+            return Ok(lobes);
+        }
+        let row = node_cell(DielectricWalkTable::roughness_node(alpha), N);
+        let (l, fu) = node_cell(DielectricWalkTable::eta_node(eta_ge_1), N);
+        lobes.corner = l * N + row.0;
+        lobes.walk_row = row;
+        lobes.walk_u = fu;
+        lobes.alpha = alpha;
+        lobes.one_plus_alpha = 1.0 + alpha;
+        // the averages [ΔR̄, ΔT̄, Var(ΔT̄)] of each view side, blended in u
+        let average = |view: usize| {
+            let side = lobes.side(view);
+            let (a, b) = (side.averages_at(l, row), side.averages_at(l + 1, row));
+            let mean = a.lerp(b, fu);
+            Vec4::new(mean.x, mean.y, (1.0 - fu) * (1.0 - fu) * a.z + fu * fu * b.z, 0.0)
+        };
+        // (not `array::map`, whose closures are not inlined)
+        let averages = [average(0), average(1)];
+        // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in (n_out = 1, n_in = η)
+        let (m_out, m_in) = (averages[0].y, eta * eta * averages[1].y);
+        let c = if m_out > 0.0 && m_in > 0.0 {
+            let ratio = m_in / m_out;
+            let (v_out, v_in) = (
+                averages[0].z / (averages[0].y * averages[0].y),
+                averages[1].z / (averages[1].y * averages[1].y),
+            );
+            let w = if v_out + v_in > 0.0 { v_out / (v_out + v_in) } else { 0.5 };
+            lobes.mismatch = 1.0 / ratio - 1.0;
+            let c_out = 1.0 + w * (ratio - 1.0);
+            [c_out, c_out / ratio]
+        } else {
+            [0.0, 0.0]
+        };
+        lobes.c = c;
+        for view in 0..2 {
+            let (r_avg, t_other) = (averages[view].x, averages[1 - view].y);
+            lobes.scales[view][0] = if r_avg > 0.0 { 1.0 / (PI * r_avg) } else { 0.0 };
+            lobes.transmitted_scale[view] = if t_other > 0.0 { c[view] / (PI * t_other) } else { 0.0 };
+        }
+        // the light profiles' rows: reflection on the view's side, transmission on the other
+        let n = row.0 + l * N;
+        for view in 0..2 {
+            for cross in 0..2 {
+                let rows = &lobes.side(view ^ cross).rows;
+                let m = [rows[n].masses[cross], rows[n + 1].masses[cross], rows[n + N].masses[cross], rows[n + N + 1].masses[cross]];
+                lobes.corners[view][cross] = corner_probabilities(row.1, fu, m);
+            }
+        }
+        Ok(DielectricLobes::with_transport(lobes, Transport::Radiance))
+    }
+
+    #[inline]
+    fn lobes_with_transport(lobes: DielectricLobes, transport: Transport) -> DielectricLobes {
+        DielectricLobes::with_transport(lobes, transport)
+    }
+}
+
+impl DielectricLobes {
+    /// The transmission scales for `transport`: (η_wo/η_wi)² for radiance, from outside 1/η²
+    /// and from inside η².
+    #[inline(always)]
+    fn with_transport(mut self, transport: Transport) -> Self {
+        let eta = self.transmitted_eta[0];
+        let factors = match transport {
+            Transport::Radiance => [1.0 / (eta * eta), eta * eta],
+            Transport::Importance => [1.0, 1.0],
+        };
+        for ((scales, transmitted), factor) in self.scales.iter_mut().zip(self.transmitted_scale).zip(factors)
+        {
+            scales[1] = transmitted * factor;
+        }
+        self
+    }
+}
+
+/// The compensated dielectric's queries.
+impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
+    /// ΔT̄_out/(η² ΔT̄_in) − 1: how far the interpolated walk tables are from the reciprocity of
+    /// the walk's higher orders (0 without transmission lobes, and for Turquin's scheme).
+    pub fn transmission_mismatch(&self) -> f32 {
+        self.lobes.mismatch
+    }
+
+    /// The added albedo (ΔR, c ΔT) of a view with |cos θo| = μ ∈ [0, 1] on `side`, as this
+    /// BSDF interpolates it (importance transport); `None` outside [0, 1] (NaN included) and
+    /// for Turquin's scheme.
+    pub fn higher_orders(&self, mu: f32, side: Side) -> Option<(f32, f32)> {
+        if !(0.0..=1.0).contains(&mu) || self.scheme == Compensation::Turquin {
+            return None;
+        }
+        let l = &self.lobes;
+        if !l.active {
+            return Some((0.0, 0.0));
+        }
+        let a = usize::from(side == Side::Inside);
+        let x = l.coordinates(mu, mu).0;
+        Some((l.walk(a, 0, x), l.c[a] * l.walk(a, 1, x)))
+    }
+
+    /// E(μo) = R + T of the single-scattering tables for a view on `side`
+    /// ([`Side::Outside`]: above the surface, seeing η; [`Side::Inside`]: below it, seeing
+    /// 1/η), as Turquin's scheme interpolates it, for μo = |cos θo| ∈ [0, 1]; `None` outside
+    /// (NaN included) and for the other schemes.
+    pub fn directional_albedo(&self, mu: f32, side: Side) -> Option<f32> {
+        if !(0.0..=1.0).contains(&mu) || self.scheme != Compensation::Turquin {
+            return None;
+        }
+        if !self.lobes.active {
+            return Some(1.0);
+        }
+        Some(self.lobes.single_albedo(usize::from(side == Side::Inside), mu))
+    }
+
+    /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
+    /// horizon.
+    #[inline(always)]
+    fn compensates(&self, wo: Vec3, wi: Vec3) -> bool {
+        self.lobes.active && wo.z != 0.0 && wi.z != 0.0
+    }
+
+    /// Turquin's factor 1/E(μo) for the view `wo` (1 on the horizon, where f_ss = 0).
+    #[inline(always)]
+    fn turquin_factor(&self, wo: Vec3) -> f32 {
+        if wo.z == 0.0 || !self.lobes.active {
+            return 1.0;
+        }
+        1.0 / self.lobes.single_albedo(side_of(wo), wo.z.abs())
+    }
+
+    /// f·factor, or 0 where it is not a finite f32 (see Turquin's special cases).
+    #[inline(always)]
+    fn scaled(v: BsdfValue, factor: f32) -> BsdfValue {
+        let f = v.f * factor;
+        BsdfValue { f: if f.is_finite() { f } else { Vec3::ZERO }, exact: v.exact }
+    }
+
+    /// Single scattering's density at valid directions off the horizon of a rough surface:
+    /// its research-layer density without the trait's repeated checks (the same bits as
+    /// `self.single.pdf(wo, wi)`).
+    #[inline(always)]
+    fn single_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let surface = self.single.surface();
+        let pdf = SingleScattering::new(*surface.slope(), *surface.material()).pdf_unchecked(wo, wi);
+        if pdf.is_finite() { pdf } else { 0.0 }
+    }
+}
+
+/// The value of invalid arguments (the documented nothing of [`Bsdf::eval`]).
+const NOTHING: BsdfValue = BsdfValue { f: Vec3::ZERO, exact: true };
+
+impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
+    #[inline]
+    fn flags(&self) -> BsdfFlags {
+        self.single.flags()
+    }
+
+    #[inline]
+    fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
+        unit_directions!(wo, wi, NOTHING, self.eval_keyed(wo, wi, key));
+        if self.scheme == Compensation::Turquin {
+            return Self::scaled(self.single.eval_valid(wo, wi, key), self.turquin_factor(wo));
+        }
+        let v = self.single.eval_valid(wo, wi, key);
+        if !self.compensates(wo, wi) {
+            return v;
+        }
+        let f = self.lobes.added(side_of(wo), crossing(wo, wi), wo.z.abs(), wi.z.abs());
+        BsdfValue { f: v.f + Vec3::splat(f), exact: true }
+    }
+
+    #[inline]
+    fn sample_keyed(&self, wo: Vec3, uc: f32, u: Vec2, key: u64) -> Option<BsdfSample> {
+        unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, key));
+        if self.scheme == Compensation::Turquin {
+            let s = self.single.sample_keyed(wo, uc, u, key)?;
+            if s.flags.specular {
+                return Some(s);
+            }
+            let weight = s.weight * self.turquin_factor(wo);
+            return weight.is_finite().then_some(BsdfSample { weight, ..s });
+        }
+        let lobes = &self.lobes;
+        if !lobes.active || wo.z == 0.0 {
+            return self.single.sample_keyed(wo, uc, u, key);
+        }
+        let a = side_of(wo);
+        let p = lobes.mixture(a, wo.z.abs());
+        let (wi, f_cos_ss, pdf_ss) = if uc < p.x {
+            // the single-scattering lobe: its sample carries f·|cos θi| (weight × pdf) and its
+            // density
+            let s = self.single.sample_keyed(wo, (uc / p.x).min(ONE_MINUS_ULP), u, key)?;
+            (s.wi, s.weight * s.pdf, s.pdf)
+        } else {
+            // the added lobe of the light's side, and one of its four rows' profiles by the
+            // rest of uc (its cumulated probabilities scaled to the lobe's share: no division)
+            let c = usize::from(uc >= p.x + p.y);
+            let (start, share) = if c == 0 { (p.x, p.y) } else { (p.x + p.y, p.z) };
+            let cum = lobes.corners[a][c] * share;
+            let v = uc - start;
+            let corner = usize::from(v >= cum.x) + usize::from(v >= cum.y) + usize::from(v >= cum.z);
+            let n = lobes.corner + [0, 1, N, N + 1][corner];
+            let w = lobes.side(a ^ c).rows[n].profiles[c].sample(u)?;
+            // its direction on the view's side, mirrored through the interface for a
+            // transmission
+            let wi = if (wo.z > 0.0) == (c == 0) { w } else { -w };
+            // f and the density as eval and pdf compute them
+            (wi, self.single.eval_keyed(wo, wi, key).f * wi.z.abs(), self.single_pdf(wo, wi))
+        };
+        if wi.z == 0.0 {
+            return None;
+        }
+        let c = crossing(wo, wi);
+        let f_cos = f_cos_ss + Vec3::splat(lobes.added(a, c, wo.z.abs(), wi.z.abs()) * wi.z.abs());
+        let eta = lobes.transmitted_eta[a];
+        mixture_sample(wo, wi, f_cos, lobes.mixture_pdf(a, p, wo, wi, pdf_ss), eta)
+    }
+
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
+        if self.scheme == Compensation::Turquin || !self.compensates(wo, wi) {
+            return self.single.pdf(wo, wi);
+        }
+        let a = side_of(wo);
+        let p = self.lobes.mixture(a, wo.z.abs());
+        self.lobes.mixture_pdf(a, p, wo, wi, self.single_pdf(wo, wi))
+    }
+
+    #[inline]
+    fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
+        unit_directions!(wo, wi, (NOTHING, 0.0), self.eval_with_pdf_keyed(wo, wi, key));
+        let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
+        if self.scheme == Compensation::Turquin {
+            return (Self::scaled(v, self.turquin_factor(wo)), pdf_ss);
+        }
+        if !self.compensates(wo, wi) {
+            return (v, pdf_ss);
+        }
+        let a = side_of(wo);
+        let c = crossing(wo, wi);
+        let p = self.lobes.mixture(a, wo.z.abs());
+        let pdf = self.lobes.mixture_pdf(a, p, wo, wi, pdf_ss);
+        let f = self.lobes.added(a, c, wo.z.abs(), wi.z.abs());
+        (BsdfValue { f: v.f + Vec3::splat(f), exact: true }, pdf)
+    }
+}

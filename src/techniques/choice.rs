@@ -100,7 +100,7 @@ impl Candidates {
         };
         let isotropic = slope.alpha_x() == slope.alpha_y();
         let compensated = match single {
-            Some(e) if isotropic => material.compensated_bound().map(|b| b.at(e)),
+            Some(_) if isotropic => material.compensated_error::<S>(),
             _ => None,
         };
         Ok(Self { single, compensated, compensated_cost: costs.compensated, walk_cost: costs.walk })
@@ -130,8 +130,8 @@ impl Choice {
     ///   conductor's); dielectrics 1 − Ā_ss of the
     ///   [`DielectricAlbedoTable`](crate::compensation::DielectricAlbedoTable) (the walk
     ///   conserves the flux), the worse side.
-    /// * The compensated lobe's error: a bound proportional to single scattering's plus a
-    ///   floor, measured against the walk (the page [`techniques`](super) gives the figures).
+    /// * The compensated lobe's error: a bound per slope family and material class, measured
+    ///   against the walk (the page [`techniques`](super) gives the figures).
     /// * Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes: single scattering, error 0.
     /// * Anisotropic slopes are rated as the isotropic surface of their largest roughness
     ///   (single scattering loses more as α grows), and never get the compensated lobe (it

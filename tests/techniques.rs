@@ -69,8 +69,10 @@ fn choices_on_the_table_grid_follow_the_shipped_tables() {
                 }
                 .unwrap();
                 let single = cand.single.expect("within the tables");
-                // the node value, up to the interpolation weight of a node computed through √α
-                assert!((single - (1.0 - e_avg)).abs() <= 1e-6, "{name} node {j}: {single} vs {}", 1.0 - e_avg);
+                // the node value plus the interpolation error of Ē (3.0e-4, `AlbedoTable::average`),
+                // up to the interpolation weight of a node computed through √α
+                let expected = 1.0 - e_avg + 3e-4;
+                assert!((single - expected).abs() <= 1e-6, "{name} node {j}: {single} vs {expected}");
                 let comp = cand.compensated.expect("isotropic, within the tables");
                 assert!(comp >= 0.0 && comp.is_finite());
                 // the rule on the node values
@@ -137,6 +139,8 @@ struct Point {
     bsdfs: [Box<dyn Bsdf>; 3],
     sides: &'static [bool],
     candidates: Candidates,
+    /// Views per technique and side (the dielectrics' weights vary more).
+    n: usize,
 }
 
 fn conductor_point<S: WalkTabulated + 'static>(label: &'static str, slope: S, c: Conductor) -> Point {
@@ -149,6 +153,7 @@ fn conductor_point<S: WalkTabulated + 'static>(label: &'static str, slope: S, c:
         ],
         sides: &[false],
         candidates: Candidates::new(&slope, &c).unwrap(),
+        n: 1 << 16,
     }
 }
 
@@ -164,6 +169,7 @@ fn glass_point<S: WalkTabulated + 'static>(label: &'static str, slope: S, eta: f
         ],
         sides: &[false, true],
         candidates: Candidates::new(&slope, &d).unwrap(),
+        n: 1 << 17,
     }
 }
 
@@ -181,7 +187,6 @@ fn stated_errors_hold_against_the_walk() {
         glass_point("ggx glass 1.5 α 0.45", Ggx::isotropic(0.45).unwrap(), 1.5),
         glass_point("beckmann glass 1.7 α 0.25", Beckmann::isotropic(0.25).unwrap(), 1.7),
     ];
-    let n = 1 << 14;
     let tests: usize = points.iter().map(|p| 2 * 3 * p.sides.len()).sum();
     // one-sided tests: the two-sided z at twice the level
     let z = family_z(2.0 * 1e-3, tests);
@@ -189,13 +194,14 @@ fn stated_errors_hold_against_the_walk() {
         let stated = [p.candidates.single.unwrap(), p.candidates.compensated.unwrap()];
         for &below in p.sides {
             let seed = 100 * k as u64 + u64::from(below);
+            let n = p.n;
             let walk = hemispherical(p.bsdfs[2].as_ref(), below, n, seed);
             for (t, name) in [(0, "single scattering"), (1, "compensated")] {
                 let est = hemispherical(p.bsdfs[t].as_ref(), below, n, seed + 50);
                 for c in 0..3 {
                     let diff = (est[c].mean() - walk[c].mean()).abs();
                     let se = est[c].se().hypot(walk[c].se());
-                    assert!(se <= 2.5e-3, "{}: {name} SE {se} too large to test a bound", p.label);
+                    assert!(se <= 1.5e-3, "{}: {name} SE {se} too large to test a bound", p.label);
                     assert!(
                         diff <= f64::from(stated[t]) + z * se,
                         "{} (below: {below}) channel {c}: {name} |Ā − Ā_walk| = {diff:.5} (N = {n}, walk {:.5}, \

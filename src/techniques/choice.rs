@@ -129,8 +129,8 @@ impl Choice {
     ///   [`AlbedoTable`](crate::compensation::AlbedoTable) (the F = 1 loss, which bounds every
     ///   conductor's) plus the interpolation error of Ē (3 · 10⁻⁴); dielectrics 1 − Ā_ss of
     ///   the [`DielectricAlbedoTable`](crate::compensation::DielectricAlbedoTable) (the walk
-    ///   conserves the flux, Ā_ss by a 64-point rule in μ²), the worse side, plus a margin
-    ///   for the table's interpolation measured against the walk (0.002 GGX, 0.005 Beckmann).
+    ///   conserves the flux, Ā_ss by a 64-point rule in μ²), the worse side, plus 2 % of
+    ///   it for the table's interpolation (measured against the walk).
     /// * The compensated lobe's error: a bound per slope family and material class, measured
     ///   against the walk (the page [`techniques`](super) gives the figures).
     /// * Surfaces smoother than [`SMOOTH_ALPHA`] are Dirac lobes: single scattering, error 0.

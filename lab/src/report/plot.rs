@@ -4,7 +4,9 @@
 
 use super::configure::{Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, THETAS};
 use super::reduce::{LobePanel, Results};
+use super::decision;
 use super::tables::{self, Family, Tabulated};
+use microsurface::techniques::ChosenTechnique;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -97,6 +99,7 @@ pub fn figures(results: &Results, budget: &Budget) -> PlotResult<Vec<Figure>> {
         figures.push(lobes(results, material, budget)?);
     }
     figures.push(table_errors(results, budget)?);
+    figures.push(decision_map()?);
     Ok(figures)
 }
 
@@ -441,4 +444,89 @@ fn table_errors(results: &Results, budget: &Budget) -> PlotResult<Figure> {
         root.present()?;
     }
     Ok(Figure { file: "albedo_tables.svg".into(), svg, title })
+}
+
+/// The colour of a chosen technique on the decision map.
+fn technique_color(t: ChosenTechnique) -> RGBColor {
+    match t {
+        ChosenTechnique::SingleScattering => LIGHT,
+        ChosenTechnique::Compensated => PALETTE[1],
+        ChosenTechnique::RandomWalk => PALETTE[0],
+    }
+}
+
+/// The technique chooser's decision map: one panel per budget, α across, slope family and
+/// material down, the chosen technique coloured.
+fn decision_map() -> PlotResult<Figure> {
+    let rows = decision::map();
+    let alphas = decision::alphas();
+    let (w, h) = (1380u32, 120 + 34 * rows.len() as u32);
+    let title = "Technique chooser: the cheapest technique within an albedo error budget".to_string();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (header, grid) = root.split_vertically(96);
+        text_lines(
+            &header,
+            &[
+                title.clone(),
+                "microsurface::techniques::Choice per slope family and material (rows) and roughness α (log axis); error: the hemispherical albedo error against the walk.".to_string(),
+            ],
+            (12, 8),
+            15,
+            22,
+        )?;
+        for (k, t) in [ChosenTechnique::SingleScattering, ChosenTechnique::Compensated, ChosenTechnique::RandomWalk]
+            .into_iter()
+            .enumerate()
+        {
+            legend_entry(&header, (12 + k as i32 * 220, 76), technique_color(t), false, decision::short(t))?;
+        }
+        let panels = grid.split_evenly((1, decision::BUDGETS.len()));
+        let step = (alphas[1] / alphas[0]).sqrt();
+        for (b, budget) in decision::BUDGETS.iter().enumerate() {
+            let labels: Vec<String> = rows.iter().map(|r| r.label.clone()).collect();
+            let n = rows.len() as f64;
+            let mut chart = ChartBuilder::on(&panels[b])
+                .caption(format!("budget {:.1} %", budget * 100.0), (FONT, 16))
+                .margin(6)
+                .margin_right(14)
+                .x_label_area_size(42)
+                .y_label_area_size(if b == 0 { 150 } else { 8 })
+                .build_cartesian_2d(
+                    (f64::from(alphas[0] / step)..f64::from(alphas[alphas.len() - 1] * step)).log_scale(),
+                    0.0..n,
+                )?;
+            chart
+                .configure_mesh()
+                .x_desc("α")
+                .x_labels(4)
+                .y_labels(rows.len())
+                .x_label_formatter(&|v| format!("{v:.2}"))
+                .y_label_formatter(&|v| {
+                    let i = (n - v - 0.5).round();
+                    if b == 0 && (0.0..n).contains(&i) && (n - v - 0.5 - i).abs() < 1e-6 {
+                        labels[i as usize].clone()
+                    } else {
+                        String::new()
+                    }
+                })
+                .label_style((FONT, 13))
+                .axis_desc_style((FONT, 15))
+                .disable_mesh()
+                .draw()?;
+            for (i, row) in rows.iter().enumerate() {
+                let y = n - i as f64;
+                chart.draw_series(row.choices[b].iter().zip(&alphas).map(|(c, &a)| {
+                    Rectangle::new(
+                        [(f64::from(a / step), y - 0.92), (f64::from(a * step), y - 0.08)],
+                        technique_color(c.technique).filled(),
+                    )
+                }))?;
+            }
+        }
+        root.present()?;
+    }
+    Ok(Figure { file: "decision_map.svg".into(), svg, title })
 }

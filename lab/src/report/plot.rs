@@ -37,6 +37,7 @@ const FONT: &str = "sans-serif";
 fn est_color(est: Est) -> RGBColor {
     match est {
         Est::Single => GRAY,
+        Est::Compensated => PALETTE[5],
         Est::Walk => PALETTE[0],
         Est::PtUncorrelated => PALETTE[1],
         Est::PtCorrelated => PALETTE[2],
@@ -152,11 +153,11 @@ fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResu
         for (k, est) in Est::ALL.iter().enumerate() {
             let (col, row) = (k % 2, k / 2);
             let at = (12 + col as i32 * 530, 80 + row as i32 * 22);
-            legend_entry(&header, at, est_color(*est), *est == Est::Single, est.label())?;
+            legend_entry(&header, at, est_color(*est), est.is_biased(), est.label())?;
         }
         legend_entry(
             &header,
-            (12, 80 + 3 * 22),
+            (542, 80 + 3 * 22),
             BLACK,
             true,
             "slope −½ (the Monte Carlo rate), through the walk's first point",
@@ -198,7 +199,7 @@ fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResu
                     .map(|p| (p.seconds, p.rel_rmse))
                     .collect();
                 let style = est_color(est).stroke_width(2);
-                if est == Est::Single {
+                if est.is_biased() {
                     chart.draw_series(DashedLineSeries::new(points, 6, 4, style))?;
                 } else {
                     chart.draw_series(LineSeries::new(points, style))?;

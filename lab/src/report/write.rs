@@ -98,7 +98,7 @@ fn ratio_table(results: &Results) -> Table {
 }
 
 fn choice_table(results: &Results) -> Table {
-    let ests: Vec<Est> = Est::ALL.into_iter().filter(|&e| e != Est::Single).collect();
+    let ests: Vec<Est> = Est::ALL.into_iter().filter(|&e| !e.is_biased()).collect();
     let mut header = vec!["configuration".to_string()];
     header.extend(ests.iter().map(|e| e.name().to_string()));
     header.push("most efficient".into());
@@ -178,7 +178,7 @@ fn cost(conductor: bool, t: ChosenTechnique) -> f32 {
 
 fn efficiency_table(results: &Results) -> Table {
     let mut header = vec!["configuration".to_string(), "θi".into(), "ωo".into()];
-    header.extend(Est::ALL.iter().filter(|&&e| e != Est::Single).map(|e| e.name().to_string()));
+    header.extend(Est::ALL.iter().filter(|&&e| !e.is_biased()).map(|e| e.name().to_string()));
     let rows = results
         .efficiency
         .iter()
@@ -189,7 +189,7 @@ fn efficiency_table(results: &Results) -> Table {
                 walk.case.theta_i().to_string(),
                 walk.case.wo.name().into(),
             ];
-            for est in Est::ALL.into_iter().filter(|&e| e != Est::Single) {
+            for est in Est::ALL.into_iter().filter(|&e| !e.is_biased()) {
                 let e = results.row(walk.case, est).and_then(|r| r.efficiency).unwrap_or(f64::NAN);
                 row.push(format!("{e:.3e}"));
             }
@@ -599,8 +599,9 @@ pub fn write(
         html.push_str(&figure_html(f, &f.title));
     }
     html.push_str("<h2 id=\"error-vs-time\">Error against run time</h2>\n<p>One panel per (θi, ωo) that the ratios average. \
-        Single scattering is a different model: its curve is that model's error against the walk's converged reference (a bias that \
-        no number of samples removes), not a Monte Carlo error.</p>\n");
+        Single scattering and the compensated lobe (conductors) are deterministic models other than the walk: their curves \
+        are their error against the walk's converged reference at their cost (a bias that no number of samples removes: the floor \
+        an unbiased estimator reaches in that time), not a Monte Carlo error.</p>\n");
     for f in figures.iter().filter(|f| f.file.starts_with("error_vs_time")) {
         html.push_str(&figure_html(f, &f.title));
     }

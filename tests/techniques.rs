@@ -97,9 +97,15 @@ fn choices_on_the_table_grid_follow_the_shipped_tables() {
     }
     // beyond the tables: the walk, whatever the budget; beyond the walk: refused
     let rough = Ggx::isotropic(MAX_TABULATED_ALPHA * 1.5).unwrap();
-    assert_eq!(Choice::new(&rough, &Conductor::perfect(), 1.0).unwrap().technique, ChosenTechnique::RandomWalk);
+    assert_eq!(
+        Choice::new(&rough, &Conductor::perfect(), 1.0).unwrap().technique,
+        ChosenTechnique::RandomWalk
+    );
     let dense = Dielectric::new(3.5).unwrap();
-    assert_eq!(Choice::new(&Ggx::isotropic(0.3).unwrap(), &dense, 1.0).unwrap().technique, ChosenTechnique::RandomWalk);
+    assert_eq!(
+        Choice::new(&Ggx::isotropic(0.3).unwrap(), &dense, 1.0).unwrap().technique,
+        ChosenTechnique::RandomWalk
+    );
     assert!(matches!(
         Choice::new(&Ggx::isotropic(11.0).unwrap(), &Conductor::perfect(), 0.01),
         Err(Error::InvalidParameter { name: "alpha", .. })
@@ -163,7 +169,12 @@ fn glass_point<S: WalkTabulated + 'static>(label: &'static str, slope: S, eta: f
     Point {
         label,
         bsdfs: [
-            Box::new(MicrofacetBsdf::new(slope, d).unwrap().with_technique(Technique::SingleScattering).with_transport(t)),
+            Box::new(
+                MicrofacetBsdf::new(slope, d)
+                    .unwrap()
+                    .with_technique(Technique::SingleScattering)
+                    .with_transport(t),
+            ),
             Box::new(Dielectric::compensated(slope, d).unwrap().with_transport(t)),
             Box::new(MicrofacetBsdf::new(slope, d).unwrap().with_transport(t)),
         ],
@@ -181,7 +192,11 @@ fn glass_point<S: WalkTabulated + 'static>(label: &'static str, slope: S, eta: f
 fn stated_errors_hold_against_the_walk() {
     let points = [
         conductor_point("ggx gold α 0.35", Ggx::isotropic(0.35).unwrap(), Conductor::new(ComplexIor::GOLD)),
-        conductor_point("beckmann copper α 0.8", Beckmann::isotropic(0.8).unwrap(), Conductor::new(ComplexIor::COPPER)),
+        conductor_point(
+            "beckmann copper α 0.8",
+            Beckmann::isotropic(0.8).unwrap(),
+            Conductor::new(ComplexIor::COPPER),
+        ),
         conductor_point("ggx F = 1 α 0.6", Ggx::isotropic(0.6).unwrap(), Conductor::perfect()),
         conductor_point("ggx silver α 0.9", Ggx::isotropic(0.9).unwrap(), Conductor::new(ComplexIor::SILVER)),
         glass_point("ggx glass 1.5 α 0.45", Ggx::isotropic(0.45).unwrap(), 1.5),
@@ -234,9 +249,9 @@ fn the_built_bsdf_is_the_chosen_technique() {
         let v = bsdf.eval(wo, wi);
         assert_eq!(v.exact, exact, "{technique:?}");
         let reference: Box<dyn Bsdf> = match technique {
-            ChosenTechnique::SingleScattering => {
-                Box::new(MicrofacetBsdf::new(slope, gold).unwrap().with_technique(Technique::SingleScattering))
-            }
+            ChosenTechnique::SingleScattering => Box::new(
+                MicrofacetBsdf::new(slope, gold).unwrap().with_technique(Technique::SingleScattering),
+            ),
             ChosenTechnique::Compensated => Box::new(Conductor::compensated(slope, gold).unwrap()),
             ChosenTechnique::RandomWalk => Box::new(MicrofacetBsdf::new(slope, gold).unwrap()),
         };

@@ -2,7 +2,10 @@
 //! budget, per material, and the BSDF it names, per hit.
 
 use super::error_model::Rated;
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SpecularLimit, Technique};
+use crate::bsdf::{
+    Bsdf, BsdfFlags, BsdfSample, BsdfValue, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SpecularLimit,
+    Technique,
+};
 use crate::compensation::{CompensatedConductor, Compensation, KullaContyDielectric, WalkTabulated};
 use crate::error::Error;
 use crate::material::{Conductor, Dielectric, Material};
@@ -109,7 +112,9 @@ impl Candidates {
     /// The cheapest technique whose error is at most `budget`.
     fn choose(&self, budget: f32) -> Choice {
         match (self.single, self.compensated) {
-            (Some(e), _) if e <= budget => Choice { technique: ChosenTechnique::SingleScattering, error: e, cost: 1.0 },
+            (Some(e), _) if e <= budget => {
+                Choice { technique: ChosenTechnique::SingleScattering, error: e, cost: 1.0 }
+            }
             (_, Some(e)) if e <= budget => {
                 Choice { technique: ChosenTechnique::Compensated, error: e, cost: self.compensated_cost }
             }
@@ -153,8 +158,14 @@ impl Choice {
     ///
     /// # Errors
     /// Those of [`MicrofacetBsdf::new`] and of the compensated lobe's constructor.
-    pub fn build<S: WalkTabulated, M: Budgeted>(self, slope: S, material: M) -> Result<ChosenBsdf<S, M>, Error> {
-        let microfacet = |technique| Ok(ChosenBsdf::Microfacet(MicrofacetBsdf::new(slope, material)?.with_technique(technique)));
+    pub fn build<S: WalkTabulated, M: Budgeted>(
+        self,
+        slope: S,
+        material: M,
+    ) -> Result<ChosenBsdf<S, M>, Error> {
+        let microfacet = |technique| {
+            Ok(ChosenBsdf::Microfacet(MicrofacetBsdf::new(slope, material)?.with_technique(technique)))
+        };
         match self.technique {
             ChosenTechnique::SingleScattering => microfacet(Technique::SingleScattering),
             ChosenTechnique::RandomWalk => microfacet(Technique::RandomWalk),

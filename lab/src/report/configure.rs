@@ -2,11 +2,11 @@
 //! how much (the sample budget of a quick or a full run).
 
 use glam::Vec3;
+use microsurface::compensation::WalkTabulated;
 use microsurface::research::{
     Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
 use microsurface::slope::MicrosurfaceSlope;
-use microsurface::compensation::WalkTabulated;
 use microsurface::techniques::Budgeted;
 use microsurface::{Beckmann, Bsdf, Conductor, Dielectric, Diffuse, Ggx};
 use std::path::PathBuf;
@@ -509,7 +509,9 @@ impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
         let v = match est {
             Est::Single => self.walk.eval_single_scattering(wi, wo, rng),
             // the renderer layer's f(ωo = viewer, ωi = light) times |cos θo|
-            Est::Compensated => self.compensated.as_ref().map_or(Vec3::NAN, |b| b.eval(wo, wi).f * wo.z.abs()),
+            Est::Compensated => {
+                self.compensated.as_ref().map_or(Vec3::NAN, |b| b.eval(wo, wi).f * wo.z.abs())
+            }
             Est::Walk => self.walk.eval(wi, wo, order, rng),
             Est::PtUncorrelated => self.uncorrelated.eval_pt(wi, wo, order, rng),
             Est::PtCorrelated => self.correlated.eval_pt(wi, wo, order, rng),
@@ -560,7 +562,11 @@ pub trait WithModels {
 
 /// Runs `task` on the models of `surface`.
 pub fn with_surface<T: WithModels>(surface: Surface, task: T) -> T::Out {
-    fn on_material<S: WalkTabulated + 'static, T: WithModels>(slope: S, material: MaterialKind, task: T) -> T::Out {
+    fn on_material<S: WalkTabulated + 'static, T: WithModels>(
+        slope: S,
+        material: MaterialKind,
+        task: T,
+    ) -> T::Out {
         match material {
             MaterialKind::Conductor => {
                 let c = Conductor::perfect();

@@ -232,7 +232,9 @@ fn error_study(opts: &Options, budget: &Budget) -> (Vec<EstimatorRun>, Vec<Refer
     for config in Config::ALL {
         for case in Case::all(config) {
             let material = config.surface().material;
-            jobs.extend(Est::ALL.into_iter().filter(|e| e.applies_to(material)).map(|est| (case, Role::Study(est))));
+            jobs.extend(
+                Est::ALL.into_iter().filter(|e| e.applies_to(material)).map(|est| (case, Role::Study(est))),
+            );
             jobs.extend(Model::ALL.map(|model| (case, Role::Reference(model))));
         }
     }

@@ -3,8 +3,8 @@
 //! every (θi, ωo), and the lobes per order of the walk and both position-free models.
 
 use super::configure::{Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, THETAS};
-use super::reduce::{LobePanel, Results};
 use super::decision;
+use super::reduce::{LobePanel, Results};
 use super::tables::{self, Family, Tabulated};
 use microsurface::techniques::ChosenTechnique;
 use plotters::coord::Shift;
@@ -478,9 +478,10 @@ fn decision_map() -> PlotResult<Figure> {
             15,
             22,
         )?;
-        for (k, t) in [ChosenTechnique::SingleScattering, ChosenTechnique::Compensated, ChosenTechnique::RandomWalk]
-            .into_iter()
-            .enumerate()
+        for (k, t) in
+            [ChosenTechnique::SingleScattering, ChosenTechnique::Compensated, ChosenTechnique::RandomWalk]
+                .into_iter()
+                .enumerate()
         {
             legend_entry(&header, (12 + k as i32 * 220, 76), technique_color(t), false, decision::short(t))?;
         }

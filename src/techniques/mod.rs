@@ -56,10 +56,11 @@
 //!
 //! # The figures
 //!
-//! The chooser's data per material and roughness (GGX), and the measured errors and costs the
-//! compensated lobes' bounds and the costs come from, written by
-//! `cargo run --release -p lab --bin techniques` (its full run; `--quick` checks that the shipped
-//! bounds hold):
+//! The measured costs, and per slope family, material and roughness the measured errors beside
+//! the chooser's (single scattering's error from the tables, the compensated lobes' bounds) and
+//! its choices, written by `cargo run --release -p lab --bin techniques` (its full run;
+//! `--quick` checks that the shipped bounds hold). The report's results page has the decision
+//! map over α.
 //!
 #![doc = include_str!("../../docs/techniques.md")]
 

@@ -461,7 +461,7 @@ fn technique_color(t: ChosenTechnique) -> RGBColor {
 fn decision_map() -> PlotResult<Figure> {
     let rows = decision::map();
     let alphas = decision::alphas();
-    let (w, h) = (1380u32, 120 + 34 * rows.len() as u32);
+    let (w, h) = (1380u32, 150 + 36 * rows.len() as u32);
     let title = "Technique chooser: the cheapest technique within an albedo error budget".to_string();
     let mut svg = String::new();
     {
@@ -488,7 +488,6 @@ fn decision_map() -> PlotResult<Figure> {
         let panels = grid.split_evenly((1, decision::BUDGETS.len()));
         let step = (alphas[1] / alphas[0]).sqrt();
         for (b, budget) in decision::BUDGETS.iter().enumerate() {
-            let labels: Vec<String> = rows.iter().map(|r| r.label.clone()).collect();
             let n = rows.len() as f64;
             let mut chart = ChartBuilder::on(&panels[b])
                 .caption(format!("budget {:.1} %", budget * 100.0), (FONT, 16))
@@ -504,22 +503,21 @@ fn decision_map() -> PlotResult<Figure> {
                 .configure_mesh()
                 .x_desc("α")
                 .x_labels(4)
-                .y_labels(rows.len())
+                .y_labels(0)
                 .x_label_formatter(&|v| format!("{v:.2}"))
-                .y_label_formatter(&|v| {
-                    let i = (n - v - 0.5).round();
-                    if b == 0 && (0.0..n).contains(&i) && (n - v - 0.5 - i).abs() < 1e-6 {
-                        labels[i as usize].clone()
-                    } else {
-                        String::new()
-                    }
-                })
                 .label_style((FONT, 13))
                 .axis_desc_style((FONT, 15))
                 .disable_mesh()
                 .draw()?;
             for (i, row) in rows.iter().enumerate() {
                 let y = n - i as f64;
+                if b == 0 {
+                    // the row's label, right-aligned left of the panel's plotting area
+                    let (px, py) = chart.backend_coord(&(f64::from(alphas[0] / step), y - 0.5));
+                    let style =
+                        TextStyle::from((FONT, 13).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
+                    root.draw(&Text::new(row.label.clone(), (px - 8, py), style))?;
+                }
                 chart.draw_series(row.choices[b].iter().zip(&alphas).map(|(c, &a)| {
                     Rectangle::new(
                         [(f64::from(a / step), y - 0.92), (f64::from(a * step), y - 0.08)],

@@ -4,7 +4,7 @@
 use super::error_model::Rated;
 use crate::bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, MAX_WALK_ALPHA, MicrofacetBsdf, SMOOTH_ALPHA, SpecularLimit,
-    Technique,
+    Technique, Transport,
 };
 use crate::compensation::{CompensatedConductor, Compensation, KullaContyDielectric, WalkTabulated};
 use crate::error::Error;
@@ -184,6 +184,14 @@ pub trait Budgeted: Material + SpecularLimit + Copy + Rated {
     /// # Errors
     /// Those of the lobe's constructor.
     fn compensated<S: WalkTabulated>(slope: S, material: Self) -> Result<Self::Compensated<S>, Error>;
+
+    /// The compensated lobe with the given transport mode (conductors: unchanged, no light
+    /// crosses them).
+    #[must_use]
+    fn with_transport<S: WalkTabulated>(
+        lobe: Self::Compensated<S>,
+        transport: Transport,
+    ) -> Self::Compensated<S>;
 }
 
 impl Budgeted for Conductor {
@@ -191,12 +199,21 @@ impl Budgeted for Conductor {
     fn compensated<S: WalkTabulated>(slope: S, material: Self) -> Result<Self::Compensated<S>, Error> {
         CompensatedConductor::new(slope, material, Compensation::PerOrder)
     }
+    fn with_transport<S: WalkTabulated>(lobe: Self::Compensated<S>, _: Transport) -> Self::Compensated<S> {
+        lobe
+    }
 }
 
 impl Budgeted for Dielectric {
     type Compensated<S: WalkTabulated> = KullaContyDielectric<S>;
     fn compensated<S: WalkTabulated>(slope: S, material: Self) -> Result<Self::Compensated<S>, Error> {
         KullaContyDielectric::new(slope, material)
+    }
+    fn with_transport<S: WalkTabulated>(
+        lobe: Self::Compensated<S>,
+        transport: Transport,
+    ) -> Self::Compensated<S> {
+        lobe.with_transport(transport)
     }
 }
 
@@ -208,6 +225,18 @@ pub enum ChosenBsdf<S: WalkTabulated, M: Budgeted> {
     Microfacet(MicrofacetBsdf<S, M>),
     /// The compensated lobe.
     Compensated(M::Compensated<S>),
+}
+
+impl<S: WalkTabulated, M: Budgeted> ChosenBsdf<S, M> {
+    /// The same BSDF with the given transport mode ([`Transport::Radiance`] by default;
+    /// [`Transport::Importance`] for paths from the lights): matters to dielectrics only.
+    #[must_use]
+    pub fn with_transport(self, transport: Transport) -> Self {
+        match self {
+            Self::Microfacet(b) => Self::Microfacet(b.with_transport(transport)),
+            Self::Compensated(b) => Self::Compensated(M::with_transport(b, transport)),
+        }
+    }
 }
 
 /// Forwards a call to the variant's BSDF.

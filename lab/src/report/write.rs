@@ -601,7 +601,9 @@ pub fn write(
     html.push_str("<h2 id=\"error-vs-time\">Error against run time</h2>\n<p>One panel per (θi, ωo) that the ratios average. \
         Single scattering and the compensated lobe (conductors) are deterministic models other than the walk: their curves \
         are their error against the walk's converged reference at their cost (a bias that no number of samples removes: the floor \
-        an unbiased estimator reaches in that time), not a Monte Carlo error.</p>\n");
+        an unbiased estimator reaches in that time), not a Monte Carlo error. The compensated lobe restores the energy with a separable \
+        lobe of the wrong shape: where the walk's value is tiny (views at right angles to the plane of grazing light) its relative \
+        error is large, and its curve is clipped at the top edge of the panel.</p>\n");
     for f in figures.iter().filter(|f| f.file.starts_with("error_vs_time")) {
         html.push_str(&figure_html(f, &f.title));
     }

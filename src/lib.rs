@@ -12,6 +12,7 @@
 //! | you want | start at |
 //! |---|---|
 //! | a BSDF in a renderer | [`Bsdf`], [`MicrofacetBsdf`], [`ShadingFrame`] (this page) |
+//! | which technique, at what cost and error; a chooser within a budget | [`techniques`] |
 //! | energy-conserving lobes at single-scattering cost | [`Compensated`], [`Compensation`], [`compensation`] |
 //! | the papers' models for references and experiments | [`research`] |
 //! | slope distributions and visible normals | [`slope`], [`vndf`] |
@@ -155,6 +156,7 @@ pub mod slope;
 pub mod special;
 #[cfg(feature = "data-driven")]
 pub mod tabulated;
+pub mod techniques;
 pub mod vndf;
 
 // The renderer layer: what a renderer reaches first.

@@ -5,8 +5,8 @@
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    BatchBsdf, Beckmann, Bsdf, Channels, ComplexIor, Conductor, Dielectric, Directions, Error, Ggx,
-    MicrofacetBsdf, SampleOutputs, Technique,
+    BatchBsdf, Beckmann, Channels, ComplexIor, Conductor, Dielectric, Directions, Error, Ggx, MicrofacetBsdf,
+    SampleOutputs, Technique,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;

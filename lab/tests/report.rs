@@ -31,6 +31,7 @@ fn expected_files() -> Vec<String> {
         "lobes.csv",
         "albedo_tables.csv",
         "albedo_tables.svg",
+        "decision_map.svg",
         "summary.md",
         "index.html",
     ]
@@ -77,7 +78,18 @@ fn check_svgs(files: &[std::path::PathBuf]) {
         }
         let text = svg_text(&doc);
         let name = f.file_name().unwrap().to_string_lossy();
-        let needed: &[&str] = if name == "albedo_tables.svg" {
+        let needed: &[&str] = if name == "decision_map.svg" {
+            &[
+                "budget 0.5 %",
+                "budget 3.0 %",
+                "GGX gold",
+                "Beckmann glass 2",
+                "single",
+                "compensated",
+                "walk",
+                "α",
+            ]
+        } else if name == "albedo_tables.svg" {
             &["|error|", "μ = cos θ", "α = 0.4", "conductor E", "dielectric R + T", "Beckmann"]
         } else if name.starts_with("error_vs_time") {
             &[
@@ -113,7 +125,11 @@ fn check_svgs(files: &[std::path::PathBuf]) {
             }
         }
     }
-    assert_eq!(count, Config::ALL.len() + LOBE_MATERIALS.len() + 1, "SVG figures (with albedo_tables.svg)");
+    assert_eq!(
+        count,
+        Config::ALL.len() + LOBE_MATERIALS.len() + 2,
+        "SVG figures (with albedo_tables.svg and decision_map.svg)"
+    );
 }
 
 fn check_html(dir: &Path) {

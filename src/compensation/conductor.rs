@@ -209,7 +209,8 @@ impl CompensatedMaterial for Conductor {
         let alpha = single.surface().slope().albedo_alpha();
         let r = alpha.sqrt();
         let row = node_cell(r * LAST_R, ALBEDO_ROUGHNESSES);
-        let lobes = ConductorLobes { alpha, one_plus_alpha: 1.0 + alpha, row, ..ConductorLobes::none(tables) };
+        let lobes =
+            ConductorLobes { alpha, one_plus_alpha: 1.0 + alpha, row, ..ConductorLobes::none(tables) };
         if scheme == Compensation::Turquin {
             // the view's 1 − E and F0: nothing else (the averages are the queries')
             return Ok(ConductorLobes { scale: conductor.fresnel(1.0), ..lobes });

@@ -318,7 +318,12 @@ impl CompensatedMaterial for Dielectric {
         for view in 0..2 {
             for cross in 0..2 {
                 let rows = &lobes.side(view ^ cross).rows;
-                let m = [rows[n].masses[cross], rows[n + 1].masses[cross], rows[n + N].masses[cross], rows[n + N + 1].masses[cross]];
+                let m = [
+                    rows[n].masses[cross],
+                    rows[n + 1].masses[cross],
+                    rows[n + N].masses[cross],
+                    rows[n + N + 1].masses[cross],
+                ];
                 lobes.corners[view][cross] = corner_probabilities(row.1, fu, m);
             }
         }

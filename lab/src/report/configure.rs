@@ -2,11 +2,13 @@
 //! how much (the sample budget of a quick or a full run).
 
 use glam::Vec3;
+use microsurface::compensation::AlbedoTabulated;
 use microsurface::research::{
     Material, Microsurface, PositionFree, ScatteringOrder, Shadowing, UniformHeight,
 };
 use microsurface::slope::MicrosurfaceSlope;
-use microsurface::{Beckmann, Conductor, Dielectric, Diffuse, Ggx};
+
+use microsurface::{Beckmann, Bsdf, Conductor, Dielectric, Diffuse, Ggx};
 use std::path::PathBuf;
 
 pub type Rng = rand_pcg::Pcg64Mcg;
@@ -180,6 +182,8 @@ impl Budget {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Est {
     Single,
+    /// The compensated conductor (`Compensated`, default scheme): conductors only.
+    Compensated,
     Walk,
     PtUncorrelated,
     PtCorrelated,
@@ -188,8 +192,9 @@ pub enum Est {
 }
 
 impl Est {
-    pub const ALL: [Est; 6] = [
+    pub const ALL: [Est; 7] = [
         Est::Single,
+        Est::Compensated,
         Est::Walk,
         Est::PtUncorrelated,
         Est::PtCorrelated,
@@ -200,6 +205,7 @@ impl Est {
     pub fn name(self) -> &'static str {
         match self {
             Est::Single => "single",
+            Est::Compensated => "compensated",
             Est::Walk => "heitz-walk",
             Est::PtUncorrelated => "pt-uncorr",
             Est::PtCorrelated => "pt-corr",
@@ -212,6 +218,7 @@ impl Est {
     pub fn label(self) -> &'static str {
         match self {
             Est::Single => "single scattering (a different model: its error against the walk)",
+            Est::Compensated => "compensated lobe (deterministic: its error against the walk)",
             Est::Walk => "Heitz random walk",
             Est::PtUncorrelated => "position-free PT, uncorrelated",
             Est::PtCorrelated => "position-free PT, correlated",
@@ -224,10 +231,23 @@ impl Est {
     /// its error is measured against the walk's reference).
     pub fn model(self) -> Model {
         match self {
-            Est::Single | Est::Walk => Model::Walk,
+            Est::Single | Est::Compensated | Est::Walk => Model::Walk,
             Est::PtUncorrelated | Est::BdptUncorrelated => Model::Uncorrelated,
             Est::PtCorrelated | Est::BdptCorrelated => Model::Correlated,
         }
+    }
+}
+
+impl Est {
+    /// A deterministic model other than the walk (single scattering, the compensated lobe):
+    /// its curve is a bias against the walk's reference at its cost, not a Monte Carlo error.
+    pub fn is_biased(self) -> bool {
+        matches!(self, Est::Single | Est::Compensated)
+    }
+
+    /// Whether the estimator exists for a material (the compensated lobe: conductors).
+    pub fn applies_to(self, material: MaterialKind) -> bool {
+        self != Est::Compensated || material == MaterialKind::Conductor
     }
 }
 
@@ -464,6 +484,8 @@ pub struct Models<S, M> {
     pub walk: Microsurface<UniformHeight, S, M>,
     pub uncorrelated: PositionFree<S, M>,
     pub correlated: PositionFree<S, M>,
+    /// The compensated lobe of the renderer layer (conductors).
+    pub compensated: Option<Box<dyn Bsdf>>,
 }
 
 impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
@@ -472,7 +494,13 @@ impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
             walk: Microsurface::new(UniformHeight, slope, material),
             uncorrelated: PositionFree::new(slope, material, Shadowing::Uncorrelated),
             correlated: PositionFree::new(slope, material, Shadowing::Correlated),
+            compensated: None,
         }
+    }
+
+    /// The same models with a compensated lobe.
+    pub fn with_compensated(self, lobe: Box<dyn Bsdf>) -> Self {
+        Self { compensated: Some(lobe), ..self }
     }
 
     /// One estimate of f·|cos θo| (mean over RGB).
@@ -480,6 +508,10 @@ impl<S: MicrosurfaceSlope, M: Material> Models<S, M> {
     pub fn eval(&self, est: Est, wi: Vec3, wo: Vec3, order: ScatteringOrder, rng: &mut Rng) -> f64 {
         let v = match est {
             Est::Single => self.walk.eval_single_scattering(wi, wo, rng),
+            // the renderer layer's f(ωo = viewer, ωi = light) times |cos θo|
+            Est::Compensated => {
+                self.compensated.as_ref().map_or(Vec3::NAN, |b| b.eval(wo, wi).f * wo.z.abs())
+            }
             Est::Walk => self.walk.eval(wi, wo, order, rng),
             Est::PtUncorrelated => self.uncorrelated.eval_pt(wi, wo, order, rng),
             Est::PtCorrelated => self.correlated.eval_pt(wi, wo, order, rng),
@@ -530,9 +562,17 @@ pub trait WithModels {
 
 /// Runs `task` on the models of `surface`.
 pub fn with_surface<T: WithModels>(surface: Surface, task: T) -> T::Out {
-    fn on_material<S: MicrosurfaceSlope, T: WithModels>(slope: S, material: MaterialKind, task: T) -> T::Out {
+    fn on_material<S: AlbedoTabulated + 'static, T: WithModels>(
+        slope: S,
+        material: MaterialKind,
+        task: T,
+    ) -> T::Out {
         match material {
-            MaterialKind::Conductor => task.go(Models::new(slope, Conductor::perfect())),
+            MaterialKind::Conductor => {
+                let c = Conductor::perfect();
+                let lobe = microsurface::Compensated::new(slope, c).expect("α within the tables");
+                task.go(Models::new(slope, c).with_compensated(Box::new(lobe)))
+            }
             MaterialKind::Dielectric => task.go(Models::new(slope, Dielectric::new(1.5).expect("valid η"))),
             MaterialKind::Diffuse => task.go(Models::new(slope, Diffuse::white())),
         }

@@ -231,7 +231,10 @@ fn error_study(opts: &Options, budget: &Budget) -> (Vec<EstimatorRun>, Vec<Refer
     let mut jobs = Vec::new();
     for config in Config::ALL {
         for case in Case::all(config) {
-            jobs.extend(Est::ALL.map(|est| (case, Role::Study(est))));
+            let material = config.surface().material;
+            jobs.extend(
+                Est::ALL.into_iter().filter(|e| e.applies_to(material)).map(|est| (case, Role::Study(est))),
+            );
             jobs.extend(Model::ALL.map(|model| (case, Role::Reference(model))));
         }
     }
@@ -772,7 +775,7 @@ impl WithModels for CostTask {
         let wos = cost_directions(M::TRANSMITS);
         let mut rng = Rng::seed_from_u64(99);
         let mut rows = Vec::new();
-        for est in Est::ALL {
+        for est in Est::ALL.into_iter().filter(|e| e.applies_to(self.surface.material)) {
             let start = Instant::now();
             let mut acc = 0.0;
             for i in 0..n {
@@ -781,7 +784,7 @@ impl WithModels for CostTask {
             }
             let ns_per_eval = start.elapsed().as_secs_f64() * 1e9 / n as f64;
             black_box(acc);
-            let (ns_per_sample, mean_bounces) = if est == Est::Single {
+            let (ns_per_sample, mean_bounces) = if est.is_biased() {
                 (None, None)
             } else {
                 let start = Instant::now();

@@ -5,12 +5,14 @@
 //! The stages, one file each: [`configure`] (what and how much), [`measure`] (per-sample
 //! values, timings, references, energy, lobes, cost), [`reduce`] (errors against time,
 //! efficiency ratios with confidence intervals, lobe panels), [`tables`] (the albedo tables'
-//! interpolation error), [`plot`] (SVG figures) and
+//! interpolation error), [`decision`] (the technique chooser's decision map), [`plot`] (SVG
+//! figures) and
 //! [`write`](mod@write) (CSV, Markdown, HTML); [`pipeline`] runs them in order, then the
 //! efficiency table of the invariance-principle estimator ([`invariance`](mod@invariance)); a
 //! full run rewrites the results page `docs/results.md` ([`results_page`]).
 
 pub mod configure;
+pub mod decision;
 pub mod invariance;
 pub mod measure;
 pub mod pipeline;

@@ -3,8 +3,10 @@
 //! every (θi, ωo), and the lobes per order of the walk and both position-free models.
 
 use super::configure::{Budget, Case, Config, Est, LOBE_MATERIALS, MaterialKind, Model, THETAS};
+use super::decision;
 use super::reduce::{LobePanel, Results};
 use super::tables::{self, Family, Tabulated};
+use microsurface::techniques::ChosenTechnique;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -35,6 +37,7 @@ const FONT: &str = "sans-serif";
 fn est_color(est: Est) -> RGBColor {
     match est {
         Est::Single => GRAY,
+        Est::Compensated => PALETTE[5],
         Est::Walk => PALETTE[0],
         Est::PtUncorrelated => PALETTE[1],
         Est::PtCorrelated => PALETTE[2],
@@ -97,6 +100,7 @@ pub fn figures(results: &Results, budget: &Budget) -> PlotResult<Vec<Figure>> {
         figures.push(lobes(results, material, budget)?);
     }
     figures.push(table_errors(results, budget)?);
+    figures.push(decision_map()?);
     Ok(figures)
 }
 
@@ -107,8 +111,14 @@ fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResu
     let cases = Case::all(config);
     let rows: Vec<_> = results.efficiency.iter().filter(|r| r.case.config == config).collect();
     let positive = |v: f64| v.is_finite() && v > 0.0;
-    let pts =
-        rows.iter().flat_map(|r| r.curve.iter()).filter(|p| positive(p.seconds) && positive(p.rel_rmse));
+    // the axes from every estimator but the compensated lobe, whose relative error can be huge
+    // where the walk's value is tiny (its separable lobe has the right energy, not the right
+    // shape): its curve is clipped at the top edge instead
+    let pts = rows
+        .iter()
+        .filter(|r| r.est != Est::Compensated)
+        .flat_map(|r| r.curve.iter())
+        .filter(|p| positive(p.seconds) && positive(p.rel_rmse));
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in pts {
         (x0, x1, y0, y1) = (x0.min(p.seconds), x1.max(p.seconds), y0.min(p.rel_rmse), y1.max(p.rel_rmse));
@@ -149,11 +159,11 @@ fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResu
         for (k, est) in Est::ALL.iter().enumerate() {
             let (col, row) = (k % 2, k / 2);
             let at = (12 + col as i32 * 530, 80 + row as i32 * 22);
-            legend_entry(&header, at, est_color(*est), *est == Est::Single, est.label())?;
+            legend_entry(&header, at, est_color(*est), est.is_biased(), est.label())?;
         }
         legend_entry(
             &header,
-            (12, 80 + 3 * 22),
+            (542, 80 + 3 * 22),
             BLACK,
             true,
             "slope −½ (the Monte Carlo rate), through the walk's first point",
@@ -192,10 +202,10 @@ fn error_vs_time(results: &Results, config: Config, budget: &Budget) -> PlotResu
                     .curve
                     .iter()
                     .filter(|p| positive(p.seconds) && positive(p.rel_rmse))
-                    .map(|p| (p.seconds, p.rel_rmse))
+                    .map(|p| (p.seconds, p.rel_rmse.min(y1)))
                     .collect();
                 let style = est_color(est).stroke_width(2);
-                if est == Est::Single {
+                if est.is_biased() {
                     chart.draw_series(DashedLineSeries::new(points, 6, 4, style))?;
                 } else {
                     chart.draw_series(LineSeries::new(points, style))?;
@@ -441,4 +451,88 @@ fn table_errors(results: &Results, budget: &Budget) -> PlotResult<Figure> {
         root.present()?;
     }
     Ok(Figure { file: "albedo_tables.svg".into(), svg, title })
+}
+
+/// The colour of a chosen technique on the decision map.
+fn technique_color(t: ChosenTechnique) -> RGBColor {
+    match t {
+        ChosenTechnique::SingleScattering => LIGHT,
+        ChosenTechnique::Compensated => PALETTE[1],
+        ChosenTechnique::RandomWalk => PALETTE[0],
+    }
+}
+
+/// The technique chooser's decision map: one panel per budget, α across, slope family and
+/// material down, the chosen technique coloured.
+fn decision_map() -> PlotResult<Figure> {
+    let rows = decision::map();
+    let alphas = decision::alphas();
+    let (w, h) = (1380u32, 150 + 36 * rows.len() as u32);
+    let title = "Technique chooser: the cheapest technique within an albedo error budget".to_string();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (header, grid) = root.split_vertically(96);
+        text_lines(
+            &header,
+            &[
+                title.clone(),
+                "microsurface::techniques::Choice per slope family and material (rows) and roughness α (log axis); error: the hemispherical albedo error against the walk.".to_string(),
+            ],
+            (12, 8),
+            15,
+            22,
+        )?;
+        for (k, t) in
+            [ChosenTechnique::SingleScattering, ChosenTechnique::Compensated, ChosenTechnique::RandomWalk]
+                .into_iter()
+                .enumerate()
+        {
+            legend_entry(&header, (12 + k as i32 * 220, 76), technique_color(t), false, decision::short(t))?;
+        }
+        let panels = grid.split_evenly((1, decision::BUDGETS.len()));
+        let step = (alphas[1] / alphas[0]).sqrt();
+        for (b, budget) in decision::BUDGETS.iter().enumerate() {
+            let n = rows.len() as f64;
+            let mut chart = ChartBuilder::on(&panels[b])
+                .caption(format!("budget {:.1} %", budget * 100.0), (FONT, 16))
+                .margin(6)
+                .margin_right(14)
+                .x_label_area_size(42)
+                .y_label_area_size(if b == 0 { 150 } else { 8 })
+                .build_cartesian_2d(
+                    (f64::from(alphas[0] / step)..f64::from(alphas[alphas.len() - 1] * step)).log_scale(),
+                    0.0..n,
+                )?;
+            chart
+                .configure_mesh()
+                .x_desc("α")
+                .x_labels(4)
+                .y_labels(0)
+                .x_label_formatter(&|v| format!("{v:.2}"))
+                .label_style((FONT, 13))
+                .axis_desc_style((FONT, 15))
+                .disable_mesh()
+                .draw()?;
+            for (i, row) in rows.iter().enumerate() {
+                let y = n - i as f64;
+                if b == 0 {
+                    // the row's label, right-aligned left of the panel's plotting area
+                    let (px, py) = chart.backend_coord(&(f64::from(alphas[0] / step), y - 0.5));
+                    let style =
+                        TextStyle::from((FONT, 13).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
+                    root.draw(&Text::new(row.label.clone(), (px - 8, py), style))?;
+                }
+                chart.draw_series(row.choices[b].iter().zip(&alphas).map(|(c, &a)| {
+                    Rectangle::new(
+                        [(f64::from(a / step), y - 0.92), (f64::from(a * step), y - 0.08)],
+                        technique_color(c.technique).filled(),
+                    )
+                }))?;
+            }
+        }
+        root.present()?;
+    }
+    Ok(Figure { file: "decision_map.svg".into(), svg, title })
 }

@@ -176,7 +176,7 @@ pub fn reduce(m: Measurements) -> Results {
             let reference = references[&(run.case, run.est.model())];
             let scale = if reference.mean != 0.0 { reference.mean.abs() } else { 1.0 };
             let rel_var = var / (scale * scale);
-            let efficiency = (run.est != Est::Single).then(|| {
+            let efficiency = (!run.est.is_biased()).then(|| {
                 if rel_var > 0.0 { 1.0 / (rel_var * run.timing.ns_per_sample * 1e-9) } else { f64::INFINITY }
             });
             EfficiencyRow {
@@ -271,7 +271,7 @@ fn ratio(config: Config, kind: RatioKind, index: &HashMap<(Case, Est), &Efficien
 fn choice(config: Config, index: &HashMap<(Case, Est), &EfficiencyRow>) -> Choice {
     let relative_to_walk: Vec<(Est, f64)> = Est::ALL
         .into_iter()
-        .filter(|&e| e != Est::Single)
+        .filter(|&e| !e.is_biased())
         .map(|est| {
             let logs: Vec<f64> = Case::all(config)
                 .into_iter()

@@ -5,6 +5,7 @@ use super::configure::{Budget, Config, Est, Model, Options, RunSize};
 use super::measure::{TIMING_CHUNKS, cost_surfaces};
 use super::plot::Figure;
 use super::reduce::{RatioKind, Results};
+use microsurface::techniques::{Candidates, ChosenTechnique};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -97,7 +98,7 @@ fn ratio_table(results: &Results) -> Table {
 }
 
 fn choice_table(results: &Results) -> Table {
-    let ests: Vec<Est> = Est::ALL.into_iter().filter(|&e| e != Est::Single).collect();
+    let ests: Vec<Est> = Est::ALL.into_iter().filter(|&e| !e.is_biased()).collect();
     let mut header = vec!["configuration".to_string()];
     header.extend(ests.iter().map(|e| e.name().to_string()));
     header.push("most efficient".into());
@@ -126,9 +127,58 @@ fn choice_table(results: &Results) -> Table {
     }
 }
 
+/// The technique chooser's decision map in words: per slope family, material and budget, the
+/// roughnesses at which the choice changes.
+fn decision_table() -> Table {
+    let mut header = vec!["slopes, material".to_string()];
+    header.extend(super::decision::BUDGETS.iter().map(|b| format!("budget {:.1} %", b * 100.0)));
+    let rows = super::decision::map()
+        .iter()
+        .map(|row| {
+            let mut cells = vec![row.label.clone()];
+            cells.extend(row.choices.iter().map(|c| super::decision::transitions(c)));
+            cells
+        })
+        .collect();
+    let (lo, hi) = super::decision::ALPHA_RANGE;
+    Table {
+        id: "decision",
+        caption: "Technique chooser: the cheapest technique within an albedo error budget, over α".into(),
+        header,
+        rows,
+        note: format!(
+            "microsurface::techniques::Choice on {} log-spaced α from {lo} to {hi}: where the choice changes along α (\"single < 0.1 ≤ compensated\": \
+             single scattering below α = 0.1, the compensated lobe from there). Error: the hemispherical albedo error against the walk; \
+             single scattering's from the albedo tables, the compensated lobes' bounds measured by `lab --bin techniques`. \
+             Costs per bounce relative to single scattering: compensated {:.2} (conductor) and {:.2} (glass), walk {:.2} and {:.2}.",
+            super::decision::ALPHA_STEPS,
+            cost(true, ChosenTechnique::Compensated),
+            cost(false, ChosenTechnique::Compensated),
+            cost(true, ChosenTechnique::RandomWalk),
+            cost(false, ChosenTechnique::RandomWalk),
+        ),
+    }
+}
+
+/// The chooser's cost of a technique on GGX α = 0.5 (gold or glass).
+fn cost(conductor: bool, t: ChosenTechnique) -> f32 {
+    let slope = microsurface::Ggx::isotropic(0.5).expect("valid α");
+    let candidates = if conductor {
+        Candidates::new(&slope, &microsurface::Conductor::perfect())
+    } else {
+        Candidates::new(&slope, &microsurface::Dielectric::new(1.5).expect("valid η"))
+    }
+    .expect("valid");
+    match t {
+        ChosenTechnique::SingleScattering => 1.0,
+        ChosenTechnique::Compensated => candidates.compensated_cost,
+        ChosenTechnique::RandomWalk => candidates.walk_cost,
+    }
+}
+
 fn efficiency_table(results: &Results) -> Table {
     let mut header = vec!["configuration".to_string(), "θi".into(), "ωo".into()];
-    header.extend(Est::ALL.iter().filter(|&&e| e != Est::Single).map(|e| e.name().to_string()));
+    header.extend(Est::ALL.iter().filter(|&&e| !e.is_biased()).map(|e| e.name().to_string()));
     let rows = results
         .efficiency
         .iter()
@@ -139,7 +189,7 @@ fn efficiency_table(results: &Results) -> Table {
                 walk.case.theta_i().to_string(),
                 walk.case.wo.name().into(),
             ];
-            for est in Est::ALL.into_iter().filter(|&e| e != Est::Single) {
+            for est in Est::ALL.into_iter().filter(|&e| !e.is_biased()) {
                 let e = results.row(walk.case, est).and_then(|r| r.efficiency).unwrap_or(f64::NAN);
                 row.push(format!("{e:.3e}"));
             }
@@ -493,16 +543,17 @@ pub fn write(
     for f in figures {
         names.push(put(&f.file, &f.svg)?);
     }
-    let (ratio, choice, efficiency, energy, cost, lobe) = (
+    let (ratio, choice, efficiency, energy, cost, lobe, decision) = (
         ratio_table(results),
         choice_table(results),
         efficiency_table(results),
         energy_table(results),
         cost_table(results),
         lobe_table(results),
+        decision_table(),
     );
     let mut markdown = String::from("# microsurface report\n\n");
-    for t in [&ratio, &choice, &energy, &cost, &lobe] {
+    for t in [&ratio, &choice, &decision, &energy, &cost, &lobe] {
         markdown.push_str(&t.markdown());
         markdown.push('\n');
     }
@@ -543,9 +594,16 @@ pub fn write(
     html.push_str(&kv(&parameters));
     html.push_str(&ratio.html());
     html.push_str(&choice.html());
+    html.push_str(&decision.html());
+    for f in figures.iter().filter(|f| f.file == "decision_map.svg") {
+        html.push_str(&figure_html(f, &f.title));
+    }
     html.push_str("<h2 id=\"error-vs-time\">Error against run time</h2>\n<p>One panel per (θi, ωo) that the ratios average. \
-        Single scattering is a different model: its curve is that model's error against the walk's converged reference (a bias that \
-        no number of samples removes), not a Monte Carlo error.</p>\n");
+        Single scattering and the compensated lobe (conductors) are deterministic models other than the walk: their curves \
+        are their error against the walk's converged reference at their cost (a bias that no number of samples removes: the floor \
+        an unbiased estimator reaches in that time), not a Monte Carlo error. The compensated lobe restores the energy with a separable \
+        lobe of the wrong shape: where the walk's value is tiny (views at right angles to the plane of grazing light) its relative \
+        error is large, and its curve is clipped at the top edge of the panel.</p>\n");
     for f in figures.iter().filter(|f| f.file.starts_with("error_vs_time")) {
         html.push_str(&figure_html(f, &f.title));
     }

@@ -63,8 +63,12 @@ fn main() {
                     .with_technique(Technique::SingleScattering),
             ),
             ("gold", _, Some(scheme)) => keep(
-                Compensated::with_scheme(slope, Conductor::new(ComplexIor::new(eta, k).expect("an index")), scheme)
-                    .expect("α ≤ 1"),
+                Compensated::with_scheme(
+                    slope,
+                    Conductor::new(ComplexIor::new(eta, k).expect("an index")),
+                    scheme,
+                )
+                .expect("α ≤ 1"),
             ),
             ("glass", _, Some(scheme)) => keep(
                 Compensated::with_scheme(slope, Dielectric::new(glass_eta).expect("η > 0"), scheme)

@@ -285,6 +285,7 @@ fn unequal_lengths_are_rejected() {
 #[cfg(not(debug_assertions))]
 #[test]
 fn invalid_lanes_get_nothing_and_do_not_poison_their_neighbours() {
+    use microsurface::Bsdf;
     let gold = single(Ggx::isotropic(0.5).expect("valid roughness"), Conductor::new(ComplexIor::GOLD));
     let glass = single(Ggx::isotropic(0.5).expect("valid roughness"), Dielectric::new(1.5).expect("valid"));
     let bad = [

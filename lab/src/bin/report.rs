@@ -1,4 +1,4 @@
-//! The crate's main job: a report of every estimator's accuracy against run time, the lobes
+//! The report: every estimator's accuracy against run time, the lobes
 //! and energy per scattering order, and the cost of every model, measured on this machine.
 //!
 //! `cargo run --release -p lab --bin report -- [--quick] [--out DIR] [--results FILE]` writes CSV

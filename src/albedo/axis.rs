@@ -7,7 +7,41 @@
 /// tables").
 #[inline(always)]
 pub(crate) fn scale_invariant_direction(mu: f32, alpha: f32) -> f32 {
-    (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt()
+    DirectionAxis::new(alpha).coordinate(mu)
+}
+
+/// The scale-invariant direction axis x = √(μ (1 + α)/(μ + α)) at one roughness α, with 1 + α
+/// computed once: the axis of the conductor tables and of the dielectric walk tables, read per
+/// hit by the compensated lobes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct DirectionAxis {
+    alpha: f32,
+    one_plus_alpha: f32,
+}
+
+impl DirectionAxis {
+    /// The axis of a Dirac lobe (never read; α = 1).
+    pub(crate) const NONE: Self = Self { alpha: 1.0, one_plus_alpha: 2.0 };
+
+    /// The axis at roughness α > 0.
+    #[inline(always)]
+    pub(crate) fn new(alpha: f32) -> Self {
+        Self { alpha, one_plus_alpha: 1.0 + alpha }
+    }
+
+    /// The coordinates x of two cosines in [0, 1] from one division.
+    #[inline(always)]
+    pub(crate) fn coordinates(self, mu_o: f32, mu_i: f32) -> (f32, f32) {
+        let (so, si) = (mu_o + self.alpha, mu_i + self.alpha);
+        let inv = self.one_plus_alpha / (so * si);
+        ((mu_o * si * inv).min(1.0).sqrt(), (mu_i * so * inv).min(1.0).sqrt())
+    }
+
+    /// The coordinate x of one cosine in [0, 1].
+    #[inline(always)]
+    pub(crate) fn coordinate(self, mu: f32) -> f32 {
+        (mu * self.one_plus_alpha / (mu + self.alpha)).min(1.0).sqrt()
+    }
 }
 
 /// The cell index i ∈ [0, `nodes` − 2] and the fraction within it of the fractional node

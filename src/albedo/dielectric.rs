@@ -176,9 +176,6 @@ impl DielectricAlbedoTable {
 
     /// The (reflected, transmitted) grids of one side.
     pub(crate) fn grids(&self, range: EtaRange) -> [&'static super::grid::Grid; 2] {
-        match range {
-            EtaRange::AtLeastOne => self.grids.outside,
-            EtaRange::AtMostOne => self.grids.inside,
-        }
+        self.grids.side(range)
     }
 }

@@ -59,13 +59,19 @@ impl SideGrids {
         if eta >= 1.0 { (&self.outside, eta) } else { (&self.inside, 1.0 / eta) }
     }
 
+    /// The (reflected, transmitted) grids of one side.
+    #[inline(always)]
+    pub(crate) fn side(&self, range: EtaRange) -> [&'static Grid; 2] {
+        match range {
+            EtaRange::AtLeastOne => self.outside,
+            EtaRange::AtMostOne => self.inside,
+        }
+    }
+
     /// The raw node values (reflected, transmitted) of one side.
     pub(crate) fn nodes(&self, range: EtaRange) -> (&'static [f32], &'static [f32]) {
-        let t = match range {
-            EtaRange::AtLeastOne => &self.outside,
-            EtaRange::AtMostOne => &self.inside,
-        };
-        (t[0], t[1])
+        let [r, t] = self.side(range);
+        (r, t)
     }
 
     /// Both quantities of the side of η, interpolated trilinearly at the fractional node

@@ -15,7 +15,9 @@ mod grid;
 mod orders;
 mod table;
 
-pub(crate) use axis::{DielectricDirection, floor_index, node_cell, scale_invariant_direction};
+pub(crate) use axis::{
+    DielectricDirection, DirectionAxis, floor_index, node_cell, scale_invariant_direction,
+};
 pub use dielectric::{DielectricAlbedo, DielectricAlbedoTable};
 pub use dielectric_walk::{DielectricWalkTable, HigherOrders, MAX_WALK_TABLE_SE, WALK_BATCH};
 pub use grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};

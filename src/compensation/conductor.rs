@@ -27,7 +27,7 @@ use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::conductor_tables::ConductorTables;
 use super::fresnel_average::fresnel_average;
 use super::shared::{Shared, mixture_sample};
-use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, ORDER_TABLE_SIZE, node_cell};
+use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
 use crate::bsdf::MicrofacetBsdf;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
 use crate::compensation::AlbedoTabulated;
@@ -47,9 +47,8 @@ const LAST_O: f32 = (ORDER_TABLE_SIZE - 1) as f32;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConductorLobes {
     tables: Shared<ConductorTables>,
-    /// α of the direction axis x = √(μ (1 + α)/(μ + α)), and 1 + α.
-    alpha: f32,
-    one_plus_alpha: f32,
+    /// The direction axis at the hit's α.
+    axis: DirectionAxis,
     /// The albedo table's roughness cell of α and the fraction in it.
     row: (usize, f32),
     /// The per-order tables' roughness cell of α and the fraction in it.
@@ -70,8 +69,7 @@ impl ConductorLobes {
     fn none(tables: &'static ConductorTables) -> Self {
         Self {
             tables: Shared(tables),
-            alpha: 1.0,
-            one_plus_alpha: 2.0,
+            axis: DirectionAxis::NONE,
             row: (0, 0.0),
             order_row: (0, 0.0),
             upper: 0.0,
@@ -84,15 +82,13 @@ impl ConductorLobes {
     /// The direction coordinates x of two cosines in [0, 1] from one division.
     #[inline(always)]
     fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
-        let (so, si) = (mu_o + self.alpha, mu_i + self.alpha);
-        let inv = self.one_plus_alpha / (so * si);
-        ((mu_o * si * inv).min(1.0).sqrt(), (mu_i * so * inv).min(1.0).sqrt())
+        self.axis.coordinates(mu_o, mu_i)
     }
 
     /// The direction coordinate x of one cosine in [0, 1].
     #[inline(always)]
     fn coordinate(&self, mu: f32) -> f32 {
-        (mu * self.one_plus_alpha / (mu + self.alpha)).min(1.0).sqrt()
+        self.axis.coordinate(mu)
     }
 
     /// 1 − E at the direction coordinate x.
@@ -209,8 +205,7 @@ impl CompensatedMaterial for Conductor {
         let alpha = single.surface().slope().albedo_alpha();
         let r = alpha.sqrt();
         let row = node_cell(r * LAST_R, ALBEDO_ROUGHNESSES);
-        let lobes =
-            ConductorLobes { alpha, one_plus_alpha: 1.0 + alpha, row, ..ConductorLobes::none(tables) };
+        let lobes = ConductorLobes { axis: DirectionAxis::new(alpha), row, ..ConductorLobes::none(tables) };
         if scheme == Compensation::Turquin {
             // the view's 1 − E and F0: nothing else (the averages are the queries')
             return Ok(ConductorLobes { scale: conductor.fresnel(1.0), ..lobes });

@@ -50,7 +50,7 @@ use super::glass_tables::{GlassSide, GlassTables};
 use super::lobe_profile::mu_cell;
 use super::shared::{ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
 use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable,
+    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable, DirectionAxis,
     MAX_TABULATED_ETA, node_cell,
 };
 use crate::bsdf::{
@@ -84,9 +84,8 @@ pub struct DielectricLobes {
     corner: usize,
     walk_row: (usize, f32),
     walk_u: f32,
-    /// α of the walk tables' direction axis, and 1 + α.
-    alpha: f32,
-    one_plus_alpha: f32,
+    /// The walk tables' direction axis at the hit's α.
+    axis: DirectionAxis,
     /// The added lobes' scales per view side: [1/(π ΔR̄_a), c_a/(π ΔT̄_b) × transport].
     scales: [[f32; 2]; 2],
     /// [c_a/(π ΔT̄_b)] before the transport factor, per view side.
@@ -117,8 +116,7 @@ impl DielectricLobes {
             corner: 0,
             walk_row: (0, 0.0),
             walk_u: 0.0,
-            alpha: 1.0,
-            one_plus_alpha: 2.0,
+            axis: DirectionAxis::NONE,
             scales: [[0.0; 2]; 2],
             transmitted_scale: [0.0; 2],
             c: [1.0; 2],
@@ -139,9 +137,7 @@ impl DielectricLobes {
     /// The direction coordinates of two cosines in [0, 1] from one division.
     #[inline(always)]
     fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
-        let (so, si) = (mu_o + self.alpha, mu_i + self.alpha);
-        let inv = self.one_plus_alpha / (so * si);
-        ((mu_o * si * inv).min(1.0).sqrt(), (mu_i * so * inv).min(1.0).sqrt())
+        self.axis.coordinates(mu_o, mu_i)
     }
 
     /// The walk table's value of quantity q (ΔR, ΔT) of view side `view` at direction
@@ -281,8 +277,7 @@ impl CompensatedMaterial for Dielectric {
         lobes.corner = l * N + row.0;
         lobes.walk_row = row;
         lobes.walk_u = fu;
-        lobes.alpha = alpha;
-        lobes.one_plus_alpha = 1.0 + alpha;
+        lobes.axis = DirectionAxis::new(alpha);
         // the averages [ΔR̄, ΔT̄, Var(ΔT̄)] of each view side, blended in u
         let average = |view: usize| {
             let side = lobes.side(view);

@@ -3,6 +3,7 @@
 //! per hit needs of its Fresnel term, in a few nanoseconds instead of a quadrature.
 
 use crate::fresnel::ComplexIor;
+use crate::special::GAUSS_LEGENDRE_16;
 use glam::{Vec3, Vec4};
 use std::sync::OnceLock;
 
@@ -15,18 +16,6 @@ const LAST: f32 = (NODES - 1) as f32;
 const PADDED: usize = NODES + 2;
 /// The scale of the extinction axis: v = k/(K_SCALE + k).
 const K_SCALE: f32 = 2.0;
-
-/// 16-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; symmetric).
-const GL16: [(f64, f64); 8] = [
-    (0.095_012_509_837_637_44, 0.189_450_610_455_068_5),
-    (0.281_603_550_779_258_9, 0.182_603_415_044_923_6),
-    (0.458_016_777_657_227_4, 0.169_156_519_395_002_5),
-    (0.617_876_244_402_643_7, 0.149_595_988_816_576_7),
-    (0.755_404_408_355_003, 0.124_628_971_255_533_9),
-    (0.865_631_202_387_831_7, 0.095_158_511_682_492_78),
-    (0.944_575_023_073_232_6, 0.062_253_523_938_647_89),
-    (0.989_400_934_991_649_9, 0.027_152_459_411_754_1),
-];
 
 /// Panels of 16-point Gauss–Legendre of the table's nodes.
 const PANELS: usize = 8;
@@ -51,7 +40,7 @@ pub(crate) fn quadrature(eta: f64, k: f64, panels: usize) -> f64 {
     let mut sum = 0.0;
     for panel in 0..panels {
         let mid = (panel as f64 + 0.5) * h;
-        for &(x, w) in &GL16 {
+        for &(x, w) in &GAUSS_LEGENDRE_16 {
             for mu in [mid - 0.5 * h * x, mid + 0.5 * h * x] {
                 sum += w * mu * reflectance(eta, k, mu);
             }

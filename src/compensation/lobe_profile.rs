@@ -9,6 +9,7 @@
 //! [`MuProfile`] samples g(μ) μ by cells of that axis (alias method) and gives its density.
 
 use crate::albedo::floor_index;
+use crate::special::GAUSS_LEGENDRE_8;
 use crate::special::sin_cos_turns;
 use core::f64::consts::PI;
 use glam::{Vec2, Vec3};
@@ -121,14 +122,6 @@ pub(crate) fn profile_average<const N: usize>(g: &[f32; N], alpha: f32) -> f64 {
         .sum()
 }
 
-/// 8-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; symmetric).
-const GL8: [(f64, f64); 4] = [
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
-    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
-    (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
-    (0.960_289_856_497_536_2, 0.101_228_536_290_376_3),
-];
-
 /// 2∫₀¹ g(x(μ)) μ dμ of a vector function g of the direction coordinate x = √(μ (1 + α)/(μ + α))
 /// at roughness α > 0, for g smooth on each of the `cells` equal cells of x (the pieces of a
 /// row interpolated on a `cells + 1`-node axis, or on a coarser axis whose cells are unions of
@@ -148,7 +141,7 @@ pub(crate) fn axis_average<const L: usize>(
     for i in 0..cells {
         let (ua, ub) = (mu_of(i as f64 / cells as f64).sqrt(), mu_of((i + 1) as f64 / cells as f64).sqrt());
         let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
-        for &(t, w) in &GL8 {
+        for &(t, w) in &GAUSS_LEGENDRE_8 {
             for u in [mid - half * t, mid + half * t] {
                 let mu = u * u;
                 let x = (mu * k / (mu + alpha)).min(1.0).sqrt();

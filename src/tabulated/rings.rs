@@ -258,6 +258,7 @@ impl RingLookup {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::special::GAUSS_LEGENDRE_8;
 
     /// S(R, c) against Gauss–Legendre quadrature of its defining integral in polar coordinates,
     /// ∫_c^R 2r(√(r² − c²) − c·acos(c/r))/(1 + r²)² dr, on both sides of the series' regime
@@ -267,12 +268,6 @@ mod tests {
         // composite Gauss–Legendre (8 nodes on each of 256 panels) in ψ, v = √(r² − c²) =
         // k tan ψ (k² = 1 + c²), where the integrand 2v(v − c atan(v/c))/(v² + k²)² dv becomes
         // 2 sin ψ cos ψ (v − c atan(v/c))/k² dψ, smooth and bounded
-        const GL8: [(f64, f64); 4] = [
-            (0.183_434_642_495_649_8, 0.362_683_783_378_362),
-            (0.525_532_409_916_329, 0.313_706_645_877_887_3),
-            (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
-            (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
-        ];
         let quad = |r: f64, c: f64| {
             let k2 = 1.0 + c * c;
             let k = k2.sqrt();
@@ -298,7 +293,7 @@ mod tests {
             let mut sum = 0.0;
             for p in 0..panels {
                 let mid = (p as f64 + 0.5) * h;
-                for (x, w) in GL8 {
+                for (x, w) in GAUSS_LEGENDRE_8 {
                     sum += w * 0.5 * h * (f(mid - 0.5 * h * x) + f(mid + 0.5 * h * x));
                 }
             }

@@ -3,6 +3,7 @@
 use super::seed::{Hasher, PrimedPcg, PrimedRng};
 use super::sidedness::{Facing, Sidedness, mirror_z};
 use super::specular::SpecularLimit;
+use super::walk_density::walk_exit_density;
 use super::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, SampleFlags, Transport, renormalized, unit_directions, unit_view,
 };
@@ -77,8 +78,11 @@ pub enum Technique {
     /// resolution limit of backfacing Beckmann views below α ≈ 1e-3.
     SingleScattering,
     /// The height-tracing random walk of Heitz et al. 2016: stochastic eval, exact sample
-    /// weights, approximate pdf (0.8 × the single-scattering density + 0.2 × a cosine lobe,
-    /// for MIS weights only). Valid for backfacing views of opaque materials (normal
+    /// weights, approximate pdf for MIS weights only: on conductors of GGX and Beckmann slopes
+    /// (α within the albedo tables) seen and lit from above, the F = 1 walk's exit density
+    /// (the exact single-scattering part plus a Kulla–Conty lobe of the lost energy, from the
+    /// shared albedo tables); elsewhere 0.8 × the single-scattering density + 0.2 × a cosine
+    /// lobe. See `DESIGN.md`, "The MIS density of the stochastic techniques". Valid for backfacing views of opaque materials (normal
     /// mapping): the walk starts with the full-spherical first intersection
     /// (`Microsurface::eval_from_below`, DESIGN.md), and F = 1 conserves energy there, except
     /// for smooth Beckmann surfaces seen from well below (|cot θo|/α ≳ 9.6), where the walk's
@@ -431,6 +435,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     fn research_pdf_out(&self, walk_in: Vec3, walk_out: Vec3) -> f32 {
         match self.technique {
             Technique::SingleScattering => self.single().pdf_unchecked(walk_in, walk_out),
+            // a conductor seen and lit from above: the F = 1 walk's exit density (walk_density.rs)
+            _ if M::MIRROR_FACETS && walk_in.z > 0.0 && walk_out.z > 0.0 => {
+                walk_exit_density(self.surface.slope(), walk_in, walk_out)
+                    .unwrap_or_else(|| self.single().mis_pdf_unchecked(walk_in, walk_out))
+            }
             _ => self.single().mis_pdf_unchecked(walk_in, walk_out),
         }
     }

@@ -27,6 +27,7 @@ mod mint;
 mod seed;
 mod sidedness;
 mod specular;
+mod walk_density;
 
 pub use batch::{BatchBsdf, SampleOutputs};
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};

@@ -236,6 +236,12 @@ impl<S> Elliptical<S> {
 impl<S: AxisAlignedSlope> crate::sealed::Sealed for Elliptical<S> {}
 
 impl<S: AxisAlignedSlope> MicrosurfaceSlope for Elliptical<S> {
+    /// The axis-aligned slope's: √(α₁ α₂) is invariant under the rotation.
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(crate::albedo::AlbedoTable, f32)> {
+        self.axis_aligned().conductor_albedo()
+    }
+
     /// The marginal roughness αx (eq. 2.29).
     #[inline]
     fn alpha_x(&self) -> f32 {

@@ -23,6 +23,7 @@ pub(crate) use ggx::{
 pub(crate) use ggx::{sample_spherical_cap, sample_visible_hemisphere};
 pub(crate) use stretch::{Azimuth, disk_frame, stretch, stretch64};
 
+use crate::albedo::AlbedoTable;
 pub(crate) use crate::contract::{is_direction, is_direction64, is_uniform};
 use crate::error::Error;
 use crate::lanes::Lanes;
@@ -69,6 +70,16 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     #[doc(hidden)]
     #[inline]
     fn ggx_roughness(&self) -> Option<(f32, f32)> {
+        None
+    }
+
+    /// The family's F = 1 single-scattering albedo table and the roughness it is read at,
+    /// √(αx αy) (GGX, Beckmann and their elliptical rotations); `None` for every other
+    /// distribution. The stochastic techniques' MIS density reads it
+    /// ([`MicrofacetBsdf`](crate::MicrofacetBsdf)).
+    #[doc(hidden)]
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(AlbedoTable, f32)> {
         None
     }
 

@@ -8,6 +8,7 @@ use crate::special::{
 };
 mod inversion;
 
+use crate::albedo::AlbedoTable;
 use glam::{DVec3, Vec2, Vec3};
 pub(crate) use inversion::{gaussian_slope, sample_visible_normal, visible_slope_x_above, visible_slopes};
 
@@ -186,6 +187,11 @@ impl Beckmann {
 impl crate::sealed::Sealed for Beckmann {}
 
 impl MicrosurfaceSlope for Beckmann {
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(AlbedoTable, f32)> {
+        Some((AlbedoTable::BECKMANN, (self.alpha_x() * self.alpha_y()).sqrt()))
+    }
+
     #[inline]
     fn alpha_x(&self) -> f32 {
         self.alpha_x

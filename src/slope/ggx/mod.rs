@@ -10,6 +10,7 @@ mod visible;
 
 pub(crate) use visible::{bounded_area_of, kappa_of, sample_cap_of};
 
+use crate::albedo::AlbedoTable;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
 use visible::bounded_area;
@@ -183,6 +184,11 @@ impl Ggx {
 impl crate::sealed::Sealed for Ggx {}
 
 impl MicrosurfaceSlope for Ggx {
+    #[inline]
+    fn conductor_albedo(&self) -> Option<(AlbedoTable, f32)> {
+        Some((AlbedoTable::GGX, (self.alpha_x() * self.alpha_y()).sqrt()))
+    }
+
     #[inline]
     fn ggx_roughness(&self) -> Option<(f32, f32)> {
         Some((self.alpha_x, self.alpha_y))

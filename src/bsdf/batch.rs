@@ -14,8 +14,10 @@
 //!
 //! The lanes compute with the same kernels as the scalar calls (`crate::lanes`: GGX Λ, projected
 //! area, D and reflection density, the spherical-cap visible normal, the conductor and dielectric
-//! Fresnel terms, G2 and G2/G1), generic over the lane type. Where the scalar path branches to a
-//! rare form (a half vector within rounding of −ωi, a subnormal density, a cap point near −v̂,
+//! Fresnel terms, G2 and G2/G1), generic over the lane type; the transmission's height-correlated
+//! G2, a beta function, with the lane form of `crate::special` (the scalar path forms it from f64
+//! log-gammas). Where the scalar path branches to a rare form (a half vector within rounding of
+//! −ωi, a subnormal density, a cap point near −v̂, a beta function below the normal f32 range,
 //! a near-perpendicular facet's Fresnel cosine, a backfacing view, an invalid argument), the
 //! lanes compute a mask of the queries their common path covers, and every other query is
 //! answered by the scalar call itself. A bad lane therefore gets exactly the scalar contract's
@@ -40,6 +42,7 @@ use crate::slope::{
     reflection_density_of, sample_cap_of,
 };
 use crate::soa::{Channels, Directions, check_len};
+use crate::special::{beta_1p_of, ln_beta_1p_of};
 use glam::{Vec2, Vec3, Vec3A};
 
 /// The outputs of [`BatchBsdf::sample_batch`], one element per query: the sampled direction,
@@ -215,8 +218,9 @@ fn check_sample_lengths(
 enum Kernel {
     /// GGX (αx, αy) conductor with the Fresnel constants per channel (`None`: F = 1).
     Conductor { ax: f32, ay: f32, fresnel: Option<(Vec3A, Vec3A)> },
-    /// GGX (αx, αy) dielectric of index η.
-    Dielectric { ax: f32, ay: f32, eta: f32 },
+    /// GGX (αx, αy) dielectric of index η; `transport`: the transport factor of a
+    /// transmission from above (1/η² for radiance, 1 for importance).
+    Dielectric { ax: f32, ay: f32, eta: f32, transport: f32 },
 }
 
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
@@ -231,7 +235,8 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             LaneMaterial::Conductor(fresnel) => Some(Kernel::Conductor { ax, ay, fresnel }),
             // near η = 1 the refraction half vector cancels: the f64 scalar path serves
             LaneMaterial::Dielectric(eta) if (eta - 1.0).abs() >= DIELECTRIC_LANES_MIN_CONTRAST => {
-                Some(Kernel::Dielectric { ax, ay, eta })
+                let transport = self.transport_scale(Vec3::Z, Vec3::NEG_Z);
+                Some(Kernel::Dielectric { ax, ay, eta, transport })
             }
             _ => None,
         }
@@ -307,10 +312,11 @@ const REFRACTION_MARGIN: f32 = 1e-4;
 /// The density of a refraction from ωo (above) to ωi (below) through a GGX dielectric of
 /// index η (the phase function of `Dielectric`, Heitz et al. 2016, supplement §3.4):
 /// η² (1 − F) D_ωo(ωh) |ωi·ωh|/(ωo·ωh + η ωi·ωh)², with ωh ∝ −(ωo + η ωi) turned up, D from
-/// the unnormalized sum ([`d_of_sum`]). `ok`: where the half vector's validity tests
-/// (ωh.z > 0, ωo·ωh > 0 > ωi·ωh) hold or fail with a margin (0 where they fail).
+/// the unnormalized sum ([`d_of_sum`]), and Λ(ωo). `valid`: where the half vector's validity
+/// tests (ωh.z > 0, ωo·ωh > 0 > ωi·ωh) hold with a margin (the density is 0 elsewhere); `ok`:
+/// where they hold or fail with a margin.
 #[inline(always)]
-fn transmission_density<L: Lanes>(ax: L, ay: L, eta: L, wo: V3<L>, wi: V3<L>) -> (L, L::Mask) {
+fn transmission_density<L: Lanes>(ax: L, ay: L, eta: L, wo: V3<L>, wi: V3<L>) -> (L, L, L::Mask, L::Mask) {
     let zero = L::lit(0.0);
     let sum = wo.add(wi.scale(eta));
     let up = sum.z.gt(zero);
@@ -322,12 +328,44 @@ fn transmission_density<L: Lanes>(ax: L, ay: L, eta: L, wo: V3<L>, wi: V3<L>) ->
     let valid = h.z.gt(margin * len) & cos_ih.gt(margin) & cos_oh.lt(-margin);
     let invalid = h.z.lt(-margin * len) | cos_ih.lt(-margin) | cos_oh.gt(margin);
     let d = d_of_sum(ax, ay, h, L::lit(core::f32::consts::FRAC_1_PI));
-    let (_, area) = lambda_and_area_of(ax, ay, wo);
+    let (lambda, area) = lambda_and_area_of(ax, ay, wo);
     let transmittance = L::lit(1.0) - fresnel_dielectric_cosines_of(cos_ih, -cos_oh, eta);
     let d_wi = cos_ih * d / area;
     let pdf = eta * eta * transmittance * d_wi * (-cos_oh) / len_sq;
     let sane = len.gt(L::lit(DIELECTRIC_LANES_MIN_CONTRAST)) & len_sq.ge(L::lit(F32_DENSITY_MIN_SUM));
-    (L::select(valid, pdf, zero), sane & (valid | invalid))
+    (L::select(valid, pdf, zero), lambda, valid, sane & (valid | invalid))
+}
+
+/// Below this ln B the transmission's shadowing B(1 + Λ(ωo), 1 + Λ(−ωi)) leaves the normal
+/// f32 range of [`beta_1p_of`]: the scalar call answers.
+const LN_BETA_MIN: f32 = -87.0;
+
+/// f of a refraction from ωo (above) to ωi (below) through a GGX dielectric (Walter et al.
+/// 2007, eq. 21, with the height-correlated masking-shadowing of Heitz 2014, eq. 99, as the
+/// scalar `Dielectric` evaluates it, supplement §3.4 of Heitz et al. 2016):
+///
+/// f = |ωo·ωh| |ωi·ωh| η² (1 − F) D(ωh) B(1 + Λ(ωo), 1 + Λ(−ωi)) / (cos θo |cos θi| (ωo·ωh + η ωi·ωh)²) · s
+///   = pdf · (1 + Λ(ωo)) B(1 + Λ(ωo), 1 + Λ(−ωi)) · s/|cos θi|,
+///
+/// pdf the density of [`transmission_density`] (D_ωo = |ωo·ωh| D/((1 + Λ(ωo)) cos θo)) and s the
+/// transport factor. `ok`: where f is a normal f32 and ln B ≥ [`LN_BETA_MIN`], or the pair is
+/// not a refraction (f = 0).
+#[inline(always)]
+fn transmission_value<L: Lanes>(
+    ax: L,
+    ay: L,
+    transport: L,
+    wi: V3<L>,
+    pdf: L,
+    lambda_o: L,
+    valid: L::Mask,
+) -> (L, L::Mask) {
+    let one = L::lit(1.0);
+    let (lambda_i, _) = lambda_and_area_of(ax, ay, V3::new(-wi.x, -wi.y, -wi.z));
+    let ln_b = ln_beta_1p_of(lambda_o, lambda_i);
+    let f = pdf * ((one + lambda_o) * beta_1p_of(ln_b)) * (transport / -wi.z);
+    let f = L::select(valid, f, L::lit(0.0));
+    (f, (valid & ln_b.ge(L::lit(LN_BETA_MIN)) & normal(f)) | !valid)
 }
 
 /// f as the trait returns it: 0 where not finite.
@@ -381,32 +419,34 @@ fn evaluate_conductor<L: Lanes, const WANT: u8>(
     (f, L::select(above, pdf, zero), (above & ok & ok_b) | below)
 }
 
-/// [`evaluate_conductor`] for a GGX dielectric of index η: reflections from above, and the
-/// density of transmissions from above (their f, with the height-correlated G2 a beta
-/// function, is the scalar call's).
+/// [`evaluate_conductor`] for a GGX dielectric of index η and transport factor `transport`:
+/// reflections and transmissions from above.
 #[inline(always)]
 fn evaluate_dielectric<L: Lanes, const WANT: u8>(
     ax: f32,
     ay: f32,
     eta: f32,
+    transport: f32,
     wo: V3<L>,
     wi: V3<L>,
 ) -> ([L; 3], L, L::Mask) {
     let zero = L::lit(0.0);
     let front = is_direction(wo) & is_direction(wi) & wo.z.gt(zero);
     let above = front & wi.z.gt(zero);
+    let below = front & wi.z.lt(zero);
     let (ax, ay, eta) = (L::lit(ax), L::lit(ay), L::lit(eta));
     let (density, g2_over_g1, cos, ok) = front_reflection(ax, ay, wo, wi);
     let fr = dielectric_fresnel(eta, cos);
-    let f = finite_or_zero(L::select(above, fr * density * g2_over_g1 / wi.z, zero));
+    let (pdf_transmit, lambda_o, valid_t, ok_t) = transmission_density(ax, ay, eta, wo, wi);
+    let pdf = L::select(above, fr * density, pdf_transmit);
+    let reflected = L::select(above, fr * density * g2_over_g1 / wi.z, zero);
     if WANT == Want::PDF {
-        let below = front & wi.z.lt(zero);
-        let (pdf_transmit, ok_t) = transmission_density(ax, ay, eta, wo, wi);
-        let pdf = L::select(above, fr * density, pdf_transmit);
-        ([f; 3], pdf, (above & ok) | (below & ok_t))
-    } else {
-        ([f; 3], fr * density, above & ok)
+        return ([finite_or_zero(reflected); 3], pdf, (above & ok) | (below & ok_t));
     }
+    let (transmitted, ok_f) =
+        transmission_value(ax, ay, L::lit(transport), wi, pdf_transmit, lambda_o, valid_t);
+    let f = finite_or_zero(L::select(above, reflected, L::select(below, transmitted, zero)));
+    ([f; 3], pdf, (above & ok) | (below & ok_t & ok_f))
 }
 
 /// The sample of a GGX conductor seen from above (`SingleScattering::sample_mirror_front` and
@@ -554,7 +594,9 @@ impl<B: Bsdf, const WANT: u8> LaneLoop for EvalLoop<'_, '_, '_, B, WANT> {
             Kernel::Conductor { ax, ay, fresnel: Some(fresnel) } => {
                 self.pass(ConductorQuery { ax, ay, fresnel })
             }
-            Kernel::Dielectric { ax, ay, eta } => self.pass(DielectricQuery { ax, ay, eta }),
+            Kernel::Dielectric { ax, ay, eta, transport } => {
+                self.pass(DielectricQuery { ax, ay, eta, transport })
+            }
         }
     }
 }
@@ -578,11 +620,12 @@ struct ConductorQuery {
     fresnel: (Vec3A, Vec3A),
 }
 
-/// A GGX dielectric.
+/// A GGX dielectric with the transport factor of its transmissions.
 struct DielectricQuery {
     ax: f32,
     ay: f32,
     eta: f32,
+    transport: f32,
 }
 
 impl<const WANT: u8> QueryKernel<WANT> for MirrorQuery {
@@ -602,7 +645,7 @@ impl<const WANT: u8> QueryKernel<WANT> for ConductorQuery {
 impl<const WANT: u8> QueryKernel<WANT> for DielectricQuery {
     #[inline(always)]
     fn eval(&self, wo: V3<f32>, wi: V3<f32>) -> ([f32; 3], f32, bool) {
-        evaluate_dielectric::<f32, WANT>(self.ax, self.ay, self.eta, wo, wi)
+        evaluate_dielectric::<f32, WANT>(self.ax, self.ay, self.eta, self.transport, wo, wi)
     }
 }
 
@@ -688,9 +731,10 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 /// from α = 10⁻³ to 10, anisotropic, grazing to 10⁻⁶): densities and samples of conductors are
 /// equal bit for bit; f of a reflection within 2e-5 relative (the scalar forms D, Λ and G2 in
 /// f64, the lanes in f32) plus 4e-6 of f/F for the Fresnel cosine; a dielectric's densities
-/// within 2e-5 relative plus 1e-6 absolute. Glass transmission eval and glass samples run the
-/// scalar calls (the transmission's height-correlated G2 is a beta function, which has no lane
-/// kernel yet).
+/// within 1e-4 relative plus 1e-6 absolute; f of a dielectric's transmission within 1.5e-4
+/// relative plus (4e-6 + 1e-6/pdf) of f (the density's bound carried over, and the lane beta
+/// function of the height-correlated G2, `special::ln_beta_1p_of`: 4e-7·(1 + |ln B|) + 3 ulps).
+/// Glass samples run the scalar calls.
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for MicrofacetBsdf<S, M> {
     fn eval_batch(
         &self,

@@ -331,7 +331,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 
     /// (η_wo/η_wi)² for radiance transport across a dielectric, 1 otherwise.
     #[inline(always)]
-    fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(super) fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self.transport {
             // the research layer's relative_eta_sq(light from, light to): light goes wi → wo
             Transport::Radiance => self

@@ -344,7 +344,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 
     /// η_wi/η_wo: the relative index of a transmission from wo's side to wi's side.
     #[inline(always)]
-    fn relative_eta(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(super) fn relative_eta(&self, wo: Vec3, wi: Vec3) -> f32 {
         if (wi.z > 0.0) == (wo.z > 0.0) {
             1.0
         } else {

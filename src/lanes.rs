@@ -69,6 +69,15 @@ pub(crate) trait Lanes:
     /// The nearest integer q = ⌊x + ½⌋ of each lane x ∈ [0, 4.5) (a quadrant), as a float, with
     /// masks of its bits 0 and 1.
     fn quadrant(self) -> (Self, Self::Mask, Self::Mask);
+    /// The nearest integer of each lane x with |x| < 2²² (ties to even), as a float: x plus and
+    /// minus 1.5·2ᵖ⁻¹ (p the significand's bits), exact in the lane type's arithmetic.
+    fn nearest_int(self) -> Self;
+    /// (k, m) with x = 2ᵏ m and m ∈ [√½, √2) for each lane x, a positive normal float: k (a
+    /// float) from the exponent field, m with that field replaced, both exact.
+    fn exponent_and_mantissa(self) -> (Self, Self);
+    /// 2ᵏ of each lane k, an integer in [−126, 127] (a float; a normal f32), built in the
+    /// exponent field: exact.
+    fn exp2_int(self) -> Self;
 }
 
 impl Mask for bool {
@@ -84,7 +93,7 @@ impl Mask for bool {
 
 /// The scalar float types: one lane.
 macro_rules! scalar_lanes {
-    ($t:ty) => {
+    ($t:ty, $i:ty, $u:ty, $sqrt_half:expr, $shift:expr, $bias:expr, $magic:expr) => {
         impl Lanes for $t {
             type Mask = bool;
             #[inline(always)]
@@ -145,12 +154,27 @@ macro_rules! scalar_lanes {
                 let q = (self + 0.5) as i32;
                 (q as $t, q & 1 != 0, q & 2 != 0)
             }
+            #[inline(always)]
+            fn nearest_int(self) -> Self {
+                (self + $magic) - $magic
+            }
+            #[inline(always)]
+            fn exponent_and_mantissa(self) -> (Self, Self) {
+                let bits = self.to_bits();
+                let k = (bits.wrapping_sub($sqrt_half) as $i) >> $shift;
+                (k as $t, <$t>::from_bits(bits.wrapping_sub((k << $shift) as $u)))
+            }
+            #[inline(always)]
+            fn exp2_int(self) -> Self {
+                <$t>::from_bits(((self as $i + $bias) as $u) << $shift)
+            }
         }
     };
 }
 
-scalar_lanes!(f32);
-scalar_lanes!(f64);
+// the bits of √½, the significand's width and the exponent's bias of each float type
+scalar_lanes!(f32, i32, u32, 0x3f35_04f3, 23, 127, 12_582_912.0);
+scalar_lanes!(f64, i64, u64, 0x3fe6_a09e_667f_3bcd, 52, 1023, 6_755_399_441_055_744.0);
 
 impl Mask for BVec3A {
     #[inline(always)]
@@ -219,6 +243,19 @@ impl Lanes for Vec3A {
         let q = self.to_array().map(|x| (x + 0.5) as i32);
         let bit = |b: i32| BVec3A::new(q[0] & b != 0, q[1] & b != 0, q[2] & b != 0);
         (Vec3A::new(q[0] as f32, q[1] as f32, q[2] as f32), bit(1), bit(2))
+    }
+    #[inline(always)]
+    fn nearest_int(self) -> Self {
+        Vec3A::from_array(self.to_array().map(Lanes::nearest_int))
+    }
+    #[inline(always)]
+    fn exponent_and_mantissa(self) -> (Self, Self) {
+        let [a, b, c] = self.to_array().map(Lanes::exponent_and_mantissa);
+        (Vec3A::new(a.0, b.0, c.0), Vec3A::new(a.1, b.1, c.1))
+    }
+    #[inline(always)]
+    fn exp2_int(self) -> Self {
+        Vec3A::from_array(self.to_array().map(Lanes::exp2_int))
     }
 }
 
@@ -360,6 +397,35 @@ mod tests {
             let (q, odd, high) = Lanes::quadrant(x);
             let (q3, odd3, high3) = Lanes::quadrant(Vec3A::splat(x));
             assert_eq!((q3.x, odd3.all(), high3.all()), (q, odd, high), "{x}");
+        }
+    }
+
+    /// The exponent primitives: x = 2ᵏ m with m ∈ [√½, √2) for normal x of both float types
+    /// (at the boundaries of m's range too), 2ᵏ over the whole normal f32 range, the nearest
+    /// integer with ties to even.
+    #[test]
+    fn exponent_primitives_are_exact() {
+        let sqrt_half = core::f32::consts::FRAC_1_SQRT_2;
+        for x in
+            [f32::MIN_POSITIVE, 1e-30, 0.3, sqrt_half, sqrt_half.next_down(), 1.0, 1.414, 1.5, 7.0, f32::MAX]
+        {
+            let (k, m) = Lanes::exponent_and_mantissa(x);
+            assert!((sqrt_half..core::f32::consts::SQRT_2).contains(&m), "{x}: m = {m}");
+            assert_eq!(f64::from(m) * f64::exp2(f64::from(k)), f64::from(x), "{x}");
+            let (k64, m64) = Lanes::exponent_and_mantissa(f64::from(x));
+            assert!((0.5f64.sqrt()..2f64.sqrt()).contains(&m64), "{x}: m = {m64}");
+            assert_eq!(m64 * f64::exp2(k64), f64::from(x), "{x}");
+            let (k3, m3) = Lanes::exponent_and_mantissa(Vec3A::splat(x));
+            assert_eq!((k3.x, m3.z), (k, m), "{x}");
+        }
+        for k in -126..=127 {
+            assert_eq!(Lanes::exp2_int(k as f32), f32::exp2(k as f32), "2^{k}");
+            assert_eq!(Lanes::exp2_int(f64::from(k)), f64::exp2(f64::from(k)), "2^{k}");
+        }
+        for (x, n) in [(0.5f32, 0.0f32), (1.5, 2.0), (-2.5, -2.0), (3.49, 3.0), (-125.7, -126.0), (4e6, 4e6)]
+        {
+            assert_eq!(Lanes::nearest_int(x), n, "{x}");
+            assert_eq!(Lanes::nearest_int(f64::from(x)), f64::from(n), "{x}");
         }
     }
 }

@@ -335,7 +335,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 
     /// (η_wo/η_wi)² for radiance transport across a dielectric, 1 otherwise.
     #[inline(always)]
-    fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(super) fn transport_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self.transport {
             // the research layer's relative_eta_sq(light from, light to): light goes wi → wo
             Transport::Radiance => self
@@ -348,7 +348,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 
     /// η_wi/η_wo: the relative index of a transmission from wo's side to wi's side.
     #[inline(always)]
-    fn relative_eta(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(super) fn relative_eta(&self, wo: Vec3, wi: Vec3) -> f32 {
         if (wi.z > 0.0) == (wo.z > 0.0) {
             1.0
         } else {

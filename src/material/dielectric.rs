@@ -299,7 +299,7 @@ impl Material for Dielectric {
 
     #[inline]
     fn lane_material(&self) -> LaneMaterial {
-        LaneMaterial::Dielectric(self.eta)
+        LaneMaterial::Dielectric(self.eta, self.inv_eta)
     }
 
     /// η = 1 exactly. A nearly index-matched interface (|η − 1| of a few f32 ulps) is not

@@ -9,6 +9,7 @@ mod side;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
+pub(crate) use dielectric::reflectance_scaled_of;
 pub use diffuse::Diffuse;
 pub use interaction::{Event, Interaction};
 pub use side::Side;
@@ -26,8 +27,10 @@ pub enum LaneMaterial {
     /// Conductor facets: the per-channel constants (η² − k² − 1, 4η²k²) of their Fresnel
     /// term, `None` for a perfect mirror.
     Conductor(Option<(Vec3A, Vec3A)>),
-    /// Dielectric facets of relative index η.
-    Dielectric(f32),
+    /// Dielectric facets of relative index η, with 1/η as the material keeps it (the
+    /// refraction's factor: `Dielectric::flipped` swaps the two, so 1/η is not always 1.0/η
+    /// rounded).
+    Dielectric(f32, f32),
     /// No lane kernels.
     Other,
 }

@@ -12,6 +12,7 @@
 //! 4e-15 for the exponential, [`exp_nonpositive`]; asserted against the f64 library below).
 
 use super::exp_nonpositive;
+use crate::lanes::Lanes;
 use core::f64::consts::LN_2;
 
 /// The bits of √½: a positive f64 whose bits minus these have the exponent field k with
@@ -84,6 +85,55 @@ pub(crate) fn ln_1m_exp_f32(x: f32) -> f32 {
     } else {
         ln_1p(-exp_nonpositive(x)) as f32
     }
+}
+
+/// ln 2 = `LN2_HI` + `LN2_LO`: the high part has 9 significant bits, so that k·`LN2_HI` is exact
+/// in f32 for every integer |k| ≤ 2¹⁵.
+const LN2_HI: f32 = 0.693_359_375;
+/// ln 2 − `LN2_HI`, rounded to f32.
+const LN2_LO: f32 = -2.121_944_4e-4;
+
+/// ln x of a positive normal x, for every lane type (Cody and Waite's reduction): x = 2ᵏ m with
+/// m ∈ [√½, √2) ([`Lanes::exponent_and_mantissa`]), ln m = 2 atanh(s) with s = (m − 1)/(m + 1)
+/// = f/(2 + f), |s| ≤ 0.1716, by its series to s⁹ (relative truncation s¹⁰/11 ≤ 2e-9), and
+/// k ln 2 in two parts. Relative error in f32 lanes below 4 ulps (2.4e-7; `lanes_ln_exp`
+/// below measures it).
+#[inline(always)]
+pub(crate) fn ln_of<L: Lanes>(x: L) -> L {
+    let (k, m) = x.exponent_and_mantissa();
+    let f = m - L::lit(1.0);
+    let s = f / (L::lit(2.0) + f);
+    let s2 = s * s;
+    let series = L::lit(1.0 / 3.0) + s2 * (L::lit(0.2) + s2 * (L::lit(1.0 / 7.0) + s2 * L::lit(1.0 / 9.0)));
+    let two_s = L::lit(2.0) * s;
+    k * L::lit(LN2_HI) + (k * L::lit(LN2_LO) + (two_s + two_s * (s2 * series)))
+}
+
+/// ln(1 + t) for t ≥ 0, for every lane type, without losing small t: u = 1 + t rounded,
+/// ln u + (t − (u − 1))/u (the rounding of u corrected to first order). Relative error in f32
+/// lanes below 4 ulps (measured below).
+#[inline(always)]
+pub(crate) fn ln_1p_of<L: Lanes>(t: L) -> L {
+    let u = L::lit(1.0) + t;
+    ln_of(u) + (t - (u - L::lit(1.0))) / u
+}
+
+/// eˣ for x ∈ [−87, 88], for every lane type (normal f32 results): k = nearest(x/ln 2),
+/// r = x − k ln 2 (ln 2 in two parts, |r| ≤ 0.347), eʳ by its Taylor polynomial of degree 7
+/// (relative truncation r⁸/8! ≤ 5.2e-9) and 2ᵏ from the exponent field
+/// ([`Lanes::exp2_int`]). Relative error in f32 lanes below 3 ulps (measured below).
+#[inline(always)]
+pub(crate) fn exp_of<L: Lanes>(x: L) -> L {
+    let k = (x * L::lit(core::f32::consts::LOG2_E)).nearest_int();
+    let r = (x - k * L::lit(LN2_HI)) - k * L::lit(LN2_LO);
+    let c = |v: f64| L::lit(v as f32);
+    let poly = L::lit(1.0)
+        + r * (L::lit(1.0)
+            + r * (c(1.0 / 2.0)
+                + r * (c(1.0 / 6.0)
+                    + r * (c(1.0 / 24.0)
+                        + r * (c(1.0 / 120.0) + r * (c(1.0 / 720.0) + r * c(1.0 / 5040.0)))))));
+    poly * k.exp2_int()
 }
 
 #[cfg(test)]
@@ -207,5 +257,32 @@ mod tests {
         assert_eq!(ln_1m_exp_f32(f32::MIN), -0.0);
         eprintln!("ln(1 − eˣ): {:.3} ulp at x = {:e}", worst.0, worst.1);
         assert!(worst.0 < 0.51, "{} ulp at x = {:e}", worst.0, worst.1);
+    }
+
+    /// The f32 lane forms of ln, ln(1 + t) and eˣ within their stated ulps of the f64 library
+    /// over 10⁶ points each: ln over the whole normal range, ln(1 + t) for t from 1e-30 to 1e30,
+    /// eˣ over [−87, 88].
+    #[test]
+    fn lanes_ln_exp() {
+        let mut u = uniforms(17);
+        let (mut ln_worst, mut ln1p_worst, mut exp_worst) = (0.0f64, 0.0f64, 0.0f64);
+        for _ in 0..1_000_000 {
+            let x = (f64::from(f32::MIN_POSITIVE).ln() + u() * 175.0).exp() as f32;
+            if x.is_normal() {
+                ln_worst = ln_worst.max(ulps(ln_of(x), f64::from(x).ln()));
+            }
+            let t = (u() * 138.0 - 69.0).exp() as f32;
+            ln1p_worst = ln1p_worst.max(ulps(ln_1p_of(t), f64::from(t).ln_1p()));
+            let e = (u() * 175.0 - 87.0) as f32;
+            exp_worst = exp_worst.max(ulps(exp_of(e), f64::from(e).exp()));
+        }
+        for x in [f32::MIN_POSITIVE, 0.5, 1.0, 1.0 + f32::EPSILON, 2.0, f32::MAX] {
+            ln_worst = ln_worst.max(ulps(ln_of(x), f64::from(x).ln()));
+        }
+        eprintln!("lane ln {ln_worst:.2} ulps, ln_1p {ln1p_worst:.2}, exp {exp_worst:.2}");
+        assert!(ln_worst <= 4.0 && ln1p_worst <= 4.0 && exp_worst <= 3.0);
+        assert_eq!(ln_of(1.0f32), 0.0);
+        assert_eq!(ln_1p_of(0.0f32), 0.0);
+        assert_eq!(exp_of(0.0f32), 1.0);
     }
 }

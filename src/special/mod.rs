@@ -12,6 +12,7 @@ mod gamma;
 mod gauss_legendre;
 mod gaussian;
 mod ln;
+mod stirling;
 mod tail_ratio;
 mod trig;
 
@@ -25,6 +26,7 @@ pub use gamma::{beta, ln_beta, ln_gamma};
 pub(crate) use gauss_legendre::{GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_16};
 pub(crate) use gaussian::gaussian_integral_and_half;
 pub(crate) use ln::{exp_f32, ln_1m_exp_f32, ln_f32};
+pub(crate) use stirling::{beta_1p_of, ln_beta_1p_of};
 pub(crate) use tail_ratio::tail_ratio;
 pub use trig::sin_cos_turns;
 pub(crate) use trig::sin_cos_turns_of;

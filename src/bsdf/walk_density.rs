@@ -32,7 +32,7 @@ pub(crate) fn walk_exit_density<S: MicrosurfaceSlope>(
 ) -> Option<f32> {
     let (table, alpha) = slope.conductor_albedo()?;
     let lost = 1.0 - table.average(alpha)?;
-    if !(lost > 0.0) {
+    if lost.is_nan() || lost <= 0.0 {
         return None;
     }
     let (zi, zo) = (walk_in.z, walk_out.z);

@@ -67,10 +67,11 @@ impl TabulatedOrder {
 /// needs, since each further bounce multiplies it by a Fresnel term (Kulla and Conty 2017;
 /// Hill's suggestion of E_F ≈ E_ss,F + Σ_k e_k F̄^k per RGB channel).
 ///
-/// **Axes** those of [`super::AlbedoTable`] at a third of its direction resolution (every node
-/// here is a node there): r = √α in 31 equal steps (row 0 at α = 1e-6), direction node
-/// x = i/31 at μ = X α/(1 + α − X), X = x²; bilinear in (x, r). Column x = 0 (μ = 0) is 0: a
-/// grazing ray sees only the top of the surface and leaves after one bounce.
+/// **Axes** those of [`super::AlbedoTable`] at a third of its direction resolution and half
+/// its roughness resolution (every node here is a node there): r = √α in 31 equal steps (row 0
+/// at α = 1e-6), direction node x = i/31 at μ = X α/(1 + α − X), X = x²; bilinear in (x, r).
+/// Column x = 0 (μ = 0) is 0: a grazing ray sees only the top of the surface and leaves after
+/// one bounce.
 ///
 /// **Accuracy.** Every node is the mean of 2¹⁶ walks of its own seeded generator: standard
 /// error √(e (1 − e)/2¹⁶) ≤ [`ORDER_TABLE_MAX_STANDARD_ERROR`] per node (and per average

@@ -5,8 +5,8 @@ use super::generated::conductor as data;
 /// Direction nodes of a roughness row of [`AlbedoTable`] (x = i/93).
 pub const ALBEDO_DIRECTIONS: usize = 94;
 
-/// Roughness rows of [`AlbedoTable`] (r = √α = j/31), and nodes of its E_avg.
-pub const ALBEDO_ROUGHNESSES: usize = 32;
+/// Roughness rows of [`AlbedoTable`] (r = √α = j/62), and nodes of its E_avg.
+pub const ALBEDO_ROUGHNESSES: usize = 63;
 
 /// The largest roughness α the tables cover (their roughness axis is r = √α ∈ [0, 1]).
 pub const MAX_TABULATED_ALPHA: f32 = 1.0;
@@ -30,7 +30,7 @@ pub(crate) enum Family {
 /// G2 = 1/(1 + Λ(ωi) + Λ(ωo)) (Heitz 2014; the first order of the random walk of Heitz et al.
 /// 2016), and its cosine-weighted average E_avg(α) = 2 ∫₀¹ E(μ) μ dμ (Kulla and Conty 2017).
 ///
-/// **Axes.** Roughness r = √α ∈ [0, 1] (as in Cycles' tables), 31 equal steps. The direction
+/// **Axes.** Roughness r = √α ∈ [0, 1] (as in Cycles' tables), 62 equal steps. The direction
 /// axis is scale-invariant: node x ∈ [0, 1] holds μ = X α / (1 + α − X) with X = x², so that the
 /// sharp feature of E at μ ≈ α (E(0) = 1: a grazing ray sees the top of the surface, from
 /// which every reflection escapes, and E dips to ≈ 0.89 at μ ≈ α) is resolved at every α; the
@@ -42,10 +42,10 @@ pub(crate) enum Family {
 /// `DESIGN.md`): every node is within 1e-6 of the exact integral (two quadrature resolutions
 /// agree to that). Bilinear interpolation, measured against quadrature at every cell centre and
 /// at the midpoint of every cell edge (where a bilinear interpolant is farthest from its
-/// nodes), errs by at most 5.5e-4 for GGX (cell centres 5.2e-4, edge midpoints along x 1.2e-4,
-/// along r 5.42e-4; RMS ≤ 1.2e-4) and 1.3e-3 for Beckmann (centres 8.6e-4, edges along x 6.7e-4,
-/// along r 1.29e-3 at μ = 1, α ≈ 0.48; RMS ≤ 1.3e-4). A uniform μ axis of 32 nodes errs by up
-/// to 7.4e-2.
+/// nodes), errs by at most 1.9e-4 for GGX (cell centres 1.86e-4, edge midpoints along x
+/// 1.21e-4, along r 1.35e-4; RMS ≤ 3.9e-5) and 6.8e-4 for Beckmann (centres 5.87e-4, edges along
+/// x 6.73e-4 at μ ≈ 0.97, α ≈ 0.50, along r 3.24e-4; RMS ≤ 6.5e-5). A uniform μ axis of 32
+/// nodes errs by up to 7.4e-2.
 ///
 /// # Examples
 /// ```
@@ -103,7 +103,7 @@ impl AlbedoTable {
     }
 
     /// E_avg(α) = 2 ∫₀¹ E(μ, α) μ dμ, interpolated linearly in r = √α. Its nodes are exact to
-    /// 1e-6; the interpolation errs by at most 3.0e-4 (GGX) and 2.4e-4 (Beckmann), measured at
+    /// 1e-6; the interpolation errs by at most 7.4e-5 (GGX) and 5.9e-5 (Beckmann), measured at
     /// the midpoints between nodes.
     ///
     /// Returns `None` unless α ∈ (0, [`MAX_TABULATED_ALPHA`]].
@@ -118,7 +118,7 @@ impl AlbedoTable {
     }
 
     /// The raw node values of E, row-major with the roughness index slowest
-    /// (`values[j * 94 + i]` at x = i/93, r = j/31), for export to shaders.
+    /// (`values[j * ALBEDO_DIRECTIONS + i]` at x = i/93, r = j/62), for export to shaders.
     #[must_use]
     pub fn directional_nodes(&self) -> &'static [f32] {
         self.directional
@@ -141,14 +141,14 @@ impl AlbedoTable {
         self.family
     }
 
-    /// The raw node values of E_avg at r = j/31.
+    /// The raw node values of E_avg at r = j/62.
     #[must_use]
     pub fn average_nodes(&self) -> &'static [f32] {
         self.average
     }
 }
 
-/// Bilinear interpolation of the row-major grid at fractional indices (i, j) ∈ [0, 93] × [0, 31].
+/// Bilinear interpolation of the row-major grid at fractional indices (i, j) ∈ [0, 93] × [0, 62].
 #[inline(always)]
 fn bilinear(grid: &[f32; ALBEDO_DIRECTIONS * ALBEDO_ROUGHNESSES], i: f32, j: f32) -> f32 {
     let (i0, fi) = super::node_cell(i, ALBEDO_DIRECTIONS);

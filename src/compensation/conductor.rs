@@ -8,7 +8,7 @@
 //! the complements 1 − E of its nodes (exact in f64, rounded once), so that 1 − E keeps its
 //! relative precision where E → 1. The added lobes are normalized by the average of what they
 //! interpolate at this α (not the shipped E_avg table): 2∫(1 − E) μ dμ in closed form per cell,
-//! tabulated at 64 sub-steps of each roughness cell and interpolated linearly (within 4e-4
+//! tabulated at 32 sub-steps of each roughness cell and interpolated linearly (within 4e-4
 //! relative at α ≥ 1e-3, 4e-5 at α ≥ 1e-2), so that the Kulla–Conty lobe integrates to
 //! F_ms (1 − E(μo)) and the white furnace errs by the table's interpolation error alone.
 //!

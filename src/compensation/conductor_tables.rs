@@ -22,8 +22,8 @@ use crate::albedo::{
 use glam::Vec4;
 use std::sync::OnceLock;
 
-/// Sub-steps per roughness cell of the tabulated averages.
-pub(crate) const SUBSTEPS: usize = 64;
+/// Sub-steps per roughness cell of the tabulated averages (steps of r = √α of 1/1984).
+pub(crate) const SUBSTEPS: usize = 32;
 /// Roughness cells of the albedo table.
 const CELLS: usize = ALBEDO_ROUGHNESSES - 1;
 /// The roughness of the albedo table's row 0 (its α → 0 limit profile).

@@ -43,9 +43,9 @@ pub(crate) const COMPENSATED_DIELECTRIC: [f32; 2] = [0.009, 0.016];
 /// at most 1.014 (GGX) and 1.019 (Beckmann) times 1 − Ā_ss of the tables.
 const DIELECTRIC_SINGLE_MARGIN: f32 = 0.02;
 /// The margin of a conductor's single-scattering error: the interpolation error of the
-/// average albedo table Ē(α) (at most 3.0e-4 for GGX and 2.4e-4 for Beckmann, measured by
+/// average albedo table Ē(α) (at most 7.4e-5 for GGX and 5.9e-5 for Beckmann, measured by
 /// the generator, see [`AlbedoTable::average`]).
-const CONDUCTOR_SINGLE_MARGIN: f32 = 3e-4;
+const CONDUCTOR_SINGLE_MARGIN: f32 = 7.4e-5;
 
 /// Time per bounce of a path tracer with next-event estimation (one `sample`, one
 /// `eval_with_pdf` towards a light) relative to single scattering, measured by

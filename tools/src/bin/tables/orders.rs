@@ -222,7 +222,8 @@ pub(crate) fn export(tables: &[(Family, OrderTables)], dir: &std::path::Path) ->
     }
     let text = format!(
         "\n<family>_order_<k>.f32, k = 2 ... {K}, and <family>_order_tail.f32 (orders > {K}): 32 x 32 values\n\
-         each, laid out and looked up as <family>_directional.f32: the energy e_k(mu, alpha) that\n\
+         each, laid out and looked up as <family>_directional.f32 at x = i/31, r = j/31 (its every third\n\
+         direction node and every other roughness row): the energy e_k(mu, alpha) that\n\
          leaves the F = 1 conductor after exactly k bounces of the random walk (mean of {WALKS} walks,\n\
          standard error at most {:.1e}). <family>_order_<k>_average.f32: 32 values, their\n\
          cosine-weighted averages 2 int e_k mu dmu at r = j/31 (linear in r). A conductor with a\n\

@@ -658,19 +658,26 @@ impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
     }
 }
 
+/// One pass of `$loop` per kernel and Fresnel term, each loop free of branches on them: the
+/// dispatch of every lane loop's `run`.
+macro_rules! pass_per_kernel {
+    ($loop:ident) => {
+        match $loop.kernel {
+            Kernel::Conductor { ax, ay, fresnel: None } => $loop.pass(MirrorQuery { ax, ay }),
+            Kernel::Conductor { ax, ay, fresnel: Some(fresnel) } => {
+                $loop.pass(ConductorQuery { ax, ay, fresnel })
+            }
+            Kernel::Dielectric { ax, ay, eta, inv_eta, transport, eta_out } => {
+                $loop.pass(DielectricQuery { ax, ay, eta, inv_eta, transport, eta_out })
+            }
+        }
+    };
+}
+
 impl<B: Bsdf, const WANT: u8> LaneLoop for EvalLoop<'_, '_, '_, B, WANT> {
     #[inline(always)]
     fn run(&mut self) {
-        // one loop per kernel and Fresnel term, each free of branches on them
-        match self.kernel {
-            Kernel::Conductor { ax, ay, fresnel: None } => self.pass(MirrorQuery { ax, ay }),
-            Kernel::Conductor { ax, ay, fresnel: Some(fresnel) } => {
-                self.pass(ConductorQuery { ax, ay, fresnel })
-            }
-            Kernel::Dielectric { ax, ay, eta, inv_eta, transport, eta_out } => {
-                self.pass(DielectricQuery { ax, ay, eta, inv_eta, transport, eta_out })
-            }
-        }
+        pass_per_kernel!(self)
     }
 }
 
@@ -806,15 +813,7 @@ impl<B: Bsdf> SampleLoop<'_, '_, '_, B> {
 impl<B: Bsdf> LaneLoop for SampleLoop<'_, '_, '_, B> {
     #[inline(always)]
     fn run(&mut self) {
-        match self.kernel {
-            Kernel::Conductor { ax, ay, fresnel: None } => self.pass(MirrorQuery { ax, ay }),
-            Kernel::Conductor { ax, ay, fresnel: Some(fresnel) } => {
-                self.pass(ConductorQuery { ax, ay, fresnel })
-            }
-            Kernel::Dielectric { ax, ay, eta, inv_eta, transport, eta_out } => {
-                self.pass(DielectricQuery { ax, ay, eta, inv_eta, transport, eta_out })
-            }
-        }
+        pass_per_kernel!(self)
     }
 }
 

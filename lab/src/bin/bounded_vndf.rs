@@ -11,7 +11,7 @@
 //! pdf_vndf(ωm)/(4 ωi·ωm) of the sampler's own density. Rows: α ∈ {0.05, 0.1, 0.2, 0.5, 1}
 //! isotropic and αx = 1, αy = 0.25 (view azimuth 0.7 rad); columns θo ∈ {0°, 30°, 60°, 80°, 89°}.
 //!
-//! `cargo run --release --example bounded_vndf -- [--samples N]` (default 1 000 000 per cell,
+//! `cargo run --release -p lab --bin bounded_vndf -- [--samples N]` (default 1 000 000 per cell,
 //! a fixed seed); prints a Markdown table.
 
 use glam::Vec3;

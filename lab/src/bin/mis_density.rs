@@ -15,7 +15,7 @@
 //! per-order lobe, `mixture` the compensated conductor's sampling density; for glass
 //! (non-absorbing): the Kulla–Conty dielectric's f·|cos| and its mixture density.
 //!
-//! `cargo run --release --example mis_density -- [--samples N]` (default 200 000 per
+//! `cargo run --release -p lab --bin mis_density -- [--samples N]` (default 200 000 per
 //! configuration, fixed seeds).
 
 use glam::{Vec2, Vec3};

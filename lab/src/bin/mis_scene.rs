@@ -9,7 +9,7 @@
 //! per-pixel variance of one sample (spp × the squared standard error of the pixel mean),
 //! and the render time.
 //!
-//! `cargo run --release --example mis_scene -- [--spp N] [--light-radius R]` (default 64 spp,
+//! `cargo run --release -p lab --bin mis_scene -- [--spp N] [--light-radius R]` (default 64 spp,
 //! R = 0.25; at that size light sampling dominates the MIS weights whatever the BSDF density:
 //! the density matters for lights whose solid angle is not small, R ≈ 1 to 3 here).
 

@@ -9,7 +9,12 @@
 //! per-pixel variance of one sample (spp × the squared standard error of the pixel mean),
 //! and the render time.
 //!
-//! `cargo run --release -p lab --bin mis_scene -- [--spp N] [--light-radius R]` (default 64 spp,
+//! `--single` renders the four spheres with single scattering instead (gold at α = 0.1, 0.3,
+//! 0.6 and 1), whose conductor sampler is the bounded visible-normal cap (Eto and Tokuyoshi
+//! 2023): the scene for the noise of that sampler at equal time against a build whose cap is
+//! the whole spherical one.
+//!
+//! `cargo run --release -p lab --bin mis_scene -- [--spp N] [--light-radius R] [--single]` (default 64 spp,
 //! R = 0.25; at that size light sampling dominates the MIS weights whatever the BSDF density:
 //! the density matters for lights whose solid angle is not small, R ≈ 1 to 3 here).
 
@@ -31,23 +36,32 @@ fn gold(alpha: f32, technique: Technique) -> Material {
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let (mut spp, mut light_radius) = (64u32, 0.25f32);
+    let (mut spp, mut light_radius, mut single) = (64u32, 0.25f32, false);
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--spp" => spp = args.next().and_then(|v| v.parse().ok()).expect("--spp N"),
             "--light-radius" => {
                 light_radius = args.next().and_then(|v| v.parse().ok()).expect("--light-radius R")
             }
-            other => panic!("unknown argument {other}; usage: mis_scene [--spp N] [--light-radius R]"),
+            "--single" => single = true,
+            other => {
+                panic!("unknown argument {other}; usage: mis_scene [--spp N] [--light-radius R] [--single]")
+            }
         }
     }
-    let labels = ["walk α = 0.3", "walk α = 1", "PT α = 0.6", "BDPT α = 0.6"];
-    let mut materials = vec![
-        gold(0.3, Technique::RandomWalk),
-        gold(1.0, Technique::RandomWalk),
-        gold(0.6, PT),
-        gold(0.6, BDPT),
-    ];
+    let (labels, mut materials) = if single {
+        let alphas = [0.1, 0.3, 0.6, 1.0];
+        let materials: Vec<Material> = alphas.iter().map(|&a| gold(a, Technique::SingleScattering)).collect();
+        (["single α = 0.1", "single α = 0.3", "single α = 0.6", "single α = 1"], materials)
+    } else {
+        let materials = vec![
+            gold(0.3, Technique::RandomWalk),
+            gold(1.0, Technique::RandomWalk),
+            gold(0.6, PT),
+            gold(0.6, BDPT),
+        ];
+        (["walk α = 0.3", "walk α = 1", "PT α = 0.6", "BDPT α = 0.6"], materials)
+    };
     let mut spheres: Vec<Sphere> = (0..4)
         .map(|i| Sphere { center: Vec3::new(-1.65 + 1.1 * i as f32, 0.5, 0.0), radius: 0.5, material: i })
         .collect();

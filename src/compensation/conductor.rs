@@ -26,7 +26,7 @@
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::conductor_tables::ConductorTables;
 use super::fresnel_average::fresnel_average;
-use super::shared::{Shared, mixture_sample};
+use super::shared::{NOTHING, Shared, mixture_sample};
 use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
 use crate::bsdf::MicrofacetBsdf;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
@@ -362,9 +362,6 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
         (surface.material().fresnel(cos) * (shadowing * areas * pdf), pdf)
     }
 }
-
-/// The value of invalid arguments (the documented nothing of [`Bsdf::eval`]).
-const NOTHING: BsdfValue = BsdfValue { f: Vec3::ZERO, exact: true };
 
 impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
     #[inline]

@@ -15,6 +15,7 @@
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MuProfile, axis_average, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
+use super::shared::boxed;
 use crate::albedo::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, Family, ORDER_TABLE_SIZE, ORDER_TABLES,
     ScatteringOrderTable, node_cell,
@@ -63,15 +64,6 @@ pub(crate) struct ConductorTables {
 fn row_alpha(j: usize) -> f64 {
     let r = j as f64 / CELLS as f64;
     (r * r).max(ALPHA_LIMIT)
-}
-
-/// A boxed array from its elements.
-fn boxed<T, const N: usize>(f: impl FnMut(usize) -> T) -> Box<[T; N]> {
-    let v: Vec<T> = (0..N).map(f).collect();
-    match v.into_boxed_slice().try_into() {
-        Ok(b) => b,
-        Err(_) => unreachable!("N elements"),
-    }
 }
 
 impl ConductorTables {

@@ -48,7 +48,7 @@
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::glass_tables::{GlassSide, GlassTables};
 use super::lobe_profile::mu_cell;
-use super::shared::{ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
+use super::shared::{NOTHING, ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
 use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable, DirectionAxis,
     MAX_TABULATED_ETA, node_cell,
@@ -420,9 +420,6 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
         if pdf.is_finite() { pdf } else { 0.0 }
     }
 }
-
-/// The value of invalid arguments (the documented nothing of [`Bsdf::eval`]).
-const NOTHING: BsdfValue = BsdfValue { f: Vec3::ZERO, exact: true };
 
 impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
     #[inline]

@@ -2,6 +2,7 @@
 //! channel, from a table over the complex index built once: what a compensated conductor built
 //! per hit needs of its Fresnel term, in a few nanoseconds instead of a quadrature.
 
+use super::shared::boxed;
 use crate::fresnel::ComplexIor;
 use crate::special::GAUSS_LEGENDRE_16;
 use glam::{Vec3, Vec4};
@@ -81,8 +82,7 @@ fn table() -> &'static [[f32; PADDED]; PADDED] {
     TABLE.get_or_init(|| {
         let nodes: Vec<f32> = (0..NODES * NODES).map(|n| node(n / NODES, n % NODES)).collect();
         let at = |i: usize, j: usize| nodes[(i.clamp(1, NODES) - 1) * NODES + j.clamp(1, NODES) - 1];
-        let rows: Vec<[f32; PADDED]> = (0..PADDED).map(|i| core::array::from_fn(|j| at(i, j))).collect();
-        rows.into_boxed_slice().try_into().expect("PADDED rows")
+        boxed(|i| core::array::from_fn(|j| at(i, j)))
     })
 }
 

@@ -16,6 +16,7 @@
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
+use super::shared::boxed;
 use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricWalkTable, EtaRange, Family, Grid, SideGrids,
     floor_index,
@@ -70,15 +71,6 @@ pub(crate) struct GlassTables {
 fn node_alpha(j: usize) -> f64 {
     let r = j as f64 / (N - 1) as f64;
     r * r
-}
-
-/// A boxed array from its elements.
-fn boxed<T, const M: usize>(f: impl FnMut(usize) -> T) -> Box<[T; M]> {
-    let v: Vec<T> = (0..M).map(f).collect();
-    match v.into_boxed_slice().try_into() {
-        Ok(b) => b,
-        Err(_) => unreachable!("M elements"),
-    }
 }
 
 impl GlassTables {

@@ -1,12 +1,26 @@
 //! What the energy-compensated BSDFs share: the error of an index beyond the tables, the
-//! reference to shared tables, and the final filter of a sample drawn from a sampling mixture.
+//! reference to shared tables and their boxed construction, the value of invalid arguments, and
+//! the final filter of a sample drawn from a sampling mixture.
 
-use crate::bsdf::{BsdfSample, SampleFlags};
+use crate::bsdf::{BsdfSample, BsdfValue, SampleFlags};
 use crate::error::Error;
 use glam::Vec3;
 
 /// The largest f32 below 1: where a rescaled lobe-choice uniform is kept below 1.
 pub(crate) const ONE_MINUS_ULP: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The value of invalid arguments (the documented nothing of [`crate::Bsdf::eval`]).
+pub(crate) const NOTHING: BsdfValue = BsdfValue { f: Vec3::ZERO, exact: true };
+
+/// A boxed array of N elements `f(0)`, …, `f(N − 1)`, built on the heap (the shared tables are
+/// too large for the stack).
+pub(crate) fn boxed<T, const N: usize>(f: impl FnMut(usize) -> T) -> Box<[T; N]> {
+    let v: Vec<T> = (0..N).map(f).collect();
+    match v.into_boxed_slice().try_into() {
+        Ok(b) => b,
+        Err(_) => unreachable!("N elements"),
+    }
+}
 
 /// The error of a relative index `value` outside the dielectric tables' range.
 pub(crate) fn eta_error(value: f32) -> Error {

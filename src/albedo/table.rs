@@ -98,8 +98,7 @@ impl AlbedoTable {
         if !((0.0..=1.0).contains(&mu) && alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA) {
             return None;
         }
-        let x = super::scale_invariant_direction(mu, alpha);
-        Some(bilinear(self.directional, x * LAST_X, alpha.sqrt() * LAST_R))
+        Some(self.row(alpha)?.directional(mu))
     }
 
     /// E_avg(α) = 2 ∫₀¹ E(μ, α) μ dμ, interpolated linearly in r = √α. Its nodes are exact to
@@ -110,11 +109,18 @@ impl AlbedoTable {
     #[must_use]
     #[inline]
     pub fn average(&self, alpha: f32) -> Option<f32> {
+        Some(self.row(alpha)?.average())
+    }
+
+    /// The table at one roughness α ∈ (0, [`MAX_TABULATED_ALPHA`]] (`None` outside, NaN
+    /// included): √α and the direction axis formed once for any number of lookups.
+    #[inline]
+    pub(crate) fn row(&self, alpha: f32) -> Option<AlbedoRow> {
         if !(alpha > 0.0 && alpha <= MAX_TABULATED_ALPHA) {
             return None;
         }
-        let (j, f) = super::node_cell(alpha.sqrt() * LAST_R, ALBEDO_ROUGHNESSES);
-        Some(self.average[j] + f * (self.average[j + 1] - self.average[j]))
+        let (j, fj) = super::node_cell(alpha.sqrt() * LAST_R, ALBEDO_ROUGHNESSES);
+        Some(AlbedoRow { table: *self, axis: super::DirectionAxis::new(alpha), j, fj })
     }
 
     /// The raw node values of E, row-major with the roughness index slowest
@@ -148,15 +154,34 @@ impl AlbedoTable {
     }
 }
 
-/// Bilinear interpolation of the row-major grid at fractional indices (i, j) ∈ [0, 93] × [0, 62].
-#[inline(always)]
-fn bilinear(grid: &[f32; ALBEDO_DIRECTIONS * ALBEDO_ROUGHNESSES], i: f32, j: f32) -> f32 {
-    let (i0, fi) = super::node_cell(i, ALBEDO_DIRECTIONS);
-    let (j0, fj) = super::node_cell(j, ALBEDO_ROUGHNESSES);
-    let row = j0 * ALBEDO_DIRECTIONS + i0;
-    let (a, b) = (grid[row], grid[row + 1]);
-    let (c, d) = (grid[row + ALBEDO_DIRECTIONS], grid[row + ALBEDO_DIRECTIONS + 1]);
-    let lower = a + fi * (b - a);
-    let upper = c + fi * (d - c);
-    lower + fj * (upper - lower)
+/// An [`AlbedoTable`] at one roughness: E(μ) and E_avg interpolated in the roughness cell
+/// (j, fj) of the r axis, on the direction axis of that α.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AlbedoRow {
+    table: AlbedoTable,
+    axis: super::DirectionAxis,
+    j: usize,
+    fj: f32,
+}
+
+impl AlbedoRow {
+    /// E(μ) for μ ∈ [0, 1] (μ rounded above 1 reads x = 1), bilinear in (x, r).
+    #[inline]
+    pub(crate) fn directional(&self, mu: f32) -> f32 {
+        let grid = self.table.directional;
+        let (i0, fi) = super::node_cell(self.axis.coordinate(mu) * LAST_X, ALBEDO_DIRECTIONS);
+        let row = self.j * ALBEDO_DIRECTIONS + i0;
+        let (a, b) = (grid[row], grid[row + 1]);
+        let (c, d) = (grid[row + ALBEDO_DIRECTIONS], grid[row + ALBEDO_DIRECTIONS + 1]);
+        let lower = a + fi * (b - a);
+        let upper = c + fi * (d - c);
+        lower + self.fj * (upper - lower)
+    }
+
+    /// E_avg, linear in r.
+    #[inline]
+    pub(crate) fn average(&self) -> f32 {
+        let (average, j) = (self.table.average, self.j);
+        average[j] + self.fj * (average[j + 1] - average[j])
+    }
 }

@@ -31,12 +31,14 @@ pub(crate) fn walk_exit_density<S: MicrosurfaceSlope>(
     walk_out: Vec3,
 ) -> Option<f32> {
     let (table, alpha) = slope.conductor_albedo()?;
-    let lost = 1.0 - table.average(alpha)?;
+    // √α and the direction axis once for the three lookups
+    let row = table.row(alpha)?;
+    let lost = 1.0 - row.average();
     if lost.is_nan() || lost <= 0.0 {
         return None;
     }
     let (zi, zo) = (walk_in.z, walk_out.z);
-    let (e_in, e_out) = (table.directional(zi, alpha)?, table.directional(zo, alpha)?);
+    let (e_in, e_out) = (row.directional(zi), row.directional(zo));
     // G2/G1(ωin) = (1 + Λin)/(1 + Λin + Λout) from the projected areas A = (1 + Λ) cos θ
     let (area_in, area_out) =
         (slope.projected_area_unchecked(walk_in), slope.projected_area_unchecked(walk_out));

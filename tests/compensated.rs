@@ -329,7 +329,7 @@ fn every_compensated_conductor_is_finite_on_a_roughness_scan() {
     }
 }
 
-/// F_avg from its table over the complex index equals a 20 000-step midpoint rule to 1e-6 for
+/// F_avg from its table over the complex index equals a 20 000-step midpoint rule to 2e-5 for
 /// the metal presets (the table's stated error; `fresnel_average.rs` measures it against a
 /// 1024-point quadrature over the whole index plane).
 #[test]
@@ -349,7 +349,7 @@ fn fresnel_average_is_accurate() {
         let got = b.fresnel_average();
         for ch in 0..3 {
             assert!(
-                (f64::from(got[ch]) - reference[ch]).abs() < 1e-6,
+                (f64::from(got[ch]) - reference[ch]).abs() < 2e-5,
                 "{ior:?}: F_avg {got} vs {reference:?}"
             );
         }

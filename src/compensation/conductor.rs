@@ -32,6 +32,7 @@ use crate::bsdf::MicrofacetBsdf;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
 use crate::compensation::AlbedoTabulated;
 use crate::error::Error;
+use crate::fresnel::ComplexIor;
 use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
@@ -178,6 +179,12 @@ impl ConductorLobes {
     }
 }
 
+/// F0 of a conductor per channel (1 for F = 1).
+#[inline(always)]
+fn normal_reflectance(conductor: &Conductor) -> Vec3 {
+    conductor.ior().map_or(Vec3::ONE, ComplexIor::normal_reflectance)
+}
+
 /// Σ_k F̄ᵏ φ_k = F̄² (φ2 + F̄ (φ3 + F̄ (φ4 + F̄ (φ5 + F̄ (φ6 + F̄ φ7))))) per channel, with φ the
 /// lanes (φ2, φ3, φ4, φ5), (φ6, φ7, ·, ·).
 #[inline(always)]
@@ -208,7 +215,7 @@ impl CompensatedMaterial for Conductor {
         let lobes = ConductorLobes { axis: DirectionAxis::new(alpha), row, ..ConductorLobes::none(tables) };
         if scheme == Compensation::Turquin {
             // the view's 1 − E and F0: nothing else (the averages are the queries')
-            return Ok(ConductorLobes { scale: conductor.fresnel(1.0), ..lobes });
+            return Ok(ConductorLobes { scale: normal_reflectance(conductor), ..lobes });
         }
         let [a, b] = tables.averages_at(row);
         let c = a.x;
@@ -304,14 +311,14 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     }
 
     /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel (from its table over the complex index: within
-    /// 1.2e-7 for the crate's presets and 4e-6 for k ≥ 0.3 against quadrature; 1 for F = 1).
+    /// 2e-5 for the crate's presets and 1e-4 for k ≥ 0.3 against quadrature; 1 for F = 1).
     pub fn fresnel_average(&self) -> Vec3 {
         self.single.surface().material().ior().map_or(Vec3::ONE, fresnel_average)
     }
 
     /// F0 = F(μ = 1) per RGB channel.
     pub fn fresnel_normal(&self) -> Vec3 {
-        self.single.surface().material().fresnel(1.0)
+        normal_reflectance(self.single.surface().material())
     }
 
     /// Kulla and Conty's F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)) per RGB channel (1 for

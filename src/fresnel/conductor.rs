@@ -44,14 +44,40 @@ impl ComplexIor {
     /// # Errors
     /// [`Error::InvalidParameter`] if a component of `eta` is not finite and > 0, or a
     /// component of `k` is not finite and ≥ 0.
+    #[inline]
     pub fn new(eta: Vec3, k: Vec3) -> Result<Self, Error> {
-        for e in eta.to_array() {
-            Error::check_positive("eta", e)?;
-        }
-        for e in k.to_array() {
-            Error::check_non_negative("k", e)?;
+        // the three channels of each condition in one SIMD comparison (NaN fails every one); the
+        // error names the first bad channel
+        let (e, kk, inf) = (Vec3A::from(eta), Vec3A::from(k), Vec3A::INFINITY);
+        let valid = e.cmpgt(Vec3A::ZERO) & e.cmplt(inf) & kk.cmpge(Vec3A::ZERO) & kk.cmplt(inf);
+        if !valid.all() {
+            return Err(Self::invalid(eta, k));
         }
         Ok(Self::from_parts(eta, k))
+    }
+
+    /// The error of an index [`Self::new`] rejects: its first channel out of range.
+    #[cold]
+    fn invalid(eta: Vec3, k: Vec3) -> Error {
+        let eta_error = eta.to_array().into_iter().find_map(|e| Error::check_positive("eta", e).err());
+        let k_error = || k.to_array().into_iter().find_map(|e| Error::check_non_negative("k", e).err());
+        // one of the two exists (the conditions are those of `new`); a NaN η otherwise
+        eta_error.or_else(k_error).unwrap_or(Error::InvalidParameter {
+            name: "eta",
+            value: f32::NAN,
+            expected: "finite and > 0",
+        })
+    }
+
+    /// F0 = F(cos θ = 1) = ((η − 1)² + k²)/((η + 1)² + k²) per channel: the Fresnel term at
+    /// normal incidence in closed form (one division; the general expression of
+    /// [`fresnel_conductor`] reduces to it at cos θ = 1).
+    #[must_use]
+    #[inline(always)]
+    pub(crate) fn normal_reflectance(&self) -> Vec3 {
+        let k2 = self.k * self.k;
+        let (m, p) = (self.eta - Vec3::ONE, self.eta + Vec3::ONE);
+        (m * m + k2) / (p * p + k2)
     }
 
     /// Real part η.

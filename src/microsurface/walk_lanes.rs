@@ -4,7 +4,8 @@
 //! A lane carries one path: its ray, its height (ln C¹, or the undrawn rate of an opaque
 //! walk, `walk::Depth`), its weight, its bounce count, and its own generator. Every formula is
 //! the scalar walk's kernel: Λ ([`lambda_and_area_of`]), the height step
-//! ([`escapes_without_log`], [`step_ln_c1`], the logarithm `ln_f32` lane by lane), the
+//! ([`escapes_without_log`], [`step_ln_c1`], with the lanes' logarithm [`ln_of`], within 4 ulps
+//! of the scalar walk's), the
 //! spherical-cap visible normal ([`sample_cap_of`]), the reflection and its Newton
 //! renormalization, the Fresnel term ([`reflectance_of`]); the rare forms the scalar walk
 //! branches to (a cap point near −v̂, a Fresnel cosine below 0.05, a reflection far from unit
@@ -23,7 +24,7 @@ use crate::material::{LaneMaterial, Material};
 use crate::rng::TAIL_CUT;
 use crate::slope::{MicrosurfaceSlope, lambda_and_area_of, sample_cap_of};
 use crate::soa::{Channels, Directions, check_len};
-use crate::special::ln_f32;
+use crate::special::ln_of;
 use glam::{Vec3, Vec3A};
 use rand::SeedableRng;
 
@@ -108,11 +109,11 @@ fn uniform_of(bits: u32) -> f32 {
     (bits >> 8) as f32 * INV_2_POW_24
 }
 
-/// ln(1 − cut_tails(u)) (the walks' logarithm, `ln_f32`) and 1 − cut_tails(u).
+/// ln(1 − cut_tails(u)) (the lanes' logarithm) and 1 − cut_tails(u).
 #[inline(always)]
 fn ln_one_minus(u: f32) -> (f32, f32) {
     let one_minus_u = 1.0 - u.clamp(TAIL_CUT, 1.0 - TAIL_CUT);
-    (ln_f32(one_minus_u), one_minus_u)
+    (ln_of(one_minus_u), one_minus_u)
 }
 
 /// The state of the paths in flight, one array element per path.
@@ -127,10 +128,10 @@ struct Paths {
     query: [usize; PATHS],
     rng: [[u32; 4]; PATHS],
     /// The step's verdict: 0 continues with the lanes' facet; otherwise the bits
-    /// [`ESCAPED`], [`SCALAR_FACET`], [`HEIGHT_STEP`], [`ENDED`].
+    /// [`ESCAPED`], [`SCALAR_FACET`], [`ENDED`].
     status: [u8; PATHS],
-    /// The uniforms of the last step: the height's two and the facet's two.
-    u: [[f32; 4]; PATHS],
+    /// The uniforms of the last step's facet.
+    u: [[f32; 2]; PATHS],
     /// The ray and weight after the lanes' facet of the last step.
     next_wr: [[f32; PATHS]; 3],
     next_weight: [[f32; PATHS]; 3],
@@ -140,15 +141,16 @@ struct Paths {
 const ESCAPED: u8 = 1;
 /// The facet is off the kernels' common path: the scalar sampler redoes it.
 const SCALAR_FACET: u8 = 2;
-/// The ray's height is stepped with logarithms (Algorithm 1), by the scalar kernels.
-const HEIGHT_STEP: u8 = 4;
 /// The walk ends without a sample (absorbed, or the bounce cap).
 const ENDED: u8 = 8;
 
 /// One step of one path of a GGX conductor walk (`Microsurface::next_hit` of an opaque walk,
-/// then the mirror facet of `Conductor::sample_mirror_unchecked`) on the lanes' common path:
-/// the ray's escape where it needs no logarithm (a first hit from above, the closed form of an
-/// undrawn depth seen from below it), the facet, the next depth, and the verdict bits.
+/// then the mirror facet of `Conductor::sample_mirror_unchecked`): the ray's next height or
+/// escape (a first hit from above is undrawn; an undrawn depth seen from below escapes in
+/// closed form; every other ray steps its height with Algorithm 1 in ln C¹, an undrawn depth
+/// drawn first as `walk::Depth::drawn` draws it), the facet, and the verdict bits. Both
+/// logarithms are formed in every lane (two lane logarithms cost less than a branch out of the
+/// vectorized loop).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn step(
@@ -159,17 +161,29 @@ fn step(
     depth: f32,
     weight: [f32; 3],
     rng: &mut [u32; 4],
-) -> (V3<f32>, f32, [f32; 3], u8, [f32; 4]) {
+) -> (V3<f32>, f32, [f32; 3], u8, [f32; 2]) {
     let (lambda, _) = lambda_and_area_of(ax, ay, w);
     let (ua, ub) = (uniform_of(xoshiro(rng)), uniform_of(xoshiro(rng)));
     let (u1, u2) = (uniform_of(xoshiro(rng)), uniform_of(xoshiro(rng)));
     // the next intersection: a first hit from above is undrawn (rate −Λ = 1 + Λ(ωi)); an
     // undrawn depth seen by a ray going up escapes with probability a/(a + Λ); every other
-    // ray's height is stepped with logarithms (`HEIGHT_STEP`)
+    // ray's height is stepped with logarithms
     let from_above = depth == 0.0 && w.z < 0.0;
     let closed_form = depth > 0.0 && w.z > 0.0;
-    let escapes = closed_form && ua < depth / (depth + lambda);
-    let next_depth = if from_above { -lambda } else { depth };
+    let (ln_a, _) = ln_one_minus(ua);
+    let (ln_b, one_minus_b) = ln_one_minus(ub);
+    let drawn = if depth > 0.0 { step_ln_c1(-1.0, -depth, 0.0, ln_a).0 } else { depth };
+    let quick = w.z >= 0.0 && escapes_without_log(lambda, drawn, one_minus_b);
+    let (stepped, stepped_escapes) = step_ln_c1(w.z, lambda, drawn, ln_b);
+    let escapes =
+        if closed_form { ua < depth / (depth + lambda) } else { !from_above && (quick || stepped_escapes) };
+    let next_depth = if from_above {
+        -lambda
+    } else if closed_form {
+        depth
+    } else {
+        stepped
+    };
     // the facet: a visible normal of ωi = −ωr, the mirror reflection, its Fresnel weight
     let wi = V3::new(-w.x, -w.y, -w.z);
     let (m, cap_ok) = sample_cap_of(ax, ay, wi, 2.0, u1, u2);
@@ -187,10 +201,8 @@ fn step(
             ([f(t0.x, m4.x), f(t0.y, m4.y), f(t0.z, m4.z)], cap_ok && nearly_unit && c >= 0.05)
         }
     };
-    let status = u8::from(escapes) * ESCAPED
-        + u8::from(!common) * SCALAR_FACET
-        + u8::from(!from_above && !closed_form) * HEIGHT_STEP;
-    (wo, next_depth, [weight[0] * f[0], weight[1] * f[1], weight[2] * f[2]], status, [ua, ub, u1, u2])
+    let status = u8::from(escapes) * ESCAPED + u8::from(!common) * SCALAR_FACET;
+    (wo, next_depth, [weight[0] * f[0], weight[1] * f[1], weight[2] * f[2]], status, [u1, u2])
 }
 
 /// The walks of a GGX conductor in lanes.
@@ -276,28 +288,13 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
         }
     }
 
-    /// The paths off the lanes' common path, one by one: their height step with the scalar
-    /// kernels (`next_ln_c1`'s, from the step's uniforms), the scalar facet, the exits, ends and
+    /// The paths off the lanes' common path, one by one: the scalar facet, the exits, ends and
     /// refills.
     #[inline(never)]
     fn finish(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
         let Some(i) = Some(p.query[k]).filter(|&i| i != usize::MAX) else { return };
         let status = p.status[k];
-        let mut escaped = status & ESCAPED != 0;
-        if status & HEIGHT_STEP != 0 {
-            let w = Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
-            let lambda = self.surface.slope().lambda_unchecked(w);
-            let [ua, ub, _, _] = p.u[k];
-            let depth = p.depth[k];
-            // an undrawn depth is drawn from a e^{aℓ} first (`walk::Depth::drawn`)
-            let drawn = if depth > 0.0 { step_ln_c1(-1.0, -depth, 0.0, ln_one_minus(ua).0).0 } else { depth };
-            let (ln_b, one_minus_b) = ln_one_minus(ub);
-            let quick = w.z >= 0.0 && escapes_without_log(lambda, drawn, one_minus_b);
-            let (stepped, escapes) = step_ln_c1(w.z, lambda, drawn, ln_b);
-            escaped = quick || escapes;
-            p.depth[k] = stepped;
-        }
-        if escaped {
+        if status & ESCAPED != 0 {
             let s = WalkSample {
                 wo: Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]),
                 weight: Vec3::new(p.weight[0][k], p.weight[1][k], p.weight[2][k]),
@@ -307,24 +304,17 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             self.refill(p, k, next);
             return;
         }
-        if status & ENDED == 0 && status != 0 {
-            // the facet of a path that continues: the lanes' or the scalar sampler's
-            if status & SCALAR_FACET != 0 {
-                let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
-                let [_, _, u1, u2] = p.u[k];
-                let wm = self.surface.slope().sample_d_wi_unchecked(wi, u1, u2);
-                let s = self.surface.material().mirror_reflection_unchecked(wi, wm);
-                for (c, (w, f)) in
-                    [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
-                {
-                    p.wr[c][k] = w;
-                    p.weight[c][k] *= f;
-                }
-            } else {
-                for c in 0..3 {
-                    p.wr[c][k] = p.next_wr[c][k];
-                    p.weight[c][k] = p.next_weight[c][k];
-                }
+        if status & SCALAR_FACET != 0 {
+            // the facet of a path that continues, off the lanes' common path: the scalar sampler's
+            let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
+            let [u1, u2] = p.u[k];
+            let wm = self.surface.slope().sample_d_wi_unchecked(wi, u1, u2);
+            let s = self.surface.material().mirror_reflection_unchecked(wi, wm);
+            for (c, (w, f)) in
+                [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
+            {
+                p.wr[c][k] = w;
+                p.weight[c][k] *= f;
             }
             p.bounces[k] += 1;
         }
@@ -347,7 +337,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             query: [usize::MAX; PATHS],
             rng: [[1; 4]; PATHS],
             status: [0; PATHS],
-            u: [[0.0; 4]; PATHS],
+            u: [[0.0; 2]; PATHS],
             next_wr: [[0.0; PATHS]; 3],
             next_weight: [[0.0; PATHS]; 3],
         };

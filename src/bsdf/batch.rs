@@ -410,23 +410,33 @@ fn evaluate_conductor<L: Lanes, const WANT: u8>(
     // a light at or below the horizon of a view from above: no reflection, f = pdf = 0
     let below = front & wi.z.le(zero);
     let (axl, ayl) = (L::lit(ax), L::lit(ay));
+    if WANT == Want::PDF {
+        // the density alone: no projected area of ωo, no f
+        let (pdf, ok_b, wo_h) = bounded_reflection_density(axl, ayl, wo, wi);
+        let visible = wo_h.gt(L::lit(VISIBLE_SUM_MARGIN));
+        return ([zero; 3], L::select(above, pdf, zero), (above & visible & ok_b) | below);
+    }
     let (density, g2_over_g1, cos, ok) = front_reflection(axl, ayl, wo, wi);
-    let f = if WANT & Want::EVAL != 0 {
-        let w = conductor_fresnel(fresnel, cos);
-        let scale = density * g2_over_g1 / wi.z;
-        w.map(|w| finite_or_zero(L::select(above, w * scale, zero)))
-    } else {
-        [zero; 3]
-    };
+    let w = conductor_fresnel(fresnel, cos);
+    let scale = density * g2_over_g1 / wi.z;
+    let f = w.map(|w| finite_or_zero(L::select(above, w * scale, zero)));
     if WANT & Want::PDF == 0 {
         return (f, zero, (above & ok) | below);
     }
-    // the density of the bounded cap the sampler draws from: D(ωh)/(4 A_b(ωo))
-    let area_b = bounded_area_of(axl, ayl, wo, kappa_of(axl.min(ayl), wo));
-    let (pdf, len_sq, t) = reflection_density_of(axl, ayl, wo.add(wi), area_b);
-    let min = L::lit(F32_DENSITY_MIN_SUM);
-    let ok_b = len_sq.ge(min) & t.ge(min) & normal(pdf);
+    let (pdf, ok_b, _) = bounded_reflection_density(axl, ayl, wo, wi);
     (f, L::select(above, pdf, zero), (above & ok & ok_b) | below)
+}
+
+/// The density of a GGX reflection from the bounded cap the sampler draws from,
+/// D(ωh)/(4 A_b(ωo)) with h = ωo + ωi unnormalized, whether it is the scalar f32 form's, and
+/// ωo·h.
+#[inline(always)]
+fn bounded_reflection_density<L: Lanes>(ax: L, ay: L, wo: V3<L>, wi: V3<L>) -> (L, L::Mask, L) {
+    let h = wo.add(wi);
+    let area_b = bounded_area_of(ax, ay, wo, kappa_of(ax.min(ay), wo));
+    let (pdf, len_sq, t) = reflection_density_of(ax, ay, h, area_b);
+    let min = L::lit(F32_DENSITY_MIN_SUM);
+    (pdf, len_sq.ge(min) & t.ge(min) & normal(pdf), wo.dot(h))
 }
 
 /// [`evaluate_conductor`] for a GGX dielectric of index η and transport factor `transport`:

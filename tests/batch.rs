@@ -1,7 +1,8 @@
 //! The batch calls (`BatchBsdf`) against the scalar calls they stand for, query by query: over
 //! views and lights on the whole sphere (grazing down to cos θ = 1e-6, backfacing views), GGX
 //! roughness from 2e-3 to 10 (isotropic and anisotropic), gold, a perfect mirror and glass of
-//! η = 1.5, 1/1.5 and 1.33; invalid lanes mixed with valid ones; slices of unequal length.
+//! η = 1.5, 1/1.5 and 1.33, and glass reflections near the critical angle; invalid lanes mixed
+//! with valid ones; slices of unequal length.
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
@@ -265,6 +266,61 @@ fn dielectric_batches_are_the_scalar_calls() {
                 GLASS_WEIGHT_REL,
                 GLASS.pdf_rel,
                 GLASS.pdf_abs,
+            );
+        }
+    }
+}
+
+/// Reflections of glass seen from the denser side (η = 1/1.5, 1/1.33, 1/2.5) at facet cosines
+/// within 10⁻⁶ to 10⁻¹ of the critical angle, on both sides of it (F has an infinite slope
+/// there): within [`GLASS`].
+#[test]
+fn dielectric_reflections_near_the_critical_angle() {
+    use microsurface::Bsdf;
+    for (k, eta) in [1.0f32 / 1.5, 1.0 / 1.33, 1.0 / 2.5].into_iter().enumerate() {
+        let mut rng = Pcg64Mcg::seed_from_u64(250 + k as u64);
+        let critical = (1.0 - eta * eta).sqrt();
+        let (mut wo, mut wi) = (Vec::with_capacity(N), Vec::with_capacity(N));
+        while wo.len() < N {
+            // a facet normal and a view at cos θ = critical ± 10⁻ʲ from it, in the facet's plane
+            // of incidence, and its mirror image
+            let h = direction(&mut rng, true);
+            let offset = 10f32.powf(-1.0 - 5.0 * rng.random::<f32>());
+            let c = (critical + if rng.random::<bool>() { offset } else { -offset }).min(1.0);
+            let t = h.any_orthonormal_vector();
+            let phi = core::f32::consts::TAU * rng.random::<f32>();
+            let (b, tangent) = (h.cross(t), t);
+            let side = tangent * phi.cos() + b * phi.sin();
+            let o = (h * c + side * (1.0 - c * c).max(0.0).sqrt()).normalize();
+            let i = (h * (2.0 * o.dot(h)) - o).normalize();
+            if o.z > 0.0 && i.z > 0.0 {
+                wo.push(o);
+                wi.push(i);
+            }
+        }
+        for (ax, ay) in [(2e-3f32, 2e-3f32), (0.5, 0.5), (0.3, 0.02)] {
+            let bsdf =
+                single(Ggx::new(ax, ay).expect("valid roughness"), Dielectric::new(eta).expect("valid"));
+            let (so, si) = (Soa::of(&wo), Soa::of(&wi));
+            let (mut f, mut pdf) = (Out::new(N), vec![-1.0; N]);
+            bsdf.eval_with_pdf_batch(&so.dirs(), &si.dirs(), &mut f.channels(), &mut pdf).expect("lengths");
+            let mut worst = 0.0f32;
+            for i in 0..N {
+                let (v, p) = bsdf.eval_with_pdf(wo[i], wi[i]);
+                let e = excess(f.get(i), v.f, GLASS.rel, GLASS.abs * v.f.max_element());
+                worst = worst.max(if v.f.x > 0.0 { (f.get(i).x - v.f.x).abs() / v.f.x } else { 0.0 });
+                assert!(
+                    e <= 1.0 && (pdf[i] - p).abs() <= GLASS.pdf_rel * p + GLASS.pdf_abs,
+                    "η = {eta}, GGX ({ax}, {ay}): f({}, {}) = {}, pdf {} in the batch, ({}, {p}) scalar",
+                    wo[i],
+                    wi[i],
+                    f.get(i),
+                    pdf[i],
+                    v.f
+                );
+            }
+            eprintln!(
+                "glass η = {eta}, GGX ({ax}, {ay}) near the critical angle: f rel. error ≤ {worst:.2e}"
             );
         }
     }

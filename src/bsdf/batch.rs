@@ -71,7 +71,7 @@ impl SampleOutputs<'_> {
 
     /// Writes the scalar call's answer for query `i`.
     #[inline]
-    fn set(&mut self, i: usize, s: Option<super::BsdfSample>) {
+    pub(crate) fn set(&mut self, i: usize, s: Option<super::BsdfSample>) {
         match s {
             Some(s) => {
                 self.wi.set(i, s.wi);
@@ -99,8 +99,18 @@ impl SampleOutputs<'_> {
 /// [0, 1)) gives that query the scalar call's *nothing* (with its debug assertion) and leaves
 /// the others untouched.
 ///
-/// The provided methods call the scalar methods query by query; [`MicrofacetBsdf`] overrides
-/// them with eight-lane loops for single scattering on GGX conductors and dielectrics.
+/// The provided methods call the scalar methods query by query. The crate's lobes override
+/// them:
+///
+/// * [`MicrofacetBsdf`]: eight-lane loops for single scattering on GGX conductors and
+///   dielectrics (η at least 0.05 from 1), the scalar calls for every other configuration;
+///   the bounds against the scalar calls are stated on its implementation.
+/// * [`Compensated`](crate::Compensated) of a conductor or a dielectric, every scheme: the
+///   batch of its single-scattering lobe (in lanes where that has them), then each query's
+///   compensation by the scalar calls' own expressions, so that the single-scattering bounds
+///   carry over (a conductor's densities bit for bit). Turquin's samples are the
+///   single-scattering batch samples with the scalar call's weight factor; the additive
+///   schemes sample by the scalar call, query by query.
 ///
 /// # Examples
 /// ```
@@ -190,12 +200,24 @@ pub trait BatchBsdf: Bsdf {
         u2: &[f32],
         out: &mut SampleOutputs<'_>,
     ) -> Result<(), Error> {
-        let n = check_sample_lengths(wo, uc, u1, u2, out)?;
-        for i in 0..n {
-            out.set(i, self.sample(wo.get(i), uc[i], Vec2::new(u1[i], u2[i])));
-        }
-        Ok(())
+        sample_each(self, wo, uc, u1, u2, out)
     }
+}
+
+/// [`BatchBsdf::sample_batch`] by the scalar call query by query.
+pub(crate) fn sample_each<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    wo: &Directions<'_>,
+    uc: &[f32],
+    u1: &[f32],
+    u2: &[f32],
+    out: &mut SampleOutputs<'_>,
+) -> Result<(), Error> {
+    let n = check_sample_lengths(wo, uc, u1, u2, out)?;
+    for i in 0..n {
+        out.set(i, bsdf.sample(wo.get(i), uc[i], Vec2::new(u1[i], u2[i])));
+    }
+    Ok(())
 }
 
 fn check_sample_lengths(
@@ -920,14 +942,9 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         u2: &[f32],
         out: &mut SampleOutputs<'_>,
     ) -> Result<(), Error> {
-        let n = check_sample_lengths(wo, uc, u1, u2, out)?;
-        if let Some(kernel) = self.kernel() {
-            dispatch(&mut SampleLoop { bsdf: self, kernel, wo, uc, u1, u2, out });
-        } else {
-            for i in 0..n {
-                out.set(i, self.sample(wo.get(i), uc[i], Vec2::new(u1[i], u2[i])));
-            }
-        }
+        let Some(kernel) = self.kernel() else { return sample_each(self, wo, uc, u1, u2, out) };
+        check_sample_lengths(wo, uc, u1, u2, out)?;
+        dispatch(&mut SampleLoop { bsdf: self, kernel, wo, uc, u1, u2, out });
         Ok(())
     }
 }

@@ -1,18 +1,20 @@
 //! Benchmarks of the batch calls (`BatchBsdf`) on the rows of `examples/throughput` (gold and
-//! glass, GGX α = 0.5, single scattering: eval, pdf, eval_with_pdf, sample), each iteration one
-//! batch of the `N` pre-generated inputs of `validation::inputs` (criterion reports the time
-//! per batch and, with the throughput set, per query); and the random walk in lanes
-//! (`Microsurface::sample_batch`) against the scalar walk for the same queries.
+//! glass, GGX α = 0.5, single scattering and the compensated lobes built on it: eval, pdf,
+//! eval_with_pdf, sample), each iteration one batch of the `N` pre-generated inputs of
+//! `validation::inputs` (criterion reports the time per batch and, with the throughput set,
+//! per query); and the random walk in lanes (`Microsurface::sample_batch`) against the scalar
+//! walk for the same queries.
 //!
 //! Benchmark ids: `{gold|glass}/batch/{eval|pdf|eval_with_pdf|sample}`,
-//! `walk/{gold|mirror}/{lanes|scalar}`.
+//! `gold/compensated/{walk|kulla-conty|turquin}/batch/{…}`,
+//! `glass/compensated/{walk|turquin}/batch/{…}`, `walk/{gold|mirror}/{lanes|scalar}`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use microsurface::glam::Vec3;
 use microsurface::research::{Material, Microsurface, SpecularLimit, UniformHeight, WalkOutputs};
 use microsurface::{
-    BatchBsdf, Channels, ComplexIor, Conductor, Dielectric, Directions, Ggx, MicrofacetBsdf, SampleOutputs,
-    Technique,
+    BatchBsdf, Channels, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Directions, Ggx,
+    MicrofacetBsdf, SampleOutputs, Technique,
 };
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -49,24 +51,49 @@ fn bench_material<M: Material + SpecularLimit>(c: &mut Criterion<Clock>, name: &
     let slope = Ggx::isotropic(0.5).expect("valid roughness");
     let bsdf =
         MicrofacetBsdf::new(slope, material).expect("valid").with_technique(Technique::SingleScattering);
-    let x = inputs(M::TRANSMITS, seed);
+    bench_batch(c, &format!("{name}/batch"), &bsdf, M::TRANSMITS, seed);
+}
+
+/// The compensated lobes on the inputs of the single-scattering rows.
+fn bench_compensated(c: &mut Criterion<Clock>) {
+    let slope = Ggx::isotropic(0.5).expect("valid roughness");
+    let schemes = [
+        ("walk", Compensation::Walk),
+        ("kulla-conty", Compensation::KullaConty),
+        ("turquin", Compensation::Turquin),
+    ];
+    for (name, scheme) in schemes {
+        let gold = Compensated::with_scheme(slope, Conductor::new(ComplexIor::GOLD), scheme).expect("α ≤ 1");
+        bench_batch(c, &format!("gold/compensated/{name}/batch"), &gold, false, 3);
+    }
+    // (Kulla–Conty's glass lobes are the walk's)
+    for (name, scheme) in [schemes[0], schemes[2]] {
+        let glass = Dielectric::new(1.5).expect("valid index");
+        let glass = Compensated::with_scheme(slope, glass, scheme).expect("in range");
+        bench_batch(c, &format!("glass/compensated/{name}/batch"), &glass, true, 4);
+    }
+}
+
+/// eval, pdf, eval_with_pdf and sample of `bsdf` in group `group`, on the inputs of `seed`.
+fn bench_batch<B: BatchBsdf>(c: &mut Criterion<Clock>, group: &str, bsdf: &B, transmits: bool, seed: u64) {
+    let x = inputs(transmits, seed);
     let (wo, wi) = (Soa::of(&x.wo), Soa::of(&x.wi));
     let u1: Vec<f32> = x.u.iter().map(|u| u.x).collect();
     let u2: Vec<f32> = x.u.iter().map(|u| u.y).collect();
     let (mut f, mut pdf) = (Soa::zeros(N), vec![0.0f32; N]);
     let (mut sw, mut weight, mut spdf, mut eta) =
         (Soa::zeros(N), Soa::zeros(N), vec![0.0f32; N], vec![0.0f32; N]);
-    let mut g = c.benchmark_group(format!("{name}/batch"));
+    let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements(N as u64));
     g.bench_function("eval", |b| {
-        b.iter(|| black_box(&bsdf).eval_batch(&wo.dirs(), &wi.dirs(), &mut f.channels()).expect("lengths"))
+        b.iter(|| black_box(bsdf).eval_batch(&wo.dirs(), &wi.dirs(), &mut f.channels()).expect("lengths"))
     });
     g.bench_function("pdf", |b| {
-        b.iter(|| black_box(&bsdf).pdf_batch(&wo.dirs(), &wi.dirs(), &mut pdf).expect("lengths"))
+        b.iter(|| black_box(bsdf).pdf_batch(&wo.dirs(), &wi.dirs(), &mut pdf).expect("lengths"))
     });
     g.bench_function("eval_with_pdf", |b| {
         b.iter(|| {
-            black_box(&bsdf)
+            black_box(bsdf)
                 .eval_with_pdf_batch(&wo.dirs(), &wi.dirs(), &mut f.channels(), &mut pdf)
                 .expect("lengths")
         })
@@ -75,7 +102,7 @@ fn bench_material<M: Material + SpecularLimit>(c: &mut Criterion<Clock>, name: &
         b.iter(|| {
             let mut out =
                 SampleOutputs { wi: sw.channels(), weight: weight.channels(), pdf: &mut spdf, eta: &mut eta };
-            black_box(&bsdf).sample_batch(&wo.dirs(), &x.uc, &u1, &u2, &mut out).expect("lengths")
+            black_box(bsdf).sample_batch(&wo.dirs(), &x.uc, &u1, &u2, &mut out).expect("lengths")
         })
     });
     g.finish();
@@ -114,6 +141,7 @@ fn walks(c: &mut Criterion<Clock>) {
 fn benches(c: &mut Criterion<Clock>) {
     bench_material(c, "gold", Conductor::new(ComplexIor::GOLD), 3);
     bench_material(c, "glass", Dielectric::new(1.5).expect("valid index"), 4);
+    bench_compensated(c);
     walks(c);
 }
 

@@ -4,7 +4,8 @@
 //! queries (views uniform on the upper hemisphere; lights on the upper hemisphere for gold and
 //! on the whole sphere for glass), one thread, the thread's CPU time per query, the median of
 //! calls 2 to 7 (the first call warms the caches and is left out, as the script leaves out
-//! Mitsuba's JIT compilation).
+//! Mitsuba's JIT compilation). The compensated lobes (`Compensated`, every scheme; no Mitsuba
+//! counterpart) follow on the same queries.
 //!
 //! ```sh
 //! cargo run --release --example throughput
@@ -12,8 +13,8 @@
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    BatchBsdf, Channels, ComplexIor, Conductor, Dielectric, Directions, Ggx, MicrofacetBsdf, SampleOutputs,
-    Technique,
+    BatchBsdf, Channels, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Directions, Ggx,
+    MicrofacetBsdf, SampleOutputs, Technique,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -220,6 +221,20 @@ fn main() -> Result<(), microsurface::Error> {
         MicrofacetBsdf::new(slope, Dielectric::new(1.5)?)?.with_technique(Technique::SingleScattering);
     rows("gold", &gold, false, 3);
     rows("glass", &glass, true, 4);
+    let schemes = [
+        ("walk", Compensation::Walk),
+        ("kulla-conty", Compensation::KullaConty),
+        ("turquin", Compensation::Turquin),
+    ];
+    for (name, scheme) in schemes {
+        let gold = Compensated::with_scheme(slope, Conductor::new(ComplexIor::GOLD), scheme)?;
+        rows(&format!("gold compensated ({name})"), &gold, false, 3);
+    }
+    // (Kulla–Conty's glass lobes are the walk's)
+    for (name, scheme) in [schemes[0], schemes[2]] {
+        let glass = Compensated::with_scheme(slope, Dielectric::new(1.5)?, scheme)?;
+        rows(&format!("glass compensated ({name})"), &glass, true, 4);
+    }
     walk_rows("gold", Conductor::new(ComplexIor::GOLD), 5);
     walk_rows("mirror", Conductor::perfect(), 6);
     println!("load average after: {}", load());

@@ -92,6 +92,12 @@ impl<'a> Channels<'a> {
         check_len(name, n, self.c.len())
     }
 
+    /// Element `i` of the three channels.
+    #[inline(always)]
+    pub(crate) fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.a[i], self.b[i], self.c[i])
+    }
+
     #[inline(always)]
     pub(crate) fn set(&mut self, i: usize, v: Vec3) {
         self.a[i] = v.x;

@@ -1,12 +1,14 @@
 //! The batch calls (`BatchBsdf`) against the scalar calls they stand for, query by query: over
 //! views and lights on the whole sphere (grazing down to cos θ = 1e-6, backfacing views), GGX
 //! roughness from 2e-3 to 10 (isotropic and anisotropic), gold, a perfect mirror and glass of
-//! η = 1.5, 1/1.5 and 1.33; invalid lanes mixed with valid ones; slices of unequal length.
+//! η = 1.5, 1/1.5 and 1.33, and glass reflections near the critical angle; the compensated lobes
+//! (gold, copper and glass, every scheme, GGX, Beckmann and Dirac lobes); invalid and drifted
+//! lanes mixed with valid ones; slices of unequal length.
 
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::{
-    BatchBsdf, Beckmann, Channels, ComplexIor, Conductor, Dielectric, Directions, Error, Ggx, MicrofacetBsdf,
-    SampleOutputs, Technique,
+    BatchBsdf, Beckmann, Channels, Compensated, Compensation, ComplexIor, Conductor, Dielectric, Directions,
+    Error, Ggx, MicrofacetBsdf, SampleOutputs, Technique,
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -270,6 +272,61 @@ fn dielectric_batches_are_the_scalar_calls() {
     }
 }
 
+/// Reflections of glass seen from the denser side (η = 1/1.5, 1/1.33, 1/2.5) at facet cosines
+/// within 10⁻⁶ to 10⁻¹ of the critical angle, on both sides of it (F has an infinite slope
+/// there): within [`GLASS`].
+#[test]
+fn dielectric_reflections_near_the_critical_angle() {
+    use microsurface::Bsdf;
+    for (k, eta) in [1.0f32 / 1.5, 1.0 / 1.33, 1.0 / 2.5].into_iter().enumerate() {
+        let mut rng = Pcg64Mcg::seed_from_u64(250 + k as u64);
+        let critical = (1.0 - eta * eta).sqrt();
+        let (mut wo, mut wi) = (Vec::with_capacity(N), Vec::with_capacity(N));
+        while wo.len() < N {
+            // a facet normal and a view at cos θ = critical ± 10⁻ʲ from it, in the facet's plane
+            // of incidence, and its mirror image
+            let h = direction(&mut rng, true);
+            let offset = 10f32.powf(-1.0 - 5.0 * rng.random::<f32>());
+            let c = (critical + if rng.random::<bool>() { offset } else { -offset }).min(1.0);
+            let t = h.any_orthonormal_vector();
+            let phi = core::f32::consts::TAU * rng.random::<f32>();
+            let (b, tangent) = (h.cross(t), t);
+            let side = tangent * phi.cos() + b * phi.sin();
+            let o = (h * c + side * (1.0 - c * c).max(0.0).sqrt()).normalize();
+            let i = (h * (2.0 * o.dot(h)) - o).normalize();
+            if o.z > 0.0 && i.z > 0.0 {
+                wo.push(o);
+                wi.push(i);
+            }
+        }
+        for (ax, ay) in [(2e-3f32, 2e-3f32), (0.5, 0.5), (0.3, 0.02)] {
+            let bsdf =
+                single(Ggx::new(ax, ay).expect("valid roughness"), Dielectric::new(eta).expect("valid"));
+            let (so, si) = (Soa::of(&wo), Soa::of(&wi));
+            let (mut f, mut pdf) = (Out::new(N), vec![-1.0; N]);
+            bsdf.eval_with_pdf_batch(&so.dirs(), &si.dirs(), &mut f.channels(), &mut pdf).expect("lengths");
+            let mut worst = 0.0f32;
+            for i in 0..N {
+                let (v, p) = bsdf.eval_with_pdf(wo[i], wi[i]);
+                let e = excess(f.get(i), v.f, GLASS.rel, GLASS.abs * v.f.max_element());
+                worst = worst.max(if v.f.x > 0.0 { (f.get(i).x - v.f.x).abs() / v.f.x } else { 0.0 });
+                assert!(
+                    e <= 1.0 && (pdf[i] - p).abs() <= GLASS.pdf_rel * p + GLASS.pdf_abs,
+                    "η = {eta}, GGX ({ax}, {ay}): f({}, {}) = {}, pdf {} in the batch, ({}, {p}) scalar",
+                    wo[i],
+                    wi[i],
+                    f.get(i),
+                    pdf[i],
+                    v.f
+                );
+            }
+            eprintln!(
+                "glass η = {eta}, GGX ({ax}, {ay}) near the critical angle: f rel. error ≤ {worst:.2e}"
+            );
+        }
+    }
+}
+
 /// Configurations without lane kernels (Beckmann, the random walk) answer with the scalar calls.
 #[test]
 fn other_configurations_are_the_scalar_calls() {
@@ -392,5 +449,313 @@ fn check_lanes<B: BatchBsdf>(label: &str, bsdf: &B, wo: &[Vec3], wi: &[Vec3]) {
         {
             assert!(f.get(i) == Vec3::ZERO && pdf[i] == 0.0, "{label}: invalid query {i} got a value");
         }
+    }
+}
+
+/// The compensated lobes' schemes.
+const SCHEMES: [Compensation; 3] = [Compensation::Walk, Compensation::KullaConty, Compensation::Turquin];
+
+/// GGX roughnesses of the compensated lobes (√(αx αy) within the tables' α ≤ 1), isotropic and
+/// anisotropic.
+const COMPENSATED_GGX: [(f32, f32); 6] =
+    [(2e-3, 2e-3), (0.05, 0.05), (0.5, 0.5), (1.0, 1.0), (0.3, 0.02), (2.0, 0.4)];
+
+/// A Dirac lobe's roughness (below `SMOOTH_ALPHA`): f and pdf are 0, the batch calls
+/// single scattering's.
+const DIRAC: f32 = 1e-4;
+
+/// Batch eval, pdf and eval_with_pdf equal to the scalar calls bit for bit, on the given queries.
+fn check_exact<B: BatchBsdf>(label: &str, bsdf: &B, wo: &[Vec3], wi: &[Vec3]) {
+    let n = wo.len();
+    let (so, si) = (Soa::of(wo), Soa::of(wi));
+    let (mut f, mut f2, mut pdf, mut pdf2) = (Out::new(n), Out::new(n), vec![-1.0; n], vec![-1.0; n]);
+    bsdf.eval_batch(&so.dirs(), &si.dirs(), &mut f.channels()).expect("lengths");
+    bsdf.pdf_batch(&so.dirs(), &si.dirs(), &mut pdf).expect("lengths");
+    bsdf.eval_with_pdf_batch(&so.dirs(), &si.dirs(), &mut f2.channels(), &mut pdf2).expect("lengths");
+    for i in 0..n {
+        let (v, p) = bsdf.eval_with_pdf(wo[i], wi[i]);
+        let same = |a: Vec3, b: Vec3| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits);
+        assert!(
+            same(f.get(i), bsdf.eval(wo[i], wi[i]).f)
+                && pdf[i].to_bits() == bsdf.pdf(wo[i], wi[i]).to_bits()
+                && same(f2.get(i), v.f)
+                && pdf2[i].to_bits() == p.to_bits(),
+            "{label}: query {i} ({}, {}): batch ({}, {}), scalar ({}, {p})",
+            wo[i],
+            wi[i],
+            f2.get(i),
+            pdf2[i],
+            v.f
+        );
+    }
+}
+
+/// Compensated conductors (gold, copper; every scheme): the batch is single scattering's batch
+/// with the scalar calls' added lobe, Turquin factor and mixture density: densities bit for
+/// bit, f within single scattering's bounds (a compensated f is at least single scattering's,
+/// Turquin's scales it), samples bit for bit (Turquin's are single scattering's batch samples);
+/// Beckmann (the scalar fallback) and the Dirac mirror bit for bit.
+#[test]
+fn compensated_conductor_batches_are_the_scalar_calls() {
+    let bounds = Bounds { rel: 4e-6, transmit_rel: 4e-6, abs: 1e-6, ..Bounds::EXACT };
+    for (m, (name, ior)) in
+        [("gold", ComplexIor::GOLD), ("copper", ComplexIor::COPPER)].into_iter().enumerate()
+    {
+        let metal = Conductor::new(ior);
+        for (s, scheme) in SCHEMES.into_iter().enumerate() {
+            for (k, (ax, ay)) in COMPENSATED_GGX.into_iter().enumerate() {
+                let slope = Ggx::new(ax, ay).expect("valid roughness");
+                let bsdf = Compensated::with_scheme(slope, metal, scheme).expect("tabulated");
+                let label = format!("{name} {scheme:?} GGX ({ax}, {ay})");
+                let seed = 500 + 100 * m as u64 + 10 * s as u64 + k as u64;
+                check_eval(&label, &bsdf, seed, bounds);
+                check_sample(&label, &bsdf, seed, 0.0, 0.0, 0.0);
+            }
+            let seed = 590 + 100 * m as u64 + s as u64;
+            let beckmann = Beckmann::isotropic(0.4).expect("valid roughness");
+            let bsdf = Compensated::with_scheme(beckmann, metal, scheme).expect("tabulated");
+            let label = format!("{name} {scheme:?} Beckmann 0.4");
+            check_eval(&label, &bsdf, seed, Bounds::EXACT);
+            check_sample(&label, &bsdf, seed, 0.0, 0.0, 0.0);
+            let dirac = Compensated::with_scheme(Ggx::isotropic(DIRAC).expect("valid"), metal, scheme);
+            let (dirac, label) = (dirac.expect("tabulated"), format!("{name} {scheme:?} Dirac"));
+            let (wo, wi) = queries(seed, false);
+            check_exact(&label, &dirac, &wo, &wi);
+            check_sample(&label, &dirac, seed, 0.0, 0.0, 0.0);
+        }
+    }
+}
+
+/// Compensated glass (η = 1.5 and 1/1.5; every scheme): within the single-scattering
+/// dielectric's bounds ([`GLASS`], carried through the added lobes, the mixture and Turquin's
+/// factor); Turquin's samples with single scattering's batch direction, event and η bit for bit
+/// and its weight within [`GLASS_WEIGHT_REL`], the additive schemes' samples bit for bit (the
+/// scalar call); Beckmann and the Dirac lobe bit for bit.
+#[test]
+fn compensated_dielectric_batches_are_the_scalar_calls() {
+    for (e, eta) in [1.5f32, 1.0 / 1.5].into_iter().enumerate() {
+        let glass = Dielectric::new(eta).expect("valid index");
+        for (s, scheme) in SCHEMES.into_iter().enumerate() {
+            for (k, (ax, ay)) in COMPENSATED_GGX.into_iter().enumerate() {
+                let slope = Ggx::new(ax, ay).expect("valid roughness");
+                let bsdf = Compensated::with_scheme(slope, glass, scheme).expect("tabulated");
+                let label = format!("glass η = {eta} {scheme:?} GGX ({ax}, {ay})");
+                let seed = 700 + 100 * e as u64 + 10 * s as u64 + k as u64;
+                check_eval(&label, &bsdf, seed, GLASS);
+                if scheme == Compensation::Turquin {
+                    check_sample(&label, &bsdf, seed, GLASS_WEIGHT_REL, GLASS.pdf_rel, GLASS.pdf_abs);
+                } else {
+                    check_sample(&label, &bsdf, seed, 0.0, 0.0, 0.0);
+                }
+            }
+            let seed = 790 + 100 * e as u64 + s as u64;
+            let beckmann = Beckmann::isotropic(0.4).expect("valid roughness");
+            let bsdf = Compensated::with_scheme(beckmann, glass, scheme).expect("tabulated");
+            let label = format!("glass η = {eta} {scheme:?} Beckmann 0.4");
+            check_eval(&label, &bsdf, seed, Bounds::EXACT);
+            check_sample(&label, &bsdf, seed, 0.0, 0.0, 0.0);
+            let dirac = Compensated::with_scheme(Ggx::isotropic(DIRAC).expect("valid"), glass, scheme);
+            let (dirac, label) = (dirac.expect("tabulated"), format!("glass η = {eta} {scheme:?} Dirac"));
+            let (wo, wi) = queries(seed, false);
+            check_exact(&label, &dirac, &wo, &wi);
+            check_sample(&label, &dirac, seed, 0.0, 0.0, 0.0);
+        }
+    }
+}
+
+/// Compensated lobes (both materials, every scheme): slices of unequal length are rejected
+/// before anything is written.
+#[test]
+fn compensated_unequal_lengths_are_rejected() {
+    let slope = Ggx::isotropic(0.5).expect("valid roughness");
+    for scheme in SCHEMES {
+        let gold =
+            Compensated::with_scheme(slope, Conductor::new(ComplexIor::GOLD), scheme).expect("tabulated");
+        let glass =
+            Compensated::with_scheme(slope, Dielectric::new(1.5).expect("valid"), scheme).expect("tabulated");
+        check_lengths(&format!("gold {scheme:?}"), &gold);
+        check_lengths(&format!("glass {scheme:?}"), &glass);
+    }
+}
+
+fn check_lengths<B: BatchBsdf>(label: &str, bsdf: &B) {
+    let (x, z) = (vec![0.0f32; 16], vec![1.0f32; 16]);
+    let d = Directions::new(&x, &x, &z).expect("equal");
+    let short = Directions::new(&x[..8], &x[..8], &z[..8]).expect("equal");
+    let (mut f, mut f_short) = (Out::new(16), Out::new(15));
+    let (mut pdf, mut pdf_short) = (vec![-1.0; 16], vec![-1.0; 15]);
+    let rejected = |r: Result<(), Error>, name: &str| matches!(r, Err(Error::LengthMismatch { name: n, .. }) if n == name);
+    assert!(rejected(bsdf.eval_batch(&d, &short, &mut f.channels()), "wi"), "{label}: eval, short wi");
+    assert!(rejected(bsdf.eval_batch(&d, &d, &mut f_short.channels()), "f"), "{label}: eval, short f");
+    assert!(rejected(bsdf.pdf_batch(&d, &d, &mut pdf_short), "pdf"), "{label}: pdf, short pdf");
+    assert!(rejected(bsdf.pdf_batch(&d, &short, &mut pdf), "wi"), "{label}: pdf, short wi");
+    assert!(
+        rejected(bsdf.eval_with_pdf_batch(&d, &d, &mut f.channels(), &mut pdf_short), "pdf"),
+        "{label}: eval_with_pdf, short pdf"
+    );
+    assert!(
+        rejected(bsdf.eval_with_pdf_batch(&d, &d, &mut f_short.channels(), &mut pdf), "f"),
+        "{label}: eval_with_pdf, short f"
+    );
+    let untouched = |v: &[f32]| v.iter().all(|&v| v == -1.0);
+    assert!(
+        untouched(&f.a) && untouched(&f_short.a) && untouched(&pdf) && untouched(&pdf_short),
+        "{label}: a rejected call wrote"
+    );
+    let (mut w, mut weight, mut p, mut eta) = (Out::new(16), Out::new(16), vec![-1.0; 16], vec![-1.0; 16]);
+    let mut out = SampleOutputs { wi: w.channels(), weight: weight.channels(), pdf: &mut p, eta: &mut eta };
+    let u = vec![0.5f32; 16];
+    assert!(rejected(bsdf.sample_batch(&d, &u, &u[..3], &u, &mut out), "u1"), "{label}: sample, short u1");
+    assert!(rejected(bsdf.sample_batch(&d, &u[..15], &u, &u, &mut out), "uc"), "{label}: sample, short uc");
+    assert!(untouched(&p) && untouched(&w.a) && untouched(&weight.a), "{label}: a rejected sample wrote");
+}
+
+/// Compensated lobes (gold and glass, every scheme): invalid lanes (NaN, zero, non-unit
+/// directions, uniforms outside [0, 1)) get the scalar calls' nothing and drifted directions
+/// (|ω| within 10⁻² of 1, which the scalar calls renormalize) the scalar call's answer, both
+/// bit for bit; their neighbours stay within the bounds (release builds: the scalar calls assert
+/// on garbage in debug builds).
+#[cfg(not(debug_assertions))]
+#[test]
+fn compensated_invalid_and_drifted_lanes_are_the_scalar_calls() {
+    let bad = [
+        Vec3::NAN,
+        Vec3::ZERO,
+        Vec3::new(0.0, 0.0, 2.0),
+        Vec3::new(f32::INFINITY, 0.0, 0.0),
+        Vec3::new(0.6, 0.0, 0.9),
+    ];
+    let (mut wo, mut wi) = queries(450, false);
+    // the queries with an odd direction, and those with an odd view (the sample's argument)
+    let (mut odd, mut odd_views) = (Vec::new(), Vec::new());
+    for (k, b) in bad.iter().enumerate() {
+        (wo[8 * k + 3], wi[8 * k + 5]) = (*b, *b);
+        odd.extend([8 * k + 3, 8 * k + 5]);
+        odd_views.push(8 * k + 3);
+    }
+    // drifted: lengths 1.006 and 0.995 (|‖ω‖² − 1| beyond the as-is tolerance 10⁻³)
+    for k in 0..40 {
+        let i = 64 + 16 * k;
+        (wo[i], wi[i + 1], wi[i + 2]) = (wo[i] * 1.006, wi[i + 1] * 0.995, wi[i + 2] * 1.006);
+        wo[i + 2] *= 0.995;
+        odd.extend([i, i + 1, i + 2]);
+        odd_views.extend([i, i + 2]);
+    }
+    let mut rng = Pcg64Mcg::seed_from_u64(451);
+    let mut u1: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let u2: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    let uc: Vec<f32> = (0..N).map(|_| rng.random()).collect();
+    for (k, u) in [f32::NAN, -0.1, 1.0, 3.0].into_iter().enumerate() {
+        u1[8 * k + 2] = u;
+        odd_views.push(8 * k + 2);
+    }
+    let slope = Ggx::new(0.5, 0.3).expect("valid roughness");
+    let conductor = Bounds { rel: 4e-6, transmit_rel: 4e-6, abs: 1e-6, ..Bounds::EXACT };
+    for scheme in SCHEMES {
+        let gold =
+            Compensated::with_scheme(slope, Conductor::new(ComplexIor::GOLD), scheme).expect("tabulated");
+        let glass =
+            Compensated::with_scheme(slope, Dielectric::new(1.5).expect("valid"), scheme).expect("tabulated");
+        check_odd_lanes(
+            &format!("gold {scheme:?}"),
+            &gold,
+            conductor,
+            0.0,
+            (&wo, &wi),
+            (&uc, &u1, &u2),
+            (&odd, &odd_views),
+        );
+        check_odd_lanes(
+            &format!("glass {scheme:?}"),
+            &glass,
+            GLASS,
+            GLASS_WEIGHT_REL,
+            (&wo, &wi),
+            (&uc, &u1, &u2),
+            (&odd, &odd_views),
+        );
+    }
+}
+
+#[cfg(not(debug_assertions))]
+fn check_odd_lanes<B: BatchBsdf>(
+    label: &str,
+    bsdf: &B,
+    bounds: Bounds,
+    weight_rel: f32,
+    (wo, wi): (&[Vec3], &[Vec3]),
+    (uc, u1, u2): (&[f32], &[f32], &[f32]),
+    (odd, odd_views): (&[usize], &[usize]),
+) {
+    let (so, si) = (Soa::of(wo), Soa::of(wi));
+    let (mut f, mut pdf) = (Out::new(N), vec![-1.0; N]);
+    bsdf.eval_with_pdf_batch(&so.dirs(), &si.dirs(), &mut f.channels(), &mut pdf).expect("lengths");
+    let (mut f_only, mut pdf_only) = (Out::new(N), vec![-1.0; N]);
+    bsdf.eval_batch(&so.dirs(), &si.dirs(), &mut f_only.channels()).expect("lengths");
+    bsdf.pdf_batch(&so.dirs(), &si.dirs(), &mut pdf_only).expect("lengths");
+    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+    for i in 0..N {
+        let (v, p) = bsdf.eval_with_pdf(wo[i], wi[i]);
+        let (e, q) = (bsdf.eval(wo[i], wi[i]).f, bsdf.pdf(wo[i], wi[i]));
+        if odd.contains(&i) {
+            assert!(
+                bits(f.get(i)) == bits(v.f)
+                    && pdf[i].to_bits() == p.to_bits()
+                    && bits(f_only.get(i)) == bits(e)
+                    && pdf_only[i].to_bits() == q.to_bits(),
+                "{label}: odd query {i} ({}, {}): batch ({}, {}), scalar ({}, {p})",
+                wo[i],
+                wi[i],
+                f.get(i),
+                pdf[i],
+                v.f
+            );
+            continue;
+        }
+        let (rel, carried) = if wo[i].z * wi[i].z < 0.0 && p > 0.0 {
+            (bounds.transmit_rel, bounds.pdf_abs / p)
+        } else {
+            (bounds.rel, 0.0)
+        };
+        let close = |b: Vec3, s: Vec3, bp: f32, sp: f32| {
+            excess(b, s, rel, (bounds.abs + carried) * s.max_element()) <= 1.0
+                && (bp - sp).abs() <= bounds.pdf_rel * sp + bounds.pdf_abs
+        };
+        assert!(
+            close(f.get(i), v.f, pdf[i], p) && close(f_only.get(i), e, pdf_only[i], q),
+            "{label}: query {i} ({}, {}): batch ({}, {}), scalar ({}, {p})",
+            wo[i],
+            wi[i],
+            f.get(i),
+            pdf[i],
+            v.f
+        );
+    }
+    let so = Soa::of(wo);
+    let (mut w, mut weight, mut sp, mut eta) = (Out::new(N), Out::new(N), vec![-1.0; N], vec![-1.0; N]);
+    let mut out = SampleOutputs { wi: w.channels(), weight: weight.channels(), pdf: &mut sp, eta: &mut eta };
+    bsdf.sample_batch(&so.dirs(), uc, u1, u2, &mut out).expect("lengths");
+    for i in 0..N {
+        let s = bsdf.sample(wo[i], uc[i], Vec2::new(u1[i], u2[i]));
+        let ok = match s {
+            None => sp[i] == 0.0 && w.get(i) == Vec3::ZERO && weight.get(i) == Vec3::ZERO && eta[i] == 1.0,
+            Some(s) if odd_views.contains(&i) => {
+                s.wi == w.get(i) && bits(s.weight) == bits(weight.get(i)) && s.pdf == sp[i] && s.eta == eta[i]
+            }
+            Some(s) => {
+                s.wi == w.get(i)
+                    && s.eta == eta[i]
+                    && excess(weight.get(i), s.weight, weight_rel, 0.0) <= 1.0
+                    && (sp[i] - s.pdf).abs() <= bounds.pdf_rel * s.pdf + bounds.pdf_abs
+            }
+        };
+        assert!(
+            ok,
+            "{label}: sample {i} of {}: {s:?}, batch ({}, {}, {})",
+            wo[i],
+            w.get(i),
+            weight.get(i),
+            sp[i]
+        );
     }
 }

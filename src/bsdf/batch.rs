@@ -18,9 +18,9 @@
 //! G2, a beta function, with the lane form of `crate::special` (the scalar path forms it from f64
 //! log-gammas). Where the scalar path branches to a rare form (a half vector within rounding of
 //! −ωi, a subnormal density, a cap point near −v̂, a beta function below the normal f32 range,
-//! a near-perpendicular facet's Fresnel cosine, a backfacing view, an invalid argument), the
-//! lanes compute a mask of the queries their common path covers, and every other query is
-//! answered by the scalar call itself. A bad lane therefore gets exactly the scalar contract's
+//! a near-perpendicular facet's Fresnel cosine, a dielectric's Fresnel cosine near the critical
+//! angle, a backfacing view, an invalid argument), the lanes compute a mask of the queries
+//! their common path covers, and every other query is answered by the scalar call itself. A bad lane therefore gets exactly the scalar contract's
 //! answer and its neighbours are untouched.
 //!
 //! # Accuracy
@@ -71,7 +71,7 @@ impl SampleOutputs<'_> {
 
     /// Writes the scalar call's answer for query `i`.
     #[inline]
-    fn set(&mut self, i: usize, s: Option<super::BsdfSample>) {
+    pub(crate) fn set(&mut self, i: usize, s: Option<super::BsdfSample>) {
         match s {
             Some(s) => {
                 self.wi.set(i, s.wi);
@@ -99,8 +99,18 @@ impl SampleOutputs<'_> {
 /// [0, 1)) gives that query the scalar call's *nothing* (with its debug assertion) and leaves
 /// the others untouched.
 ///
-/// The provided methods call the scalar methods query by query; [`MicrofacetBsdf`] overrides
-/// them with eight-lane loops for single scattering on GGX conductors and dielectrics.
+/// The provided methods call the scalar methods query by query. The crate's lobes override
+/// them:
+///
+/// * [`MicrofacetBsdf`]: eight-lane loops for single scattering on GGX conductors and
+///   dielectrics (η at least 0.05 from 1), the scalar calls for every other configuration;
+///   the bounds against the scalar calls are stated on its implementation.
+/// * [`Compensated`](crate::Compensated) of a conductor or a dielectric, every scheme: the
+///   batch of its single-scattering lobe (in lanes where that has them), then each query's
+///   compensation by the scalar calls' own expressions, so that the single-scattering bounds
+///   carry over (a conductor's densities bit for bit). Turquin's samples are the
+///   single-scattering batch samples with the scalar call's weight factor; the additive
+///   schemes sample by the scalar call, query by query.
 ///
 /// # Examples
 /// ```
@@ -190,12 +200,24 @@ pub trait BatchBsdf: Bsdf {
         u2: &[f32],
         out: &mut SampleOutputs<'_>,
     ) -> Result<(), Error> {
-        let n = check_sample_lengths(wo, uc, u1, u2, out)?;
-        for i in 0..n {
-            out.set(i, self.sample(wo.get(i), uc[i], Vec2::new(u1[i], u2[i])));
-        }
-        Ok(())
+        sample_each(self, wo, uc, u1, u2, out)
     }
+}
+
+/// [`BatchBsdf::sample_batch`] by the scalar call query by query.
+pub(crate) fn sample_each<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    wo: &Directions<'_>,
+    uc: &[f32],
+    u1: &[f32],
+    u2: &[f32],
+    out: &mut SampleOutputs<'_>,
+) -> Result<(), Error> {
+    let n = check_sample_lengths(wo, uc, u1, u2, out)?;
+    for i in 0..n {
+        out.set(i, bsdf.sample(wo.get(i), uc[i], Vec2::new(u1[i], u2[i])));
+    }
+    Ok(())
 }
 
 fn check_sample_lengths(
@@ -276,16 +298,25 @@ fn conductor_fresnel<L: Lanes>(fresnel: Option<(Vec3A, Vec3A)>, cos: L) -> [L; 3
     }
 }
 
+/// Within this of 0, η² cos² θt = cos² θ + η² − 1 (a cosine near the critical angle of η < 1)
+/// leaves a reflection to the scalar call: F has an infinite slope in cos θ at the critical
+/// angle, and the lanes' f32 cosine (a few ulps from the scalar's f64 one) moves it by up to
+/// 6e-4 relative below 0.01, by at most 1e-5 above it (2²⁰ queries each for η = 1/1.33, 1/1.5
+/// and 1/2.5).
+const CRITICAL_MARGIN: f32 = 0.01;
+
 /// The dielectric's Fresnel reflectance at cos θ = `c` ∈ [0, 1] with index η
-/// (`dielectric_reflectance`, in f32).
+/// (`dielectric_reflectance`, in f32), and whether c is clear of the critical angle
+/// ([`CRITICAL_MARGIN`]; always for η ≥ 1 + 0.05).
 #[inline(always)]
-fn dielectric_fresnel<L: Lanes>(eta: L, c: L) -> L {
+fn dielectric_fresnel<L: Lanes>(eta: L, c: L) -> (L, L::Mask) {
     let one = L::lit(1.0);
     let c = c.abs().min(one);
     let eta2_cos2_t = c * c + (eta - one) * (eta + one);
     let total = eta2_cos2_t.le(L::lit(0.0));
     let t = eta2_cos2_t.max(L::lit(0.0)).sqrt() / eta;
-    L::select(total, one, fresnel_dielectric_cosines_of(c, t, eta))
+    let clear = eta2_cos2_t.abs().ge(L::lit(CRITICAL_MARGIN));
+    (L::select(total, one, fresnel_dielectric_cosines_of(c, t, eta)), clear)
 }
 
 /// Single scattering of a front-facing reflection (ωo, ωi both above the horizon, renderer
@@ -456,7 +487,8 @@ fn evaluate_dielectric<L: Lanes, const WANT: u8>(
     let below = front & wi.z.lt(zero);
     let (ax, ay, eta) = (L::lit(ax), L::lit(ay), L::lit(eta));
     let (density, g2_over_g1, cos, ok) = front_reflection(ax, ay, wo, wi);
-    let fr = dielectric_fresnel(eta, cos);
+    let (fr, clear) = dielectric_fresnel(eta, cos);
+    let ok = ok & clear;
     let (pdf_transmit, lambda_o, valid_t, ok_t) = transmission_density(ax, ay, eta, wo, wi);
     let pdf = L::select(above, fr * density, pdf_transmit);
     let reflected = L::select(above, fr * density * g2_over_g1 / wi.z, zero);
@@ -572,11 +604,12 @@ fn sample_dielectric(
     let wi = v.scale(1.5 - 0.5 * len_sq);
     let exits = if reflects { wi.z > 0.0 } else { wi.z < 0.0 };
     let (density, g2_over_g1_r, cos, ok_r) = front_reflection(ax, ay, wo, wi);
-    let pdf_r = dielectric_fresnel(eta, cos) * density;
+    let (fresnel_r, clear) = dielectric_fresnel(eta, cos);
+    let pdf_r = fresnel_r * density;
     let (pdf_t, lambda_o, valid_t, ok_t) = transmission_density(ax, ay, eta, wo, wi);
     let (g2_over_g1_t, in_range) = transmission_g2_over_g1(ax, ay, wi, lambda_o);
     let (weight, pdf, density_ok) = if reflects {
-        (g2_over_g1_r, pdf_r, ok_r)
+        (g2_over_g1_r, pdf_r, ok_r & clear)
     } else {
         (g2_over_g1_t * k.transport, pdf_t, valid_t & ok_t & in_range)
     };
@@ -848,14 +881,18 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
 /// Bounds against the scalar call (`tests/batch.rs`, over views and lights on the whole sphere
 /// from α = 10⁻³ to 10, anisotropic, grazing to 10⁻⁶): densities and samples of conductors are
 /// equal bit for bit; f of a reflection within 2e-5 relative (the scalar forms D, Λ and G2 in
-/// f64, the lanes in f32) plus 4e-6 of f/F for the Fresnel cosine; a dielectric's densities
-/// within 1e-4 relative plus 1e-6 absolute; f of a dielectric's transmission within 1.5e-4
-/// relative plus (4e-6 + 1e-6/pdf) of f (the density's bound carried over, and the lane beta
-/// function of the height-correlated G2, `special::ln_beta_1p_of`: 4e-7·(1 + |ln B|) + 3 ulps).
+/// f64, the lanes in f32) plus 4e-6 of f/F for the Fresnel cosine (a dielectric's facet cosine
+/// with |cos² θ + η² − 1| below 0.01, near the critical angle of η < 1, where F has an
+/// infinite slope, takes the scalar call); a dielectric's densities within 1e-4 relative plus
+/// 1e-6 absolute; f of a dielectric's transmission within 1.5e-4 relative plus
+/// (4e-6 + 1e-6/pdf) of f (the density's bound carried over, and the lane beta function of the
+/// height-correlated G2, `special::ln_beta_1p_of`: 4e-7·(1 + |ln B|) + 3 ulps).
 /// A dielectric's samples seen from above: the direction, the event and η equal to the scalar
 /// call's bit for bit (the visible normal is the scalar's f32 kernel, the Fresnel choice and
 /// the refraction's c − s are formed in f64 as the scalar forms them), the weight within 5e-5
-/// relative, the density within the dielectric's density bound.
+/// relative, the density within the dielectric's density bound (but for transmissions sampled
+/// from grazing views of sharp glass at the critical angle, measured up to 1.64e-4 relative:
+/// `DESIGN.md`, "Accuracy in f32 lanes").
 impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for MicrofacetBsdf<S, M> {
     fn eval_batch(
         &self,
@@ -915,14 +952,9 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> BatchBsdf for Microfacet
         u2: &[f32],
         out: &mut SampleOutputs<'_>,
     ) -> Result<(), Error> {
-        let n = check_sample_lengths(wo, uc, u1, u2, out)?;
-        if let Some(kernel) = self.kernel() {
-            dispatch(&mut SampleLoop { bsdf: self, kernel, wo, uc, u1, u2, out });
-        } else {
-            for i in 0..n {
-                out.set(i, self.sample(wo.get(i), uc[i], Vec2::new(u1[i], u2[i])));
-            }
-        }
+        let Some(kernel) = self.kernel() else { return sample_each(self, wo, uc, u1, u2, out) };
+        check_sample_lengths(wo, uc, u1, u2, out)?;
+        dispatch(&mut SampleLoop { bsdf: self, kernel, wo, uc, u1, u2, out });
         Ok(())
     }
 }

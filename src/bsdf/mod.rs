@@ -29,6 +29,7 @@ mod sidedness;
 mod specular;
 mod walk_density;
 
+pub(crate) use batch::sample_each;
 pub use batch::{BatchBsdf, SampleOutputs};
 pub use classic::{ClassicBrdf, ClassicMasking, ClassicNdf};
 pub use frame::ShadingFrame;

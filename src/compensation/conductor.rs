@@ -336,6 +336,42 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
         self.lobes.mixing && wo.z > 0.0
     }
 
+    /// f of a rough surface at valid directions from single scattering's `f_ss` at the same
+    /// directions: f_ss plus the additive lobe (Kulla–Conty, the walk's orders) or f_ss times
+    /// Turquin's factor of the view. Every evaluation of the BSDF (`eval`, `eval_with_pdf`, the
+    /// batch calls) ends with this expression.
+    #[inline(always)]
+    pub(super) fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
+        match self.scheme {
+            Compensation::Turquin => f_ss * self.lobes.turquin_factor(self.lobes.view_complement(wo)),
+            scheme => f_ss + self.lobes.added(scheme, wo.z, wi.z),
+        }
+    }
+
+    /// Turquin's sample weight from single scattering's sample `weight` for the view `wo`
+    /// (valid): scaled by the view's factor on a rough surface; `None` where not finite. Every
+    /// sample of Turquin's scheme (`sample`, the batch call) ends with this expression.
+    #[inline(always)]
+    pub(super) fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
+        let lobes = &self.lobes;
+        let weight = if self.single.is_specular() {
+            weight
+        } else {
+            weight * lobes.turquin_factor(lobes.view_complement(wo))
+        };
+        weight.is_finite().then_some(weight)
+    }
+
+    /// The density at valid directions from single scattering's `pdf_ss` at the same
+    /// directions: the sampling mixture's p pdf_ss + (1 − p) d(μi) μi/π where the sampler mixes
+    /// and the light is above the horizon, else `pdf_ss` (a light below the horizon of a view
+    /// from above has density 0 in both lobes). Every density of the BSDF but the sample's
+    /// (`pdf`, `eval_with_pdf`, the batch calls) ends with this expression.
+    #[inline(always)]
+    pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        if self.mixes(wo) && wi.z > 0.0 { self.lobes.mixture_pdf(wo.z, pdf_ss, wi.z) } else { pdf_ss }
+    }
+
     /// Single scattering's density at a pair of valid directions with `wo` above the horizon:
     /// for `wi` above it the mirror facets' density (the function single scattering's `pdf`,
     /// `eval_with_pdf` and `sample` share, called here without their repeated checks), else
@@ -383,11 +419,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         if self.single.is_specular() {
             return v;
         }
-        let f = match self.scheme {
-            Compensation::Turquin => v.f * self.lobes.turquin_factor(self.lobes.view_complement(wo)),
-            scheme => v.f + self.lobes.added(scheme, wo.z, wi.z),
-        };
-        BsdfValue { f, exact: true }
+        BsdfValue { f: self.compensated_f(wo, wi, v.f), exact: true }
     }
 
     #[inline]
@@ -395,11 +427,8 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         unit_view!(wo, uc, u, None, self.sample_keyed(wo, uc, u, key));
         let lobes = &self.lobes;
         if self.scheme == Compensation::Turquin {
-            let mut s = self.single.sample_keyed(wo, uc, u, key)?;
-            if !self.single.is_specular() {
-                s.weight *= lobes.turquin_factor(lobes.view_complement(wo));
-            }
-            return if s.weight.is_finite() { Some(s) } else { None };
+            let s = self.single.sample_keyed(wo, uc, u, key)?;
+            return Some(BsdfSample { weight: self.turquin_weight(wo, s.weight)?, ..s });
         }
         if !self.mixes(wo) {
             return self.single.sample_keyed(wo, uc, u, key);
@@ -440,11 +469,9 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
             // — the mixture's p·0 + q·0)
             return self.single.pdf(wo, wi);
         }
-        // the mixture's lookups first (`mixture_pdf`'s expression, the same bits)
-        let (p, added) = self.lobes.mixture_parts(wo.z, wi.z);
         // `single_pdf` of a light above the horizon, without its test
         let pdf_ss = SingleScattering::<S, Conductor>::mirror_density(self.single.surface().slope(), wo, wi);
-        p * if pdf_ss.is_finite() { pdf_ss } else { 0.0 } + added
+        self.compensated_pdf(wo, wi, if pdf_ss.is_finite() { pdf_ss } else { 0.0 })
     }
 
     #[inline]
@@ -454,17 +481,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         if self.single.is_specular() {
             return (v, pdf_ss);
         }
-        let lobes = &self.lobes;
-        match self.scheme {
-            Compensation::Turquin => {
-                (BsdfValue { f: v.f * lobes.turquin_factor(lobes.view_complement(wo)), exact: true }, pdf_ss)
-            }
-            scheme => {
-                let f = v.f + lobes.added(scheme, wo.z, wi.z);
-                let pdf = if self.mixes(wo) { lobes.mixture_pdf(wo.z, pdf_ss, wi.z) } else { pdf_ss };
-                (BsdfValue { f, exact: true }, pdf)
-            }
-        }
+        (BsdfValue { f: self.compensated_f(wo, wi, v.f), exact: true }, self.compensated_pdf(wo, wi, pdf_ss))
     }
 }
 

@@ -405,9 +405,46 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
 
     /// f·factor, or 0 where it is not a finite f32 (see Turquin's special cases).
     #[inline(always)]
-    fn scaled(v: BsdfValue, factor: f32) -> BsdfValue {
-        let f = v.f * factor;
-        BsdfValue { f: if f.is_finite() { f } else { Vec3::ZERO }, exact: v.exact }
+    fn scaled(f: Vec3, factor: f32) -> Vec3 {
+        let f = f * factor;
+        if f.is_finite() { f } else { Vec3::ZERO }
+    }
+
+    /// f at valid directions from single scattering's `f_ss` at the same directions: f_ss
+    /// scaled by Turquin's factor, or f_ss plus the added lobe of the light's side where the
+    /// lobes answer. Every evaluation of the BSDF (`eval`, `eval_with_pdf`, the batch calls)
+    /// ends with this expression.
+    #[inline(always)]
+    pub(super) fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
+        if self.scheme == Compensation::Turquin {
+            return Self::scaled(f_ss, self.turquin_factor(wo));
+        }
+        if !self.compensates(wo, wi) {
+            return f_ss;
+        }
+        f_ss + Vec3::splat(self.lobes.added(side_of(wo), crossing(wo, wi), wo.z.abs(), wi.z.abs()))
+    }
+
+    /// Turquin's sample weight from single scattering's sample `weight` (not a Dirac lobe's)
+    /// for the view `wo` (valid); `None` where not finite. Every sample of Turquin's scheme
+    /// (`sample`, the batch call) ends with this expression.
+    #[inline(always)]
+    pub(super) fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
+        let weight = weight * self.turquin_factor(wo);
+        weight.is_finite().then_some(weight)
+    }
+
+    /// The density at valid directions from single scattering's `pdf_ss` at the same
+    /// directions: the sampling mixture's density where the lobes answer (not Turquin's), else
+    /// `pdf_ss`. Every density of the BSDF but the sample's (`pdf`, `eval_with_pdf`, the batch
+    /// calls) ends with this expression.
+    #[inline(always)]
+    pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        if self.scheme == Compensation::Turquin || !self.compensates(wo, wi) {
+            return pdf_ss;
+        }
+        let a = side_of(wo);
+        self.lobes.mixture_pdf(a, self.lobes.mixture(a, wo.z.abs()), wo, wi, pdf_ss)
     }
 
     /// Single scattering's density at valid directions off the horizon of a rough surface:
@@ -430,15 +467,8 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
     #[inline]
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
         unit_directions!(wo, wi, NOTHING, self.eval_keyed(wo, wi, key));
-        if self.scheme == Compensation::Turquin {
-            return Self::scaled(self.single.eval_valid(wo, wi, key), self.turquin_factor(wo));
-        }
         let v = self.single.eval_valid(wo, wi, key);
-        if !self.compensates(wo, wi) {
-            return v;
-        }
-        let f = self.lobes.added(side_of(wo), crossing(wo, wi), wo.z.abs(), wi.z.abs());
-        BsdfValue { f: v.f + Vec3::splat(f), exact: true }
+        BsdfValue { f: self.compensated_f(wo, wi, v.f), ..v }
     }
 
     #[inline]
@@ -449,8 +479,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
             if s.flags.specular {
                 return Some(s);
             }
-            let weight = s.weight * self.turquin_factor(wo);
-            return weight.is_finite().then_some(BsdfSample { weight, ..s });
+            return Some(BsdfSample { weight: self.turquin_weight(wo, s.weight)?, ..s });
         }
         let lobes = &self.lobes;
         if !lobes.active || wo.z == 0.0 {
@@ -494,26 +523,14 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
         if self.scheme == Compensation::Turquin || !self.compensates(wo, wi) {
             return self.single.pdf(wo, wi);
         }
-        let a = side_of(wo);
-        let p = self.lobes.mixture(a, wo.z.abs());
-        self.lobes.mixture_pdf(a, p, wo, wi, self.single_pdf(wo, wi))
+        self.compensated_pdf(wo, wi, self.single_pdf(wo, wi))
     }
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
         unit_directions!(wo, wi, (NOTHING, 0.0), self.eval_with_pdf_keyed(wo, wi, key));
         let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-        if self.scheme == Compensation::Turquin {
-            return (Self::scaled(v, self.turquin_factor(wo)), pdf_ss);
-        }
-        if !self.compensates(wo, wi) {
-            return (v, pdf_ss);
-        }
-        let a = side_of(wo);
-        let c = crossing(wo, wi);
-        let p = self.lobes.mixture(a, wo.z.abs());
-        let pdf = self.lobes.mixture_pdf(a, p, wo, wi, pdf_ss);
-        let f = self.lobes.added(a, c, wo.z.abs(), wi.z.abs());
-        (BsdfValue { f: v.f + Vec3::splat(f), exact: true }, pdf)
+        let pdf = self.compensated_pdf(wo, wi, pdf_ss);
+        (BsdfValue { f: self.compensated_f(wo, wi, v.f), ..v }, pdf)
     }
 }

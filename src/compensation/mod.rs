@@ -4,6 +4,7 @@
 //! built per hit from tables shared by every instance; and the tables themselves.
 
 mod albedo_tabulated;
+mod batch;
 mod compensated;
 mod conductor;
 mod conductor_tables;

@@ -23,11 +23,12 @@
 //!   rejection with the exact ratio (0.78–0.98 of the proposals accepted for a tabulated GGX),
 //!   and GGX(s)'s spherical cap for the directions that see only the tail. Construction takes
 //!   45 ms and 148 KB at N = 256 (0.7 s and 1.9 MB at [`MAX_RINGS`] = 4096).
-//! * **Speed** (criterion medians against GGX α = 0.5, 256 rings, θi = 0.3, 1.4, 2.2, on a
-//!   shared machine under load, so the ratios vary from run to run): `d` 16–25 ns, 1.5–3.0×
-//!   GGX's; `sample_d_wi` 250–300 ns, 3.1–6.4× GGX's spherical cap (3.6–4.3× in instructions:
-//!   760–950 per call against 211–219). [`StretchedTabulated`] adds the stretch (`d` 28–45 ns,
-//!   `sample_d_wi` 300–350 ns); the grid's inversion sampler takes 30–46 µs at 2 × 32 cells.
+//! * **Speed** (criterion medians against GGX α = 0.5, 256 rings, θi = 0.3, 1.4, 2.2, one run
+//!   on a shared machine, thread CPU time, load average about 3; the ratios move from run to
+//!   run): `d` 10–14 ns, 2.1–2.2× GGX's; `sample_d_wi` 122–145 ns, 2.8–3.0× GGX's spherical cap
+//!   (3.6–4.3× in instructions: 760–950 per call against 211–219). [`StretchedTabulated`] adds
+//!   the stretch (`d` 14–16 ns, `sample_d_wi` 162–178 ns); the grid's inversion sampler takes
+//!   14–15 µs at 2 × 32 cells.
 //! * **The grid.** [`GridSlope`] tabulates an anisotropic P²² on 2N × 2N cells; Λ is
 //!   interpolated over the incident direction and visible normals are sampled exactly by
 //!   inverting the marginal and conditional CDFs, O(N) per sample. [`StretchedTabulated`] is

@@ -7,7 +7,8 @@
 use glam::Vec3;
 use microsurface::compensation::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable,
-    DielectricLossTable, EtaRange, LOSS_TABLE_SHAPE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable,
+    DielectricLossTable, EtaRange, LOSS_TABLE_SHAPE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE,
+    ORDER_TABLES, ScatteringOrderTable,
 };
 use microsurface::research::{Microsurface, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
@@ -641,7 +642,8 @@ fn dielectric_lookup_reproduces_the_nodes() {
 /// The measured interpolation errors of the loss lookups (max over 256 random points against
 /// quadrature, `tools --bin tables -- --interpolation --only dielectric-loss`; the loss table's
 /// documentation), per family (GGX, Beckmann) and side (outside, inside).
-const STATED_LOSS_ERROR: [[f64; 2]; 2] = [[LOSS_ERROR_GGX_OUT, LOSS_ERROR_GGX_IN], [LOSS_ERROR_BECKMANN_OUT, LOSS_ERROR_BECKMANN_IN]];
+const STATED_LOSS_ERROR: [[f64; 2]; 2] =
+    [[LOSS_ERROR_GGX_OUT, LOSS_ERROR_GGX_IN], [LOSS_ERROR_BECKMANN_OUT, LOSS_ERROR_BECKMANN_IN]];
 const LOSS_ERROR_GGX_OUT: f64 = 1e-1;
 const LOSS_ERROR_GGX_IN: f64 = 1e-1;
 const LOSS_ERROR_BECKMANN_OUT: f64 = 1e-1;
@@ -682,7 +684,13 @@ fn loss_nodes_match_the_single_scattering_bsdf() {
     let [nx, nr, nu] = LOSS_TABLE_SHAPE;
     let cells: Vec<(usize, bool, usize, usize, usize)> = (0..24)
         .map(|k| {
-            (k % 2, (k / 2) % 2 == 1, pick.random_range(1..nx), pick.random_range(1..nr), pick.random_range(1..nu))
+            (
+                k % 2,
+                (k / 2) % 2 == 1,
+                pick.random_range(1..nx),
+                pick.random_range(1..nr),
+                pick.random_range(1..nu),
+            )
         })
         .collect();
     let z = family_z(FAMILY_ALPHA, cells.len());
@@ -786,7 +794,8 @@ fn loss_lookup_reproduces_the_nodes() {
                     for i in [0, 5, 16, 23] {
                         let (mu, alpha, eta) = loss_node_coordinates(i, j, l, inside);
                         let k = (l * nr + j) * nx + i;
-                        let d = loss_table(family).loss(mu, alpha, if inside { 1.0 / eta } else { eta }).unwrap();
+                        let d =
+                            loss_table(family).loss(mu, alpha, if inside { 1.0 / eta } else { eta }).unwrap();
                         // the coordinates round-trip through f32 arithmetic
                         assert!(
                             (d - nodes[k]).abs() < 2e-5,

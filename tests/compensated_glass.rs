@@ -205,13 +205,13 @@ fn added_lobes_are_normalized() {
 /// the same uniforms give the same samples and weight × `eta`² is the importance weight. α at
 /// r = j/23, j ∈ {8, 15, 23} (α = 0.12, 0.43, 1); η at u = l/31, l ∈ {6, 14, 25} (η = 1.015,
 /// 1.18, 2.05); μo at x = i/23, i ∈ {6, 14, 21}; both sides and families (108 cases,
-/// family-wise level 1 %, N = 40 000, SE ≤ 4e-3: σ̂ reaches 0.54 at grazing views from inside,
-/// where the mixture's lobe probabilities follow the walk tables, not the sampled lobe).
+/// family-wise level 1 %, N = 100 000, SE ≤ 4e-3: σ̂ reaches 0.74, GGX α = 0.12, η = 1.015,
+/// μo = 0.033 from inside).
 #[test]
 fn white_furnace_at_the_nodes() {
     let cases = 108;
     let z = family_z(0.01, cases);
-    let n = 40_000;
+    let n = 100_000;
     let mut worst: f64 = 0.0;
     let mut seed = 16_700;
     fn run<S: AlbedoTabulated + Copy>(
@@ -224,16 +224,20 @@ fn white_furnace_at_the_nodes() {
     ) {
         for above in [true, false] {
             let (mu, alpha, eta) = loss_node(i, j, l, !above);
-            let imp = Compensated::new(slope(alpha), glass(eta)).unwrap().with_transport(Transport::Importance);
+            let imp =
+                Compensated::new(slope(alpha), glass(eta)).unwrap().with_transport(Transport::Importance);
             let rad = imp.with_transport(Transport::Radiance);
             let wo = view(mu, above);
             let mut rng = validation::rng(seed + u64::from(above));
             let mut stats = Stats::default();
-            for _ in 0..n {
+            for k in 0..n {
                 let uc = uniform32(&mut rng);
                 let u = Vec2::new(uniform32(&mut rng), uniform32(&mut rng));
                 let a = imp.sample(wo, uc, u);
-                if let (Some(a), Some(b)) = (a, rad.sample(wo, uc, u)) {
+                // (the transports' identity on every 4th sample: it is exact, not statistical)
+                if let (Some(a), true) = (a, k % 4 == 0)
+                    && let Some(b) = rad.sample(wo, uc, u)
+                {
                     assert_eq!(a.wi, b.wi, "radiance and importance sample alike");
                     assert!(rel_close(a.weight, b.weight * (b.eta * b.eta), 1e-5), "{a:?} vs {b:?}");
                 }
@@ -286,7 +290,14 @@ fn white_furnace_between_the_nodes() {
     }
     let z = family_z(0.01, points.len());
     let n = 1 << 17;
-    fn albedo<S: AlbedoTabulated + Copy>(slope: S, mu: f32, eta: f32, inside: bool, n: usize, seed: u64) -> (Stats, f64) {
+    fn albedo<S: AlbedoTabulated + Copy>(
+        slope: S,
+        mu: f32,
+        eta: f32,
+        inside: bool,
+        n: usize,
+        seed: u64,
+    ) -> (Stats, f64) {
         let b = Compensated::new(slope, glass(eta)).unwrap().with_transport(Transport::Importance);
         let (dr, dt) = b.higher_orders(mu, side_of(!inside)).unwrap();
         let ss = b.single_scattering();
@@ -317,7 +328,9 @@ fn white_furnace_between_the_nodes() {
         assert_mean(&label, stats, 1.0 - added, z, 2e-3, FURNACE_BOUND);
         worst = worst.max((stats.mean() + added - 1.0).abs());
     }
-    println!("KC glass white furnace between the nodes: largest |albedo − 1| = {worst:.2e} (N = {n}, z = {z:.2})");
+    println!(
+        "KC glass white furnace between the nodes: largest |albedo − 1| = {worst:.2e} (N = {n}, z = {z:.2})"
+    );
 }
 
 /// R and T of each side against the walk (`MicrofacetBsdf` with `Technique::RandomWalk`,

@@ -42,8 +42,8 @@
 //!
 //! **Sampling.** A mixture chosen by the view's energies: per cell of a uniform μ axis of the
 //! view (32 cells) the probabilities of the single-scattering sample, the reflection lobe and
-//! the transmission lobe are E_ss : ΔR_a : ΔT_a at the cell's centre (E_ss = 1 − ΔR − ΔT, at
-//! least 1e-3 of the total), blended bilinearly between the four (roughness, index) rows of
+//! the transmission lobe are the energies 1 − D : D − ΔT' : ΔT' at the cell's centre (the
+//! first at least 1e-3 of the total), blended bilinearly between the four (roughness, index) rows of
 //! the walk tables around the hit; each lobe samples the walk's light profile ΔR(μi) μi or
 //! ΔT(μi) μi on its hemisphere as the mixture of the four rows' profiles (each at its row's α,
 //! chosen with probability ∝ blend weight × mass), each a density continuous and linear in μi²
@@ -60,11 +60,10 @@
 
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::glass_tables::{GlassSide, GlassTables};
-use super::lobe_profile::mu_cell;
 use super::shared::{NOTHING, ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
 use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricLossTable, DielectricWalkTable,
-    DirectionAxis, LOSS_TABLE_SHAPE, MAX_TABULATED_ETA, node_cell,
+    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricLossTable,
+    DielectricWalkTable, DirectionAxis, LOSS_TABLE_SHAPE, MAX_TABULATED_ETA, node_cell,
 };
 use crate::bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, unit_directions, unit_view,
@@ -81,6 +80,9 @@ use glam::{Vec2, Vec3, Vec4};
 const N: usize = DIELECTRIC_TABLE_SIZE;
 /// The last node index, as a float.
 const LAST: f32 = (N - 1) as f32;
+/// The smallest share of the single-scattering lobe in the sampling mixture, relative to the
+/// added lobes' total: keeps its density positive wherever it scatters.
+const MIN_SINGLE_SHARE: f32 = 1e-3;
 /// Nodes of the loss grid's direction and roughness axes, per (roughness, direction) plane,
 /// and of its index axis.
 const NX: usize = LOSS_TABLE_SHAPE[0];
@@ -213,17 +215,17 @@ impl DielectricLobes {
         vo.dot(w).max(0.0) * vi.dot(w).max(0.0) * self.scales[a][c]
     }
 
-    /// The mixture's probabilities (single, reflection, transmission) of a view on side `a`
-    /// with |cos θo| = `mu_o`: bilinear in the tables' rows at the centre of its μ cell.
+    /// The mixture's probabilities (single, reflection, transmission, 0) of a view on side `a`
+    /// with |cos θo| = `mu_o`: the lobes' energies at the view, 1 − D : g_R : c_a ΔT' (their sum
+    /// D), the first at least [`MIN_SINGLE_SHARE`] of D.
     #[inline(always)]
     fn mixture(&self, a: usize, mu_o: f32) -> Vec4 {
-        let rows = &self.side(a).rows;
-        let k = mu_cell(mu_o);
-        let n = self.corner;
-        let (fr, fu) = (self.walk_row.1, self.walk_u);
-        let near = rows[n].mixture[k].lerp(rows[n + 1].mixture[k], fr);
-        let far = rows[n + N].mixture[k].lerp(rows[n + N + 1].mixture[k], fr);
-        near.lerp(far, fu)
+        let v = self.lobe_values(a, self.loss_node(a, self.axis.coordinate(mu_o), mu_o));
+        let d = v.x.max(0.0);
+        let t = (self.c[a] * v.y).clamp(0.0, d);
+        let single = (1.0 - d).max(MIN_SINGLE_SHARE * d);
+        let scale = 1.0 / (single + d);
+        Vec4::new(single * scale, (d - t) * scale, t * scale, 0.0)
     }
 
     /// The density of the light's profile for a view on side `a` and a light crossing (`c`)

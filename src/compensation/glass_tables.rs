@@ -9,22 +9,19 @@
 //!   the loss (so that D − c ΔT' ≥ 0 at every node for any c ≤ 1), and at [`SUBSTEPS`] sub-steps
 //!   of every roughness cell of every index row their averages 2∫ · μ dμ at that α (the lobes'
 //!   normalizations, which depend on α through the direction axis);
-//! * at every (roughness, index) row of the walk tables: the samplers of the rows' profiles
-//!   ΔR(μ) μ and ΔT(μ) μ at the row's α, their masses, and the sampling mixture's
-//!   probabilities of single scattering, reflection and transmission per cell of the uniform μ
-//!   axis;
+//! * at every (roughness, index) row of the walk tables: the samplers of the light profiles
+//!   (D − ΔT' + κ D)(μ) μ for the reflection lobe (the share κ of the loss bounds the ratio of
+//!   the hit's g_R to it) and ΔT'(μ) μ for the transmission lobe, at the row's nodes and α, and
+//!   their masses;
 //! * the single-scattering albedo E = R + T of the dielectric tables (Turquin's scheme).
 
-use super::lobe_profile::{
-    DirectionAxis, MU_CELLS, MuProfile, mixed_axis_weights, mu_cell_centre, mu_cell_masses, profile_average,
-    row_at,
-};
+use super::lobe_profile::{MuProfile, mixed_axis_weights, mu_cell_masses, profile_average};
 use super::shared::boxed;
 use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricLossTable, DielectricWalkTable, EtaRange, Family,
     Grid, LOSS_NODES, LOSS_TABLE_SHAPE, SideGrids, floor_index,
 };
-use glam::{Vec2, Vec4};
+use glam::Vec2;
 use std::sync::OnceLock;
 
 /// Nodes per axis of the walk tables.
@@ -37,23 +34,19 @@ const NU: usize = LOSS_TABLE_SHAPE[2];
 const AVERAGES: usize = NU * (NR - 1) * (SUBSTEPS + 1);
 /// Sub-steps per roughness cell of the tabulated averages.
 pub(crate) const SUBSTEPS: usize = 32;
-/// The smallest share of the single-scattering lobe in the sampling mixture, relative to the
-/// lobes' total: keeps its density positive wherever it scatters.
-const MIN_SINGLE_SHARE: f32 = 1e-3;
+/// The share κ of the loss D in the reflection lobe's sampled profile D − ΔT' + κ D.
+const REFLECTION_LOSS_SHARE: f32 = 0.1;
 /// The smallest α of the averages and profiles (α = 0 at r = 0 has only the smooth limit).
 const ALPHA_FLOOR: f64 = 1e-9;
 
 /// One row of a side's walk table: the samplers of its two profiles and the mixture.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Row {
-    /// The samplers of ΔR(μ) μ and ΔT(μ) μ at the row's α.
+    /// The samplers of the reflection and transmission lobes' light profiles,
+    /// (D − ΔT' + κ D)(μ) μ and ΔT'(μ) μ, at the row's α.
     pub(crate) profiles: [MuProfile; 2],
-    /// 2∫ΔR μ dμ and 2∫ΔT μ dμ of the row at its α.
+    /// The profiles' masses 2∫ · μ dμ at the row's α.
     pub(crate) masses: [f32; 2],
-    /// Per cell of the uniform μ axis: the probabilities (single scattering, reflection,
-    /// transmission, 0) of a view at the cell's centre, E_ss : ΔR : ΔT with E_ss = 1 − ΔR − ΔT
-    /// (the walk conserves energy) and at least [`MIN_SINGLE_SHARE`] of the total.
-    pub(crate) mixture: [Vec4; MU_CELLS],
 }
 
 /// The shared tables of one side.
@@ -159,23 +152,31 @@ impl GlassTables {
             let rows: Box<[Row; N * N]> = boxed(|n| {
                 let (j, l) = (n % N, n / N);
                 let alpha = node_alpha(j).max(ALPHA_FLOOR) as f32;
-                let (dr, dt) = (row_of(0, j, l), row_of(1, j, l));
-                let axis = DirectionAxis::<N>::new(alpha);
+                // the index of the walk tables' row l (u = √((η − 1)/2) = l/15), as seen
+                let u = l as f32 / (N - 1) as f32;
+                let eta = 1.0 + 2.0 * u * u;
+                let seen = if side == 0 { eta } else { 1.0 / eta };
+                // the lobes' profiles at the row's nodes (x = i/15 on the scale-invariant
+                // axis): the loss D split as the lobes split it, ΔT' = min(ΔT, D) and the
+                // reflection the rest
+                let walk_t = row_of(1, j, l);
+                let split = |i: usize| {
+                    let big_x = (i as f32 / (N - 1) as f32).powi(2);
+                    let mu = if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
+                    let d = loss.loss(mu, alpha, seen).unwrap_or(0.0).max(0.0);
+                    let t = walk_t[i].max(0.0).min(d);
+                    (d - t, t)
+                };
+                // the reflection lobe samples D − ΔT' + κ D: the hit's g_R = D − c_a ΔT'
+                // (c_a ≤ 1) plus a share of the loss, which bounds the ratio of g_R to the
+                // sampled profile where the row's split and the hit's differ; the transmission
+                // lobe ΔT'
+                let dr: [f32; N] =
+                    core::array::from_fn(|i| split(i).0 + REFLECTION_LOSS_SHARE * (split(i).0 + split(i).1));
+                let dt: [f32; N] = core::array::from_fn(|i| split(i).1);
                 Row {
                     profiles: [dr, dt].map(|g| MuProfile::new(&mu_cell_masses(&g, alpha))),
                     masses: [dr, dt].map(|g| profile_average(&g, alpha) as f32),
-                    mixture: core::array::from_fn(|k| {
-                        let cell = axis.cell(mu_cell_centre(k));
-                        let (er, et) = (row_at(&dr, cell).max(0.0), row_at(&dt, cell).max(0.0));
-                        let single = (1.0 - er - et).max(MIN_SINGLE_SHARE * (er + et));
-                        let total = single + er + et;
-                        if total > 0.0 {
-                            let (p0, p1) = (single / total, er / total);
-                            Vec4::new(p0, p1, (1.0 - p0 - p1).max(0.0), 0.0)
-                        } else {
-                            Vec4::new(1.0, 0.0, 0.0, 0.0)
-                        }
-                    }),
                 }
             });
             // the lobes' nodes: the loss, and the walk's ΔT at the node capped by it
@@ -187,7 +188,8 @@ impl GlassTables {
                 let eta = 1.0 + 2.0 * u * u * u;
                 let seen = if side == 0 { eta } else { 1.0 / eta };
                 let mu = loss_mu(side, i, alpha);
-                let dt = walk.energy(mu as f32, alpha as f32, seen as f32).map_or(0.0, |h| h.transmitted.max(0.0));
+                let dt =
+                    walk.energy(mu as f32, alpha as f32, seen as f32).map_or(0.0, |h| h.transmitted.max(0.0));
                 let dd = d[k].max(0.0);
                 Vec2::new(dd, dt.min(dd))
             });

@@ -14,7 +14,9 @@ use crate::dielectric::dielectric_albedo;
 use crate::dielectric_axes::{Axes, BelowKnee, Direction, Roughness};
 use crate::quadrature::Family;
 use crate::walk_dielectric::MU_HORIZON;
-use crate::{DIELECTRIC_CHECK_PANELS, DIELECTRIC_CHECK_STRIDE, DIELECTRIC_PANELS, MAX_DIELECTRIC_ERROR, Side, par_map};
+use crate::{
+    DIELECTRIC_CHECK_PANELS, DIELECTRIC_CHECK_STRIDE, DIELECTRIC_PANELS, MAX_DIELECTRIC_ERROR, Side, par_map,
+};
 use std::fmt::Write as _;
 
 /// Nodes of the direction, roughness and index axes (as `microsurface::compensation::LOSS_TABLE_SHAPE`).
@@ -74,7 +76,10 @@ pub fn build(family: Family, side: Side) -> Vec<f32> {
         if c.1 > MAX_LOSS_ERROR / 2.0 {
             let (i, j, l) = (k % SHAPE[0], (k / SHAPE[0]) % SHAPE[1], k / (SHAPE[0] * SHAPE[1]));
             let (mu, alpha, eta) = node_parameters(i, j, l, side);
-            println!("  node {k} = ({i}, {j}, {l}) μ {mu:.4e} α {alpha:.4e} η {eta:.4}: D {:.7}, disagreement {:.1e}", c.0, c.1);
+            println!(
+                "  node {k} = ({i}, {j}, {l}) μ {mu:.4e} α {alpha:.4e} η {eta:.4}: D {:.7}, disagreement {:.1e}",
+                c.0, c.1
+            );
         }
     }
     println!(
@@ -107,7 +112,8 @@ pub fn source(tables: &[(Family, Side, Vec<f32>)]) -> String {
             side.name().to_uppercase()
         );
         for row in values.chunks(8) {
-            let _ = writeln!(s, "    {},", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "));
+            let _ =
+                writeln!(s, "    {},", row.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "));
         }
         let _ = writeln!(s, "];");
     }
@@ -148,7 +154,8 @@ pub fn quick(state: &mut u64) -> usize {
         for side in [Side::Outside, Side::Inside] {
             let values = table.nodes(crate::range_of(side));
             for _ in 0..QUICK_LOSS_CELLS {
-                *state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                *state =
+                    state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
                 let k = (*state >> 33) as usize % NODES;
                 let d = node(family, side, k, DIELECTRIC_PANELS) as f32;
                 if d.to_bits() != values[k].to_bits() {
@@ -170,10 +177,7 @@ pub fn quick(state: &mut u64) -> usize {
         failures += 1;
         println!("{} is not the generator's text for its own nodes", path.display());
     }
-    println!(
-        "dielectric loss: {} nodes recomputed, {failures} differ",
-        2 * 2 * QUICK_LOSS_CELLS
-    );
+    println!("dielectric loss: {} nodes recomputed, {failures} differ", 2 * 2 * QUICK_LOSS_CELLS);
     failures
 }
 
@@ -209,9 +213,5 @@ pub fn interpolation_error(family: Family, side: Side, uniform: bool, mu_min: f6
         let rms = (of.iter().map(|x| e(x) * e(x)).sum::<f64>() / of.len() as f64).sqrt();
         (worst.0, rms, worst.1)
     };
-    [
-        [stats(&|x| x.0, true), stats(&|x| x.0, false)],
-        [stats(&|x| x.1, true), stats(&|x| x.1, false)],
-    ]
+    [[stats(&|x| x.0, true), stats(&|x| x.0, false)], [stats(&|x| x.1, true), stats(&|x| x.1, false)]]
 }
-

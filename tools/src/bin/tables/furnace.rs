@@ -136,7 +136,6 @@ pub fn run() -> Vec<FurnacePoint> {
     out
 }
 
-
 /// How often the cap ΔT' = min(ΔT, D) binds: at the loss grid's nodes, the walk tables' ΔT
 /// interpolated there against the loss table's D (both as the crate's lookups read them).
 fn cap() {

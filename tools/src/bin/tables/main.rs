@@ -674,12 +674,16 @@ fn main() {
             eta_power,
             roughness: if args.iter().any(|a| a == "sqrt") { Roughness::Sqrt } else { Roughness::Blend },
             direction: [
-                if let Some(p) = args.iter().find_map(|a| a.strip_prefix("mix-out=").and_then(|v| v.parse().ok())) {
+                if let Some(p) =
+                    args.iter().find_map(|a| a.strip_prefix("mix-out=").and_then(|v| v.parse().ok()))
+                {
                     dielectric_axes::Direction::Mixed(p)
                 } else {
                     si("scale-invariant-outside")
                 },
-                if let Some(p) = args.iter().find_map(|a| a.strip_prefix("mix-in=").and_then(|v| v.parse().ok())) {
+                if let Some(p) =
+                    args.iter().find_map(|a| a.strip_prefix("mix-in=").and_then(|v| v.parse().ok()))
+                {
                     dielectric_axes::Direction::Mixed(p)
                 } else if args.iter().any(|a| a == "knee-si") {
                     dielectric_axes::Direction::KneeScaleInvariant

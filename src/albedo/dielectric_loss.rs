@@ -45,6 +45,15 @@ const LAST_U: f32 = (LOSS_TABLE_SHAPE[2] - 1) as f32;
 ///   total internal reflection sets in (at μc = √(1 − η²)) and a rough lobe's loss changes
 ///   across the whole range.
 ///
+/// **Accuracy.** Nodes within 1e-5 of the quadrature's limit. Interpolation error against
+/// direct quadrature (`cargo run --release -p tools --bin tables -- --interpolation --only
+/// dielectric-loss`, 256 random points per family and side, μ ≥ 1e-3): at most 7.7e-3 (GGX,
+/// outside), 7.2e-3 (GGX, inside), 1.1e-2 (Beckmann, outside) and 5.1e-2 (Beckmann, inside),
+/// the worst within 0.003 of η = 1, where the loss changes fastest in η; RMS 1.1e-3 to 4.7e-3.
+/// Closer to the horizon (μ < 1e-3) the first direction cell errs by up to 6.5e-2. On the
+/// white-furnace grid of the compensated glass (η ≥ 1.05, μ ≥ 0.005) the error is at most
+/// 3.3e-3 (GGX) and 6.7e-3 (Beckmann).
+///
 /// # Examples
 /// ```
 /// use microsurface::compensation::{DielectricAlbedoTable, DielectricLossTable};

@@ -296,6 +296,7 @@ fn corner_probabilities(fr: f32, fu: f32, m: [f32; 4]) -> Vec4 {
 impl CompensatedMaterial for Dielectric {
     type Lobes = DielectricLobes;
 
+    #[inline]
     fn lobes<S: AlbedoTabulated>(
         single: &MicrofacetBsdf<S, Self>,
         scheme: Compensation,

@@ -181,11 +181,17 @@ pub fn quick(state: &mut u64) -> usize {
     failures
 }
 
+/// A point (μ, α, η).
+pub type Point = (f64, f64, f64);
+/// (max, RMS, the worst point) over all points and over those with μ ≥ the threshold.
+pub type Errors = [(f64, f64, Point); 2];
+/// One measurement: the loss table's error, the walk tables' error, the point.
+type Measured = (f64, f64, Point);
+
 /// The interpolation error of the crate's loss lookups at the measurement points
 /// ([`crate::measurement_point`]) against direct quadrature, over all points and over those
 /// with μ ≥ `mu_min`: (max, RMS, the worst point) of each; and the same of the walk tables'
 /// ΔR + ΔT in the loss's place.
-pub type Errors = [(f64, f64, (f64, f64, f64)); 2];
 pub fn interpolation_error(family: Family, side: Side, uniform: bool, mu_min: f64) -> [Errors; 2] {
     let (table, walk) = match family {
         Family::Ggx => (
@@ -207,7 +213,7 @@ pub fn interpolation_error(family: Family, side: Side, uniform: bool, mu_min: f6
         let d = 1.0 - r - t;
         ((f64::from(v) - d).abs(), (f64::from(h.reflected + h.transmitted) - d).abs(), p)
     });
-    let stats = |e: &dyn Fn(&(f64, f64, (f64, f64, f64))) -> f64, all: bool| {
+    let stats = |e: &dyn Fn(&Measured) -> f64, all: bool| {
         let of: Vec<_> = errors.iter().filter(|x| all || x.2.0 >= mu_min).collect();
         let worst = of.iter().fold((0.0, (0.0, 0.0, 0.0)), |w, x| if e(x) > w.0 { (e(x), x.2) } else { w });
         let rms = (of.iter().map(|x| e(x) * e(x)).sum::<f64>() / of.len() as f64).sqrt();

@@ -1,12 +1,14 @@
-//! The single-scattering albedo tables (`AlbedoTable`) against independent Monte Carlo
-//! estimates from the crate's exact visible-normal samplers and from the random walk's first
-//! order: nodes, interpolation between nodes within the stated bound, the average albedo, and
-//! the range policy.
+//! The single-scattering albedo tables (`AlbedoTable`, `DielectricAlbedoTable`, and the
+//! dielectric loss 1 − R − T, `DielectricLossTable`) against independent Monte Carlo estimates
+//! from the crate's exact visible-normal samplers and from the random walk's first order: nodes,
+//! interpolation between nodes within the stated bound, the average albedo, and the range
+//! policy.
 
 use glam::Vec3;
 use microsurface::compensation::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable,
-    EtaRange, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable,
+    DielectricLossTable, EtaRange, LOSS_TABLE_SHAPE, ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE,
+    ORDER_TABLES, ScatteringOrderTable,
 };
 use microsurface::research::{Microsurface, UniformHeight};
 use microsurface::slope::MicrosurfaceSlope;
@@ -625,6 +627,181 @@ fn dielectric_lookup_reproduces_the_nodes() {
                             "{side:?} node ({i}, {j}, {l}): lookup {v:?}, nodes {} {}",
                             r_nodes[k],
                             t_nodes[k]
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loss tables (`DielectricLossTable`)
+// ---------------------------------------------------------------------------------------------
+
+/// The measured interpolation errors of the loss lookups (max over 256 random points against
+/// quadrature, `tools --bin tables -- --interpolation --only dielectric-loss`; the loss table's
+/// documentation), per family (GGX, Beckmann) and side (outside, inside).
+const STATED_LOSS_ERROR: [[f64; 2]; 2] =
+    [[LOSS_ERROR_GGX_OUT, LOSS_ERROR_GGX_IN], [LOSS_ERROR_BECKMANN_OUT, LOSS_ERROR_BECKMANN_IN]];
+// (`DielectricLossTable`'s stated interpolation error at μ ≥ 1e-3)
+const LOSS_ERROR_GGX_OUT: f64 = 7.7e-3;
+const LOSS_ERROR_GGX_IN: f64 = 7.2e-3;
+const LOSS_ERROR_BECKMANN_OUT: f64 = 1.1e-2;
+const LOSS_ERROR_BECKMANN_IN: f64 = 5.1e-2;
+
+fn loss_table(family: usize) -> DielectricLossTable {
+    [DielectricLossTable::GGX, DielectricLossTable::BECKMANN][family]
+}
+
+/// (μ, α, η ≥ 1) of loss node (i, j, l) of the table of light from outside or `inside`, as the
+/// table's documentation defines the axes: x = i/23, r = j/23 (α = r², 1e-6 at r = 0), u = l/31
+/// (η = 1 + 2u³); from outside x = √X with X = μ (1 + α)/(μ + α), from inside x = ½ √X + ½ μ
+/// (inverted by bisection).
+fn loss_node_coordinates(i: usize, j: usize, l: usize, inside: bool) -> (f32, f32, f32) {
+    let [nx, nr, nu] = LOSS_TABLE_SHAPE.map(|n| (n - 1) as f64);
+    let (x, r, u) = (i as f64 / nx, j as f64 / nr, l as f64 / nu);
+    let alpha = (r * r).max(1e-6);
+    let scale_invariant = |mu: f64| (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
+    let axis = |mu: f64| if inside { 0.5 * scale_invariant(mu) + 0.5 * mu } else { scale_invariant(mu) };
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if axis(mid) < x {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let mu = if i == 0 { 0.0 } else { hi };
+    (mu as f32, alpha as f32, (1.0 + 2.0 * u * u * u) as f32)
+}
+
+#[test]
+fn loss_nodes_match_the_single_scattering_bsdf() {
+    // nodes with μ > 0, α ≥ 1.9e-3 (j ≥ 1) and η > 1 (l ≥ 1), both sides: 1 − the mean weight
+    // of the single-scattering BSDF (its R + T)
+    let mut pick = rng(23);
+    let [nx, nr, nu] = LOSS_TABLE_SHAPE;
+    let cells: Vec<(usize, bool, usize, usize, usize)> = (0..24)
+        .map(|k| {
+            (
+                k % 2,
+                (k / 2) % 2 == 1,
+                pick.random_range(1..nx),
+                pick.random_range(1..nr),
+                pick.random_range(1..nu),
+            )
+        })
+        .collect();
+    let z = family_z(FAMILY_ALPHA, cells.len());
+    let results = par_map(&cells, |k, &(family, inside, i, j, l)| {
+        let (mu, alpha, eta) = loss_node_coordinates(i, j, l, inside);
+        let eta_seen = if inside { 1.0 / eta } else { eta };
+        let [_, _, total] = dielectric_albedo_mc(family, mu, alpha, eta_seen, 700 + k as u64);
+        total
+    });
+    for (&(family, inside, i, j, l), total) in cells.iter().zip(&results) {
+        let (mu, alpha, eta) = loss_node_coordinates(i, j, l, inside);
+        let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
+        let d = loss_table(family).nodes(side)[(l * nr + j) * nx + i];
+        let label = format!(
+            "{} loss {side:?} node ({i}, {j}, {l}) μ = {mu:e}, α = {alpha:e}, η = {eta}",
+            loss_table(family).name()
+        );
+        // the node's quadrature error is below 1e-5; the BSDF's f32 Fresnel and directions
+        // add below 1e-5
+        assert_mean(&label, total, 1.0 - f64::from(d), z, MAX_SE, 2e-5);
+    }
+}
+
+#[test]
+fn loss_interpolation_is_within_the_stated_bound() {
+    let mut pick = rng(24);
+    let points: Vec<(usize, f32, f32, f32)> = (0..24)
+        .map(|k| {
+            let alpha = pick.random_range(0.0f32..1.0).powi(2).max(1e-3);
+            let mu = pick.random_range(0.0f32..1.0).powi(2).max(1e-3);
+            let eta = 1.0 + 2.0 * pick.random_range(0.0f32..1.0).powi(2);
+            (k % 2, mu, alpha, if k % 4 < 2 { eta } else { 1.0 / eta })
+        })
+        .collect();
+    let z = family_z(FAMILY_ALPHA, points.len());
+    let results = par_map(&points, |k, &(family, mu, alpha, eta)| {
+        let [_, _, total] = dielectric_albedo_mc(family, mu, alpha, eta, 800 + k as u64);
+        total
+    });
+    for (&(family, mu, alpha, eta), total) in points.iter().zip(&results) {
+        let d = loss_table(family).loss(mu, alpha, eta).unwrap();
+        let label = format!("{} loss lookup at μ = {mu}, α = {alpha}, η = {eta}", loss_table(family).name());
+        let bound = STATED_LOSS_ERROR[family][usize::from(eta < 1.0)];
+        assert_mean(&label, total, 1.0 - f64::from(d), z, MAX_SE, bound);
+    }
+}
+
+#[test]
+fn loss_nodes_are_physical() {
+    // every node: 0 ≤ D ≤ 1 (single scattering loses energy, never gains; the quadrature's
+    // error is below 1e-5); a smooth interface (r = 0, α = 1e-6) seen at normal incidence
+    // (x = 1) loses nothing (on the scale-invariant axis the other nodes of that row are views
+    // within a few α of the horizon, where the surface is effectively rough)
+    let [nx, nr, _] = LOSS_TABLE_SHAPE;
+    for family in 0..2 {
+        for side in [EtaRange::AtLeastOne, EtaRange::AtMostOne] {
+            for (k, &d) in loss_table(family).nodes(side).iter().enumerate() {
+                let label = format!("{} {side:?} loss node {k}: {d}", loss_table(family).name());
+                assert!((-1e-5..=1.0).contains(&d), "{label}");
+                if (k / nx) % nr == 0 && k % nx == nx - 1 {
+                    assert!(d.abs() <= 1e-5, "{label}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn loss_out_of_range_gives_none() {
+    for t in [DielectricLossTable::GGX, DielectricLossTable::BECKMANN] {
+        for (mu, alpha, eta) in [
+            (0.5, 0.5, 3.01),
+            (0.5, 0.5, 0.33),
+            (0.5, 0.5, f32::NAN),
+            (0.5, 0.0, 1.5),
+            (0.5, 1.01, 1.5),
+            (-0.1, 0.5, 1.5),
+            (1.1, 0.5, 1.5),
+            (f32::NAN, 0.5, 1.5),
+        ] {
+            assert_eq!(t.loss(mu, alpha, eta), None, "{} at ({mu}, {alpha}, {eta})", t.name());
+        }
+        for eta in [3.0, 1.0 / 3.0, 1.0] {
+            assert!(t.loss(0.0, 1.0, eta).is_some() && t.loss(1.0, 1e-7, eta).is_some());
+        }
+    }
+}
+
+#[test]
+fn loss_lookup_reproduces_the_nodes() {
+    let [nx, nr, _] = LOSS_TABLE_SHAPE;
+    for family in 0..2 {
+        for inside in [false, true] {
+            let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
+            let nodes = loss_table(family).nodes(side);
+            // η = 1 itself reads the outside table; node 1 (η = 1 + 6.7e-5) is skipped: one f32
+            // ulp of η moves it by 6e-4 of a cell there, more than the check's tolerance
+            let planes: &[usize] = if inside { &[2, 13, 31] } else { &[0, 2, 13, 31] };
+            for &l in planes {
+                for j in [1, 9, 23] {
+                    for i in [0, 5, 16, 23] {
+                        let (mu, alpha, eta) = loss_node_coordinates(i, j, l, inside);
+                        let k = (l * nr + j) * nx + i;
+                        let d =
+                            loss_table(family).loss(mu, alpha, if inside { 1.0 / eta } else { eta }).unwrap();
+                        // the coordinates round-trip through f32 arithmetic
+                        assert!(
+                            (d - nodes[k]).abs() < 2e-5,
+                            "{side:?} node ({i}, {j}, {l}): lookup {d}, node {}",
+                            nodes[k]
                         );
                     }
                 }

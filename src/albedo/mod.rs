@@ -9,6 +9,7 @@
 
 mod axis;
 mod dielectric;
+mod dielectric_loss;
 mod dielectric_walk;
 mod generated;
 mod grid;
@@ -19,6 +20,8 @@ pub(crate) use axis::{
     DielectricDirection, DirectionAxis, floor_index, node_cell, scale_invariant_direction,
 };
 pub use dielectric::{DielectricAlbedo, DielectricAlbedoTable};
+pub(crate) use dielectric_loss::LOSS_NODES;
+pub use dielectric_loss::{DielectricLossTable, LOSS_TABLE_SHAPE};
 pub use dielectric_walk::{DielectricWalkTable, HigherOrders, MAX_WALK_TABLE_SE, WALK_BATCH};
 pub use grid::{DIELECTRIC_TABLE_SIZE, EtaRange, MAX_TABULATED_ETA};
 pub(crate) use grid::{Grid, SideGrids};

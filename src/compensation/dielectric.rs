@@ -6,37 +6,50 @@
 //! same for a dielectric): two separable lobes,
 //!
 //! f = f_ss + f_R + f_T,
-//! f_R(ωo, ωi) = ΔR_a(μo) ΔR_a(μi) / (π ΔR̄_a)                (ωi on the view's side a),
-//! f_T(ωo, ωi) = c_a ΔT_a(μo) · ΔT_b(μi) / (π ΔT̄_b)          (ωi on the other side b),
+//! f_R(ωo, ωi) = g_a(μo) g_a(μi) / (π ḡ_a)                      (ωi on the view's side a),
+//! f_T(ωo, ωi) = c_a ΔT'_a(μo) · ΔT'_b(μi) / (π ΔT̄'_b)          (ωi on the other side b),
+//! g_s = D_s − c_s ΔT'_s,
 //!
-//! with ΔR_s, ΔT_s the walk's reflected and transmitted energy of orders ≥ 2 for light from
-//! side s ([`super::DielectricWalkTable`]: the walk of Heitz et al. 2016, supplement §3.4),
-//! ḡ = 2∫₀¹ g(μ) μ dμ of the interpolated row, and μ = |cos θ|: Kulla and Conty's separable
-//! lobe (2017) applied to each side's reflected and transmitted higher orders.
+//! with, for light from side s, D_s = 1 − R_ss − T_ss the energy single scattering loses
+//! ([`super::DielectricLossTable`]: deterministic quadrature), ΔT_s the walk's transmitted energy
+//! of orders ≥ 2 ([`super::DielectricWalkTable`]: the walk of Heitz et al. 2016, supplement
+//! §3.4) and ΔT'_s = min(ΔT_s, D_s), the walk's value capped by the loss at each node of the
+//! loss table's grid (where both are tabulated for the lobes); ḡ = 2∫₀¹ g(μ) μ dμ of the
+//! interpolated row, and μ = |cos θ|: Kulla and Conty's separable lobe (2017) applied to each
+//! side's reflected and transmitted higher orders, their total from the loss table and their
+//! split between the sides from the walk.
 //!
-//! **Energy** (importance transport, the flux): ∫ f_R cos dωi = ΔR_a(μo) and
-//! ∫ f_T |cos| dωi = c_a ΔT_a(μo) for every view, so the albedo is
-//! R_ss + T_ss + ΔR + c_a ΔT = 1 up to the tables' errors and the factor c_a.
+//! **Energy** (importance transport, the flux): ∫ f_R cos dωi = g_a(μo) and
+//! ∫ f_T |cos| dωi = c_a ΔT'_a(μo) for every view, so the albedo is
+//! R_ss + T_ss + D_a(μo) = 1 up to the loss table's interpolation error alone: the reflection
+//! lobe takes what the transmission lobe leaves of the loss, whatever the walk tables' errors
+//! and the factor c_a. The lobes' split follows the walk's within the walk tables' errors.
 //!
 //! **Reciprocity.** Detailed balance in a medium of index n (equilibrium radiance ∝ n²) makes
 //! the flux BSDF of a transmission satisfy n_a² f(ωa, ωb) = n_b² f(ωb, ωa) (Veach 1997, §5.2,
 //! in importance form): the rank-1 f_T satisfies it if and only if
-//! n_a² c_a ΔT̄_a = n_b² c_b ΔT̄_b, which the walk's own higher orders satisfy up to the tables'
-//! noise and interpolation. The factors c enforce it exactly: with R = η² ΔT̄_in/ΔT̄_out and
-//! w = v_out/(v_out + v_in), the share of the relative variance v = Var(ΔT̄)/ΔT̄² of the outside
-//! average (from the nodes' standard errors), c_out = 1 + w (R − 1) and c_in = c_out/R: the
-//! noisier side absorbs more of the residual. The albedo from side a errs by (c_a − 1) ΔT_a(μo)
-//! for it; [`Compensated::transmission_mismatch`] reports 1/R − 1.
+//! n_a² c_a ΔT̄'_a = n_b² c_b ΔT̄'_b, which the walk's own higher orders satisfy up to the
+//! tables' noise and interpolation. The factors c enforce it exactly: with
+//! R = η² ΔT̄'_in/ΔT̄'_out, c_out = min(1, R) and c_in = min(1, 1/R), so that the side whose
+//! average is the larger gives up the residual to its reflection lobe;
+//! [`Compensated::transmission_mismatch`] reports 1/R − 1. The reflection lobe, a symmetric
+//! rank-1 product, is reciprocal on its side.
+//!
+//! **Non-negative without a clamp.** ΔT' ≤ D at every node and c ≤ 1 make every node value
+//! of g_s non-negative, so the interpolated profile is, and its average is the same linear
+//! function of the nodes as the lookup (the normalizations are exact, up to the averages'
+//! interpolation between sub-steps of α).
 //!
 //! **Sampling.** A mixture chosen by the view's energies: per cell of a uniform μ axis of the
 //! view (32 cells) the probabilities of the single-scattering sample, the reflection lobe and
-//! the transmission lobe are E_ss : ΔR_a : ΔT_a at the cell's centre (E_ss = 1 − ΔR − ΔT, at
-//! least 1e-3 of the total), blended bilinearly between the four (roughness, index) rows of
-//! the tables around the hit; each lobe samples its light profile g(μi) μi on its hemisphere as
-//! the mixture of the four rows' profiles (each at its row's α, chosen with probability
-//! ∝ blend weight × mass), each a density continuous and linear in μi² on the cells of the
-//! uniform μ axis (alias method). `pdf` is the exact mixture density, and a sample's weight is
-//! f·|cos θi|/pdf at its direction.
+//! the transmission lobe are the energies 1 − D : D − ΔT' : ΔT' at the cell's centre (the
+//! first at least 1e-3 of the total), blended bilinearly between the four (roughness, index) rows of
+//! the walk tables around the hit; each lobe samples the walk's light profile ΔR(μi) μi or
+//! ΔT(μi) μi on its hemisphere as the mixture of the four rows' profiles (each at its row's α,
+//! chosen with probability ∝ blend weight × mass), each a density continuous and linear in μi²
+//! on the cells of the uniform μ axis (alias method). The sampled profiles are the walk's, not
+//! the lobes' g and ΔT' (any density is exact for the mixture): `pdf` is the exact mixture
+//! density, and a sample's weight is f·|cos θi|/pdf at its direction.
 //!
 //! **Turquin** ([`Compensation::Turquin`]): f = f_ss/E(μo), E = R + T of the single-scattering
 //! dielectric tables ([`super::DielectricAlbedoTable`]) on the view's side, interpolated
@@ -47,11 +60,10 @@
 
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::glass_tables::{GlassSide, GlassTables};
-use super::lobe_profile::mu_cell;
 use super::shared::{NOTHING, ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
 use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricWalkTable, DirectionAxis,
-    MAX_TABULATED_ETA, node_cell,
+    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricLossTable,
+    DielectricWalkTable, DirectionAxis, LOSS_TABLE_SHAPE, MAX_TABULATED_ETA, node_cell,
 };
 use crate::bsdf::{
     Bsdf, BsdfFlags, BsdfSample, BsdfValue, MicrofacetBsdf, Transport, unit_directions, unit_view,
@@ -68,6 +80,19 @@ use glam::{Vec2, Vec3, Vec4};
 const N: usize = DIELECTRIC_TABLE_SIZE;
 /// The last node index, as a float.
 const LAST: f32 = (N - 1) as f32;
+/// The smallest share of the single-scattering lobe in the sampling mixture, relative to the
+/// added lobes' total: keeps its density positive wherever it scatters.
+const MIN_SINGLE_SHARE: f32 = 1e-3;
+/// Nodes of the loss grid's direction and roughness axes, per (roughness, direction) plane,
+/// and of its index axis.
+const NX: usize = LOSS_TABLE_SHAPE[0];
+const NR: usize = LOSS_TABLE_SHAPE[1];
+const PLANE: usize = NX * NR;
+const NU: usize = LOSS_TABLE_SHAPE[2];
+/// The loss grid's fractional direction node t = a √X + b μ of each table side (0: η ≥ 1,
+/// t = 23 x; 1: η ≤ 1, t = 23 (½ x + ½ μ)), with x = √X the scale-invariant coordinate.
+const LOSS_DIRECTION: [(f32, f32); 2] =
+    [((NX - 1) as f32, 0.0), (0.5 * (NX - 1) as f32, 0.5 * (NX - 1) as f32)];
 
 /// The per-hit state of a compensated dielectric.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,16 +104,21 @@ pub struct DielectricLobes {
     table_side: [usize; 2],
     /// η_wi/η_wo of a transmission from outside (η) and from inside (1/η).
     transmitted_eta: [f32; 2],
-    /// The walk tables' cell: the row index l·16 + j of the lower (roughness, index) corner,
-    /// the roughness cell and its fraction, and the index fraction.
+    /// The walk tables' cell (the samplers' rows): the row index l·16 + j of the lower
+    /// (roughness, index) corner, the roughness cell and its fraction, and the index fraction.
     corner: usize,
     walk_row: (usize, f32),
     walk_u: f32,
-    /// The walk tables' direction axis at the hit's α.
+    /// The scale-invariant direction axis at the hit's α (the loss grid's coordinates derive
+    /// from it).
     axis: DirectionAxis,
-    /// The added lobes' scales per view side: [1/(π ΔR̄_a), c_a/(π ΔT̄_b) × transport].
+    /// The loss grid's cell: the row index l·24 + j of the lower (roughness, index) corner, and
+    /// the roughness and index fractions.
+    loss_corner: usize,
+    loss_f: (f32, f32),
+    /// The added lobes' scales per view side: [1/(π ḡ_R,a), c_a/(π ΔT̄'_b) × transport].
     scales: [[f32; 2]; 2],
-    /// [c_a/(π ΔT̄_b)] before the transport factor, per view side.
+    /// [c_a/(π ΔT̄'_b)] before the transport factor, per view side.
     transmitted_scale: [f32; 2],
     /// c_a per view side.
     c: [f32; 2],
@@ -117,6 +147,8 @@ impl DielectricLobes {
             walk_row: (0, 0.0),
             walk_u: 0.0,
             axis: DirectionAxis::NONE,
+            loss_corner: 0,
+            loss_f: (0.0, 0.0),
             scales: [[0.0; 2]; 2],
             transmitted_scale: [0.0; 2],
             c: [1.0; 2],
@@ -140,18 +172,34 @@ impl DielectricLobes {
         self.axis.coordinates(mu_o, mu_i)
     }
 
-    /// The walk table's value of quantity q (ΔR, ΔT) of view side `view` at direction
-    /// coordinate x: trilinear at this hit's (roughness, index) cell.
+    /// The loss grid's fractional direction node of a cosine μ with scale-invariant coordinate
+    /// x on the table of view side `view`.
     #[inline(always)]
-    fn walk(&self, view: usize, q: usize, x: f32) -> f32 {
-        let grid = self.side(view).walk[q];
-        let (i, fx) = node_cell(x * LAST, N);
-        let base = self.corner * N + i;
-        let (fr, fu) = (self.walk_row.1, self.walk_u);
-        let at = |k: usize| grid[k] + fx * (grid[k + 1] - grid[k]);
-        let near = at(base) + fr * (at(base + N) - at(base));
-        let far = at(base + N * N) + fr * (at(base + N * N + N) - at(base + N * N));
-        near + fu * (far - near)
+    fn loss_node(&self, view: usize, x: f32, mu: f32) -> f32 {
+        let (a, b) = LOSS_DIRECTION[self.table_side[view]];
+        a * x + b * mu
+    }
+
+    /// The lobes' node values (D, ΔT') of view side `view` at the loss grid's fractional
+    /// direction node t: trilinear at this hit's (roughness, index) cell.
+    #[inline(always)]
+    fn lobe_values(&self, view: usize, t: f32) -> Vec2 {
+        let grid = &self.side(view).lobes;
+        let (i, fx) = node_cell(t, NX);
+        let base = self.loss_corner * NX + i;
+        let (fr, fu) = self.loss_f;
+        let at = |k: usize| grid[k].lerp(grid[k + 1], fx);
+        let near = at(base).lerp(at(base + NX), fr);
+        let far = at(base + PLANE).lerp(at(base + PLANE + NX), fr);
+        near.lerp(far, fu)
+    }
+
+    /// The weights of (D, ΔT') in the μ profile of the lobe of a view on side `a` and a light
+    /// crossing (`c` = 1: ΔT', on either side) or not (g_R = D − c_a ΔT').
+    #[inline(always)]
+    fn profile_weights(&self, a: usize, c: usize) -> Vec2 {
+        let t = c as f32;
+        Vec2::new(1.0 - t, t - (1.0 - t) * self.c[a])
     }
 
     /// The added lobe f_R or f_T for a view on side `a` and a light crossing (`c` = 1) or not,
@@ -159,22 +207,25 @@ impl DielectricLobes {
     #[inline(always)]
     fn added(&self, a: usize, c: usize, mu_o: f32, mu_i: f32) -> f32 {
         let (xo, xi) = self.coordinates(mu_o, mu_i);
-        // the light's factor: ΔR of the view's side, or ΔT of the other side
-        let light = self.walk(a ^ c, c, xi);
-        self.walk(a, c, xo) * light * self.scales[a][c]
+        let b = a ^ c;
+        let vo = self.lobe_values(a, self.loss_node(a, xo, mu_o));
+        let vi = self.lobe_values(b, self.loss_node(b, xi, mu_i));
+        let w = self.profile_weights(a, c);
+        // (both profiles are ≥ 0 at every node; rounding may leave −1e-9)
+        vo.dot(w).max(0.0) * vi.dot(w).max(0.0) * self.scales[a][c]
     }
 
-    /// The mixture's probabilities (single, reflection, transmission) of a view on side `a`
-    /// with |cos θo| = `mu_o`: bilinear in the tables' rows at the centre of its μ cell.
+    /// The mixture's probabilities (single, reflection, transmission, 0) of a view on side `a`
+    /// with |cos θo| = `mu_o`: the lobes' energies at the view, 1 − D : g_R : c_a ΔT' (their sum
+    /// D), the first at least [`MIN_SINGLE_SHARE`] of D.
     #[inline(always)]
     fn mixture(&self, a: usize, mu_o: f32) -> Vec4 {
-        let rows = &self.side(a).rows;
-        let k = mu_cell(mu_o);
-        let n = self.corner;
-        let (fr, fu) = (self.walk_row.1, self.walk_u);
-        let near = rows[n].mixture[k].lerp(rows[n + 1].mixture[k], fr);
-        let far = rows[n + N].mixture[k].lerp(rows[n + N + 1].mixture[k], fr);
-        near.lerp(far, fu)
+        let v = self.lobe_values(a, self.loss_node(a, self.axis.coordinate(mu_o), mu_o));
+        let d = v.x.max(0.0);
+        let t = (self.c[a] * v.y).clamp(0.0, d);
+        let single = (1.0 - d).max(MIN_SINGLE_SHARE * d);
+        let scale = 1.0 / (single + d);
+        Vec4::new(single * scale, (d - t) * scale, t * scale, 0.0)
     }
 
     /// The density of the light's profile for a view on side `a` and a light crossing (`c`)
@@ -245,6 +296,7 @@ fn corner_probabilities(fr: f32, fu: f32, m: [f32; 4]) -> Vec4 {
 impl CompensatedMaterial for Dielectric {
     type Lobes = DielectricLobes;
 
+    #[inline]
     fn lobes<S: AlbedoTabulated>(
         single: &MicrofacetBsdf<S, Self>,
         scheme: Compensation,
@@ -278,34 +330,31 @@ impl CompensatedMaterial for Dielectric {
         lobes.walk_row = row;
         lobes.walk_u = fu;
         lobes.axis = DirectionAxis::new(alpha);
-        // the averages [ΔR̄, ΔT̄, Var(ΔT̄)] of each view side, blended in u
+        let loss_row = node_cell(DielectricLossTable::roughness_node(alpha), NR);
+        let (ll, loss_u) = node_cell(DielectricLossTable::eta_node(eta_ge_1), NU);
+        lobes.loss_corner = ll * NR + loss_row.0;
+        lobes.loss_f = (loss_row.1, loss_u);
+        // the averages [D̄, ΔT̄'] of each view side, blended in u
         let average = |view: usize| {
             let side = lobes.side(view);
-            let (a, b) = (side.averages_at(l, row), side.averages_at(l + 1, row));
-            let mean = a.lerp(b, fu);
-            Vec4::new(mean.x, mean.y, (1.0 - fu) * (1.0 - fu) * a.z + fu * fu * b.z, 0.0)
+            side.averages_at(ll, loss_row).lerp(side.averages_at(ll + 1, loss_row), loss_u)
         };
         // (not `array::map`, whose closures are not inlined)
         let averages = [average(0), average(1)];
-        // reciprocity: c_out ΔT̄_out = η² c_in ΔT̄_in (n_out = 1, n_in = η)
+        // reciprocity: c_out ΔT̄'_out = η² c_in ΔT̄'_in (n_out = 1, n_in = η), both c ≤ 1
         let (m_out, m_in) = (averages[0].y, eta * eta * averages[1].y);
         let c = if m_out > 0.0 && m_in > 0.0 {
             let ratio = m_in / m_out;
-            let (v_out, v_in) = (
-                averages[0].z / (averages[0].y * averages[0].y),
-                averages[1].z / (averages[1].y * averages[1].y),
-            );
-            let w = if v_out + v_in > 0.0 { v_out / (v_out + v_in) } else { 0.5 };
             lobes.mismatch = 1.0 / ratio - 1.0;
-            let c_out = 1.0 + w * (ratio - 1.0);
-            [c_out, c_out / ratio]
+            if ratio >= 1.0 { [1.0, 1.0 / ratio] } else { [ratio, 1.0] }
         } else {
             [0.0, 0.0]
         };
         lobes.c = c;
         for view in 0..2 {
-            let (r_avg, t_other) = (averages[view].x, averages[1 - view].y);
-            lobes.scales[view][0] = if r_avg > 0.0 { 1.0 / (PI * r_avg) } else { 0.0 };
+            let reflected = averages[view].x - c[view] * averages[view].y;
+            let t_other = averages[1 - view].y;
+            lobes.scales[view][0] = if reflected > 0.0 { 1.0 / (PI * reflected) } else { 0.0 };
             lobes.transmitted_scale[view] = if t_other > 0.0 { c[view] / (PI * t_other) } else { 0.0 };
         }
         // the light profiles' rows: reflection on the view's side, transmission on the other
@@ -351,15 +400,17 @@ impl DielectricLobes {
 
 /// The compensated dielectric's queries.
 impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
-    /// ΔT̄_out/(η² ΔT̄_in) − 1: how far the interpolated walk tables are from the reciprocity of
-    /// the walk's higher orders (0 without transmission lobes, and for Turquin's scheme).
+    /// ΔT̄'_out/(η² ΔT̄'_in) − 1: how far the walk's transmitted higher orders, as the lobes
+    /// interpolate them, are from the reciprocity of the walk's own (0 without transmission
+    /// lobes, and for Turquin's scheme).
     pub fn transmission_mismatch(&self) -> f32 {
         self.lobes.mismatch
     }
 
-    /// The added albedo (ΔR, c ΔT) of a view with |cos θo| = μ ∈ [0, 1] on `side`, as this
-    /// BSDF interpolates it (importance transport); `None` outside [0, 1] (NaN included) and
-    /// for Turquin's scheme.
+    /// The added albedo (g_R, c ΔT') of a view with |cos θo| = μ ∈ [0, 1] on `side`: the
+    /// energies of the reflection and transmission lobes as this BSDF interpolates them
+    /// (importance transport; their sum is the loss table's 1 − R_ss − T_ss); `None` outside
+    /// [0, 1] (NaN included) and for Turquin's scheme.
     pub fn higher_orders(&self, mu: f32, side: Side) -> Option<(f32, f32)> {
         if !(0.0..=1.0).contains(&mu) || self.scheme == Compensation::Turquin {
             return None;
@@ -370,7 +421,8 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
         }
         let a = usize::from(side == Side::Inside);
         let x = l.coordinates(mu, mu).0;
-        Some((l.walk(a, 0, x), l.c[a] * l.walk(a, 1, x)))
+        let v = l.lobe_values(a, l.loss_node(a, x, mu));
+        Some(((v.x - l.c[a] * v.y).max(0.0), l.c[a] * v.y))
     }
 
     /// E(μo) = R + T of the single-scattering tables for a view on `side`

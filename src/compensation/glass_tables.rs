@@ -1,64 +1,66 @@
 //! What a compensated dielectric built per hit reads and does not recompute: per slope family,
-//! built once (on first use) from the shipped walk tables ([`DielectricWalkTable`]) and
-//! single-scattering dielectric tables ([`DielectricAlbedoTable`]).
+//! built once (on first use) from the shipped walk tables ([`DielectricWalkTable`]), loss
+//! tables ([`DielectricLossTable`]) and single-scattering dielectric tables
+//! ([`DielectricAlbedoTable`]).
 //!
-//! Per side of the walk tables (the relative index seen η ≥ 1 or η ≤ 1):
-//! * at every (roughness, index) row of the tables: the samplers of the rows' profiles
-//!   ΔR(μ) μ and ΔT(μ) μ at the row's α, their masses, and the sampling mixture's
-//!   probabilities of single scattering, reflection and transmission per cell of the uniform μ
-//!   axis;
-//! * at [`SUBSTEPS`] sub-steps of every roughness cell of every index row: the averages
-//!   2∫ · μ dμ of the interpolated ΔR and ΔT at that α (the lobes' normalizations, which depend
-//!   on α through the direction axis) and the variance of the ΔT average from the nodes'
-//!   standard errors (what splits the reciprocity residual between the sides);
+//! Per side of the tables (the relative index seen η ≥ 1 or η ≤ 1):
+//! * on the loss table's grid: the added lobes' node values (D, ΔT'), D = 1 − R_ss − T_ss of
+//!   the loss table and ΔT' = min(ΔT, D), the walk's ΔT interpolated at the node and capped by
+//!   the loss (so that D − c ΔT' ≥ 0 at every node for any c ≤ 1), and at [`SUBSTEPS`] sub-steps
+//!   of every roughness cell of every index row their averages 2∫ · μ dμ at that α (the lobes'
+//!   normalizations, which depend on α through the direction axis);
+//! * at every (roughness, index) row of the walk tables: the samplers of the light profiles
+//!   (D − ΔT' + κ D)(μ) μ for the reflection lobe (the share κ of the loss bounds the ratio of
+//!   the hit's g_R to it) and ΔT'(μ) μ for the transmission lobe, at the row's nodes and α, and
+//!   their masses;
 //! * the single-scattering albedo E = R + T of the dielectric tables (Turquin's scheme).
 
-use super::lobe_profile::{
-    DirectionAxis, MU_CELLS, MuProfile, mu_cell_centre, mu_cell_masses, profile_average, row_at,
-};
+use super::lobe_profile::{MuProfile, mixed_axis_weights, mu_cell_masses, profile_average};
 use super::shared::boxed;
 use crate::albedo::{
-    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricWalkTable, EtaRange, Family, Grid, SideGrids,
-    floor_index,
+    DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricLossTable, DielectricWalkTable, EtaRange, Family,
+    Grid, LOSS_NODES, LOSS_TABLE_SHAPE, SideGrids, floor_index,
 };
-use glam::Vec4;
+use glam::Vec2;
 use std::sync::OnceLock;
 
 /// Nodes per axis of the walk tables.
 const N: usize = DIELECTRIC_TABLE_SIZE;
+/// Nodes of the loss tables' direction, roughness and index axes.
+const NX: usize = LOSS_TABLE_SHAPE[0];
+const NR: usize = LOSS_TABLE_SHAPE[1];
+const NU: usize = LOSS_TABLE_SHAPE[2];
+/// Averages per side: (SUBSTEPS + 1) per roughness cell of every index row.
+const AVERAGES: usize = NU * (NR - 1) * (SUBSTEPS + 1);
 /// Sub-steps per roughness cell of the tabulated averages.
 pub(crate) const SUBSTEPS: usize = 32;
-/// The smallest share of the single-scattering lobe in the sampling mixture, relative to the
-/// lobes' total: keeps its density positive wherever it scatters.
-const MIN_SINGLE_SHARE: f32 = 1e-3;
+/// The share κ of the loss D in the reflection lobe's sampled profile D − ΔT' + κ D.
+const REFLECTION_LOSS_SHARE: f32 = 0.1;
 /// The smallest α of the averages and profiles (α = 0 at r = 0 has only the smooth limit).
 const ALPHA_FLOOR: f64 = 1e-9;
 
 /// One row of a side's walk table: the samplers of its two profiles and the mixture.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Row {
-    /// The samplers of ΔR(μ) μ and ΔT(μ) μ at the row's α.
+    /// The samplers of the reflection and transmission lobes' light profiles,
+    /// (D − ΔT' + κ D)(μ) μ and ΔT'(μ) μ, at the row's α.
     pub(crate) profiles: [MuProfile; 2],
-    /// 2∫ΔR μ dμ and 2∫ΔT μ dμ of the row at its α.
+    /// The profiles' masses 2∫ · μ dμ at the row's α.
     pub(crate) masses: [f32; 2],
-    /// Per cell of the uniform μ axis: the probabilities (single scattering, reflection,
-    /// transmission, 0) of a view at the cell's centre, E_ss : ΔR : ΔT with E_ss = 1 − ΔR − ΔT
-    /// (the walk conserves energy) and at least [`MIN_SINGLE_SHARE`] of the total.
-    pub(crate) mixture: [Vec4; MU_CELLS],
 }
 
 /// The shared tables of one side.
 #[derive(Debug)]
 pub(crate) struct GlassSide {
-    /// The walk grids (ΔR, ΔT).
-    pub(crate) walk: [&'static Grid; 2],
+    /// The added lobes' node values (D, ΔT') on the loss table's grid, index (l·24 + j)·24 + i.
+    pub(crate) lobes: Box<[Vec2; LOSS_NODES]>,
+    /// [D̄, ΔT̄'] at sub-step s of roughness cell j of index row l of the loss grid (index
+    /// (l·23 + j)(SUBSTEPS + 1) + s).
+    pub(crate) averages: Box<[Vec2; AVERAGES]>,
     /// E = R + T of the single-scattering tables.
     pub(crate) single: Box<Grid>,
-    /// The rows, index (l·16 + j).
+    /// The walk tables' rows, index (l·16 + j).
     pub(crate) rows: Box<[Row; N * N]>,
-    /// [ΔR̄, ΔT̄, Var(ΔT̄), 0] at sub-step s of roughness cell j of index row l (index
-    /// (l·15 + j)(SUBSTEPS + 1) + s).
-    pub(crate) averages: Box<[Vec4; N * (N - 1) * (SUBSTEPS + 1)]>,
 }
 
 /// The shared tables of one slope family: the side of η ≥ 1 (0) and of η ≤ 1 (1).
@@ -73,6 +75,33 @@ fn node_alpha(j: usize) -> f64 {
     r * r
 }
 
+/// The α of the loss tables' roughness node j (r = √α = j/23; the row r = 0 at α = 1e-6, as
+/// the generator evaluates it).
+fn loss_alpha(j: usize) -> f64 {
+    let r = j as f64 / (NR - 1) as f64;
+    (r * r).max(1e-6)
+}
+
+/// μ of direction node i of the loss table of side `side` (0: η ≥ 1, scale-invariant;
+/// 1: η ≤ 1, ½ √X + ½ μ) at roughness α.
+fn loss_mu(side: usize, i: usize, alpha: f64) -> f64 {
+    let x = i as f64 / (NX - 1) as f64;
+    let scale_invariant = |x: f64| {
+        let big_x = x * x;
+        if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) }
+    };
+    if side == 0 || i == 0 || i == NX - 1 {
+        return scale_invariant(x);
+    }
+    let x_of = |mu: f64| 0.5 * (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt() + 0.5 * mu;
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if x_of(mid) < x { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
+}
+
 impl GlassTables {
     /// The tables of a family, built on first use.
     #[inline]
@@ -80,31 +109,41 @@ impl GlassTables {
         static GGX: OnceLock<GlassTables> = OnceLock::new();
         static BECKMANN: OnceLock<GlassTables> = OnceLock::new();
         match family {
-            Family::Ggx => {
-                GGX.get_or_init(|| Self::build(&DielectricWalkTable::GGX, &DielectricAlbedoTable::GGX))
-            }
+            Family::Ggx => GGX.get_or_init(|| {
+                Self::build(&DielectricWalkTable::GGX, &DielectricLossTable::GGX, &DielectricAlbedoTable::GGX)
+            }),
             Family::Beckmann => BECKMANN.get_or_init(|| {
-                Self::build(&DielectricWalkTable::BECKMANN, &DielectricAlbedoTable::BECKMANN)
+                Self::build(
+                    &DielectricWalkTable::BECKMANN,
+                    &DielectricLossTable::BECKMANN,
+                    &DielectricAlbedoTable::BECKMANN,
+                )
             }),
         }
     }
 
-    fn build(walk: &DielectricWalkTable, single: &DielectricAlbedoTable) -> Self {
-        // the averages are linear in the nodes: their weights at each sub-step's α, from the
-        // unit rows (shared by every index row and side)
-        let weights: Vec<[f64; N]> = (0..(N - 1) * (SUBSTEPS + 1))
-            .map(|n| {
-                let (j, s) = (n / (SUBSTEPS + 1), n % (SUBSTEPS + 1));
-                let r = (j as f64 + s as f64 / SUBSTEPS as f64) / (N - 1) as f64;
-                let alpha = (r * r).max(ALPHA_FLOOR) as f32;
-                core::array::from_fn(|i| {
-                    let mut unit = [0.0f32; N];
-                    unit[i] = 1.0;
-                    profile_average(&unit, alpha)
+    fn build(walk: &DielectricWalkTable, loss: &DielectricLossTable, single: &DielectricAlbedoTable) -> Self {
+        // the averages are linear in the nodes: their weights at each sub-step's α, per
+        // direction axis (shared by every index row)
+        let weights = |side: usize| -> Vec<[f64; NX]> {
+            (0..(NR - 1) * (SUBSTEPS + 1))
+                .map(|n| {
+                    let (j, s) = (n / (SUBSTEPS + 1), n % (SUBSTEPS + 1));
+                    let r = (j as f64 + s as f64 / SUBSTEPS as f64) / (NR - 1) as f64;
+                    let alpha = (r * r).max(ALPHA_FLOOR);
+                    if side == 1 {
+                        return mixed_axis_weights::<NX>(alpha);
+                    }
+                    core::array::from_fn(|i| {
+                        let mut unit = [0.0f32; NX];
+                        unit[i] = 1.0;
+                        profile_average(&unit, alpha as f32)
+                    })
                 })
-            })
-            .collect();
+                .collect()
+        };
         let sides = [EtaRange::AtLeastOne, EtaRange::AtMostOne].map(|range| {
+            let side = usize::from(range == EtaRange::AtMostOne);
             let grids = walk.grids(range);
             let [r, t] = single.grids(range);
             let row_of = |q: usize, j: usize, l: usize| -> [f32; N] {
@@ -113,60 +152,77 @@ impl GlassTables {
             let rows: Box<[Row; N * N]> = boxed(|n| {
                 let (j, l) = (n % N, n / N);
                 let alpha = node_alpha(j).max(ALPHA_FLOOR) as f32;
-                let (dr, dt) = (row_of(0, j, l), row_of(1, j, l));
-                let axis = DirectionAxis::<N>::new(alpha);
+                // the index of the walk tables' row l (u = √((η − 1)/2) = l/15), as seen
+                let u = l as f32 / (N - 1) as f32;
+                let eta = 1.0 + 2.0 * u * u;
+                let seen = if side == 0 { eta } else { 1.0 / eta };
+                // the lobes' profiles at the row's nodes (x = i/15 on the scale-invariant
+                // axis): the loss D split as the lobes split it, ΔT' = min(ΔT, D) and the
+                // reflection the rest
+                let walk_t = row_of(1, j, l);
+                let split = |i: usize| {
+                    let big_x = (i as f32 / (N - 1) as f32).powi(2);
+                    let mu = if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
+                    let d = loss.loss(mu, alpha, seen).unwrap_or(0.0).max(0.0);
+                    let t = walk_t[i].max(0.0).min(d);
+                    (d - t, t)
+                };
+                // the reflection lobe samples D − ΔT' + κ D: the hit's g_R = D − c_a ΔT'
+                // (c_a ≤ 1) plus a share of the loss, which bounds the ratio of g_R to the
+                // sampled profile where the row's split and the hit's differ; the transmission
+                // lobe ΔT'
+                let dr: [f32; N] =
+                    core::array::from_fn(|i| split(i).0 + REFLECTION_LOSS_SHARE * (split(i).0 + split(i).1));
+                let dt: [f32; N] = core::array::from_fn(|i| split(i).1);
                 Row {
                     profiles: [dr, dt].map(|g| MuProfile::new(&mu_cell_masses(&g, alpha))),
                     masses: [dr, dt].map(|g| profile_average(&g, alpha) as f32),
-                    mixture: core::array::from_fn(|k| {
-                        let cell = axis.cell(mu_cell_centre(k));
-                        let (er, et) = (row_at(&dr, cell).max(0.0), row_at(&dt, cell).max(0.0));
-                        let single = (1.0 - er - et).max(MIN_SINGLE_SHARE * (er + et));
-                        let total = single + er + et;
-                        if total > 0.0 {
-                            let (p0, p1) = (single / total, er / total);
-                            Vec4::new(p0, p1, (1.0 - p0 - p1).max(0.0), 0.0)
-                        } else {
-                            Vec4::new(1.0, 0.0, 0.0, 0.0)
-                        }
-                    }),
                 }
             });
-            let variance = |j: usize, l: usize, i: usize| {
-                let k = SideGrids::index(i, j, l);
-                walk.standard_errors(range, k).map_or(0.0, |(_, t)| f64::from(t) * f64::from(t))
-            };
-            let averages: Box<[Vec4; N * (N - 1) * (SUBSTEPS + 1)]> = boxed(|n| {
+            // the lobes' nodes: the loss, and the walk's ΔT at the node capped by it
+            let d = loss.grid(range);
+            let lobes: Box<[Vec2; LOSS_NODES]> = boxed(|k| {
+                let (i, j, l) = (k % NX, (k / NX) % NR, k / (NX * NR));
+                let alpha = loss_alpha(j);
+                let u = l as f64 / (NU - 1) as f64;
+                let eta = 1.0 + 2.0 * u * u * u;
+                let seen = if side == 0 { eta } else { 1.0 / eta };
+                let mu = loss_mu(side, i, alpha);
+                let dt =
+                    walk.energy(mu as f32, alpha as f32, seen as f32).map_or(0.0, |h| h.transmitted.max(0.0));
+                let dd = d[k].max(0.0);
+                Vec2::new(dd, dt.min(dd))
+            });
+            let w = weights(side);
+            let averages: Box<[Vec2; AVERAGES]> = boxed(|n| {
                 let s = n % (SUBSTEPS + 1);
-                let (j, l) = ((n / (SUBSTEPS + 1)) % (N - 1), n / ((SUBSTEPS + 1) * (N - 1)));
+                let (j, l) = ((n / (SUBSTEPS + 1)) % (NR - 1), n / ((SUBSTEPS + 1) * (NR - 1)));
                 let f = s as f64 / SUBSTEPS as f64;
-                let w = &weights[j * (SUBSTEPS + 1) + s];
-                let (mut dr, mut dt, mut var) = (0.0, 0.0, 0.0);
-                for i in 0..N {
-                    let at = |q: usize, jj: usize| f64::from(grids[q][SideGrids::index(i, jj, l)]);
-                    dr += w[i] * (at(0, j) + f * (at(0, j + 1) - at(0, j)));
-                    dt += w[i] * (at(1, j) + f * (at(1, j + 1) - at(1, j)));
-                    var += w[i]
-                        * w[i]
-                        * ((1.0 - f) * (1.0 - f) * variance(j, l, i) + f * f * variance(j + 1, l, i));
+                let w = &w[j * (SUBSTEPS + 1) + s];
+                let (mut dd, mut dt) = (0.0, 0.0);
+                for (i, wi) in w.iter().enumerate() {
+                    let at = |jj: usize| lobes[DielectricLossTable::index(i, jj, l)].as_dvec2();
+                    let v = at(j) + f * (at(j + 1) - at(j));
+                    dd += wi * v.x;
+                    dt += wi * v.y;
                 }
-                Vec4::new(dr as f32, dt as f32, var as f32, 0.0)
+                Vec2::new(dd as f32, dt as f32)
             });
             let single: Box<Grid> = boxed(|k| r[k] + t[k]);
-            GlassSide { walk: grids, single, rows, averages }
+            GlassSide { lobes, averages, single, rows }
         });
         Self { sides }
     }
 }
 
 impl GlassSide {
-    /// [ΔR̄, ΔT̄, Var(ΔT̄)] of index row l at the roughness cell (j, f), linear between the
-    /// sub-steps.
+    /// [D̄, ΔT̄'] of the loss grid's index row l at the roughness cell (j, f), linear between
+    /// the sub-steps.
     #[inline(always)]
-    pub(crate) fn averages_at(&self, l: usize, (j, f): (usize, f32)) -> Vec4 {
+    pub(crate) fn averages_at(&self, l: usize, (j, f): (usize, f32)) -> Vec2 {
         let t = f * SUBSTEPS as f32;
         let s = floor_index(t, SUBSTEPS - 1);
-        let n = (l * (N - 1) + j) * (SUBSTEPS + 1) + s;
+        let n = (l * (NR - 1) + j) * (SUBSTEPS + 1) + s;
         self.averages[n].lerp(self.averages[n + 1], t - s as f32)
     }
 }

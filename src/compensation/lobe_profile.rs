@@ -156,6 +156,46 @@ pub(crate) fn axis_average<const L: usize>(
     out
 }
 
+/// The weights w_i = 2∫₀¹ h_i(x(μ)) μ dμ of the hat functions h_i of an `N`-node axis
+/// (node i at x = i/(N − 1)) on the direction axis x(μ) = ½ √(μ (1 + α)/(μ + α)) + ½ μ at
+/// roughness α > 0 (the loss tables' axis of internal incidence), so that the average
+/// 2∫ g μ dμ of a row g linear in x between its nodes is Σ w_i g_i: 8-point Gauss–Legendre per
+/// cell in u = √μ, where x(u²) is analytic and the measure 4u³ du smooth, with the cells' ends
+/// μ(x) found by bisection (f64).
+pub(crate) fn mixed_axis_weights<const N: usize>(alpha: f64) -> [f64; N] {
+    let k = 1.0 + alpha;
+    let x_of = |mu: f64| 0.5 * (mu * k / (mu + alpha)).min(1.0).sqrt() + 0.5 * mu;
+    let mu_of = |x: f64| {
+        if x <= 0.0 {
+            return 0.0;
+        }
+        if x >= 1.0 {
+            return 1.0;
+        }
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            if x_of(mid) < x { lo = mid } else { hi = mid }
+        }
+        0.5 * (lo + hi)
+    };
+    let last = (N - 1) as f64;
+    let mut w = [0.0; N];
+    for i in 0..N - 1 {
+        let (ua, ub) = (mu_of(node_x(i, N)).sqrt(), mu_of(node_x(i + 1, N)).sqrt());
+        let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
+        for &(t, gw) in &GAUSS_LEGENDRE_8 {
+            for u in [mid - half * t, mid + half * t] {
+                let f = (x_of(u * u) * last - i as f64).clamp(0.0, 1.0);
+                let weight = gw * half * 4.0 * u * u * u;
+                w[i] += weight * (1.0 - f);
+                w[i + 1] += weight * f;
+            }
+        }
+    }
+    w
+}
+
 /// Cells of the uniform μ axis: cell k holds μ ∈ [k/M, (k + 1)/M) (μ = 1 the last).
 pub(crate) const MU_CELLS: usize = 32;
 

@@ -16,9 +16,10 @@ mod shared;
 
 pub use crate::albedo::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, DIELECTRIC_TABLE_SIZE, DielectricAlbedo,
-    DielectricAlbedoTable, DielectricWalkTable, EtaRange, HigherOrders, LAST_TABULATED_ORDER,
-    MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, MAX_WALK_TABLE_SE, ORDER_TABLE_MAX_STANDARD_ERROR,
-    ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable, TabulatedOrder, WALK_BATCH,
+    DielectricAlbedoTable, DielectricLossTable, DielectricWalkTable, EtaRange, HigherOrders,
+    LAST_TABULATED_ORDER, LOSS_TABLE_SHAPE, MAX_TABULATED_ALPHA, MAX_TABULATED_ETA, MAX_WALK_TABLE_SE,
+    ORDER_TABLE_MAX_STANDARD_ERROR, ORDER_TABLE_SIZE, ORDER_TABLES, ScatteringOrderTable, TabulatedOrder,
+    WALK_BATCH,
 };
 pub use albedo_tabulated::AlbedoTabulated;
 pub use compensated::{Compensated, CompensatedMaterial, Compensation};

@@ -36,7 +36,7 @@ fn family<S: AlbedoTabulated>() -> usize {
 pub(crate) const COMPENSATED_CONDUCTOR: [f32; 2] = [0.007, 0.008];
 /// The compensated dielectric's error bound (the walk's higher orders as separable lobes),
 /// GGX and Beckmann.
-pub(crate) const COMPENSATED_DIELECTRIC: [f32; 2] = [0.009, 0.016];
+pub(crate) const COMPENSATED_DIELECTRIC: [f32; 2] = [0.006, 0.005];
 /// The relative margin of a dielectric's single-scattering error for the interpolation of its
 /// tables (whose pointwise errors reach 10⁻¹ near η = 1 and largely cancel in the
 /// hemispherical mean): the walk's loss measured over the grid, plus three standard errors, is

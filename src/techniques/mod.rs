@@ -27,7 +27,7 @@
 //!   Fresnel term of coloured metals, the split between reflection and transmission, the
 //!   tables' interpolation) is bounded per slope family and material class by the largest
 //!   error measured against the walk by `cargo run --release -p lab --bin techniques` (plus
-//!   three standard errors): 0.7 % (GGX) and 0.8 % (Beckmann) for conductors, 0.9 % and 1.6 %
+//!   three standard errors): 0.7 % (GGX) and 0.8 % (Beckmann) for conductors, 0.6 % and 0.5 %
 //!   for dielectrics.
 //! * **The walk** and the estimators of its model are unbiased: no error, noise instead (the
 //!   report's error-against-time plots show how fast it falls).

@@ -6,6 +6,8 @@ pub(crate) mod conductor;
 #[rustfmt::skip]
 pub(crate) mod dielectric;
 #[rustfmt::skip]
+pub(crate) mod dielectric_loss;
+#[rustfmt::skip]
 pub(crate) mod dielectric_walk;
 #[rustfmt::skip]
 pub(crate) mod orders;

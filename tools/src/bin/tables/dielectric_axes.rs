@@ -35,6 +35,8 @@ pub struct Axes {
     pub below_knee: BelowKnee,
     /// The direction axis of each side: outside, inside.
     pub direction: [Direction; 2],
+    /// Nodes of the roughness and index axes (0: `nodes`).
+    pub other_nodes: [usize; 2],
 }
 
 /// The direction axis of one side of a design.
@@ -44,6 +46,14 @@ pub enum Direction {
     Blend,
     /// The conductor's scale-invariant x = √(μ (1 + α)/(μ + α)).
     ScaleInvariant,
+    /// From inside: the knee at μc, scale-invariant in t = μ/μc at α/μc below it.
+    KneeScaleInvariant,
+    /// ½ √(μ (1 + α)/(μ + α)) + ½ μ^p (p in thousandths).
+    Mixed(u32),
+}
+
+fn mixed(mu: f64, alpha: f64, p: u32) -> f64 {
+    0.5 * (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt() + 0.5 * mu.powf(f64::from(p) / 1000.0)
 }
 
 /// The roughness axis of a design.
@@ -72,6 +82,7 @@ pub const SHIPPED: Axes = Axes {
     roughness: Roughness::Blend,
     below_knee: BelowKnee::Symmetric,
     direction: [Direction::Blend, Direction::Blend],
+    other_nodes: [0, 0],
 };
 
 /// B(μ) ∈ [0, 1].
@@ -137,6 +148,12 @@ impl Axes {
         (self.nodes - 1) as f64
     }
 
+    /// The last node of axis a (0: direction, 1: roughness, 2: index).
+    pub fn last_of(&self, a: usize) -> f64 {
+        let n = if a == 0 || self.other_nodes[a - 1] == 0 { self.nodes } else { self.other_nodes[a - 1] };
+        (n - 1) as f64
+    }
+
     /// The fraction of the direction axis below the knee.
     fn knee_x(&self) -> f64 {
         self.knee as f64 / self.last()
@@ -148,11 +165,21 @@ impl Axes {
         if self.direction[side as usize] == Direction::ScaleInvariant {
             return (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
         }
+        if let Direction::Mixed(p) = self.direction[side as usize] {
+            return mixed(mu, alpha, p);
+        }
         if side == Side::Outside {
             return blend(mu);
         }
         let mu_c = critical_cosine(eta_seen);
         let k = self.knee_x();
+        if self.direction[side as usize] == Direction::KneeScaleInvariant {
+            if mu <= mu_c {
+                let (t, a) = (mu / mu_c, alpha / mu_c);
+                return k * (t * (1.0 + a) / (t + a)).min(1.0).sqrt();
+            }
+            return k + (1.0 - k) * ((mu - mu_c) / (1.0 - mu_c)).sqrt();
+        }
         if mu <= mu_c {
             k * if self.below_knee == BelowKnee::Symmetric { knee_blend(mu / mu_c) } else { blend(mu / mu_c) }
         } else {
@@ -166,6 +193,20 @@ impl Axes {
             let big_x = x * x;
             return if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) };
         }
+        if let Direction::Mixed(p) = self.direction[side as usize] {
+            if x <= 0.0 {
+                return 0.0;
+            }
+            if x >= 1.0 {
+                return 1.0;
+            }
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if mixed(mid, alpha, p) < x { lo = mid } else { hi = mid }
+            }
+            return 0.5 * (lo + hi);
+        }
         if side == Side::Outside {
             return blend_inverse(x);
         }
@@ -174,6 +215,10 @@ impl Axes {
         if x <= k {
             if mu_c == 0.0 {
                 0.0
+            } else if self.direction[side as usize] == Direction::KneeScaleInvariant {
+                let a = alpha / mu_c;
+                let big_x = (x / k) * (x / k);
+                if big_x >= 1.0 { mu_c } else { mu_c * big_x * a / (1.0 + a - big_x) }
             } else if self.below_knee == BelowKnee::Symmetric {
                 mu_c * knee_blend_inverse(x / k)
             } else {
@@ -197,14 +242,14 @@ impl Axes {
 
     /// α of roughness node j.
     pub fn alpha_of_node(&self, j: usize) -> f64 {
-        let r = j as f64 / self.last();
+        let r = j as f64 / self.last_of(1);
         if self.roughness == Roughness::Blend { blend_inverse(r) } else { (r * r).max(ALPHA_LIMIT) }
     }
 
     /// (μ, α, η seen) of node (i, j, l) of the table of `side`.
     pub fn node(&self, i: usize, j: usize, l: usize, side: Side) -> (f64, f64, f64) {
         let alpha = self.alpha_of_node(j);
-        let eta = self.eta_of(l as f64 / self.last());
+        let eta = self.eta_of(l as f64 / self.last_of(2));
         let eta_seen = if side == Side::Inside { 1.0 / eta } else { eta };
         (self.mu_of(i as f64 / self.last(), alpha, eta_seen, side), alpha, eta_seen)
     }
@@ -213,12 +258,11 @@ impl Axes {
     pub fn coordinates(&self, mu: f64, alpha: f64, eta_seen: f64) -> [f64; 3] {
         let side = if eta_seen < 1.0 { Side::Inside } else { Side::Outside };
         let eta_ge_1 = if side == Side::Inside { 1.0 / eta_seen } else { eta_seen };
-        let l = self.last();
         [
-            self.direction(mu, alpha, eta_seen, side).clamp(0.0, 1.0) * l,
+            self.direction(mu, alpha, eta_seen, side).clamp(0.0, 1.0) * self.last_of(0),
             if self.roughness == Roughness::Blend { blend(alpha.min(1.0)) } else { alpha.sqrt().min(1.0) }
-                * l,
-            self.eta_coordinate(eta_ge_1) * l,
+                * self.last_of(1),
+            self.eta_coordinate(eta_ge_1) * self.last_of(2),
         ]
     }
 }

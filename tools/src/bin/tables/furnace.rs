@@ -1,12 +1,16 @@
 //! The dense white-furnace check of the compensated glass: at a grid of (μ, α, η, side) between
-//! the tables' nodes, the albedo of the compensated lobe, E_ss + ΔR + c ΔT (the single-scattering
-//! albedo by quadrature, exact for the exact single-scattering lobe; the added lobes integrate
-//! exactly to the energies they restore), against 1, the albedo of a non-absorbing interface.
+//! the tables' nodes, the albedo of the compensated lobe, E_ss + g_R + c ΔT' (the
+//! single-scattering albedo by quadrature, exact for the exact single-scattering lobe; the added
+//! lobes integrate exactly to the energies they restore, `tests/compensated_glass.rs`), against
+//! 1, the albedo of a non-absorbing interface; beside it the loss table's error alone and the
+//! walk tables' ΔR + ΔT in its place. Then how often the cap ΔT' = min(ΔT, D) binds at the loss
+//! grid's nodes.
 
 use crate::dielectric::dielectric_albedo;
+use crate::dielectric_loss::{NODES, SHAPE, node_parameters};
 use crate::quadrature::Family;
-use crate::{DIELECTRIC_PANELS, Side, par_map};
-use microsurface::compensation::DielectricWalkTable;
+use crate::{DIELECTRIC_PANELS, Side, par_map, range_of};
+use microsurface::compensation::{DielectricLossTable, DielectricWalkTable};
 use microsurface::{Beckmann, Compensated, Dielectric, Ggx};
 
 /// The roughnesses, indices (seen from outside; 1/η from inside) and view cosines of the check.
@@ -26,7 +30,9 @@ pub struct FurnacePoint {
     pub single: f64,
     /// ΔR + ΔT as the walk tables interpolate them.
     pub raw: f64,
-    /// ΔR + c ΔT as the compensated lobe restores them.
+    /// 1 − R − T as the loss table interpolates it.
+    pub loss: f64,
+    /// g_R + c ΔT' as the compensated lobe restores them.
     pub added: f64,
 }
 
@@ -37,30 +43,33 @@ impl FurnacePoint {
     }
 }
 
-fn added(family: Family, side: Side, mu: f64, alpha: f64, eta: f64) -> (f64, f64) {
+fn added(family: Family, side: Side, mu: f64, alpha: f64, eta: f64) -> (f64, f64, f64) {
     let material = Dielectric::new(eta as f32).expect("η in range");
     let side_of = match side {
         Side::Outside => microsurface::research::Side::Outside,
         Side::Inside => microsurface::research::Side::Inside,
     };
     let seen = if side == Side::Outside { eta } else { 1.0 / eta };
-    let (lobes, table) = match family {
+    let (lobes, table, loss) = match family {
         Family::Ggx => (
             Compensated::new(Ggx::isotropic(alpha as f32).expect("α"), material)
                 .expect("in range")
                 .higher_orders(mu as f32, side_of),
             DielectricWalkTable::GGX,
+            DielectricLossTable::GGX,
         ),
         Family::Beckmann => (
             Compensated::new(Beckmann::isotropic(alpha as f32).expect("α"), material)
                 .expect("in range")
                 .higher_orders(mu as f32, side_of),
             DielectricWalkTable::BECKMANN,
+            DielectricLossTable::BECKMANN,
         ),
     };
     let (r, t) = lobes.expect("μ in [0, 1]");
     let raw = table.energy(mu as f32, alpha as f32, seen as f32).expect("in range");
-    (f64::from(r + t), f64::from(raw.reflected + raw.transmitted))
+    let loss = loss.loss(mu as f32, alpha as f32, seen as f32).expect("in range");
+    (f64::from(r + t), f64::from(raw.reflected + raw.transmitted), f64::from(loss))
 }
 
 /// Runs the check over the grid.
@@ -82,14 +91,15 @@ pub fn run() -> Vec<FurnacePoint> {
         let (mu, alpha, eta) = (f64::from(mu as f32), f64::from(alpha as f32), f64::from(eta as f32));
         let seen = if side == Side::Outside { eta } else { 1.0 / eta };
         let (r, t) = dielectric_albedo(family, mu, alpha, seen, DIELECTRIC_PANELS);
-        let (lobes, raw) = added(family, side, mu, alpha, eta);
-        FurnacePoint { family, side, mu, alpha, eta, single: r + t, raw, added: lobes }
+        let (lobes, raw, loss) = added(family, side, mu, alpha, eta);
+        FurnacePoint { family, side, mu, alpha, eta, single: r + t, raw, loss, added: lobes }
     });
     let mut sorted: Vec<&FurnacePoint> = out.iter().collect();
     sorted.sort_by(|a, b| b.error().abs().total_cmp(&a.error().abs()));
     for p in sorted.iter().take(25) {
         println!(
-            "  {} {} μ {:.3} α {:.2} η {:.2}: albedo − 1 = {:+.4} (E_ss {:.4}, walk tables {:+.4}, lobes {:+.4})",
+            "  {} {} μ {:.3} α {:.2} η {:.2}: albedo − 1 = {:+.4} (E_ss {:.4}, loss table {:+.4}, walk tables \
+             {:+.4})",
             p.family.name(),
             p.side.name(),
             p.mu,
@@ -97,25 +107,68 @@ pub fn run() -> Vec<FurnacePoint> {
             p.eta,
             p.error(),
             p.single,
+            p.single + p.loss - 1.0,
             p.single + p.raw - 1.0,
-            p.added - p.raw
         );
     }
+    let stats = |of: &[&FurnacePoint], e: &dyn Fn(&FurnacePoint) -> f64| {
+        let max = of.iter().map(|p| e(p).abs()).fold(0.0, f64::max);
+        let rms = (of.iter().map(|p| e(p) * e(p)).sum::<f64>() / of.len() as f64).sqrt();
+        (max, rms)
+    };
     for family in [Family::Ggx, Family::Beckmann] {
-        for side in [Side::Outside, Side::Inside] {
+        for side in [None, Some(Side::Outside), Some(Side::Inside)] {
             let of: Vec<&FurnacePoint> =
-                out.iter().filter(|p| p.family == family && p.side == side).collect();
-            let max = of.iter().map(|p| p.error().abs()).fold(0.0, f64::max);
-            let raw = of.iter().map(|p| (p.single + p.raw - 1.0).abs()).fold(0.0, f64::max);
-            let rms = (of.iter().map(|p| p.error() * p.error()).sum::<f64>() / of.len() as f64).sqrt();
+                out.iter().filter(|p| p.family == family && side.is_none_or(|s| p.side == s)).collect();
+            let (max, rms) = stats(&of, &|p| p.error());
+            let (loss, _) = stats(&of, &|p| p.single + p.loss - 1.0);
+            let (raw, raw_rms) = stats(&of, &|p| p.single + p.raw - 1.0);
             println!(
-                "{} {}: white furnace |albedo − 1| max {max:.2e}, RMS {rms:.2e} ({} points; the walk tables \
-                 alone, before the reciprocity factors: max {raw:.2e})",
+                "{} {}: white furnace |albedo − 1| max {max:.2e}, RMS {rms:.2e} ({} points; the loss table \
+                 alone: max {loss:.2e}; the walk tables' ΔR + ΔT instead: max {raw:.2e}, RMS {raw_rms:.2e})",
                 family.name(),
-                side.name(),
+                side.map_or("both sides", Side::name),
                 of.len()
             );
         }
     }
+    cap();
     out
+}
+
+/// How often the cap ΔT' = min(ΔT, D) binds: at the loss grid's nodes, the walk tables' ΔT
+/// interpolated there against the loss table's D (both as the crate's lookups read them).
+fn cap() {
+    for family in [Family::Ggx, Family::Beckmann] {
+        let (walk, loss) = match family {
+            Family::Ggx => (DielectricWalkTable::GGX, DielectricLossTable::GGX),
+            Family::Beckmann => (DielectricWalkTable::BECKMANN, DielectricLossTable::BECKMANN),
+        };
+        for side in [Side::Outside, Side::Inside] {
+            let d = loss.nodes(range_of(side));
+            let (mut capped, mut worst, mut at) = (0, 0.0f32, (0.0, 0.0, 0.0));
+            for (k, &dk) in d.iter().enumerate().take(NODES) {
+                let (i, j, l) = (k % SHAPE[0], (k / SHAPE[0]) % SHAPE[1], k / (SHAPE[0] * SHAPE[1]));
+                let (mu, alpha, eta) = node_parameters(i, j, l, side);
+                let dt = walk.energy(mu as f32, alpha as f32, eta as f32).expect("in range").transmitted;
+                if dt > dk.max(0.0) {
+                    capped += 1;
+                    if dt - dk > worst {
+                        worst = dt - dk;
+                        at = (mu, alpha, eta);
+                    }
+                }
+            }
+            println!(
+                "{} {}: the cap ΔT' = min(ΔT, D) binds at {capped} of {NODES} loss nodes ({:.1} %), by at most \
+                 {worst:.2e} (μ {:.3e} α {:.3} η {:.3})",
+                family.name(),
+                side.name(),
+                100.0 * capped as f64 / NODES as f64,
+                at.0,
+                at.1,
+                at.2
+            );
+        }
+    }
 }

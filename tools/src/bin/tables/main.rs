@@ -18,6 +18,7 @@
 
 mod dielectric;
 mod dielectric_axes;
+mod dielectric_loss;
 mod furnace;
 mod orders;
 mod quadrature;
@@ -616,6 +617,7 @@ fn quick() {
         failures += 1;
         println!("{} is not the generator's text for its own nodes", path.display());
     }
+    failures += dielectric_loss::quick(&mut state);
     println!(
         "tables --quick: {} nodes recomputed (and {dielectric_nodes} dielectric R, T pairs, walk cells within \
          their combined SE), {failures} differ",
@@ -646,6 +648,7 @@ fn main() {
         (only.is_none() || only == Some("conductor"), only.is_none() || only == Some("dielectric"));
     let per_order = only.is_none() || only == Some("orders"); // the walk's per-order energies (orders.rs)
     let walk = only.is_none() || only == Some("walk-dielectric");
+    let loss = only.is_none() || only == Some("dielectric-loss");
     if std::env::var_os("TABLES_WALK_PROBE").is_some() {
         walk_dielectric::probe();
         return;
@@ -670,7 +673,28 @@ fn main() {
             knee: (7 * (nodes - 1)).div_ceil(15),
             eta_power,
             roughness: if args.iter().any(|a| a == "sqrt") { Roughness::Sqrt } else { Roughness::Blend },
-            direction: [si("scale-invariant-outside"), si("scale-invariant-inside")],
+            direction: [
+                if let Some(p) =
+                    args.iter().find_map(|a| a.strip_prefix("mix-out=").and_then(|v| v.parse().ok()))
+                {
+                    dielectric_axes::Direction::Mixed(p)
+                } else {
+                    si("scale-invariant-outside")
+                },
+                if let Some(p) =
+                    args.iter().find_map(|a| a.strip_prefix("mix-in=").and_then(|v| v.parse().ok()))
+                {
+                    dielectric_axes::Direction::Mixed(p)
+                } else if args.iter().any(|a| a == "knee-si") {
+                    dielectric_axes::Direction::KneeScaleInvariant
+                } else {
+                    si("scale-invariant-inside")
+                },
+            ],
+            other_nodes: [
+                args.iter().find_map(|a| a.strip_prefix("r=").and_then(|v| v.parse().ok())).unwrap_or(0),
+                args.iter().find_map(|a| a.strip_prefix("u=").and_then(|v| v.parse().ok())).unwrap_or(0),
+            ],
             ..dielectric_axes::SHIPPED
         };
         for family in [Family::Ggx, Family::Beckmann] {
@@ -707,6 +731,7 @@ fn main() {
                 if v == 0.0 { BelowKnee::Blend } else { BelowKnee::Symmetric }
             }),
             direction: dielectric_axes::SHIPPED.direction,
+            other_nodes: [0, 0],
         };
         let points = num(4).map_or(INTERPOLATION_POINTS, |v| v as usize);
         let uniform = args.iter().any(|a| a == "--uniform");
@@ -761,6 +786,32 @@ fn main() {
                     );
                 }
             }
+            if loss {
+                for side in [Side::Outside, Side::Inside] {
+                    let uniform = args.iter().any(|a| a == "--uniform");
+                    let mu_min = 1e-3;
+                    let [own, walk] = dielectric_loss::interpolation_error(family, side, uniform, mu_min);
+                    for (what, [all, above]) in [("loss table", own), ("walk tables' ΔR + ΔT", walk)] {
+                        println!(
+                            "{} dielectric loss from {}, {what}: interpolation error at {INTERPOLATION_POINTS} random \
+                             points: max {:.2e} (μ {:.3e}, α {:.3e}, η {:.4}), RMS {:.2e}; at μ ≥ {mu_min:e}: max {:.2e} \
+                             (μ {:.3e}, α {:.3e}, η {:.4}), RMS {:.2e}",
+                            family.name(),
+                            side.name(),
+                            all.0,
+                            all.2.0,
+                            all.2.1,
+                            all.2.2,
+                            all.1,
+                            above.0,
+                            above.2.0,
+                            above.2.1,
+                            above.2.2,
+                            above.1
+                        );
+                    }
+                }
+            }
         }
         return;
     }
@@ -789,6 +840,21 @@ fn main() {
         changed |=
             write_if_changed(&root.join("src/albedo/generated/dielectric.rs"), &dielectric_source(&tables));
         dielectric_export(&tables, &root.join("target/tables")).expect("write target/tables");
+    }
+    if loss {
+        let mut tables = Vec::new();
+        for family in [Family::Ggx, Family::Beckmann] {
+            for side in [Side::Outside, Side::Inside] {
+                let t0 = std::time::Instant::now();
+                tables.push((family, side, dielectric_loss::build(family, side)));
+                println!("  {:.1} s", t0.elapsed().as_secs_f64());
+            }
+        }
+        changed |= write_if_changed(
+            &root.join("src/albedo/generated/dielectric_loss.rs"),
+            &dielectric_loss::source(&tables),
+        );
+        dielectric_loss::export(&tables, &root.join("target/tables")).expect("write target/tables");
     }
     if walk {
         let mut tables = Vec::new();
@@ -856,15 +922,16 @@ fn design_error(family: Family, side: Side, axes: Axes, points: usize, uniform: 
 /// [`design_error`] at the given points (μ, α, η seen).
 fn design_error_at(family: Family, side: Side, axes: Axes, at: &[(f64, f64, f64)]) -> [(f64, f64); 3] {
     let points = at.len();
-    let last = axes.nodes - 1;
+    let lasts = [0, 1, 2].map(|a| axes.last_of(a) as usize);
     let located: Vec<Located> = at
         .iter()
         .map(|&p| {
             let at = axes.coordinates(p.0, p.1, p.2);
             (
                 p,
-                at.map(|t| {
-                    let i = (t as usize).min(last - 1);
+                [0, 1, 2].map(|a| {
+                    let t = at[a];
+                    let i = (t as usize).min(lasts[a] - 1);
                     (i, t - i as f64)
                 }),
             )

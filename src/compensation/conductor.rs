@@ -37,7 +37,7 @@ use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::PI;
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec3A, Vec4};
 
 /// The albedo table's last direction and roughness node indices, and the per-order tables'.
 const LAST_X: f32 = (ALBEDO_DIRECTIONS - 1) as f32;
@@ -60,9 +60,9 @@ pub struct ConductorLobes {
     /// surface).
     mixing: bool,
     /// F̄ = F_avg per channel (Kulla–Conty and the walk's orders).
-    fresnel_average: Vec3,
+    fresnel_average: Vec3A,
     /// Kulla–Conty: F_ms/(π C); the walk's orders: 1/(π ḡ) per channel; Turquin: F0.
-    scale: Vec3,
+    scale: Vec3A,
 }
 
 impl ConductorLobes {
@@ -75,8 +75,8 @@ impl ConductorLobes {
             order_row: (0, 0.0),
             upper: 0.0,
             mixing: false,
-            fresnel_average: Vec3::ZERO,
-            scale: Vec3::ZERO,
+            fresnel_average: Vec3A::ZERO,
+            scale: Vec3A::ZERO,
         }
     }
 
@@ -101,7 +101,7 @@ impl ConductorLobes {
     /// Σ_k F̄ᵏ φ_k at the direction coordinate x per channel (orders 2 … 6 and the tail at 7),
     /// by Horner's scheme.
     #[inline(always)]
-    fn order_series(&self, x: f32) -> Vec3 {
+    fn order_series(&self, x: f32) -> Vec3A {
         let [a, b] = self.tables.0.fractions_at(node_cell(x * LAST_O, ORDER_TABLE_SIZE), self.order_row);
         series(self.fresnel_average, a, b)
     }
@@ -109,10 +109,10 @@ impl ConductorLobes {
     /// The added lobe's factor g(μ) at the direction coordinate x with 1 − E = `c`:
     /// Kulla–Conty c (the constant F_ms is in the scale), the walk's orders c Σ_k F̄ᵏ φ_k.
     #[inline(always)]
-    fn factor(&self, scheme: Compensation, x: f32, c: f32) -> Vec3 {
+    fn factor(&self, scheme: Compensation, x: f32, c: f32) -> Vec3A {
         match scheme {
             Compensation::Walk => c * self.order_series(x),
-            _ => Vec3::splat(c),
+            _ => Vec3A::splat(c),
         }
     }
 
@@ -125,10 +125,10 @@ impl ConductorLobes {
         }
         let (xo, xi) = self.coordinates(mu_o, mu_i);
         let (co, ci) = (self.complement(xo), self.complement(xi));
-        match scheme {
+        Vec3::from(match scheme {
             Compensation::Walk => self.scale * self.factor(scheme, xo, co) * self.factor(scheme, xi, ci),
             _ => self.scale * (co * ci),
-        }
+        })
     }
 
     /// The mixture's probability p of single scattering for a view at cos θo = `mu_o`.
@@ -169,7 +169,7 @@ impl ConductorLobes {
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
     #[inline(always)]
     fn turquin_factor(&self, c_o: f32) -> Vec3 {
-        Vec3::ONE + self.scale * (c_o / (1.0 - c_o))
+        Vec3::from(Vec3A::ONE + self.scale * (c_o / (1.0 - c_o)))
     }
 
     /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
@@ -181,17 +181,17 @@ impl ConductorLobes {
 
 /// F0 of a conductor per channel (1 for F = 1).
 #[inline(always)]
-fn normal_reflectance(conductor: &Conductor) -> Vec3 {
-    conductor.ior().map_or(Vec3::ONE, ComplexIor::normal_reflectance)
+fn normal_reflectance(conductor: &Conductor) -> Vec3A {
+    conductor.ior().map_or(Vec3A::ONE, ComplexIor::normal_reflectance)
 }
 
 /// Σ_k F̄ᵏ φ_k = F̄² (φ2 + F̄ (φ3 + F̄ (φ4 + F̄ (φ5 + F̄ (φ6 + F̄ φ7))))) per channel, with φ the
 /// lanes (φ2, φ3, φ4, φ5), (φ6, φ7, ·, ·).
 #[inline(always)]
-fn series(f: Vec3, a: Vec4, b: Vec4) -> Vec3 {
-    let mut s = Vec3::splat(b.y);
+fn series(f: Vec3A, a: Vec4, b: Vec4) -> Vec3A {
+    let mut s = Vec3A::splat(b.y);
     for phi in [b.x, a.w, a.z, a.y, a.x] {
-        s = Vec3::splat(phi) + f * s;
+        s = Vec3A::splat(phi) + f * s;
     }
     f * f * s
 }
@@ -199,6 +199,7 @@ fn series(f: Vec3, a: Vec4, b: Vec4) -> Vec3 {
 impl CompensatedMaterial for Conductor {
     type Lobes = ConductorLobes;
 
+    #[inline(always)]
     fn lobes<S: AlbedoTabulated>(
         single: &MicrofacetBsdf<S, Self>,
         scheme: Compensation,
@@ -219,18 +220,18 @@ impl CompensatedMaterial for Conductor {
         }
         let [a, b] = tables.averages_at(row);
         let c = a.x;
-        let f = conductor.ior().map_or(Vec3::ONE, fresnel_average);
+        let f = conductor.ior().map_or(Vec3A::ONE, |ior| tables.fresnel.lookup(ior));
         let scale = match scheme {
             // no energy lost (every node of the row is 1): nothing to restore
-            _ if c <= 0.0 => Vec3::ZERO,
+            _ if c <= 0.0 => Vec3A::ZERO,
             Compensation::KullaConty => {
                 // F_ms/(π C), F_ms = F̄² E_avg/(1 − F̄ C) (the denominator is ≥ E_avg > 0)
-                f * f * (1.0 - c) / ((Vec3::ONE - f * c) * (PI * c))
+                f * f * (1.0 - c) / ((Vec3A::ONE - f * c) * (PI * c))
             }
             // 1/(π ḡ), ḡ = Σ_k F̄ᵏ m_k (> 0 for F̄ > 0: m_2 > 0 wherever C > 0)
             _ => {
                 let average = series(f, Vec4::new(a.y, a.z, a.w, b.x), Vec4::new(b.y, b.z, 0.0, 0.0));
-                Vec3::select(average.cmpgt(Vec3::ZERO), (PI * average).recip(), Vec3::ZERO)
+                Vec3A::select(average.cmpgt(Vec3A::ZERO), (PI * average).recip(), Vec3A::ZERO)
             }
         };
         // the profile mixture of the two rows, by blend weight × mass
@@ -305,7 +306,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
         let x = l.coordinate(mu);
         let c = l.complement(x);
         Some(match self.scheme {
-            Compensation::Walk => c * l.order_series(x),
+            Compensation::Walk => Vec3::from(c * l.order_series(x)),
             _ => self.fresnel_multiple_scattering() * c,
         })
     }
@@ -313,12 +314,12 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel (from its table over the complex index: within
     /// 2e-5 for the crate's presets and 1e-4 for k ≥ 0.3 against quadrature; 1 for F = 1).
     pub fn fresnel_average(&self) -> Vec3 {
-        self.single.surface().material().ior().map_or(Vec3::ONE, fresnel_average)
+        self.single.surface().material().ior().map_or(Vec3::ONE, |ior| fresnel_average(ior).into())
     }
 
     /// F0 = F(μ = 1) per RGB channel.
     pub fn fresnel_normal(&self) -> Vec3 {
-        normal_reflectance(self.single.surface().material())
+        normal_reflectance(self.single.surface().material()).into()
     }
 
     /// Kulla and Conty's F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)) per RGB channel (1 for
@@ -456,7 +457,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         // eval's shared one)
         let xi = lobes.coordinate(wi.z);
         let g_i = lobes.factor(self.scheme, xi, lobes.complement(xi));
-        let f_cos = f_cos_ss + lobes.scale * g_o * g_i * wi.z;
+        let f_cos = f_cos_ss + Vec3::from(lobes.scale * g_o * g_i * wi.z);
         mixture_sample(wo, wi, f_cos, lobes.mixture_pdf(wo.z, pdf_ss, wi.z), 1.0)
     }
 

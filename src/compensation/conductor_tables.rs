@@ -10,11 +10,13 @@
 //!   through the direction axis as well as through the rows' blend;
 //! * per roughness row, the sampler of its profile (1 − E(μ)) μ at the row's α, the profile's
 //!   mass and the sampling mixture's probability of single scattering per cell of the uniform
-//!   μ axis (E at the cell's centre).
+//!   μ axis (E at the cell's centre);
+//! * a reference to the table of F_avg over the complex index (shared by the families).
 
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MuProfile, axis_average, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
+use super::fresnel_average::FresnelAverageTable;
 use super::shared::boxed;
 use crate::albedo::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, Family, ORDER_TABLE_SIZE, ORDER_TABLES,
@@ -58,6 +60,9 @@ pub(crate) struct ConductorTables {
     pub(crate) averages: Box<[[Vec4; 2]; CELLS * (SUBSTEPS + 1)]>,
     /// The rows' profiles.
     pub(crate) rows: Box<[Row; ALBEDO_ROUGHNESSES]>,
+    /// The table of F_avg over the complex index (one for every family: a reference here, so
+    /// that a per-hit construction checks one lazily built table, not two).
+    pub(crate) fresnel: &'static FresnelAverageTable,
 }
 
 /// The α of the albedo table's row j.
@@ -150,7 +155,7 @@ impl ConductorTables {
             v[0] = profile_average(&blended, alpha as f32) as f32;
             [Vec4::from_slice(&v[..4]), Vec4::from_slice(&v[4..])]
         });
-        Self { complement, fractions, averages, rows }
+        Self { complement, fractions, averages, rows, fresnel: FresnelAverageTable::get() }
     }
 
     /// The averages [C, m_2, …, m_tail, 0] at the roughness cell `(j, f)` of the albedo table

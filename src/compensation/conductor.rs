@@ -24,10 +24,10 @@
 //! the single-scattering lobe.
 
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
-use super::conductor_tables::ConductorTables;
+use super::conductor_tables::{ConductorTables, RoughnessCells};
 use super::fresnel_average::fresnel_average;
 use super::shared::{NOTHING, Shared, mixture_sample};
-use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
+use crate::albedo::{ALBEDO_DIRECTIONS, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
 use crate::bsdf::MicrofacetBsdf;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
 use crate::compensation::AlbedoTabulated;
@@ -39,9 +39,8 @@ use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3, Vec3A, Vec4};
 
-/// The albedo table's last direction and roughness node indices, and the per-order tables'.
+/// The albedo table's last direction node index, and the per-order tables'.
 const LAST_X: f32 = (ALBEDO_DIRECTIONS - 1) as f32;
-const LAST_R: f32 = (ALBEDO_ROUGHNESSES - 1) as f32;
 const LAST_O: f32 = (ORDER_TABLE_SIZE - 1) as f32;
 
 /// The per-hit state of a compensated conductor: a few scalars and the shared tables.
@@ -135,18 +134,19 @@ impl ConductorLobes {
     #[inline(always)]
     fn single_share(&self, mu_o: f32) -> f32 {
         let k = super::lobe_profile::mu_cell(mu_o);
-        let rows = &self.tables.0.rows;
         let (j, f) = self.row;
-        let (a, b) = (rows[j].single[k], rows[j + 1].single[k]);
+        // (one bounds check for both rows)
+        let rows = &self.tables.0.rows[j..j + 2];
+        let (a, b) = (rows[0].single[k], rows[1].single[k]);
         a + f * (b - a)
     }
 
     /// The added lobe's sampling density d(μi) μi/π at a light of cosine `mu_i` ≥ 0.
     #[inline(always)]
     fn profile_pdf(&self, mu_i: f32) -> f32 {
-        let rows = &self.tables.0.rows;
         let j = self.row.0;
-        let (a, b) = (rows[j].profile.pdf(mu_i), rows[j + 1].profile.pdf(mu_i));
+        let rows = &self.tables.0.rows[j..j + 2];
+        let (a, b) = (rows[0].profile.pdf(mu_i), rows[1].profile.pdf(mu_i));
         a + self.upper * (b - a)
     }
 
@@ -211,14 +211,13 @@ impl CompensatedMaterial for Conductor {
         }
         let conductor = single.surface().material();
         let alpha = single.surface().slope().albedo_alpha();
-        let r = alpha.sqrt();
-        let row = node_cell(r * LAST_R, ALBEDO_ROUGHNESSES);
+        let RoughnessCells { row, order_row, step } = RoughnessCells::of(alpha.sqrt());
         let lobes = ConductorLobes { axis: DirectionAxis::new(alpha), row, ..ConductorLobes::none(tables) };
         if scheme == Compensation::Turquin {
             // the view's 1 − E and F0: nothing else (the averages are the queries')
             return Ok(ConductorLobes { scale: normal_reflectance(conductor), ..lobes });
         }
-        let [a, b] = tables.averages_at(row);
+        let [a, b] = tables.averages_at(step);
         let c = a.x;
         let f = conductor.ior().map_or(Vec3A::ONE, |ior| tables.fresnel.lookup(ior));
         let scale = match scheme {
@@ -235,12 +234,12 @@ impl CompensatedMaterial for Conductor {
             }
         };
         // the profile mixture of the two rows, by blend weight × mass
-        let rows = &tables.rows;
         let (j, fr) = row;
-        let (lower, upper) = ((1.0 - fr) * rows[j].mass, fr * rows[j + 1].mass);
+        let rows = &tables.rows[j..j + 2];
+        let (lower, upper) = ((1.0 - fr) * rows[0].mass, fr * rows[1].mass);
         let total = lower + upper;
         Ok(ConductorLobes {
-            order_row: node_cell(r * LAST_O, ORDER_TABLE_SIZE),
+            order_row,
             upper: if total > 0.0 { upper / total } else { 0.0 },
             mixing: c > 0.0 && total > 0.0,
             fresnel_average: f,
@@ -288,7 +287,10 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
 
     /// C = 1 − E_avg of the interpolated E at this α (0 for a Dirac mirror).
     fn complement_average(&self) -> f32 {
-        if self.single.is_specular() { 0.0 } else { self.lobes.tables.0.complement_average(self.lobes.row) }
+        if self.single.is_specular() {
+            return 0.0;
+        }
+        self.lobes.tables.0.complement_average(RoughnessCells::of(self.alpha.sqrt()).step)
     }
 
     /// The albedo ∫ f_ms cos θi dωi of the additive lobe for a view at cos θo = μ, per RGB

@@ -3,6 +3,7 @@
 //! per hit needs of its Fresnel term, in a few nanoseconds instead of a quadrature.
 
 use super::shared::boxed;
+use crate::albedo::{lane_indices, node_cells};
 use crate::fresnel::ComplexIor;
 use crate::special::GAUSS_LEGENDRE_16;
 use glam::{Vec3A, Vec4};
@@ -94,37 +95,20 @@ impl FresnelAverageTable {
     /// F_avg of `ior` per channel: see [`fresnel_average`].
     #[inline(always)]
     pub(crate) fn lookup(&self, ior: &ComplexIor) -> Vec3A {
-        let (eta, k) = (Vec3A::from(ior.eta()), Vec3A::from(ior.k()));
-        let (iu, fu) = cell(eta / (Vec3A::ONE + eta) * LAST);
-        let (iv, fv) = cell(k / (Vec3A::splat(K_SCALE) + k) * LAST);
-        // each channel's first float, 2 (iu NODES + iv) < 2²³, exact in f32 and read from the
-        // low bits of its sum with 2²³
-        let start = ((iu * NODES as f32 + iv) * 2.0 + Vec3A::splat(ROUND))
-            .to_array()
-            .map(|x| (x.to_bits() - ROUND.to_bits()) as usize);
-        let [q0, q1, q2] = start.map(|n| Vec4::from_slice(&self.pairs[n..n + 4]));
+        let (eta, k) = (ior.eta().extend(0.0), ior.k().extend(0.0));
+        let last_cell = Vec4::splat((CELLS - 1) as f32);
+        let (iu, fu) = node_cells(eta / (Vec4::ONE + eta) * LAST, last_cell);
+        let (iv, fv) = node_cells(k / (Vec4::splat(K_SCALE) + k) * LAST, last_cell);
+        let (fu, fv) = (Vec3A::from_vec4(fu), Vec3A::from_vec4(fv));
+        // each channel's first float, 2 (iu NODES + iv), a whole number below 2²³
+        let [s0, s1, s2, _] = lane_indices((iu * NODES as f32 + iv) * 2.0);
+        let [q0, q1, q2] = [s0, s1, s2].map(|n| Vec4::from_slice(&self.pairs[n..n + 4]));
         // the corners of the three channels, lane by lane
         let (a0, b0) = (Vec3A::new(q0.x, q1.x, q2.x), Vec3A::new(q0.y, q1.y, q2.y));
         let (a1, b1) = (Vec3A::new(q0.z, q1.z, q2.z), Vec3A::new(q0.w, q1.w, q2.w));
         let (low, high) = (a0 + fv * (a1 - a0), b0 + fv * (b1 - b0));
         (base(ior.normal_reflectance()) + (low + fu * (high - low))).clamp(Vec3A::ZERO, Vec3A::ONE)
     }
-}
-
-/// 2²³: a float in [0, 2²³) plus this is rounded to an integer, which the low bits of the
-/// sum hold.
-const ROUND: f32 = 8_388_608.0;
-
-/// The cell of each lane of a fractional node coordinate t ∈ [0, LAST] of the table's axes,
-/// three channels at once: the cell n = round(t − ½) ∈ [0, LAST − 1] (t − ½ clamped to that
-/// range, then rounded by adding and subtracting [`ROUND`]: exact, branch-free, in the SIMD
-/// lanes) and the fraction t − n ∈ [0, 1] (⌊t⌋ but at integer t, where n may be the cell
-/// below with fraction 1: the same interpolant).
-#[inline(always)]
-fn cell(t: Vec3A) -> (Vec3A, Vec3A) {
-    let n = ((t - Vec3A::splat(0.5)).max(Vec3A::ZERO).min(Vec3A::splat(LAST - 1.0)) + Vec3A::splat(ROUND))
-        - Vec3A::splat(ROUND);
-    (n, t - n)
 }
 
 /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel of the conductor of complex index `ior`: the
@@ -161,7 +145,8 @@ mod tests {
         };
         let mut presets: f32 = 0.0;
         for ior in [ComplexIor::GOLD, ComplexIor::COPPER, ComplexIor::ALUMINIUM, ComplexIor::SILVER] {
-            presets = presets.max((Vec3::from(fresnel_average(&ior)) - exact(ior.eta(), ior.k())).abs().max_element());
+            presets = presets
+                .max((Vec3::from(fresnel_average(&ior)) - exact(ior.eta(), ior.k())).abs().max_element());
         }
         let mut state = 0x853c_49e6_748f_ea9b_u64;
         let mut next = || {

@@ -50,9 +50,9 @@ pub struct ConductorLobes {
     /// The direction axis at the hit's α.
     axis: DirectionAxis,
     /// The albedo table's roughness cell of α and the fraction in it.
-    row: (usize, f32),
+    row: (u32, f32),
     /// The per-order tables' roughness cell of α and the fraction in it.
-    order_row: (usize, f32),
+    order_row: (u32, f32),
     /// The probability of the upper row's profile in the added lobe's sampler.
     upper: f32,
     /// Whether the sampler mixes in the added lobe (an additive scheme with energy on a rough
@@ -79,6 +79,12 @@ impl ConductorLobes {
         }
     }
 
+    /// The albedo table's roughness cell.
+    #[inline(always)]
+    fn row(&self) -> (usize, f32) {
+        cell(self.row)
+    }
+
     /// The direction coordinates x of two cosines in [0, 1] from one division.
     #[inline(always)]
     fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
@@ -94,14 +100,15 @@ impl ConductorLobes {
     /// 1 − E at the direction coordinate x.
     #[inline(always)]
     fn complement(&self, x: f32) -> f32 {
-        self.tables.0.complement_at(node_cell(x * LAST_X, ALBEDO_DIRECTIONS), self.row)
+        self.tables.0.complement_at(node_cell(x * LAST_X, ALBEDO_DIRECTIONS), self.row())
     }
 
     /// Σ_k F̄ᵏ φ_k at the direction coordinate x per channel (orders 2 … 6 and the tail at 7),
     /// by Horner's scheme.
     #[inline(always)]
     fn order_series(&self, x: f32) -> Vec3A {
-        let [a, b] = self.tables.0.fractions_at(node_cell(x * LAST_O, ORDER_TABLE_SIZE), self.order_row);
+        let [a, b] =
+            self.tables.0.fractions_at(node_cell(x * LAST_O, ORDER_TABLE_SIZE), cell(self.order_row));
         series(self.fresnel_average, a, b)
     }
 
@@ -134,7 +141,7 @@ impl ConductorLobes {
     #[inline(always)]
     fn single_share(&self, mu_o: f32) -> f32 {
         let k = super::lobe_profile::mu_cell(mu_o);
-        let (j, f) = self.row;
+        let (j, f) = self.row();
         // (one bounds check for both rows)
         let rows = &self.tables.0.rows[j..j + 2];
         let (a, b) = (rows[0].single[k], rows[1].single[k]);
@@ -144,7 +151,7 @@ impl ConductorLobes {
     /// The added lobe's sampling density d(μi) μi/π at a light of cosine `mu_i` ≥ 0.
     #[inline(always)]
     fn profile_pdf(&self, mu_i: f32) -> f32 {
-        let j = self.row.0;
+        let j = self.row().0;
         let rows = &self.tables.0.rows[j..j + 2];
         let (a, b) = (rows[0].profile.pdf(mu_i), rows[1].profile.pdf(mu_i));
         a + self.upper * (b - a)
@@ -177,6 +184,19 @@ impl ConductorLobes {
     fn view_complement(&self, wo: Vec3) -> f32 {
         if wo.z > 0.0 { self.complement(self.coordinate(wo.z)) } else { 0.0 }
     }
+}
+
+/// A table cell (index, fraction) as stored in [`ConductorLobes`] (a u32 index: 8 bytes).
+#[inline(always)]
+fn narrow((i, f): (usize, f32)) -> (u32, f32) {
+    // (a cell of a table of fewer than 256 rows)
+    (i as u32, f)
+}
+
+/// A stored table cell as the tables index it.
+#[inline(always)]
+fn cell((i, f): (u32, f32)) -> (usize, f32) {
+    (i as usize, f)
 }
 
 /// F0 of a conductor per channel (1 for F = 1).
@@ -212,7 +232,11 @@ impl CompensatedMaterial for Conductor {
         let conductor = single.surface().material();
         let alpha = single.surface().slope().albedo_alpha();
         let RoughnessCells { row, order_row, step } = RoughnessCells::of(alpha.sqrt());
-        let lobes = ConductorLobes { axis: DirectionAxis::new(alpha), row, ..ConductorLobes::none(tables) };
+        let lobes = ConductorLobes {
+            axis: DirectionAxis::new(alpha),
+            row: narrow(row),
+            ..ConductorLobes::none(tables)
+        };
         if scheme == Compensation::Turquin {
             // the view's 1 − E and F0: nothing else (the averages are the queries')
             return Ok(ConductorLobes { scale: normal_reflectance(conductor), ..lobes });
@@ -239,7 +263,7 @@ impl CompensatedMaterial for Conductor {
         let (lower, upper) = ((1.0 - fr) * rows[0].mass, fr * rows[1].mass);
         let total = lower + upper;
         Ok(ConductorLobes {
-            order_row,
+            order_row: narrow(order_row),
             upper: if total > 0.0 { upper / total } else { 0.0 },
             mixing: c > 0.0 && total > 0.0,
             fresnel_average: f,
@@ -450,7 +474,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         } else {
             // the upper row's profile with its probability (uc rescaled to the added lobe's
             // share without a division)
-            let j = lobes.row.0 + usize::from(uc < p + lobes.upper * (1.0 - p));
+            let j = lobes.row().0 + usize::from(uc < p + lobes.upper * (1.0 - p));
             let wi = lobes.tables.0.rows[j].profile.sample(u)?;
             let (f_cos, pdf) = self.single_at(wo, wi);
             (wi, f_cos, pdf)

@@ -92,20 +92,22 @@ impl FresnelAverageTable {
         })
     }
 
-    /// F_avg of `ior` per channel: see [`fresnel_average`].
+    /// F_avg of `ior` per channel: see [`fresnel_average`]. Written for a short dependency chain
+    /// (the construction waits on it): the node coordinates t = LAST u, LAST v with LAST in the
+    /// numerators, the cells' first floats as one product and one sum.
     #[inline(always)]
     pub(crate) fn lookup(&self, ior: &ComplexIor) -> Vec3A {
         let (eta, k) = (ior.eta().extend(0.0), ior.k().extend(0.0));
         let last_cell = Vec4::splat((CELLS - 1) as f32);
-        let (iu, fu) = node_cells(eta / (Vec4::ONE + eta) * LAST, last_cell);
-        let (iv, fv) = node_cells(k / (Vec4::splat(K_SCALE) + k) * LAST, last_cell);
-        let (fu, fv) = (Vec3A::from_vec4(fu), Vec3A::from_vec4(fv));
-        // each channel's first float, 2 (iu NODES + iv), a whole number below 2²³
-        let [s0, s1, s2, _] = lane_indices((iu * NODES as f32 + iv) * 2.0);
+        let (iu, fu) = node_cells(eta * LAST / (Vec4::ONE + eta), last_cell);
+        let (iv, fv) = node_cells(k * LAST / (Vec4::splat(K_SCALE) + k), last_cell);
+        // each channel's first float, 2 NODES iu + 2 iv: whole numbers below 2²³, exact
+        let [s0, s1, s2, _] = lane_indices(iu * (2 * NODES) as f32 + iv * 2.0);
         let [q0, q1, q2] = [s0, s1, s2].map(|n| Vec4::from_slice(&self.pairs[n..n + 4]));
         // the corners of the three channels, lane by lane
         let (a0, b0) = (Vec3A::new(q0.x, q1.x, q2.x), Vec3A::new(q0.y, q1.y, q2.y));
         let (a1, b1) = (Vec3A::new(q0.z, q1.z, q2.z), Vec3A::new(q0.w, q1.w, q2.w));
+        let (fu, fv) = (Vec3A::from_vec4(fu), Vec3A::from_vec4(fv));
         let (low, high) = (a0 + fv * (a1 - a0), b0 + fv * (b1 - b0));
         (base(ior.normal_reflectance()) + (low + fu * (high - low))).clamp(Vec3A::ZERO, Vec3A::ONE)
     }

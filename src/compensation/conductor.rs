@@ -279,10 +279,14 @@ impl CompensatedMaterial for Conductor {
 
 /// The compensated conductor (see [`Compensated`] for the type; this block, its queries).
 ///
-/// **Cost.** Construction reads the shared tables at α (two rows of averages, one division for
-/// the sampler's rows), F_avg from its table over the complex index ([`Compensation::Walk`] and
-/// [`Compensation::KullaConty`]; F0 for [`Compensation::Turquin`]) and forms the lobe's scale
-/// (a division per channel). Eval adds to the single-scattering eval one (Turquin) or two
+/// **Cost.** Construction finds the cells of r = √α on the tables' three roughness axes at
+/// once (SIMD lanes), reads the averages at the sub-step of r (one pair of entries) and the two
+/// rows' masses (one division for the sampler's rows), F_avg from its table over the complex
+/// index ([`Compensation::Walk`] and [`Compensation::KullaConty`]: one load of a cell's four
+/// corners per channel, the channels in SIMD lanes; F0 for [`Compensation::Turquin`]) and forms
+/// the lobe's scale (one SIMD division): about 420 instructions for `Walk`, 400 for
+/// `KullaConty` and 235 for `Turquin` with the single-scattering BSDF's own 130 (GGX gold,
+/// callgrind, `tools/src/bin/profile_per_hit.rs`). Eval adds to the single-scattering eval one (Turquin) or two
 /// (sharing one division) bilinear lookups of 1 − E and, for the walk's orders, of the order
 /// fractions; pdf two lookups of the uniform μ axis per roughness row; sample the lookups of
 /// eval and pdf (measured in `README.md`).

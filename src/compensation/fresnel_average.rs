@@ -93,14 +93,14 @@ impl FresnelAverageTable {
     }
 
     /// F_avg of `ior` per channel: see [`fresnel_average`]. Written for a short dependency chain
-    /// (the construction waits on it): the node coordinates t = LAST u, LAST v with LAST in the
-    /// numerators, the cells' first floats as one product and one sum.
+    /// (the construction waits on it): the cells' first floats as one product and one sum.
     #[inline(always)]
     pub(crate) fn lookup(&self, ior: &ComplexIor) -> Vec3A {
         let (eta, k) = (ior.eta().extend(0.0), ior.k().extend(0.0));
         let last_cell = Vec4::splat((CELLS - 1) as f32);
-        let (iu, fu) = node_cells(eta * LAST / (Vec4::ONE + eta), last_cell);
-        let (iv, fv) = node_cells(k * LAST / (Vec4::splat(K_SCALE) + k), last_cell);
+        // (u = η/(1 + η) ≤ 1 first: LAST η would overflow for η > f32::MAX/LAST)
+        let (iu, fu) = node_cells(eta / (Vec4::ONE + eta) * LAST, last_cell);
+        let (iv, fv) = node_cells(k / (Vec4::splat(K_SCALE) + k) * LAST, last_cell);
         // each channel's first float, 2 NODES iu + 2 iv: whole numbers below 2²³, exact
         let [s0, s1, s2, _] = lane_indices(iu * (2 * NODES) as f32 + iv * 2.0);
         let [q0, q1, q2] = [s0, s1, s2].map(|n| Vec4::from_slice(&self.pairs[n..n + 4]));

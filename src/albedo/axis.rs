@@ -64,24 +64,26 @@ pub(crate) fn floor_index(t: f32, last: usize) -> usize {
     usize::from(t as u8).min(last)
 }
 
-/// 2²³: a float t ∈ [0, 2²³) plus this is rounded to an integer n, and the sum's bits are
-/// those of 2²³ plus n.
-const ROUND: f32 = 8_388_608.0;
+/// 1.5 · 2²³: a float x ∈ [−2²², 2²²) plus this lies in [2²³, 2²⁴), where the floats are the
+/// integers: the sum is x rounded to an integer n (ties to even), and its bits are those of
+/// this constant plus n.
+const ROUND: f32 = 12_582_912.0;
 
 /// The cells of four fractional node coordinates at once, in SIMD lanes, branch-free: for each
-/// lane t ≥ 0 the cell n = round(t − ½) clamped to [0, `last_cell`] (a whole number < 2²³) and
-/// the fraction t − n, in [0, 1] for t ∈ [0, `last_cell` + 1] (n = ⌊t⌋, but at a whole t, where
-/// n may be the cell below with fraction 1: the same interpolant). The rounding adds and
-/// subtracts [`ROUND`] (exact); [`lane_indices`] reads n as an integer.
+/// lane t ∈ [0, 2²²) the cell n = round(t − ½) ≤ `last_cell` (a whole number ≥ 0: t − ½ ≥ −½
+/// rounds to 0 or above; `last_cell` < 2²²) and the fraction t − n, in [0, 1] for
+/// t ∈ [0, `last_cell` + 1] (n = ⌊t⌋, but at a whole t, where n may be the cell below with
+/// fraction 1: the same interpolant). The rounding adds and subtracts [`ROUND`] (exact);
+/// [`lane_indices`] reads n as an integer.
 #[inline(always)]
 pub(crate) fn node_cells(t: Vec4, last_cell: Vec4) -> (Vec4, Vec4) {
-    let n = ((t - Vec4::splat(0.5)).max(Vec4::ZERO).min(last_cell) + Vec4::splat(ROUND)) - Vec4::splat(ROUND);
+    let n = ((t - Vec4::splat(0.5)).min(last_cell) + Vec4::splat(ROUND)) - Vec4::splat(ROUND);
     (n, t - n)
 }
 
-/// The whole numbers n ∈ [0, 2²³) of the lanes of [`node_cells`] (or of sums of such cells'
-/// whole multiples below 2²³) as indices: from the bits of n + 2²³ (one SIMD addition; the
-/// indices a caller does not read cost nothing).
+/// The whole numbers n ∈ [0, 2²²) of the lanes of [`node_cells`] (or of sums of such cells'
+/// whole multiples below 2²²) as indices: from the bits of n + [`ROUND`] (one SIMD addition;
+/// the indices a caller does not read cost nothing).
 #[inline(always)]
 pub(crate) fn lane_indices(n: Vec4) -> [usize; 4] {
     (n + Vec4::splat(ROUND)).to_array().map(|x| (x.to_bits() - ROUND.to_bits()) as usize)

@@ -101,7 +101,7 @@ impl FresnelAverageTable {
         // (u = η/(1 + η) ≤ 1 first: LAST η would overflow for η > f32::MAX/LAST)
         let (iu, fu) = node_cells(eta / (Vec4::ONE + eta) * LAST, last_cell);
         let (iv, fv) = node_cells(k / (Vec4::splat(K_SCALE) + k) * LAST, last_cell);
-        // each channel's first float, 2 NODES iu + 2 iv: whole numbers below 2²³, exact
+        // each channel's first float, 2 NODES iu + 2 iv: whole numbers below 2²², exact
         let [s0, s1, s2, _] = lane_indices(iu * (2 * NODES) as f32 + iv * 2.0);
         let [q0, q1, q2] = [s0, s1, s2].map(|n| Vec4::from_slice(&self.pairs[n..n + 4]));
         // the corners of the three channels, lane by lane

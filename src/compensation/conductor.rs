@@ -284,12 +284,13 @@ impl CompensatedMaterial for Conductor {
 /// rows' masses (one division for the sampler's rows), F_avg from its table over the complex
 /// index ([`Compensation::Walk`] and [`Compensation::KullaConty`]: one load of a cell's four
 /// corners per channel, the channels in SIMD lanes; F0 for [`Compensation::Turquin`]) and forms
-/// the lobe's scale (one SIMD division): about 420 instructions for `Walk`, 400 for
-/// `KullaConty` and 235 for `Turquin` with the single-scattering BSDF's own 130 (GGX gold,
-/// callgrind, `tools/src/bin/profile_per_hit.rs`). Eval adds to the single-scattering eval one (Turquin) or two
-/// (sharing one division) bilinear lookups of 1 − E and, for the walk's orders, of the order
-/// fractions; pdf two lookups of the uniform μ axis per roughness row; sample the lookups of
-/// eval and pdf (measured in `README.md`).
+/// the lobe's scale (one SIMD division): about 410 instructions for `Walk`, 390 for
+/// `KullaConty` and 235 for `Turquin`, the single-scattering BSDF's own 130 included (GGX gold,
+/// callgrind, `tools/src/bin/profile_per_hit.rs`; `DESIGN.md`, "Speed of the compensated
+/// lobes"). Eval adds to the single-scattering eval one (Turquin) or two (sharing one division)
+/// bilinear lookups of 1 − E and, for the walk's orders, of the order fractions; pdf two lookups
+/// of the uniform μ axis per roughness row; sample the lookups of eval and pdf (measured in
+/// `README.md`).
 ///
 /// **The walk's orders** ([`Compensation::Walk`]) restore each channel's energy from the
 /// walk's per-order energies ([`super::ScatteringOrderTable`], standard error ≤ 1.95e-3 per

@@ -1,6 +1,8 @@
 //! The node axes of the albedo tables, shared by the tables' lookups and the compensated
 //! lobes that interpolate a precomputed row of them.
 
+use glam::Vec4;
+
 /// The conductor tables' scale-invariant direction coordinate x = √(μ (1 + α)/(μ + α)) ∈ [0, 1]
 /// (μ = x² α/(1 + α − x²)), for μ ∈ [0, 1] and α > 0: the sharp feature of the F = 1 albedo
 /// at μ ≈ α sits at the same x for every α (see `DESIGN.md`, "Single-scattering albedo
@@ -60,6 +62,31 @@ pub(crate) fn node_cell(t: f32, nodes: usize) -> (usize, f32) {
 pub(crate) fn floor_index(t: f32, last: usize) -> usize {
     debug_assert!(last < 256);
     usize::from(t as u8).min(last)
+}
+
+/// 1.5 · 2²³: a float x ∈ [−2²², 2²²) plus this lies in [2²³, 2²⁴), where the floats are the
+/// integers: the sum is x rounded to an integer n (ties to even), and its bits are those of
+/// this constant plus n.
+const ROUND: f32 = 12_582_912.0;
+
+/// The cells of four fractional node coordinates at once, in SIMD lanes, branch-free: for each
+/// lane t ∈ [0, 2²²) the cell n = round(t − ½) ≤ `last_cell` (a whole number ≥ 0: t − ½ ≥ −½
+/// rounds to 0 or above; `last_cell` < 2²²) and the fraction t − n, in [0, 1] for
+/// t ∈ [0, `last_cell` + 1] (n = ⌊t⌋, but at a whole t, where n may be the cell below with
+/// fraction 1: the same interpolant). The rounding adds and subtracts [`ROUND`] (exact);
+/// [`lane_indices`] reads n as an integer.
+#[inline(always)]
+pub(crate) fn node_cells(t: Vec4, last_cell: Vec4) -> (Vec4, Vec4) {
+    let n = ((t - Vec4::splat(0.5)).min(last_cell) + Vec4::splat(ROUND)) - Vec4::splat(ROUND);
+    (n, t - n)
+}
+
+/// The whole numbers n ∈ [0, 2²²) of the lanes of [`node_cells`] (or of sums of such cells'
+/// whole multiples below 2²²) as indices: from the bits of n + [`ROUND`] (one SIMD addition;
+/// the indices a caller does not read cost nothing).
+#[inline(always)]
+pub(crate) fn lane_indices(n: Vec4) -> [usize; 4] {
+    (n + Vec4::splat(ROUND)).to_array().map(|x| (x.to_bits() - ROUND.to_bits()) as usize)
 }
 
 /// Below this value the log/√ blend axis [`log_sqrt_blend`] is 0 (its lookups read the first

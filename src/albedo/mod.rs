@@ -17,7 +17,8 @@ mod orders;
 mod table;
 
 pub(crate) use axis::{
-    DielectricDirection, DirectionAxis, floor_index, node_cell, scale_invariant_direction,
+    DielectricDirection, DirectionAxis, floor_index, lane_indices, node_cell, node_cells,
+    scale_invariant_direction,
 };
 pub use dielectric::{DielectricAlbedo, DielectricAlbedoTable};
 pub(crate) use dielectric_loss::LOSS_NODES;

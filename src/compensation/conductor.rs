@@ -24,10 +24,10 @@
 //! the single-scattering lobe.
 
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
-use super::conductor_tables::ConductorTables;
+use super::conductor_tables::{ConductorTables, RoughnessCells};
 use super::fresnel_average::fresnel_average;
 use super::shared::{NOTHING, Shared, mixture_sample};
-use crate::albedo::{ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
+use crate::albedo::{ALBEDO_DIRECTIONS, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
 use crate::bsdf::MicrofacetBsdf;
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, BsdfValue, Transport, unit_directions, unit_view};
 use crate::compensation::AlbedoTabulated;
@@ -37,11 +37,10 @@ use crate::material::Conductor;
 use crate::single_scattering::SingleScattering;
 use crate::slope::MicrosurfaceSlope;
 use core::f32::consts::PI;
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec3A, Vec4};
 
-/// The albedo table's last direction and roughness node indices, and the per-order tables'.
+/// The albedo table's last direction node index, and the per-order tables'.
 const LAST_X: f32 = (ALBEDO_DIRECTIONS - 1) as f32;
-const LAST_R: f32 = (ALBEDO_ROUGHNESSES - 1) as f32;
 const LAST_O: f32 = (ORDER_TABLE_SIZE - 1) as f32;
 
 /// The per-hit state of a compensated conductor: a few scalars and the shared tables.
@@ -51,18 +50,18 @@ pub struct ConductorLobes {
     /// The direction axis at the hit's α.
     axis: DirectionAxis,
     /// The albedo table's roughness cell of α and the fraction in it.
-    row: (usize, f32),
+    row: (u32, f32),
     /// The per-order tables' roughness cell of α and the fraction in it.
-    order_row: (usize, f32),
+    order_row: (u32, f32),
     /// The probability of the upper row's profile in the added lobe's sampler.
     upper: f32,
     /// Whether the sampler mixes in the added lobe (an additive scheme with energy on a rough
     /// surface).
     mixing: bool,
     /// F̄ = F_avg per channel (Kulla–Conty and the walk's orders).
-    fresnel_average: Vec3,
+    fresnel_average: Vec3A,
     /// Kulla–Conty: F_ms/(π C); the walk's orders: 1/(π ḡ) per channel; Turquin: F0.
-    scale: Vec3,
+    scale: Vec3A,
 }
 
 impl ConductorLobes {
@@ -75,9 +74,15 @@ impl ConductorLobes {
             order_row: (0, 0.0),
             upper: 0.0,
             mixing: false,
-            fresnel_average: Vec3::ZERO,
-            scale: Vec3::ZERO,
+            fresnel_average: Vec3A::ZERO,
+            scale: Vec3A::ZERO,
         }
+    }
+
+    /// The albedo table's roughness cell.
+    #[inline(always)]
+    fn row(&self) -> (usize, f32) {
+        cell(self.row)
     }
 
     /// The direction coordinates x of two cosines in [0, 1] from one division.
@@ -95,24 +100,25 @@ impl ConductorLobes {
     /// 1 − E at the direction coordinate x.
     #[inline(always)]
     fn complement(&self, x: f32) -> f32 {
-        self.tables.0.complement_at(node_cell(x * LAST_X, ALBEDO_DIRECTIONS), self.row)
+        self.tables.0.complement_at(node_cell(x * LAST_X, ALBEDO_DIRECTIONS), self.row())
     }
 
     /// Σ_k F̄ᵏ φ_k at the direction coordinate x per channel (orders 2 … 6 and the tail at 7),
     /// by Horner's scheme.
     #[inline(always)]
-    fn order_series(&self, x: f32) -> Vec3 {
-        let [a, b] = self.tables.0.fractions_at(node_cell(x * LAST_O, ORDER_TABLE_SIZE), self.order_row);
+    fn order_series(&self, x: f32) -> Vec3A {
+        let [a, b] =
+            self.tables.0.fractions_at(node_cell(x * LAST_O, ORDER_TABLE_SIZE), cell(self.order_row));
         series(self.fresnel_average, a, b)
     }
 
     /// The added lobe's factor g(μ) at the direction coordinate x with 1 − E = `c`:
     /// Kulla–Conty c (the constant F_ms is in the scale), the walk's orders c Σ_k F̄ᵏ φ_k.
     #[inline(always)]
-    fn factor(&self, scheme: Compensation, x: f32, c: f32) -> Vec3 {
+    fn factor(&self, scheme: Compensation, x: f32, c: f32) -> Vec3A {
         match scheme {
             Compensation::Walk => c * self.order_series(x),
-            _ => Vec3::splat(c),
+            _ => Vec3A::splat(c),
         }
     }
 
@@ -125,28 +131,29 @@ impl ConductorLobes {
         }
         let (xo, xi) = self.coordinates(mu_o, mu_i);
         let (co, ci) = (self.complement(xo), self.complement(xi));
-        match scheme {
+        Vec3::from(match scheme {
             Compensation::Walk => self.scale * self.factor(scheme, xo, co) * self.factor(scheme, xi, ci),
             _ => self.scale * (co * ci),
-        }
+        })
     }
 
     /// The mixture's probability p of single scattering for a view at cos θo = `mu_o`.
     #[inline(always)]
     fn single_share(&self, mu_o: f32) -> f32 {
         let k = super::lobe_profile::mu_cell(mu_o);
-        let rows = &self.tables.0.rows;
-        let (j, f) = self.row;
-        let (a, b) = (rows[j].single[k], rows[j + 1].single[k]);
+        let (j, f) = self.row();
+        // (one bounds check for both rows)
+        let rows = &self.tables.0.rows[j..j + 2];
+        let (a, b) = (rows[0].single[k], rows[1].single[k]);
         a + f * (b - a)
     }
 
     /// The added lobe's sampling density d(μi) μi/π at a light of cosine `mu_i` ≥ 0.
     #[inline(always)]
     fn profile_pdf(&self, mu_i: f32) -> f32 {
-        let rows = &self.tables.0.rows;
-        let j = self.row.0;
-        let (a, b) = (rows[j].profile.pdf(mu_i), rows[j + 1].profile.pdf(mu_i));
+        let j = self.row().0;
+        let rows = &self.tables.0.rows[j..j + 2];
+        let (a, b) = (rows[0].profile.pdf(mu_i), rows[1].profile.pdf(mu_i));
         a + self.upper * (b - a)
     }
 
@@ -169,7 +176,7 @@ impl ConductorLobes {
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
     #[inline(always)]
     fn turquin_factor(&self, c_o: f32) -> Vec3 {
-        Vec3::ONE + self.scale * (c_o / (1.0 - c_o))
+        Vec3::from(Vec3A::ONE + self.scale * (c_o / (1.0 - c_o)))
     }
 
     /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
@@ -179,26 +186,39 @@ impl ConductorLobes {
     }
 }
 
-/// F0 of a conductor per channel (1 for F = 1).
+/// A table cell (index, fraction) as stored in [`ConductorLobes`] (a u32 index: 8 bytes).
 #[inline(always)]
-fn normal_reflectance(conductor: &Conductor) -> Vec3 {
-    conductor.ior().map_or(Vec3::ONE, ComplexIor::normal_reflectance)
+fn narrow((i, f): (usize, f32)) -> (u32, f32) {
+    // (a cell of a table of fewer than 256 rows)
+    (i as u32, f)
 }
 
-/// Σ_k F̄ᵏ φ_k = F̄² (φ2 + F̄ (φ3 + F̄ (φ4 + F̄ (φ5 + F̄ (φ6 + F̄ φ7))))) per channel, with φ the
-/// lanes (φ2, φ3, φ4, φ5), (φ6, φ7, ·, ·).
+/// A stored table cell as the tables index it.
 #[inline(always)]
-fn series(f: Vec3, a: Vec4, b: Vec4) -> Vec3 {
-    let mut s = Vec3::splat(b.y);
-    for phi in [b.x, a.w, a.z, a.y, a.x] {
-        s = Vec3::splat(phi) + f * s;
-    }
-    f * f * s
+fn cell((i, f): (u32, f32)) -> (usize, f32) {
+    (i as usize, f)
+}
+
+/// F0 of a conductor per channel (1 for F = 1).
+#[inline(always)]
+fn normal_reflectance(conductor: &Conductor) -> Vec3A {
+    conductor.ior().map_or(Vec3A::ONE, ComplexIor::normal_reflectance)
+}
+
+/// Σ_k F̄ᵏ φ_k = F̄² ((φ2 + F̄ φ3) + F̄² (φ4 + F̄ φ5) + F̄⁴ (φ6 + F̄ φ7)) per channel, with φ the
+/// lanes (φ2, φ3, φ4, φ5), (φ6, φ7, ·, ·): Estrin's scheme, four multiplications deep where
+/// Horner's is seven (every term ≥ 0 for F̄ ∈ [0, 1]: no cancellation in either).
+#[inline(always)]
+fn series(f: Vec3A, a: Vec4, b: Vec4) -> Vec3A {
+    let pair = |even: f32, odd: f32| Vec3A::splat(even) + f * odd;
+    let f2 = f * f;
+    f2 * ((pair(a.x, a.y) + f2 * pair(a.z, a.w)) + (f2 * f2) * pair(b.x, b.y))
 }
 
 impl CompensatedMaterial for Conductor {
     type Lobes = ConductorLobes;
 
+    #[inline(always)]
     fn lobes<S: AlbedoTabulated>(
         single: &MicrofacetBsdf<S, Self>,
         scheme: Compensation,
@@ -210,36 +230,39 @@ impl CompensatedMaterial for Conductor {
         }
         let conductor = single.surface().material();
         let alpha = single.surface().slope().albedo_alpha();
-        let r = alpha.sqrt();
-        let row = node_cell(r * LAST_R, ALBEDO_ROUGHNESSES);
-        let lobes = ConductorLobes { axis: DirectionAxis::new(alpha), row, ..ConductorLobes::none(tables) };
+        let RoughnessCells { row, order_row, step } = RoughnessCells::of(alpha.sqrt());
+        let lobes = ConductorLobes {
+            axis: DirectionAxis::new(alpha),
+            row: narrow(row),
+            ..ConductorLobes::none(tables)
+        };
         if scheme == Compensation::Turquin {
             // the view's 1 − E and F0: nothing else (the averages are the queries')
             return Ok(ConductorLobes { scale: normal_reflectance(conductor), ..lobes });
         }
-        let [a, b] = tables.averages_at(row);
+        let [a, b] = tables.averages_at(step);
         let c = a.x;
-        let f = conductor.ior().map_or(Vec3::ONE, fresnel_average);
+        let f = conductor.ior().map_or(Vec3A::ONE, |ior| tables.fresnel.lookup(ior));
         let scale = match scheme {
             // no energy lost (every node of the row is 1): nothing to restore
-            _ if c <= 0.0 => Vec3::ZERO,
+            _ if c <= 0.0 => Vec3A::ZERO,
             Compensation::KullaConty => {
                 // F_ms/(π C), F_ms = F̄² E_avg/(1 − F̄ C) (the denominator is ≥ E_avg > 0)
-                f * f * (1.0 - c) / ((Vec3::ONE - f * c) * (PI * c))
+                f * f * (1.0 - c) / ((Vec3A::ONE - f * c) * (PI * c))
             }
             // 1/(π ḡ), ḡ = Σ_k F̄ᵏ m_k (> 0 for F̄ > 0: m_2 > 0 wherever C > 0)
             _ => {
                 let average = series(f, Vec4::new(a.y, a.z, a.w, b.x), Vec4::new(b.y, b.z, 0.0, 0.0));
-                Vec3::select(average.cmpgt(Vec3::ZERO), (PI * average).recip(), Vec3::ZERO)
+                Vec3A::select(average.cmpgt(Vec3A::ZERO), (PI * average).recip(), Vec3A::ZERO)
             }
         };
         // the profile mixture of the two rows, by blend weight × mass
-        let rows = &tables.rows;
         let (j, fr) = row;
-        let (lower, upper) = ((1.0 - fr) * rows[j].mass, fr * rows[j + 1].mass);
+        let rows = &tables.rows[j..j + 2];
+        let (lower, upper) = ((1.0 - fr) * rows[0].mass, fr * rows[1].mass);
         let total = lower + upper;
         Ok(ConductorLobes {
-            order_row: node_cell(r * LAST_O, ORDER_TABLE_SIZE),
+            order_row: narrow(order_row),
             upper: if total > 0.0 { upper / total } else { 0.0 },
             mixing: c > 0.0 && total > 0.0,
             fresnel_average: f,
@@ -256,13 +279,18 @@ impl CompensatedMaterial for Conductor {
 
 /// The compensated conductor (see [`Compensated`] for the type; this block, its queries).
 ///
-/// **Cost.** Construction reads the shared tables at α (two rows of averages, one division for
-/// the sampler's rows), F_avg from its table over the complex index ([`Compensation::Walk`] and
-/// [`Compensation::KullaConty`]; F0 for [`Compensation::Turquin`]) and forms the lobe's scale
-/// (a division per channel). Eval adds to the single-scattering eval one (Turquin) or two
-/// (sharing one division) bilinear lookups of 1 − E and, for the walk's orders, of the order
-/// fractions; pdf two lookups of the uniform μ axis per roughness row; sample the lookups of
-/// eval and pdf (measured in `README.md`).
+/// **Cost.** Construction finds the cells of r = √α on the tables' three roughness axes at
+/// once (SIMD lanes), reads the averages at the sub-step of r (one pair of entries) and the two
+/// rows' masses (one division for the sampler's rows), F_avg from its table over the complex
+/// index ([`Compensation::Walk`] and [`Compensation::KullaConty`]: one load of a cell's four
+/// corners per channel, the channels in SIMD lanes; F0 for [`Compensation::Turquin`]) and forms
+/// the lobe's scale (one SIMD division): about 410 instructions for `Walk`, 390 for
+/// `KullaConty` and 235 for `Turquin`, the single-scattering BSDF's own 130 included (GGX gold,
+/// callgrind, `tools/src/bin/profile_per_hit.rs`; `DESIGN.md`, "Speed of the compensated
+/// lobes"). Eval adds to the single-scattering eval one (Turquin) or two (sharing one division)
+/// bilinear lookups of 1 − E and, for the walk's orders, of the order fractions; pdf two lookups
+/// of the uniform μ axis per roughness row; sample the lookups of eval and pdf (measured in
+/// `README.md`).
 ///
 /// **The walk's orders** ([`Compensation::Walk`]) restore each channel's energy from the
 /// walk's per-order energies ([`super::ScatteringOrderTable`], standard error ≤ 1.95e-3 per
@@ -287,7 +315,10 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
 
     /// C = 1 − E_avg of the interpolated E at this α (0 for a Dirac mirror).
     fn complement_average(&self) -> f32 {
-        if self.single.is_specular() { 0.0 } else { self.lobes.tables.0.complement_average(self.lobes.row) }
+        if self.single.is_specular() {
+            return 0.0;
+        }
+        self.lobes.tables.0.complement_average(RoughnessCells::of(self.alpha.sqrt()).step)
     }
 
     /// The albedo ∫ f_ms cos θi dωi of the additive lobe for a view at cos θo = μ, per RGB
@@ -305,7 +336,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
         let x = l.coordinate(mu);
         let c = l.complement(x);
         Some(match self.scheme {
-            Compensation::Walk => c * l.order_series(x),
+            Compensation::Walk => Vec3::from(c * l.order_series(x)),
             _ => self.fresnel_multiple_scattering() * c,
         })
     }
@@ -313,12 +344,12 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel (from its table over the complex index: within
     /// 2e-5 for the crate's presets and 1e-4 for k ≥ 0.3 against quadrature; 1 for F = 1).
     pub fn fresnel_average(&self) -> Vec3 {
-        self.single.surface().material().ior().map_or(Vec3::ONE, fresnel_average)
+        self.single.surface().material().ior().map_or(Vec3::ONE, |ior| fresnel_average(ior).into())
     }
 
     /// F0 = F(μ = 1) per RGB channel.
     pub fn fresnel_normal(&self) -> Vec3 {
-        normal_reflectance(self.single.surface().material())
+        normal_reflectance(self.single.surface().material()).into()
     }
 
     /// Kulla and Conty's F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)) per RGB channel (1 for
@@ -447,7 +478,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         } else {
             // the upper row's profile with its probability (uc rescaled to the added lobe's
             // share without a division)
-            let j = lobes.row.0 + usize::from(uc < p + lobes.upper * (1.0 - p));
+            let j = lobes.row().0 + usize::from(uc < p + lobes.upper * (1.0 - p));
             let wi = lobes.tables.0.rows[j].profile.sample(u)?;
             let (f_cos, pdf) = self.single_at(wo, wi);
             (wi, f_cos, pdf)
@@ -456,7 +487,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         // eval's shared one)
         let xi = lobes.coordinate(wi.z);
         let g_i = lobes.factor(self.scheme, xi, lobes.complement(xi));
-        let f_cos = f_cos_ss + lobes.scale * g_o * g_i * wi.z;
+        let f_cos = f_cos_ss + Vec3::from(lobes.scale * g_o * g_i * wi.z);
         mixture_sample(wo, wi, f_cos, lobes.mixture_pdf(wo.z, pdf_ss, wi.z), 1.0)
     }
 

@@ -10,15 +10,17 @@
 //!   through the direction axis as well as through the rows' blend;
 //! * per roughness row, the sampler of its profile (1 − E(μ)) μ at the row's α, the profile's
 //!   mass and the sampling mixture's probability of single scattering per cell of the uniform
-//!   μ axis (E at the cell's centre).
+//!   μ axis (E at the cell's centre);
+//! * a reference to the table of F_avg over the complex index (shared by the families).
 
+use super::fresnel_average::FresnelAverageTable;
 use super::lobe_profile::{
     DirectionAxis, MU_CELLS, MuProfile, axis_average, mu_cell_centre, mu_cell_masses, profile_average, row_at,
 };
 use super::shared::boxed;
 use crate::albedo::{
     ALBEDO_DIRECTIONS, ALBEDO_ROUGHNESSES, AlbedoTable, Family, ORDER_TABLE_SIZE, ORDER_TABLES,
-    ScatteringOrderTable, node_cell,
+    ScatteringOrderTable, lane_indices, node_cell, node_cells,
 };
 use glam::Vec4;
 use std::sync::OnceLock;
@@ -27,6 +29,8 @@ use std::sync::OnceLock;
 pub(crate) const SUBSTEPS: usize = 32;
 /// Roughness cells of the albedo table.
 const CELLS: usize = ALBEDO_ROUGHNESSES - 1;
+/// Sub-steps of the whole roughness axis r ∈ [0, 1].
+const STEPS: usize = CELLS * SUBSTEPS;
 /// The roughness of the albedo table's row 0 (its α → 0 limit profile).
 const ALPHA_LIMIT: f64 = 1e-6;
 /// The smallest α of the averages (α = 0 at r = 0 has only the limit).
@@ -52,12 +56,40 @@ pub(crate) struct ConductorTables {
     /// The order fractions (φ_2 … φ_6, φ_tail) at the per-order tables' nodes, as two lanes of
     /// four (the last two 0), roughness slowest.
     pub(crate) fractions: Box<[[Vec4; 2]; ORDER_TABLE_SIZE * ORDER_TABLE_SIZE]>,
-    /// [C, m_2, …, m_6, m_tail, 0] at sub-step s of roughness cell j (index
-    /// j (SUBSTEPS + 1) + s): C = 2∫(1 − E) μ dμ and m_k = 2∫(1 − E) φ_k μ dμ of the
-    /// interpolants at that roughness.
-    pub(crate) averages: Box<[[Vec4; 2]; CELLS * (SUBSTEPS + 1)]>,
+    /// [C, m_2, …, m_6, m_tail, 0] at the sub-steps g = 0 … [`STEPS`] of the roughness axis,
+    /// r = g/STEPS (sub-step s = g − j SUBSTEPS of roughness cell j): C = 2∫(1 − E) μ dμ and
+    /// m_k = 2∫(1 − E) φ_k μ dμ of the interpolants at that roughness.
+    pub(crate) averages: Box<[[Vec4; 2]; STEPS + 1]>,
     /// The rows' profiles.
     pub(crate) rows: Box<[Row; ALBEDO_ROUGHNESSES]>,
+    /// The table of F_avg over the complex index (one for every family: a reference here, so
+    /// that a per-hit construction checks one lazily built table, not two).
+    pub(crate) fresnel: &'static FresnelAverageTable,
+}
+
+/// The cells of a roughness r = √α ∈ [0, 1] on the three roughness axes of the tables, each
+/// as (cell, fraction in it): found together, in the SIMD lanes ([`node_cells`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RoughnessCells {
+    /// The albedo table's roughness cell.
+    pub(crate) row: (usize, f32),
+    /// The per-order tables' roughness cell.
+    pub(crate) order_row: (usize, f32),
+    /// The cell of the averages' sub-steps ([`ConductorTables::averages_at`]).
+    pub(crate) step: (usize, f32),
+}
+
+impl RoughnessCells {
+    /// The cells of r ∈ [0, 1].
+    #[inline(always)]
+    pub(crate) fn of(r: f32) -> Self {
+        let last = |nodes: usize| (nodes - 1) as f32;
+        let t =
+            Vec4::splat(r) * Vec4::new(last(ALBEDO_ROUGHNESSES), last(ORDER_TABLE_SIZE), STEPS as f32, 0.0);
+        let (n, f) = node_cells(t, Vec4::new(last(CELLS), last(ORDER_TABLE_SIZE - 1), last(STEPS), 0.0));
+        let [row, order_row, step, _] = lane_indices(n);
+        Self { row: (row, f.x), order_row: (order_row, f.y), step: (step, f.z) }
+    }
 }
 
 /// The α of the albedo table's row j.
@@ -109,8 +141,10 @@ impl ConductorTables {
                 single: core::array::from_fn(|k| 1.0 - row_at(&c, axis.cell(mu_cell_centre(k)))),
             }
         });
-        let averages: Box<[[Vec4; 2]; CELLS * (SUBSTEPS + 1)]> = boxed(|n| {
-            let (j, s) = (n / (SUBSTEPS + 1), n % (SUBSTEPS + 1));
+        let averages: Box<[[Vec4; 2]; STEPS + 1]> = boxed(|g| {
+            // (the last sub-step is the end of the last cell)
+            let j = (g / SUBSTEPS).min(CELLS - 1);
+            let s = g - j * SUBSTEPS;
             let r = (j as f64 + s as f64 / SUBSTEPS as f64) / CELLS as f64;
             let alpha = (r * r).max(ALPHA_FLOOR);
             let f = s as f64 / SUBSTEPS as f64;
@@ -150,26 +184,23 @@ impl ConductorTables {
             v[0] = profile_average(&blended, alpha as f32) as f32;
             [Vec4::from_slice(&v[..4]), Vec4::from_slice(&v[4..])]
         });
-        Self { complement, fractions, averages, rows }
+        Self { complement, fractions, averages, rows, fresnel: FresnelAverageTable::get() }
     }
 
-    /// The averages [C, m_2, …, m_tail, 0] at the roughness cell `(j, f)` of the albedo table
-    /// (linear between the sub-steps).
+    /// The averages [C, m_2, …, m_tail, 0] at the sub-step cell `(g, w)` of the roughness
+    /// axis ([`RoughnessCells::step`]), linear between the sub-steps.
     #[inline(always)]
-    pub(crate) fn averages_at(&self, (j, f): (usize, f32)) -> [Vec4; 2] {
-        let t = f * SUBSTEPS as f32;
-        let s = crate::albedo::floor_index(t, SUBSTEPS - 1);
-        let w = t - s as f32;
-        let n = j * (SUBSTEPS + 1) + s;
-        let (a, b) = (self.averages[n], self.averages[n + 1]);
+    pub(crate) fn averages_at(&self, (g, w): (usize, f32)) -> [Vec4; 2] {
+        let pair = &self.averages[g..g + 2];
+        let (a, b) = (pair[0], pair[1]);
         [a[0].lerp(b[0], w), a[1].lerp(b[1], w)]
     }
 
-    /// C = 1 − E_avg at the roughness cell `(j, f)` of the albedo table: the first of
+    /// C = 1 − E_avg at the sub-step cell `step` of the roughness axis: the first of
     /// [`Self::averages_at`].
     #[inline(always)]
-    pub(crate) fn complement_average(&self, row: (usize, f32)) -> f32 {
-        self.averages_at(row)[0].x
+    pub(crate) fn complement_average(&self, step: (usize, f32)) -> f32 {
+        self.averages_at(step)[0].x
     }
 
     /// 1 − E at the direction cell `(i, fx)` of the roughness cell `(j, fr)`, bilinear.
@@ -212,7 +243,7 @@ mod tests {
             let (mut worst_sum, mut worst_small, mut worst_large): (f64, f64, f64) = (0.0, 0.0, 0.0);
             for j in 0..CELLS {
                 for s in 0..=SUBSTEPS {
-                    let v = t.averages[j * (SUBSTEPS + 1) + s];
+                    let v = t.averages[j * SUBSTEPS + s];
                     let sum: f32 = v[0].y + v[0].z + v[0].w + v[1].x + v[1].y + v[1].z;
                     if v[0].x > 1e-6 {
                         worst_sum = worst_sum.max(f64::from((sum - v[0].x).abs() / v[0].x));
@@ -230,7 +261,7 @@ mod tests {
                         (lo + f64::from(f) * (hi - lo)) as f32
                     });
                     let exact = profile_average(&row, alpha);
-                    let got = f64::from(t.averages_at((j, f))[0].x);
+                    let got = f64::from(t.averages_at((j * SUBSTEPS + s, 0.5))[0].x);
                     let e = (got - exact).abs() / exact;
                     if alpha >= 1e-2 {
                         worst_large = worst_large.max(e);

@@ -3,10 +3,10 @@
 //! per hit needs of its Fresnel term, in a few nanoseconds instead of a quadrature.
 
 use super::shared::boxed;
-use crate::albedo::node_cell;
+use crate::albedo::{lane_indices, node_cells};
 use crate::fresnel::ComplexIor;
 use crate::special::GAUSS_LEGENDRE_16;
-use glam::Vec3;
+use glam::{Vec3A, Vec4};
 use std::sync::OnceLock;
 
 /// Nodes per axis of the table.
@@ -51,8 +51,8 @@ pub(crate) fn quadrature(eta: f64, k: f64, panels: usize) -> f64 {
 /// The Schlick-like base the table stores the residual of: F0 + (1 − F0)/21, the average of
 /// Schlick's approximation with the exact F0 ([`ComplexIor::normal_reflectance`]).
 #[inline(always)]
-fn base(f0: Vec3) -> Vec3 {
-    f0 + (Vec3::ONE - f0) * (1.0 / 21.0)
+fn base(f0: Vec3A) -> Vec3A {
+    f0 + (Vec3A::ONE - f0) * (1.0 / 21.0)
 }
 
 /// The residual F_avg − base at the table's node (i, j): η = u/(1 − u), k = 2v/(1 − v) with
@@ -69,10 +69,48 @@ fn node(i: usize, j: usize) -> f32 {
     (quadrature(eta, k, PANELS) - (f0 + (1.0 - f0) / 21.0)) as f32
 }
 
-/// The table of residuals, η slowest (one array per η node).
-fn table() -> &'static [[f32; NODES]; NODES] {
-    static TABLE: OnceLock<Box<[[f32; NODES]; NODES]>> = OnceLock::new();
-    TABLE.get_or_init(|| boxed(|i| core::array::from_fn(|j| node(i, j))))
+/// Cells per axis of the table.
+const CELLS: usize = NODES - 1;
+
+/// The residuals of the table, stored for its lookup: for each η cell i and k node j the pair
+/// (node(i, j), node(i + 1, j)), j fastest, so that the four corners of a cell (i, j) are four
+/// consecutive floats [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]: one 16-byte load per
+/// channel.
+#[derive(Debug)]
+pub(crate) struct FresnelAverageTable {
+    pairs: Box<[f32; CELLS * NODES * 2]>,
+}
+
+impl FresnelAverageTable {
+    /// The table, built on first use.
+    #[inline]
+    pub(crate) fn get() -> &'static Self {
+        static TABLE: OnceLock<FresnelAverageTable> = OnceLock::new();
+        TABLE.get_or_init(|| {
+            let nodes: Box<[[f32; NODES]; NODES]> = boxed(|i| core::array::from_fn(|j| node(i, j)));
+            Self { pairs: boxed(|n| nodes[n / (2 * NODES) + n % 2][(n / 2) % NODES]) }
+        })
+    }
+
+    /// F_avg of `ior` per channel: see [`fresnel_average`]. Written for a short dependency chain
+    /// (the construction waits on it): the cells' first floats as one product and one sum.
+    #[inline(always)]
+    pub(crate) fn lookup(&self, ior: &ComplexIor) -> Vec3A {
+        let (eta, k) = (ior.eta().extend(0.0), ior.k().extend(0.0));
+        let last_cell = Vec4::splat((CELLS - 1) as f32);
+        // (u = η/(1 + η) ≤ 1 first: LAST η would overflow for η > f32::MAX/LAST)
+        let (iu, fu) = node_cells(eta / (Vec4::ONE + eta) * LAST, last_cell);
+        let (iv, fv) = node_cells(k / (Vec4::splat(K_SCALE) + k) * LAST, last_cell);
+        // each channel's first float, 2 NODES iu + 2 iv: whole numbers below 2²², exact
+        let [s0, s1, s2, _] = lane_indices(iu * (2 * NODES) as f32 + iv * 2.0);
+        let [q0, q1, q2] = [s0, s1, s2].map(|n| Vec4::from_slice(&self.pairs[n..n + 4]));
+        // the corners of the three channels, lane by lane
+        let (a0, b0) = (Vec3A::new(q0.x, q1.x, q2.x), Vec3A::new(q0.y, q1.y, q2.y));
+        let (a1, b1) = (Vec3A::new(q0.z, q1.z, q2.z), Vec3A::new(q0.w, q1.w, q2.w));
+        let (fu, fv) = (Vec3A::from_vec4(fu), Vec3A::from_vec4(fv));
+        let (low, high) = (a0 + fv * (a1 - a0), b0 + fv * (b1 - b0));
+        (base(ior.normal_reflectance()) + (low + fu * (high - low))).clamp(Vec3A::ZERO, Vec3A::ONE)
+    }
 }
 
 /// F_avg = 2∫₀¹ F(μ) μ dμ per RGB channel of the conductor of complex index `ior`: the
@@ -82,29 +120,20 @@ fn table() -> &'static [[f32; NODES]; NODES] {
 /// 1024-point quadrature (the unit test below): at most 2e-5 for the crate's metal presets,
 /// 1e-4 for k ≥ 0.3; dielectric-like indices (k < 0.3) up to 2e-3 for η ≥ 1 and 1e-2 for
 /// η < 1, where the Fresnel term has a sharp feature at the critical angle (measured 1.1e-5,
-/// 8.6e-5, 1.3e-3 and 8.3e-3). A per-hit lookup
-/// (two loads of adjacent nodes per channel): a bicubic stencil would be 30 times as accurate
-/// for metals at about four times the instructions, for an input of the compensated lobes whose
-/// own albedo error against the walk is 2.5e-3 and above.
+/// 8.6e-5, 1.3e-3 and 8.3e-3). A per-hit lookup (one load of a cell's four corners per
+/// channel; the coordinates, cells and blends of the three channels in SIMD lanes): a bicubic
+/// stencil would be 30 times as accurate for metals at about four times the instructions, for
+/// an input of the compensated lobes whose own albedo error against the walk is 2.5e-3 and
+/// above.
 #[inline]
-pub(crate) fn fresnel_average(ior: &ComplexIor) -> Vec3 {
-    let (eta, k) = (ior.eta(), ior.k());
-    let u = eta / (Vec3::ONE + eta) * LAST;
-    let v = k / (Vec3::splat(K_SCALE) + k) * LAST;
-    let t = table();
-    let residual = |c: usize| {
-        let ((i, fu), (j, fv)) = (node_cell(u[c], NODES), node_cell(v[c], NODES));
-        let (a, b) = (&t[i], &t[i + 1]);
-        let (low, high) = (a[j] + fv * (a[j + 1] - a[j]), b[j] + fv * (b[j + 1] - b[j]));
-        low + fu * (high - low)
-    };
-    (base(ior.normal_reflectance()) + Vec3::new(residual(0), residual(1), residual(2)))
-        .clamp(Vec3::ZERO, Vec3::ONE)
+pub(crate) fn fresnel_average(ior: &ComplexIor) -> Vec3A {
+    FresnelAverageTable::get().lookup(ior)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     /// The stated accuracy: the lookup against 64 panels of 16-point Gauss–Legendre, at the
     /// presets and at 4000 pseudo-random indices (η ∈ [0.02, 20], k ∈ [1e-3, 30] log-uniform,
@@ -118,7 +147,8 @@ mod tests {
         };
         let mut presets: f32 = 0.0;
         for ior in [ComplexIor::GOLD, ComplexIor::COPPER, ComplexIor::ALUMINIUM, ComplexIor::SILVER] {
-            presets = presets.max((fresnel_average(&ior) - exact(ior.eta(), ior.k())).abs().max_element());
+            presets = presets
+                .max((Vec3::from(fresnel_average(&ior)) - exact(ior.eta(), ior.k())).abs().max_element());
         }
         let mut state = 0x853c_49e6_748f_ea9b_u64;
         let mut next = || {

@@ -69,14 +69,15 @@ impl ComplexIor {
         })
     }
 
-    /// F0 = F(cos θ = 1) = ((η − 1)² + k²)/((η + 1)² + k²) per channel: the Fresnel term at
-    /// normal incidence in closed form (one division; the general expression of
+    /// F0 = F(cos θ = 1) = ((η − 1)² + k²)/((η + 1)² + k²) per channel (in SIMD lanes): the
+    /// Fresnel term at normal incidence in closed form (one division; the general expression of
     /// [`fresnel_conductor`] reduces to it at cos θ = 1).
     #[must_use]
     #[inline(always)]
-    pub(crate) fn normal_reflectance(&self) -> Vec3 {
-        let k2 = self.k * self.k;
-        let (m, p) = (self.eta - Vec3::ONE, self.eta + Vec3::ONE);
+    pub(crate) fn normal_reflectance(&self) -> Vec3A {
+        let (eta, k) = (Vec3A::from(self.eta), Vec3A::from(self.k));
+        let k2 = k * k;
+        let (m, p) = (eta - Vec3A::ONE, eta + Vec3A::ONE);
         (m * m + k2) / (p * p + k2)
     }
 

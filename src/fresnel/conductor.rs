@@ -39,17 +39,23 @@ impl ComplexIor {
         }
     }
 
-    /// A complex IOR with real part `eta` > 0 and extinction `k` ≥ 0 per channel.
+    /// The largest accepted η and k: beyond any material (the Fresnel term is 1 within 4e-6
+    /// there), and far enough below f32's range that the squares of the Fresnel term's
+    /// constants (η² k² ~ 10²⁴) stay finite.
+    pub const MAX: f32 = 1e6;
+
+    /// A complex IOR with real part `eta` ∈ (0, [`Self::MAX`]] and extinction
+    /// `k` ∈ [0, [`Self::MAX`]] per channel.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if a component of `eta` is not finite and > 0, or a
-    /// component of `k` is not finite and ≥ 0.
+    /// [`Error::InvalidParameter`] if a component of `eta` or `k` is outside its range (NaN
+    /// and infinities included).
     #[inline]
     pub fn new(eta: Vec3, k: Vec3) -> Result<Self, Error> {
         // the three channels of each condition in one SIMD comparison (NaN fails every one); the
         // error names the first bad channel
-        let (e, kk, inf) = (Vec3A::from(eta), Vec3A::from(k), Vec3A::INFINITY);
-        let valid = e.cmpgt(Vec3A::ZERO) & e.cmplt(inf) & kk.cmpge(Vec3A::ZERO) & kk.cmplt(inf);
+        let (e, kk, max) = (Vec3A::from(eta), Vec3A::from(k), Vec3A::splat(Self::MAX));
+        let valid = e.cmpgt(Vec3A::ZERO) & e.cmple(max) & kk.cmpge(Vec3A::ZERO) & kk.cmple(max);
         if !valid.all() {
             return Err(Self::invalid(eta, k));
         }
@@ -59,13 +65,22 @@ impl ComplexIor {
     /// The error of an index [`Self::new`] rejects: its first channel out of range.
     #[cold]
     fn invalid(eta: Vec3, k: Vec3) -> Error {
-        let eta_error = eta.to_array().into_iter().find_map(|e| Error::check_positive("eta", e).err());
-        let k_error = || k.to_array().into_iter().find_map(|e| Error::check_non_negative("k", e).err());
+        let eta_error = eta
+            .to_array()
+            .into_iter()
+            .find(|&e| !(e > 0.0 && e <= Self::MAX))
+            .map(|value| Error::InvalidParameter { name: "eta", value, expected: "in (0, 1e6]" });
+        let k_error = || {
+            k.to_array()
+                .into_iter()
+                .find(|&v| !(0.0..=Self::MAX).contains(&v))
+                .map(|value| Error::InvalidParameter { name: "k", value, expected: "in [0, 1e6]" })
+        };
         // one of the two exists (the conditions are those of `new`); a NaN η otherwise
         eta_error.or_else(k_error).unwrap_or(Error::InvalidParameter {
             name: "eta",
             value: f32::NAN,
-            expected: "finite and > 0",
+            expected: "in (0, 1e6]",
         })
     }
 

@@ -34,7 +34,7 @@ pub struct Chi2Grid {
     /// Maximum depth of the adaptive quadrature per cell.
     pub max_depth: u32,
     /// Splits of every cell before the adaptive test (see
-    /// [`integrate_refined`](crate::quadrature::integrate_refined)): 0 except for densities
+    /// [`crate::quadrature::integrate_refined`]): 0 except for densities
     /// with a jump along a curve that the cells do not follow.
     pub min_depth: u32,
 }

@@ -344,19 +344,27 @@ impl CompensatedMaterial for Dielectric {
         // reciprocity: c_out ΔT̄'_out = η² c_in ΔT̄'_in (n_out = 1, n_in = η), both c ≤ 1
         let (m_out, m_in) = (averages[0].y, eta * eta * averages[1].y);
         let c = if m_out > 0.0 && m_in > 0.0 {
-            let ratio = m_in / m_out;
-            lobes.mismatch = 1.0 / ratio - 1.0;
-            if ratio >= 1.0 { [1.0, 1.0 / ratio] } else { [ratio, 1.0] }
+            // (one division: the ratio's reciprocal from the same quotient)
+            let (ratio, inverse) = (m_in / m_out, m_out / m_in);
+            lobes.mismatch = inverse - 1.0;
+            if ratio >= 1.0 { [1.0, inverse] } else { [ratio, 1.0] }
         } else {
             [0.0, 0.0]
         };
         lobes.c = c;
-        for view in 0..2 {
-            let reflected = averages[view].x - c[view] * averages[view].y;
-            let t_other = averages[1 - view].y;
-            lobes.scales[view][0] = if reflected > 0.0 { 1.0 / (PI * reflected) } else { 0.0 };
-            lobes.transmitted_scale[view] = if t_other > 0.0 { c[view] / (PI * t_other) } else { 0.0 };
-        }
+        // the four normalizations in one division: 1/(π ḡ_a) and c_a/(π ΔT̄'_b) per view side
+        let denominators = Vec4::new(
+            averages[0].x - c[0] * averages[0].y,
+            averages[1].x - c[1] * averages[1].y,
+            averages[1].y,
+            averages[0].y,
+        );
+        let numerators = Vec4::new(1.0, 1.0, c[0], c[1]);
+        let positive = denominators.cmpgt(Vec4::ZERO);
+        let scales = Vec4::select(positive, numerators / (PI * denominators), Vec4::ZERO);
+        lobes.scales[0][0] = scales.x;
+        lobes.scales[1][0] = scales.y;
+        lobes.transmitted_scale = [scales.z, scales.w];
         // the light profiles' rows: reflection on the view's side, transmission on the other
         let n = row.0 + l * N;
         for view in 0..2 {
@@ -385,9 +393,9 @@ impl DielectricLobes {
     /// and from inside η².
     #[inline(always)]
     fn with_transport(mut self, transport: Transport) -> Self {
-        let eta = self.transmitted_eta[0];
+        let [eta, inv_eta] = self.transmitted_eta;
         let factors = match transport {
-            Transport::Radiance => [1.0 / (eta * eta), eta * eta],
+            Transport::Radiance => [inv_eta * inv_eta, eta * eta],
             Transport::Importance => [1.0, 1.0],
         };
         for ((scales, transmitted), factor) in self.scales.iter_mut().zip(self.transmitted_scale).zip(factors)

@@ -168,7 +168,8 @@ impl Dielectric {
         if len_sq.is_nan() || len_sq <= degenerate * degenerate {
             return 0.0;
         }
-        let h = if sum.z > 0.0 { sum } else { -sum };
+        // turned up by an exact ±1 factor (a select cost 8 instructions); h.z = ±0 fails below
+        let h = sum * 1.0f64.copysign(sum.z);
         let (k_i, k_o) = (i.dot(h), -o.dot(h));
         if !(h.z > 0.0 && k_i > 0.0 && k_o > 0.0) {
             return 0.0;

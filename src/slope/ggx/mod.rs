@@ -162,7 +162,7 @@ impl Ggx {
         let axy = ax * ay;
         (1e-60..=1e60)
             .contains(&axy)
-            .then(|| (h.x * h.x * (ay * ay) + h.y * h.y * (ax * ax) + h.z * h.z * (axy * axy), axy))
+            .then_some((h.x * h.x * (ay * ay) + h.y * h.y * (ax * ax) + h.z * h.z * (axy * axy), axy))
     }
 
     /// The stretched-space primitive of [`MicrosurfaceSlope::sample_d_wi`] (supplement §2.1,

@@ -33,7 +33,7 @@
 
 use super::{Bsdf, MicrofacetBsdf, SpecularLimit, Technique};
 use crate::error::Error;
-use crate::fresnel::{fresnel_dielectric_cosines_of, reflectance_of};
+use crate::fresnel::{fresnel_dielectric_cosines_of, reflectance_of, transmittance_dielectric_cosines_of};
 use crate::lanes::{LaneLoop, Lanes, V3, dispatch};
 use crate::material::{LaneMaterial, Material, g2_over_g1_of, reflectance_scaled_of};
 use crate::single_scattering::VISIBLE_SUM_MARGIN;
@@ -362,7 +362,7 @@ fn transmission_density<L: Lanes>(ax: L, ay: L, eta: L, wo: V3<L>, wi: V3<L>) ->
     let invalid = h.z.lt(-margin * len) | cos_ih.lt(-margin) | cos_oh.gt(margin);
     let d = d_of_sum(ax, ay, h, L::lit(core::f32::consts::FRAC_1_PI));
     let (lambda, area) = lambda_and_area_of(ax, ay, wo);
-    let transmittance = L::lit(1.0) - fresnel_dielectric_cosines_of(cos_ih, -cos_oh, eta);
+    let transmittance = transmittance_dielectric_cosines_of(cos_ih, -cos_oh, eta);
     let d_wi = cos_ih * d / area;
     let pdf = eta * eta * transmittance * d_wi * (-cos_oh) / len_sq;
     let sane = len.gt(L::lit(DIELECTRIC_LANES_MIN_CONTRAST)) & len_sq.ge(L::lit(F32_DENSITY_MIN_SUM));

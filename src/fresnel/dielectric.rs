@@ -57,3 +57,20 @@ pub(crate) fn fresnel_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) -> L {
     let (rs, rp) = (num_s / den_s, num_p / den_p);
     L::select(den_s.le(zero) | den_p.le(zero), L::lit(1.0), L::lit(0.5) * (rs * rs + rp * rp))
 }
+
+/// The unpolarized dielectric transmittance 1 − F of [`fresnel_dielectric_cosines_of`] for
+/// every lane type, without its cancellation where F is close to 1 (grazing incidence):
+/// 1 − Rs² = 4ηct/(c + ηt)² and 1 − Rp² = 4ηct/(ηc + t)², so
+/// 1 − F = 2ηct (1/(c + ηt)² + 1/(ηc + t)²): a few ulps relative to the transmittance itself
+/// (1 − F formed by subtraction is a few ulps of 1). Homogeneous of degree 0 in (c, t), so
+/// cosines given with a common positive scale serve as well. 0 where a denominator is not
+/// positive (F = 1 there).
+#[must_use]
+#[inline(always)]
+pub(crate) fn transmittance_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) -> L {
+    let (den_s, den_p) = (c + eta * t, eta * c + t);
+    let zero = L::lit(0.0);
+    let two_eta_ct = L::lit(2.0) * eta * c * t;
+    let value = two_eta_ct / (den_s * den_s) + two_eta_ct / (den_p * den_p);
+    L::select(den_s.le(zero) | den_p.le(zero), zero, value)
+}

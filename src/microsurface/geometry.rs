@@ -333,9 +333,9 @@ fn exponential(u: f32) -> f64 {
 ///
 /// ln(1 − eˣ) without cancellation on either side of x = −ln 2 (Mächler 2012, “Accurately
 /// computing log(1 − exp(−|a|))”; in f64 and inline, `ln_1m_exp_f32`): ln(−x) plus a
-/// series near the top (x → 0⁻, 1 − C¹ small) and ln_1p(−eˣ) below (C¹ < ½, the result
-/// small). Within 0.51 f32 ulp for every hit depth x ∈ [−f32::MAX, −f32::MIN_POSITIVE]; −0
-/// where eˣ underflows (x < −104).
+/// series near the top (x → 0⁻, 1 − C¹ small) and ln of the rounded 1 − eˣ plus its rounding
+/// error below (C¹ < ½, the result small). Within 0.51 f32 ulp for every hit depth
+/// x ∈ [−f32::MAX, −f32::MIN_POSITIVE]; −0 where eˣ underflows (x < −104).
 #[inline(always)]
 pub(crate) fn flip_ln_c1(ln_c1: f32) -> f32 {
     ln_1m_exp_f32(ln_c1)

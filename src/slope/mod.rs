@@ -279,6 +279,19 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
         (0.25 * self.d64_of_sum_unchecked(h) / f64::from(area)) as f32
     }
 
+    /// D(ωh)/(|h|⁴ A) for the direction ωh = h/|h| of a vector `h` given unnormalized (0 for
+    /// h.z ≤ 0) and A = `area` > 0, in double precision: the slope's factor of a transmission's
+    /// density from the unnormalized refraction half vector, where |h|⁴ comes from the Jacobian
+    /// (the dielectric walk's next-event estimate, A(ωi) known). No argument check
+    /// (crate-internal hot path). The default divides [`Self::d64_of_sum_unchecked`] by |h|⁴A;
+    /// [`Ggx`] and [`Beckmann`] evaluate their D forms of degree −4 in h directly (one
+    /// division for GGX, two for Beckmann, no |h|).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn d64_over_len4_area_unchecked(&self, h: DVec3, area: f32) -> f64 {
+        d64_over_len4_area(self, h, area)
+    }
+
     /// The core of [`Self::d_wi64`]: no argument check. The default is the Smith form
     /// ⟨ωi, ωm⟩ D(ωm)/A(ωi) in f64.
     #[doc(hidden)]
@@ -334,6 +347,14 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     fn mirror_sampling_area_unchecked(&self, wi: Vec3) -> f32 {
         self.projected_area_unchecked(wi)
     }
+}
+
+/// The default [`MicrosurfaceSlope::d64_over_len4_area_unchecked`]:
+/// [`MicrosurfaceSlope::d64_of_sum_unchecked`]/(|h|⁴ A) in f64.
+#[inline(always)]
+pub(crate) fn d64_over_len4_area<S: MicrosurfaceSlope>(slope: &S, h: DVec3, area: f32) -> f64 {
+    let len_sq = h.length_squared();
+    slope.d64_of_sum_unchecked(h) / (len_sq * len_sq * f64::from(area))
 }
 
 /// The default D_ωi(ωm) in double precision, cos⟨ωi, ωm⟩ D(ωm)/A(ωi), without the argument check.

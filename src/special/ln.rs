@@ -47,18 +47,6 @@ pub(crate) fn ln_f32(x: f32) -> f32 {
     ln(f64::from(x)) as f32
 }
 
-/// ln(1 + y) for y ∈ (−1, 1]: ln_1p_reduced of y itself where 1 + y ∈ [√½, √2) (so that a
-/// small y keeps its relative accuracy), [`ln`] of 1 + y elsewhere (where ln(1 + y) is of
-/// order one). Relative error below 1e-10.
-#[inline(always)]
-pub(crate) fn ln_1p(y: f64) -> f64 {
-    if y > core::f64::consts::FRAC_1_SQRT_2 - 1.0 && y < core::f64::consts::SQRT_2 - 1.0 {
-        ln_1p_reduced(y)
-    } else {
-        ln(1.0 + y)
-    }
-}
-
 /// eˣ of an f32 x ≤ 0 through [`exp_nonpositive`], rounded once to f32 (0 below −103.98,
 /// where eˣ is below half the smallest f32 subnormal; NaN for NaN).
 #[inline(always)]
@@ -71,7 +59,10 @@ pub(crate) fn exp_f32(x: f32) -> f32 {
 /// - x ≥ −ln 2: ln(−x) + ln((1 − eˣ)/(−x)), the second term by its series
 ///   x/2 + Σ B₂ₙ x²ⁿ/(2n (2n)!) = x/2 + x²/24 − x⁴/2880 + x⁶/181440 − x⁸/9676800 (truncation
 ///   ≤ 5.4e-11 absolute, against a result of magnitude ≥ ln 2);
-/// - x < −ln 2: ln(1 + y) with y = −eˣ ∈ [−½, 0) ([`ln_1p`], relative to its small result).
+/// - x < −ln 2: with y = eˣ < ½ and w = 1 − y rounded (w ∈ (½, 1]), ln w plus w's rounding
+///   error δ = (1 − w) − y (both subtractions exact), since ln(1 − y) = ln w + ln(1 + δ/w): δ
+///   stands for ln(1 + δ/w) within 2|δ|y + 2δ², below 2.3e-16 of |ln(1 − y)| ≥ y. One [`ln`]
+///   and no branch on y (a walk's depths fall on both sides of any split of y).
 ///
 /// −0 where eˣ is below f32's smallest subnormal.
 #[inline(always)]
@@ -79,11 +70,17 @@ pub(crate) fn ln_1m_exp_f32(x: f32) -> f32 {
     let x = f64::from(x);
     if x >= -LN_2 {
         let x2 = x * x;
-        let series =
-            x * (0.5 + x * (1.0 / 24.0 + x2 * (-1.0 / 2880.0 + x2 * (1.0 / 181_440.0 - x2 / 9_676_800.0))));
+        let series = x
+            * (0.5
+                + x * (1.0 / 24.0
+                    + x2 * (-1.0 / 2880.0 + x2 * (1.0 / 181_440.0 - x2 * (1.0 / 9_676_800.0)))));
         (ln(-x) + series) as f32
     } else {
-        ln_1p(-exp_nonpositive(x)) as f32
+        // 1 − y rounded to w ∈ (½, 1] and its rounding error (1 − w) − y (both subtractions
+        // exact); in this order −0 where y = 0
+        let y = exp_nonpositive(x);
+        let w = 1.0 - y;
+        (-((y - (1.0 - w)) - ln(w))) as f32
     }
 }
 
@@ -186,20 +183,6 @@ mod tests {
         eprintln!("ln: relative {worst:.2e}, f32 {worst_f32:.3} ulp");
         assert!(worst < 1e-10, "relative error {worst:e}");
         assert!(worst_f32 < 0.51, "{worst_f32} ulp");
-    }
-
-    /// ln(1 + y) against the f64 library on (−1, 1], relative to its (small) result.
-    #[test]
-    fn ln_1p_is_accurate() {
-        let mut next = uniforms(0x2545_f491_4f6c_dd1d);
-        let mut worst = 0.0f64;
-        for _ in 0..400_000 {
-            let magnitude = (10.0f64).powf(-40.0 * next());
-            let y = if next() < 0.5 { -magnitude * 0.999_999 } else { magnitude };
-            worst = worst.max(rel(ln_1p(y), y.ln_1p()));
-        }
-        eprintln!("ln_1p: relative {worst:.2e}");
-        assert!(worst < 1e-10, "relative error {worst:e}");
     }
 
     /// eˣ in f32 ([`exp_f32`]) within 0.51 ulp of the exact value for normal results, from

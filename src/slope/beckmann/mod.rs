@@ -224,6 +224,16 @@ impl MicrosurfaceSlope for Beckmann {
         self.d_double(wm)
     }
 
+    /// D(ωh)/(|h|⁴ A): `d_double` of h itself, whose form exp(−(h.x²/αx² + h.y²/αy²)/h.z²)/
+    /// (π αx αy h.z⁴) is D(ωh)/|h|⁴ for an unnormalized h (its exponent is of degree 0 in h,
+    /// h.z⁴ = ωh.z⁴ |h|⁴), divided by A: two divisions, no square root. Its cut at
+    /// h.z < 1e-100 returns 0 only where D(ωh) vanishes (for |h| ≥ 1e-6, the walk's
+    /// refraction half vectors, the exponent exceeds 1e100 there).
+    #[inline]
+    fn d64_over_len4_area_unchecked(&self, h: DVec3, area: f32) -> f64 {
+        self.d_double(h) / f64::from(area)
+    }
+
     /// Formed from the fits of [`lambda_from_fits`] (within 0.51 f32 ulp of Λ, saturating at
     /// ±`f32::MAX`); [`MicrosurfaceSlope::lambda64`] keeps the double-precision forms.
     #[inline]

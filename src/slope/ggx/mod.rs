@@ -1,7 +1,7 @@
 //! The GGX (Trowbridge–Reitz) slope distribution.
 
 use super::{
-    MicrosurfaceSlope, check_roughness, is_direction, is_uniform, projected_roughness_sq,
+    MicrosurfaceSlope, check_roughness, d64_over_len4_area, is_direction, is_uniform, projected_roughness_sq,
     projected_roughness_sq_of, reflection_density64_over, smith_d_wi64,
 };
 use crate::error::Error;
@@ -153,6 +153,18 @@ pub(crate) fn reflection_density_of<L: Lanes>(ax: L, ay: L, h: V3<L>, area: L) -
 }
 
 impl Ggx {
+    /// t′ = h.x²αy² + h.y²αx² + h.z²αx²αy² (t αx²αy² with t = h.x²/αx² + h.y²/αy² + h.z² of
+    /// an unnormalized h) in f64 and αx αy, for the densities' forms with one division; `None`
+    /// where αx αy is outside [1e-60, 1e60] (t′² could leave f64's normal range there).
+    #[inline(always)]
+    fn scaled_t(&self, h: DVec3) -> Option<(f64, f64)> {
+        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
+        let axy = ax * ay;
+        (1e-60..=1e60)
+            .contains(&axy)
+            .then_some((h.x * h.x * (ay * ay) + h.y * h.y * (ax * ax) + h.z * h.z * (axy * axy), axy))
+    }
+
     /// The stretched-space primitive of [`MicrosurfaceSlope::sample_d_wi`] (supplement §2.1,
     /// `sampleP22_11`): visible slopes of the distribution stretched to α = 1, seen from
     /// (sin θ, 0, cos θ), θ ∈ [0, π]; rotating them into the azimuth of the stretched ωi and
@@ -250,23 +262,39 @@ impl MicrosurfaceSlope for Ggx {
     }
 
     /// D(ĥ)/(4A) = (|h|²/t)²/(4π αx αy A) written with t′ = t αx²αy² = h.x²αy² + h.y²αx² +
-    /// h.z²αx²αy² as |h|⁴ (αx αy)³/(4π t′² A): one division instead of five, the same sums of
-    /// squares (a few f64 ulps). For αx αy outside [1e-60, 1e60], where t′² could leave f64's
-    /// normal range, the default form.
+    /// h.z²αx²αy² as |h|⁴ (αx αy)³/(4π t′² A) ([`Ggx::scaled_t`]): one division instead of
+    /// five, the same sums of squares (a few f64 ulps). For αx αy outside [1e-60, 1e60], where
+    /// t′² could leave f64's normal range, the default form.
     #[inline]
     fn reflection_density_of_sum_unchecked(&self, h: DVec3, area: f32) -> f32 {
-        let (ax, ay) = (f64::from(self.alpha_x), f64::from(self.alpha_y));
-        let axy = ax * ay;
-        if !(1e-60..=1e60).contains(&axy) {
+        let Some((t, axy)) = self.scaled_t(h) else {
             return (0.25 * self.d64_of_sum_unchecked(h) / f64::from(area)) as f32;
-        }
+        };
         if h.z <= 0.0 {
             return 0.0;
         }
-        let t = h.x * h.x * (ay * ay) + h.y * h.y * (ax * ax) + h.z * h.z * (axy * axy);
         let len_sq = h.length_squared();
         let numerator = (len_sq * len_sq) * (axy * axy * axy);
         (numerator / (4.0 * core::f64::consts::PI * (t * t) * f64::from(area))) as f32
+    }
+
+    /// D(ĥ)/(|h|⁴A) = 1/(π αx αy t² A) (t of [`Self::d64_of_sum_unchecked`]), written as
+    /// (αx αy)³/(π t′² A) with t′ = t αx²αy² ([`Ggx::scaled_t`]): one division, no |h|², a
+    /// few f64 ulps. The default form where αx αy is outside [1e-60, 1e60] or the quotient is
+    /// not a normal f64 (t′ ≈ |h|² max(αx, αy, αx αy)² squared overflows f64 only for |h|, an
+    /// index η, beyond ~1e70 at moderate α).
+    #[inline]
+    fn d64_over_len4_area_unchecked(&self, h: DVec3, area: f32) -> f64 {
+        if h.z <= 0.0 {
+            return 0.0;
+        }
+        if let Some((t, axy)) = self.scaled_t(h) {
+            let d = (axy * axy * axy) / (core::f64::consts::PI * (t * t) * f64::from(area));
+            if d.is_normal() {
+                return d;
+            }
+        }
+        d64_over_len4_area(self, h, area)
     }
 
     /// The f32 form's cancellation-free q / (2z(z + √(z² + q))) in f64.

@@ -243,28 +243,36 @@ impl CompensatedMaterial for Conductor {
         let [a, b] = tables.averages_at(step);
         let c = a.x;
         let f = conductor.ior().map_or(Vec3A::ONE, |ior| tables.fresnel.lookup(ior));
-        let scale = match scheme {
+        // the lobe's scale as a quotient per channel
+        let (numerator, denominator) = match scheme {
             // no energy lost (every node of the row is 1): nothing to restore
-            _ if c <= 0.0 => Vec3A::ZERO,
-            Compensation::KullaConty => {
-                // F_ms/(π C), F_ms = F̄² E_avg/(1 − F̄ C) (the denominator is ≥ E_avg > 0)
-                f * f * (1.0 - c) / ((Vec3A::ONE - f * c) * (PI * c))
-            }
+            _ if c <= 0.0 => (Vec3A::ZERO, Vec3A::ONE),
+            // F_ms/(π C), F_ms = F̄² E_avg/(1 − F̄ C) (the denominator is ≥ E_avg > 0)
+            Compensation::KullaConty => (f * f * (1.0 - c), (Vec3A::ONE - f * c) * (PI * c)),
             // 1/(π ḡ), ḡ = Σ_k F̄ᵏ m_k (> 0 for F̄ > 0: m_2 > 0 wherever C > 0)
             _ => {
                 let average = series(f, Vec4::new(a.y, a.z, a.w, b.x), Vec4::new(b.y, b.z, 0.0, 0.0));
-                Vec3A::select(average.cmpgt(Vec3A::ZERO), (PI * average).recip(), Vec3A::ZERO)
+                let positive = average.cmpgt(Vec3A::ZERO);
+                (
+                    Vec3A::select(positive, Vec3A::ONE, Vec3A::ZERO),
+                    Vec3A::select(positive, PI * average, Vec3A::ONE),
+                )
             }
         };
-        // the profile mixture of the two rows, by blend weight × mass
+        // the profile mixture of the two rows, by blend weight × mass: the upper row's
+        // probability, in the scale's division (one SIMD division for both)
         let (j, fr) = row;
         let rows = &tables.rows[j..j + 2];
         let (lower, upper) = ((1.0 - fr) * rows[0].mass, fr * rows[1].mass);
         let total = lower + upper;
+        let has_mass = total > 0.0;
+        let (upper, total) = if has_mass { (upper, total) } else { (0.0, 1.0) };
+        let quotient = numerator.extend(upper) / denominator.extend(total);
+        let scale = Vec3A::from_vec4(quotient);
         Ok(ConductorLobes {
             order_row: narrow(order_row),
-            upper: if total > 0.0 { upper / total } else { 0.0 },
-            mixing: c > 0.0 && total > 0.0,
+            upper: quotient.w,
+            mixing: c > 0.0 && has_mass,
             fresnel_average: f,
             scale,
             ..lobes
@@ -281,10 +289,10 @@ impl CompensatedMaterial for Conductor {
 ///
 /// **Cost.** Construction finds the cells of r = √α on the tables' three roughness axes at
 /// once (SIMD lanes), reads the averages at the sub-step of r (one pair of entries) and the two
-/// rows' masses (one division for the sampler's rows), F_avg from its table over the complex
-/// index ([`Compensation::Walk`] and [`Compensation::KullaConty`]: one load of a cell's four
-/// corners per channel, the channels in SIMD lanes; F0 for [`Compensation::Turquin`]) and forms
-/// the lobe's scale (one SIMD division): about 410 instructions for `Walk`, 390 for
+/// rows' masses, F_avg from its table over the complex index ([`Compensation::Walk`] and
+/// [`Compensation::KullaConty`]: one load of a cell's four corners per channel, the channels in
+/// SIMD lanes; F0 for [`Compensation::Turquin`]) and forms the lobe's scale and the sampler's
+/// row probability (one SIMD division for both): about 410 instructions for `Walk`, 390 for
 /// `KullaConty` and 235 for `Turquin`, the single-scattering BSDF's own 130 included (GGX gold,
 /// callgrind, `tools/src/bin/profile_per_hit.rs`; `DESIGN.md`, "Speed of the compensated
 /// lobes"). Eval adds to the single-scattering eval one (Turquin) or two (sharing one division)

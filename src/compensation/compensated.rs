@@ -96,8 +96,8 @@ pub trait CompensatedMaterial: Material + SpecularLimit {
 /// scalars: no per-instance table, no heap allocation, so that a renderer builds it at
 /// every hit from textured parameters, as pbrt-v4's `GetBxDF` (the cost of construction
 /// against the calls of a prebuilt BSDF is in `DESIGN.md`, "Speed of the compensated lobes").
-/// The type is `Copy` and small: `size_of` is 224 bytes for a GGX conductor, 272 for GGX glass,
-/// 240 and 304 on Beckmann slopes (`tests/per_hit.rs`; the single-scattering
+/// The type is `Copy` and small: `size_of` is 224 bytes for a GGX conductor, 288 for GGX glass,
+/// 240 and 320 on Beckmann slopes (`tests/per_hit.rs`; the single-scattering
 /// [`MicrofacetBsdf`] inside takes 128, 40, 144 and 64 of them).
 ///
 /// **Tables.** The tables are read at α = √(αx αy) (an anisotropic surface is compensated as

@@ -654,27 +654,10 @@ fn loss_table(family: usize) -> DielectricLossTable {
     [DielectricLossTable::GGX, DielectricLossTable::BECKMANN][family]
 }
 
-/// (μ, α, η ≥ 1) of loss node (i, j, l) of the table of light from outside or `inside`, as the
-/// table's documentation defines the axes: x = i/23, r = j/23 (α = r², 1e-6 at r = 0), u = l/31
-/// (η = 1 + 2u³); from outside x = √X with X = μ (1 + α)/(μ + α), from inside x = ½ √X + ½ μ
-/// (inverted by bisection).
+/// (μ, α, η ≥ 1) of loss node (i, j, l) of the table of light from outside or `inside`.
 fn loss_node_coordinates(i: usize, j: usize, l: usize, inside: bool) -> (f32, f32, f32) {
-    let [nx, nr, nu] = LOSS_TABLE_SHAPE.map(|n| (n - 1) as f64);
-    let (x, r, u) = (i as f64 / nx, j as f64 / nr, l as f64 / nu);
-    let alpha = (r * r).max(1e-6);
-    let scale_invariant = |mu: f64| (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
-    let axis = |mu: f64| if inside { 0.5 * scale_invariant(mu) + 0.5 * mu } else { scale_invariant(mu) };
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if axis(mid) < x {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let mu = if i == 0 { 0.0 } else { hi };
-    (mu as f32, alpha as f32, (1.0 + 2.0 * u * u * u) as f32)
+    let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
+    DielectricLossTable::node_parameters(i, j, l, side)
 }
 
 #[test]

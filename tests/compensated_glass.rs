@@ -7,7 +7,7 @@
 //! edges.
 
 use microsurface::compensation::{
-    AlbedoTabulated, DielectricWalkTable, EtaRange, LOSS_TABLE_SHAPE, MAX_WALK_TABLE_SE,
+    AlbedoTabulated, DielectricLossTable, DielectricWalkTable, EtaRange, MAX_WALK_TABLE_SE,
 };
 use microsurface::glam::{Vec2, Vec3};
 use microsurface::rand::SeedableRng;
@@ -74,22 +74,10 @@ fn node(i: usize, j: usize, l: usize) -> (f32, f32, f32) {
     (mu as f32, alpha as f32, (1.0 + 2.0 * u * u) as f32)
 }
 
-/// (μ, α, η ≥ 1) of loss table node (i, j, l) of the table read from outside or `inside`, as
-/// `DielectricLossTable` documents its axes: x = i/23, r = j/23 (α = r², 1e-6 at r = 0),
-/// u = l/31 (η = 1 + 2u³); from outside x = √X, X = μ (1 + α)/(μ + α); from inside
-/// x = ½ √X + ½ μ (inverted by bisection).
+/// (μ, α, η ≥ 1) of loss table node (i, j, l) of the table read from outside or `inside`.
 fn loss_node(i: usize, j: usize, l: usize, inside: bool) -> (f32, f32, f32) {
-    let [nx, nr, nu] = LOSS_TABLE_SHAPE.map(|n| (n - 1) as f64);
-    let (x, r, u) = (i as f64 / nx, j as f64 / nr, l as f64 / nu);
-    let alpha = (r * r).max(1e-6);
-    let scale_invariant = |mu: f64| (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt();
-    let axis = |mu: f64| if inside { 0.5 * scale_invariant(mu) + 0.5 * mu } else { scale_invariant(mu) };
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if axis(mid) < x { lo = mid } else { hi = mid }
-    }
-    (hi as f32, alpha as f32, (1.0 + 2.0 * u * u * u) as f32)
+    let side = if inside { EtaRange::AtMostOne } else { EtaRange::AtLeastOne };
+    DielectricLossTable::node_parameters(i, j, l, side)
 }
 
 /// A view with |cos θ| = μ on the given side.

@@ -114,6 +114,37 @@ impl DielectricLossTable {
         Some(near + fu * (far - near))
     }
 
+    /// (μ, α, η ≥ 1) of node (i, j, l) on the axes above (i, j < 24, l < 32; η is the index
+    /// axis' value, seen as 1/η by light from inside): α = r² (1e-6 at r = 0), η = 1 + 2u³,
+    /// and μ the direction axis inverted (from outside in closed form, μ = X α/(1 + α − X);
+    /// from inside by bisection in f64), μ = 0 at x = 0 and 1 at x = 1.
+    ///
+    /// # Panics
+    /// If a node index is beyond its axis.
+    #[must_use]
+    pub fn node_parameters(i: usize, j: usize, l: usize, range: EtaRange) -> (f32, f32, f32) {
+        let [nx, nr, nu] = LOSS_TABLE_SHAPE;
+        assert!(i < nx && j < nr && l < nu, "loss node ({i}, {j}, {l}) beyond the {nx} × {nr} × {nu} grid");
+        let (x, r, u) = (i as f64 / (nx - 1) as f64, j as f64 / (nr - 1) as f64, l as f64 / (nu - 1) as f64);
+        let alpha = (r * r).max(1e-6);
+        let scale_invariant = |x: f64| {
+            let big_x = x * x;
+            if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) }
+        };
+        let mu = if range == EtaRange::AtLeastOne || i == 0 || i == nx - 1 {
+            scale_invariant(x)
+        } else {
+            let x_of = |mu: f64| 0.5 * (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt() + 0.5 * mu;
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for _ in 0..64 {
+                let mid = 0.5 * (lo + hi);
+                if x_of(mid) < x { lo = mid } else { hi = mid }
+            }
+            0.5 * (lo + hi)
+        };
+        (mu as f32, alpha as f32, (1.0 + 2.0 * u * u * u) as f32)
+    }
+
     /// The raw node values of one side, `values[(l * 24 + j) * 24 + i]` at x = i/23, r = j/23,
     /// u = l/31 on the axes of the type's documentation, for export to shaders.
     #[must_use]

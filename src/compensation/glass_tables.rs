@@ -75,33 +75,6 @@ fn node_alpha(j: usize) -> f64 {
     r * r
 }
 
-/// The α of the loss tables' roughness node j (r = √α = j/23; the row r = 0 at α = 1e-6, as
-/// the generator evaluates it).
-fn loss_alpha(j: usize) -> f64 {
-    let r = j as f64 / (NR - 1) as f64;
-    (r * r).max(1e-6)
-}
-
-/// μ of direction node i of the loss table of side `side` (0: η ≥ 1, scale-invariant;
-/// 1: η ≤ 1, ½ √X + ½ μ) at roughness α.
-fn loss_mu(side: usize, i: usize, alpha: f64) -> f64 {
-    let x = i as f64 / (NX - 1) as f64;
-    let scale_invariant = |x: f64| {
-        let big_x = x * x;
-        if big_x >= 1.0 { 1.0 } else { big_x * alpha / (1.0 + alpha - big_x) }
-    };
-    if side == 0 || i == 0 || i == NX - 1 {
-        return scale_invariant(x);
-    }
-    let x_of = |mu: f64| 0.5 * (mu * (1.0 + alpha) / (mu + alpha)).min(1.0).sqrt() + 0.5 * mu;
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    for _ in 0..64 {
-        let mid = 0.5 * (lo + hi);
-        if x_of(mid) < x { lo = mid } else { hi = mid }
-    }
-    0.5 * (lo + hi)
-}
-
 impl GlassTables {
     /// The tables of a family, built on first use.
     #[inline]
@@ -183,13 +156,9 @@ impl GlassTables {
             let d = loss.grid(range);
             let lobes: Box<[Vec2; LOSS_NODES]> = boxed(|k| {
                 let (i, j, l) = (k % NX, (k / NX) % NR, k / (NX * NR));
-                let alpha = loss_alpha(j);
-                let u = l as f64 / (NU - 1) as f64;
-                let eta = 1.0 + 2.0 * u * u * u;
+                let (mu, alpha, eta) = DielectricLossTable::node_parameters(i, j, l, range);
                 let seen = if side == 0 { eta } else { 1.0 / eta };
-                let mu = loss_mu(side, i, alpha);
-                let dt =
-                    walk.energy(mu as f32, alpha as f32, seen as f32).map_or(0.0, |h| h.transmitted.max(0.0));
+                let dt = walk.energy(mu, alpha, seen).map_or(0.0, |h| h.transmitted.max(0.0));
                 let dd = d[k].max(0.0);
                 Vec2::new(dd, dt.min(dd))
             });

@@ -65,30 +65,6 @@ fn complex_ior() {
         }
     }
     assert!(ComplexIor::new(Vec3::ONE, Vec3::ZERO).is_ok());
-    // beyond ComplexIor::MAX the Fresnel term's constants would overflow f32 (η² k² at 1e10)
-    for v in [1.000_001e6, 1e10, 1e20, f32::MAX] {
-        assert_rejects(ComplexIor::new(Vec3::new(1.0, v, 1.0), Vec3::ONE), "eta", v);
-        assert_rejects(ComplexIor::new(Vec3::ONE, Vec3::new(v, 1.0, 1.0)), "k", v);
-    }
-    let max = Vec3::splat(ComplexIor::MAX);
-    for ior in [ComplexIor::new(max, max), ComplexIor::new(max, Vec3::ZERO), ComplexIor::new(Vec3::ONE, max)]
-    {
-        let ior = ior.expect("at the largest accepted index");
-        let bsdf = MicrofacetBsdf::new(Ggx::isotropic(0.5).unwrap(), Conductor::new(ior)).unwrap();
-        let (wo, wi) = (Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.6, 0.0, 0.8));
-        let f = bsdf.eval(wo, wi).f;
-        assert!(f.is_finite() && f.min_element() > 0.0, "{ior:?}: f = {f}");
-        let s = bsdf.sample(wo, 0.5, Vec2::splat(0.3)).expect("a mirror-like lobe samples");
-        assert!(s.weight.is_finite() && s.weight.min_element() > 0.0, "{ior:?}: {s:?}");
-        for scheme in [Compensation::Walk, Compensation::KullaConty, Compensation::Turquin] {
-            let c =
-                Compensated::with_scheme(Ggx::isotropic(0.5).unwrap(), Conductor::new(ior), scheme).unwrap();
-            let f = c.eval(wo, wi).f;
-            assert!(f.is_finite() && f.min_element() > 0.0, "{scheme:?} {ior:?}: f = {f}");
-            let s = c.sample(wo, 0.5, Vec2::splat(0.3)).expect("a mirror-like lobe samples");
-            assert!(s.weight.is_finite() && s.weight.min_element() > 0.0, "{scheme:?} {ior:?}: {s:?}");
-        }
-    }
 }
 
 #[test]
@@ -170,19 +146,17 @@ fn ior_and_albedo_must_be_in_range() {
     for ior in [ComplexIor::new(max, max), ComplexIor::new(max, Vec3::ZERO), ComplexIor::new(Vec3::ONE, max)]
     {
         let ior = ior.expect("at the largest accepted index");
-        let bsdf = MicrofacetBsdf::new(Ggx::isotropic(0.5).unwrap(), Conductor::new(ior)).unwrap();
+        let (slope, conductor) = (Ggx::isotropic(0.5).unwrap(), Conductor::new(ior));
+        let single = MicrofacetBsdf::new(slope, conductor).unwrap();
+        let compensated = [Compensation::Walk, Compensation::KullaConty, Compensation::Turquin]
+            .map(|scheme| Compensated::with_scheme(slope, conductor, scheme).unwrap());
+        let bsdfs = std::iter::once(&single as &dyn Bsdf).chain(compensated.iter().map(|c| c as &dyn Bsdf));
         let (wo, wi) = (Vec3::new(0.6, 0.0, 0.8), Vec3::new(-0.6, 0.0, 0.8));
-        let f = bsdf.eval(wo, wi).f;
-        assert!(f.is_finite() && f.min_element() > 0.0, "{ior:?}: f = {f}");
-        let s = bsdf.sample(wo, 0.5, Vec2::splat(0.3)).expect("a mirror-like lobe samples");
-        assert!(s.weight.is_finite() && s.weight.min_element() > 0.0, "{ior:?}: {s:?}");
-        for scheme in [Compensation::Walk, Compensation::KullaConty, Compensation::Turquin] {
-            let c =
-                Compensated::with_scheme(Ggx::isotropic(0.5).unwrap(), Conductor::new(ior), scheme).unwrap();
-            let f = c.eval(wo, wi).f;
-            assert!(f.is_finite() && f.min_element() > 0.0, "{scheme:?} {ior:?}: f = {f}");
-            let s = c.sample(wo, 0.5, Vec2::splat(0.3)).expect("a mirror-like lobe samples");
-            assert!(s.weight.is_finite() && s.weight.min_element() > 0.0, "{scheme:?} {ior:?}: {s:?}");
+        for (n, bsdf) in bsdfs.enumerate() {
+            let f = bsdf.eval(wo, wi).f;
+            assert!(f.is_finite() && f.min_element() > 0.0, "type {n}, {ior:?}: f = {f}");
+            let s = bsdf.sample(wo, 0.5, Vec2::splat(0.3)).expect("a mirror-like lobe samples");
+            assert!(s.weight.is_finite() && s.weight.min_element() > 0.0, "type {n}, {ior:?}: {s:?}");
         }
     }
     assert!(Dielectric::new(1.0).is_ok() && Dielectric::new(1e-3).is_ok() && Dielectric::new(1e3).is_ok());

@@ -31,6 +31,8 @@ trait Composition: Bsdf {
     fn scheme(&self) -> Compensation;
     fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3;
     fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32;
+    /// Both of the above (a material whose two read the same cells reads them once).
+    fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32);
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3>;
 }
 
@@ -55,6 +57,10 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
     #[inline(always)]
     fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         Compensated::<S, Conductor>::compensated_pdf(self, wo, wi, pdf_ss)
+    }
+    #[inline(always)]
+    fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
+        (self.compensated_f(wo, wi, f_ss), self.compensated_pdf(wo, wi, pdf_ss))
     }
     #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
@@ -83,6 +89,10 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
     #[inline(always)]
     fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         Compensated::<S, Dielectric>::compensated_pdf(self, wo, wi, pdf_ss)
+    }
+    #[inline(always)]
+    fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
+        Compensated::<S, Dielectric>::compensated(self, wo, wi, f_ss, pdf_ss)
     }
     #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
@@ -189,7 +199,7 @@ fn eval_with_pdf_batch<B: Composition>(
     for i in 0..fa.len() {
         let (o, w) = (at(wo, i), at(wi, i));
         let (v, p) = if as_given(o, w) {
-            (bsdf.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i])), bsdf.compensated_pdf(o, w, pdf[i]))
+            bsdf.compensated(o, w, Vec3::new(fa[i], fb[i], fc[i]), pdf[i])
         } else {
             scalar_eval_with_pdf(bsdf, o, w)
         };

@@ -166,12 +166,6 @@ impl DielectricLobes {
         &self.tables.0.sides[self.table_side[view]]
     }
 
-    /// The direction coordinates of two cosines in [0, 1] from one division.
-    #[inline(always)]
-    fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
-        self.axis.coordinates(mu_o, mu_i)
-    }
-
     /// The loss grid's fractional direction node of a cosine μ with scale-invariant coordinate
     /// x on the table of view side `view`.
     #[inline(always)]
@@ -202,25 +196,30 @@ impl DielectricLobes {
         Vec2::new(1.0 - t, t - (1.0 - t) * self.c[a])
     }
 
-    /// The added lobe f_R or f_T for a view on side `a` and a light crossing (`c` = 1) or not,
-    /// both off the horizon.
+    /// The lobes' values (D, ΔT') at |cos θ| = `mu` on side `a` (a view's, or a light's on
+    /// the side its lobe is read at): what the added lobe and the mixture read at the view,
+    /// read once per call.
     #[inline(always)]
-    fn added(&self, a: usize, c: usize, mu_o: f32, mu_i: f32) -> f32 {
-        let (xo, xi) = self.coordinates(mu_o, mu_i);
-        let b = a ^ c;
-        let vo = self.lobe_values(a, self.loss_node(a, xo, mu_o));
-        let vi = self.lobe_values(b, self.loss_node(b, xi, mu_i));
+    fn values_at(&self, a: usize, mu: f32) -> Vec2 {
+        self.lobe_values(a, self.loss_node(a, self.axis.coordinate(mu), mu))
+    }
+
+    /// The added lobe f_R or f_T for a view on side `a` with lobe values `vo`
+    /// ([`Self::values_at`]) and a light crossing (`c` = 1) or not at |cos θi| = `mu_i`, both
+    /// off the horizon.
+    #[inline(always)]
+    fn added(&self, a: usize, c: usize, vo: Vec2, mu_i: f32) -> f32 {
+        let vi = self.values_at(a ^ c, mu_i);
         let w = self.profile_weights(a, c);
         // (both profiles are ≥ 0 at every node; rounding may leave −1e-9)
         vo.dot(w).max(0.0) * vi.dot(w).max(0.0) * self.scales[a][c]
     }
 
     /// The mixture's probabilities (single, reflection, transmission, 0) of a view on side `a`
-    /// with |cos θo| = `mu_o`: the lobes' energies at the view, 1 − D : g_R : c_a ΔT' (their sum
-    /// D), the first at least [`MIN_SINGLE_SHARE`] of D.
+    /// with lobe values `v` ([`Self::values_at`]): the lobes' energies at the view,
+    /// 1 − D : g_R : c_a ΔT' (their sum D), the first at least [`MIN_SINGLE_SHARE`] of D.
     #[inline(always)]
-    fn mixture(&self, a: usize, mu_o: f32) -> Vec4 {
-        let v = self.lobe_values(a, self.loss_node(a, self.axis.coordinate(mu_o), mu_o));
+    fn mixture(&self, a: usize, v: Vec2) -> Vec4 {
         let d = v.x.max(0.0);
         let t = (self.c[a] * v.y).clamp(0.0, d);
         let single = (1.0 - d).max(MIN_SINGLE_SHARE * d);
@@ -428,8 +427,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
             return Some((0.0, 0.0));
         }
         let a = usize::from(side == Side::Inside);
-        let x = l.coordinates(mu, mu).0;
-        let v = l.lobe_values(a, l.loss_node(a, x, mu));
+        let v = l.values_at(a, mu);
         Some(((v.x - l.c[a] * v.y).max(0.0), l.c[a] * v.y))
     }
 
@@ -470,19 +468,63 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
         if f.is_finite() { f } else { Vec3::ZERO }
     }
 
+    /// The view's side and its lobes' values ([`DielectricLobes::values_at`]) where the added
+    /// lobes answer (an additive scheme on a rough surface, valid directions off the horizon):
+    /// what f and the density read at the view.
+    #[inline(always)]
+    fn view_values(&self, wo: Vec3, wi: Vec3) -> Option<(usize, Vec2)> {
+        (self.scheme != Compensation::Turquin && self.compensates(wo, wi)).then(|| {
+            let a = side_of(wo);
+            (a, self.lobes.values_at(a, wo.z.abs()))
+        })
+    }
+
+    /// f_ss plus the added lobe of the light's side, for a view `(a, vo)` of
+    /// [`Self::view_values`].
+    #[inline(always)]
+    fn added_f(&self, (a, vo): (usize, Vec2), wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
+        f_ss + Vec3::splat(self.lobes.added(a, crossing(wo, wi), vo, wi.z.abs()))
+    }
+
+    /// The sampling mixture's density from single scattering's `pdf_ss`, for a view `(a, vo)`
+    /// of [`Self::view_values`].
+    #[inline(always)]
+    fn mixture_density(&self, (a, vo): (usize, Vec2), wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        self.lobes.mixture_pdf(a, self.lobes.mixture(a, vo), wo, wi, pdf_ss)
+    }
+
     /// f at valid directions from single scattering's `f_ss` at the same directions: f_ss
     /// scaled by Turquin's factor, or f_ss plus the added lobe of the light's side where the
-    /// lobes answer. Every evaluation of the BSDF (`eval`, `eval_with_pdf`, the batch calls)
-    /// ends with this expression.
+    /// lobes answer. Every evaluation of the BSDF (`eval`, the batch calls; `eval_with_pdf`
+    /// through [`Self::compensated`]) ends with this expression.
     #[inline(always)]
     pub(super) fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
         if self.scheme == Compensation::Turquin {
             return Self::scaled(f_ss, self.turquin_factor(wo));
         }
-        if !self.compensates(wo, wi) {
-            return f_ss;
+        self.view_values(wo, wi).map_or(f_ss, |v| self.added_f(v, wo, wi, f_ss))
+    }
+
+    /// The density at valid directions from single scattering's `pdf_ss` at the same
+    /// directions: the sampling mixture's density where the lobes answer (not Turquin's), else
+    /// `pdf_ss`. Every density of the BSDF but the sample's (`pdf`, the batch calls;
+    /// `eval_with_pdf` through [`Self::compensated`]) ends with this expression.
+    #[inline(always)]
+    pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+        self.view_values(wo, wi).map_or(pdf_ss, |v| self.mixture_density(v, wo, wi, pdf_ss))
+    }
+
+    /// [`Self::compensated_f`] and [`Self::compensated_pdf`] with the lobes read at the view
+    /// once (`eval_with_pdf`, scalar and batch).
+    #[inline(always)]
+    pub(super) fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
+        if self.scheme == Compensation::Turquin {
+            return (Self::scaled(f_ss, self.turquin_factor(wo)), pdf_ss);
         }
-        f_ss + Vec3::splat(self.lobes.added(side_of(wo), crossing(wo, wi), wo.z.abs(), wi.z.abs()))
+        match self.view_values(wo, wi) {
+            Some(v) => (self.added_f(v, wo, wi, f_ss), self.mixture_density(v, wo, wi, pdf_ss)),
+            None => (f_ss, pdf_ss),
+        }
     }
 
     /// Turquin's sample weight from single scattering's sample `weight` (not a Dirac lobe's)
@@ -492,19 +534,6 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
     pub(super) fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         let weight = weight * self.turquin_factor(wo);
         weight.is_finite().then_some(weight)
-    }
-
-    /// The density at valid directions from single scattering's `pdf_ss` at the same
-    /// directions: the sampling mixture's density where the lobes answer (not Turquin's), else
-    /// `pdf_ss`. Every density of the BSDF but the sample's (`pdf`, `eval_with_pdf`, the batch
-    /// calls) ends with this expression.
-    #[inline(always)]
-    pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        if self.scheme == Compensation::Turquin || !self.compensates(wo, wi) {
-            return pdf_ss;
-        }
-        let a = side_of(wo);
-        self.lobes.mixture_pdf(a, self.lobes.mixture(a, wo.z.abs()), wo, wi, pdf_ss)
     }
 
     /// Single scattering's density at valid directions off the horizon of a rough surface:
@@ -546,7 +575,8 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
             return self.single.sample_keyed(wo, uc, u, key);
         }
         let a = side_of(wo);
-        let p = lobes.mixture(a, wo.z.abs());
+        let vo = lobes.values_at(a, wo.z.abs());
+        let p = lobes.mixture(a, vo);
         let (wi, f_cos_ss, pdf_ss) = if uc < p.x {
             // the single-scattering lobe: its sample carries f·|cos θi| (weight × pdf) and its
             // density
@@ -572,7 +602,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
             return None;
         }
         let c = crossing(wo, wi);
-        let f_cos = f_cos_ss + Vec3::splat(lobes.added(a, c, wo.z.abs(), wi.z.abs()) * wi.z.abs());
+        let f_cos = f_cos_ss + Vec3::splat(lobes.added(a, c, vo, wi.z.abs()) * wi.z.abs());
         let eta = lobes.transmitted_eta[a];
         mixture_sample(wo, wi, f_cos, lobes.mixture_pdf(a, p, wo, wi, pdf_ss), eta)
     }
@@ -590,7 +620,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
         unit_directions!(wo, wi, (NOTHING, 0.0), self.eval_with_pdf_keyed(wo, wi, key));
         let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-        let pdf = self.compensated_pdf(wo, wi, pdf_ss);
-        (BsdfValue { f: self.compensated_f(wo, wi, v.f), ..v }, pdf)
+        let (f, pdf) = self.compensated(wo, wi, v.f, pdf_ss);
+        (BsdfValue { f, ..v }, pdf)
     }
 }

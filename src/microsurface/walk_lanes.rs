@@ -73,6 +73,14 @@ fn stream(seed: u64, i: usize) -> u64 {
     mix64(seed ^ mix64((i as u64).wrapping_add(0x632b_e59b_d9b4_e019)))
 }
 
+/// The xoshiro128++ state of a generator seeded with the 64-bit `s` (two splitmix64 outputs;
+/// the last word odd, so that the state is never zero).
+#[inline(always)]
+fn generator_of(s: u64) -> [u32; 4] {
+    let (a, b) = (mix64(s), mix64(s ^ 0xd1b5_4a32_d192_ed03));
+    [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32 | 1]
+}
+
 /// The splitmix64 finalizer.
 #[inline(always)]
 fn mix64(z: u64) -> u64 {
@@ -205,6 +213,83 @@ fn step(
     (wo, next_depth, [weight[0] * f[0], weight[1] * f[1], weight[2] * f[2]], status, [u1, u2])
 }
 
+/// The queries next in line for the lanes, prepared in a loop the compiler vectorizes (their
+/// directions read in full vectors, their generators seeded eight or four at a time): two
+/// blocks of [`PATHS`], so that a finishing pass, which refills at most [`PATHS`] slots, finds
+/// them ready.
+struct Incoming {
+    /// −ωi of each query.
+    wr: [[f32; 2 * PATHS]; 3],
+    /// The four words of each query's generator ([`generator_of`]).
+    rng: [[u32; 2 * PATHS]; 4],
+    /// Whether the lanes walk the query (a unit ωi from above); the scalar walk answers the
+    /// others.
+    lanes: [bool; 2 * PATHS],
+    /// The query of element 0.
+    start: usize,
+    /// The elements prepared.
+    len: usize,
+    /// The elements taken.
+    taken: usize,
+}
+
+impl Incoming {
+    const EMPTY: Self = Self {
+        wr: [[0.0; 2 * PATHS]; 3],
+        rng: [[0; 2 * PATHS]; 4],
+        lanes: [false; 2 * PATHS],
+        start: 0,
+        len: 0,
+        taken: 0,
+    };
+
+    /// Drops the first block once it is taken and prepares queries up to two blocks (fewer at
+    /// the end of the batch).
+    #[inline(always)]
+    fn top_up(&mut self, wi: &Directions<'_>, seed: u64) {
+        if self.taken >= PATHS {
+            for c in &mut self.wr {
+                c.copy_within(PATHS.., 0);
+            }
+            for c in &mut self.rng {
+                c.copy_within(PATHS.., 0);
+            }
+            self.lanes.copy_within(PATHS.., 0);
+            self.start += PATHS;
+            self.len -= PATHS;
+            self.taken -= PATHS;
+        }
+        let (x, y, z) = wi.slices();
+        let len = (x.len() - self.start).min(2 * PATHS);
+        let from = self.len;
+        let (x, y, z) = (&x[self.start..][..len], &y[self.start..][..len], &z[self.start..][..len]);
+        for j in from..len {
+            let w = Vec3::new(x[j], y[j], z[j]);
+            // the lanes walk from above: a unit ωi with ωi.z > 0 (what `Microsurface::sample`
+            // walks itself; a view from below is its `sample_from_below`)
+            self.lanes[j] = crate::contract::is_direction(w) & (w.z > 0.0);
+            self.wr[0][j] = -w.x;
+            self.wr[1][j] = -w.y;
+            self.wr[2][j] = -w.z;
+            let g = generator_of(stream(seed, self.start + j));
+            for (c, g) in g.into_iter().enumerate() {
+                self.rng[c][j] = g;
+            }
+        }
+        self.len = len;
+    }
+}
+
+impl Incoming {
+    /// [`Incoming::top_up`] within a finishing pass, compiled apart: only where many queries
+    /// are off the lanes' domain.
+    #[cold]
+    #[inline(never)]
+    fn top_up_again(&mut self, wi: &Directions<'_>, seed: u64) {
+        self.top_up(wi, seed);
+    }
+}
+
 /// The walks of a GGX conductor in lanes.
 struct WalkLoop<'s, 'a, 'b, H, S, M> {
     surface: &'s Microsurface<H, S, M>,
@@ -227,33 +312,39 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
 
     /// Fills slot `k` with the next query the lanes walk (answering the others with the scalar
     /// walk), or leaves it idle.
-    #[inline(never)]
-    fn refill(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
-        p.query[k] = usize::MAX;
-        // an idle slot walks a harmless ray whose results are dropped
-        let mut wi = Vec3::Z;
-        while *next < self.wi.len() {
-            let i = *next;
-            *next += 1;
-            let w = self.wi.get(i);
-            // the lanes walk from above: a unit ωi with ωi.z > 0 (what `Microsurface::sample`
-            // walks itself; a view from below is its `sample_from_below`)
-            if crate::contract::is_direction(w) && w.z > 0.0 {
+    #[inline(always)]
+    fn refill(&mut self, p: &mut Paths, inc: &mut Incoming, k: usize) {
+        loop {
+            if inc.taken == inc.len {
+                if inc.start + inc.len == self.wi.len() {
+                    // an idle slot walks a harmless ray whose results are dropped
+                    p.query[k] = usize::MAX;
+                    for (c, v) in [0.0, 0.0, -1.0].into_iter().enumerate() {
+                        p.wr[c][k] = v;
+                        p.weight[c][k] = 1.0;
+                    }
+                    p.depth[k] = 0.0;
+                    p.bounces[k] = 0;
+                    return;
+                }
+                inc.top_up_again(self.wi, self.seed);
+            }
+            let j = inc.taken;
+            inc.taken += 1;
+            let i = inc.start + j;
+            if inc.lanes[j] {
                 p.query[k] = i;
-                wi = w;
-                let s = stream(self.seed, i);
-                let (a, b) = (mix64(s), mix64(s ^ 0xd1b5_4a32_d192_ed03));
-                p.rng[k] = [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32 | 1];
-                break;
+                p.rng[k] = [inc.rng[0][j], inc.rng[1][j], inc.rng[2][j], inc.rng[3][j]];
+                for c in 0..3 {
+                    p.wr[c][k] = inc.wr[c][j];
+                    p.weight[c][k] = 1.0;
+                }
+                p.depth[k] = 0.0;
+                p.bounces[k] = 0;
+                return;
             }
             self.scalar(i);
         }
-        for (c, v) in [-wi.x, -wi.y, -wi.z].into_iter().enumerate() {
-            p.wr[c][k] = v;
-            p.weight[c][k] = 1.0;
-        }
-        p.depth[k] = 0.0;
-        p.bounces[k] = 0;
     }
 
     /// The step of every path (a loop the compiler vectorizes), then the commit of the paths
@@ -288,40 +379,72 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
         }
     }
 
-    /// The paths off the lanes' common path, one by one: the scalar facet, the exits, ends and
-    /// refills.
+    /// The facet of a path that continues, off the lanes' common path: the scalar sampler's.
     #[inline(never)]
-    fn finish(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
-        let Some(i) = Some(p.query[k]).filter(|&i| i != usize::MAX) else { return };
-        let status = p.status[k];
-        if status & ESCAPED != 0 {
-            let s = WalkSample {
-                wo: Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]),
-                weight: Vec3::new(p.weight[0][k], p.weight[1][k], p.weight[2][k]),
-                bounces: p.bounces[k],
-            };
-            self.out.set(i, Some(s));
-            self.refill(p, k, next);
-            return;
+    fn scalar_facet(surface: &Microsurface<H, S, M>, p: &mut Paths, k: usize) {
+        let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
+        let [u1, u2] = p.u[k];
+        let wm = surface.slope().sample_d_wi_unchecked(wi, u1, u2);
+        let s = surface.material().mirror_reflection_unchecked(wi, wm);
+        for (c, (w, f)) in
+            [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
+        {
+            p.wr[c][k] = w;
+            p.weight[c][k] *= f;
         }
-        if status & SCALAR_FACET != 0 {
-            // the facet of a path that continues, off the lanes' common path: the scalar sampler's
-            let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
-            let [u1, u2] = p.u[k];
-            let wm = self.surface.slope().sample_d_wi_unchecked(wi, u1, u2);
-            let s = self.surface.material().mirror_reflection_unchecked(wi, wm);
-            for (c, (w, f)) in
-                [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
-            {
-                p.wr[c][k] = w;
-                p.weight[c][k] *= f;
+        p.bounces[k] += 1;
+    }
+
+    /// The finishing pass over the paths whose step did not commit (the bits of `pending`): the
+    /// scalar facets, the outputs of the walks that exit or end, then the refill of their slots.
+    #[inline(never)]
+    fn finish_all(&mut self, p: &mut Paths, inc: &mut Incoming, mut pending: u64) {
+        let surface = self.surface;
+        let mut free = 0u64;
+        {
+            let (wo_x, wo_y, wo_z) = self.out.wo.slices();
+            let (wt_r, wt_g, wt_b) = self.out.weight.slices();
+            let n = wo_x.len();
+            let (wo_y, wo_z, wt_r, wt_g, wt_b) = (&mut wo_y[..n], &mut wo_z[..n], &mut wt_r[..n], &mut wt_g[..n], &mut wt_b[..n]);
+            let bounces = &mut self.out.bounces[..n];
+            while pending != 0 {
+                let k = pending.trailing_zeros() as usize;
+                pending &= pending - 1;
+                let i = p.query[k];
+                if i >= n {
+                    // an idle slot
+                    continue;
+                }
+                let status = p.status[k];
+                if status & ESCAPED == 0 {
+                    if status & SCALAR_FACET != 0 {
+                        Self::scalar_facet(surface, p, k);
+                    }
+                    let absorbed = (0..3).all(|c| p.weight[c][k] == 0.0);
+                    if !(status & ENDED != 0 || absorbed || p.bounces[k] >= MAX_BOUNCES) {
+                        continue;
+                    }
+                    // no sample: a zero direction, weight and bounce count
+                    for c in 0..3 {
+                        p.wr[c][k] = 0.0;
+                        p.weight[c][k] = 0.0;
+                    }
+                    p.bounces[k] = 0;
+                }
+                wo_x[i] = p.wr[0][k];
+                wo_y[i] = p.wr[1][k];
+                wo_z[i] = p.wr[2][k];
+                wt_r[i] = p.weight[0][k];
+                wt_g[i] = p.weight[1][k];
+                wt_b[i] = p.weight[2][k];
+                bounces[i] = p.bounces[k];
+                free |= 1 << k;
             }
-            p.bounces[k] += 1;
         }
-        let absorbed = (0..3).all(|c| p.weight[c][k] == 0.0);
-        if status & ENDED != 0 || absorbed || p.bounces[k] >= MAX_BOUNCES {
-            self.out.set(i, None);
-            self.refill(p, k, next);
+        while free != 0 {
+            let k = free.trailing_zeros() as usize;
+            free &= free - 1;
+            self.refill(p, inc, k);
         }
     }
 
@@ -341,9 +464,10 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             next_wr: [[0.0; PATHS]; 3],
             next_weight: [[0.0; PATHS]; 3],
         };
-        let mut next = 0;
+        let mut inc = Incoming::EMPTY;
+        inc.top_up(self.wi, self.seed);
         for k in 0..PATHS {
-            self.refill(&mut p, k, &mut next);
+            self.refill(&mut p, &mut inc, k);
         }
         while p.query.iter().any(|&q| q != usize::MAX) {
             self.step_all(&mut p, fresnel);
@@ -351,11 +475,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             for k in 0..PATHS {
                 pending |= u64::from(p.status[k] != 0) << k;
             }
-            while pending != 0 {
-                let k = pending.trailing_zeros() as usize;
-                pending &= pending - 1;
-                self.finish(&mut p, k, &mut next);
-            }
+            inc.top_up(self.wi, self.seed);
+            self.finish_all(&mut p, &mut inc, pending);
         }
     }
 }

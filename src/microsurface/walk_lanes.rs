@@ -134,12 +134,13 @@ struct Paths {
     bounces: [u32; PATHS],
     /// The query of each path; `usize::MAX` for an idle slot.
     query: [usize; PATHS],
-    rng: [[u32; 4]; PATHS],
+    /// The four words of each path's generator.
+    rng: [[u32; PATHS]; 4],
     /// The step's verdict: 0 continues with the lanes' facet; otherwise the bits
     /// [`ESCAPED`], [`SCALAR_FACET`], [`ENDED`].
     status: [u8; PATHS],
     /// The uniforms of the last step's facet.
-    u: [[f32; 2]; PATHS],
+    u: [[f32; PATHS]; 2],
     /// The ray and weight after the lanes' facet of the last step.
     next_wr: [[f32; PATHS]; 3],
     next_weight: [[f32; PATHS]; 3],
@@ -334,7 +335,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             let i = inc.start + j;
             if inc.lanes[j] {
                 p.query[k] = i;
-                p.rng[k] = [inc.rng[0][j], inc.rng[1][j], inc.rng[2][j], inc.rng[3][j]];
+                for c in 0..4 {
+                    p.rng[c][k] = inc.rng[c][j];
+                }
                 for c in 0..3 {
                     p.wr[c][k] = inc.wr[c][j];
                     p.weight[c][k] = 1.0;
@@ -354,8 +357,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
         for k in 0..PATHS {
             let w = V3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
             let weight = [p.weight[0][k], p.weight[1][k], p.weight[2][k]];
+            let mut rng = [p.rng[0][k], p.rng[1][k], p.rng[2][k], p.rng[3][k]];
             let (wo, depth, weight, status, u) =
-                step(self.ax, self.ay, fresnel, w, p.depth[k], weight, &mut p.rng[k]);
+                step(self.ax, self.ay, fresnel, w, p.depth[k], weight, &mut rng);
             for (c, v) in [wo.x, wo.y, wo.z].into_iter().enumerate() {
                 p.next_wr[c][k] = v;
             }
@@ -364,7 +368,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             }
             p.depth[k] = depth;
             p.status[k] = status;
-            p.u[k] = u;
+            for c in 0..4 {
+                p.rng[c][k] = rng[c];
+            }
+            p.u[0][k] = u[0];
+            p.u[1][k] = u[1];
         }
         for k in 0..PATHS {
             let go = p.status[k] == 0;
@@ -383,7 +391,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
     #[inline(never)]
     fn scalar_facet(surface: &Microsurface<H, S, M>, p: &mut Paths, k: usize) {
         let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
-        let [u1, u2] = p.u[k];
+        let (u1, u2) = (p.u[0][k], p.u[1][k]);
         let wm = surface.slope().sample_d_wi_unchecked(wi, u1, u2);
         let s = surface.material().mirror_reflection_unchecked(wi, wm);
         for (c, (w, f)) in
@@ -458,9 +466,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             weight: [[1.0; PATHS]; 3],
             bounces: [0; PATHS],
             query: [usize::MAX; PATHS],
-            rng: [[1; 4]; PATHS],
+            rng: [[1; PATHS]; 4],
             status: [0; PATHS],
-            u: [[0.0; 2]; PATHS],
+            u: [[0.0; PATHS]; 2],
             next_wr: [[0.0; PATHS]; 3],
             next_weight: [[0.0; PATHS]; 3],
         };

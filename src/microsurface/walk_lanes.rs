@@ -26,7 +26,6 @@ use crate::slope::{MicrosurfaceSlope, lambda_and_area_of, sample_cap_of};
 use crate::soa::{Channels, Directions, check_len};
 use crate::special::ln_of;
 use glam::{Vec3, Vec3A};
-use rand::SeedableRng;
 
 /// The outputs of [`Microsurface::sample_batch`], one element per query: the exit direction,
 /// the weight f·|cos θo|/pdf and the number of bounces, 0 where [`Microsurface::sample`]
@@ -65,20 +64,54 @@ impl WalkOutputs<'_> {
     }
 }
 
-/// The splitmix64 state of query `i`'s stream from `seed` (a lane's generator is reseeded with
-/// each query, so that query i's walk depends on (seed, i) only, not on the lane or the order
-/// in which the lanes finish).
+/// The seed of query `i`'s generator under a batch's `keys` ([`stream_keys`]): four words
+/// w₀ = h(l ⊕ k₀), w₁ = h(l ⊕ k₁), w₂ = h(w₀ ⊕ u ⊕ k₂), w₃ = h(w₁ ⊕ u ⊕ k₃) of the low and high
+/// halves l, u of i, h MurmurHash3's bijective finalizer [`fmix32`]. (w₀, w₂) determine
+/// (l, u), so every query of a batch has its own state. 32-bit words, so that the lanes
+/// seed eight generators per AVX2 instruction. A lane's generator is reseeded with each query,
+/// so query i's walk depends on (seed, i) only, not on the lane or the order in which the
+/// lanes finish. The lanes make the words the state of their xoshiro128++ ([`xoshiro_of`]),
+/// the scalar walk the state of its PCG ([`pcg_of`]).
 #[inline(always)]
-fn stream(seed: u64, i: usize) -> u64 {
-    mix64(seed ^ mix64((i as u64).wrapping_add(0x632b_e59b_d9b4_e019)))
+fn stream(keys: [u32; 4], i: usize) -> [u32; 4] {
+    stream_of_halves(keys, i as u32, ((i as u64) >> 32) as u32)
 }
 
-/// The xoshiro128++ state of a generator seeded with the 64-bit `s` (two splitmix64 outputs;
-/// the last word odd, so that the state is never zero).
+/// [`stream`] of the query whose index has the low and high halves `l`, `u`.
 #[inline(always)]
-fn generator_of(s: u64) -> [u32; 4] {
-    let (a, b) = (mix64(s), mix64(s ^ 0xd1b5_4a32_d192_ed03));
-    [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32 | 1]
+fn stream_of_halves(keys: [u32; 4], l: u32, u: u32) -> [u32; 4] {
+    let (w0, w1) = (fmix32(l ^ keys[0]), fmix32(l ^ keys[1]));
+    [w0, w1, fmix32(w0 ^ u ^ keys[2]), fmix32(w1 ^ u ^ keys[3])]
+}
+
+/// The keys of a batch's streams: the four words of two splitmix64 outputs of its seed.
+#[inline(always)]
+fn stream_keys(seed: u64) -> [u32; 4] {
+    let (a, b) = (mix64(seed), mix64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
+    [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32]
+}
+
+/// MurmurHash3's 32-bit finalizer (Appleby 2011): a bijection of `u32` whose output bits each
+/// depend on every input bit.
+#[inline(always)]
+fn fmix32(h: u32) -> u32 {
+    let h = (h ^ (h >> 16)).wrapping_mul(0x85eb_ca6b);
+    let h = (h ^ (h >> 13)).wrapping_mul(0xc2b2_ae35);
+    h ^ (h >> 16)
+}
+
+/// The xoshiro128++ state of the seed words `w` ([`stream`]; the last word odd, so that the
+/// state is never zero).
+#[inline(always)]
+fn xoshiro_of([a, b, c, d]: [u32; 4]) -> [u32; 4] {
+    [a, b, c, d | 1]
+}
+
+/// The scalar walk's generator of the seed words `w` ([`stream`]).
+#[inline(always)]
+fn pcg_of([a, b, c, d]: [u32; 4]) -> rand_pcg::Pcg64Mcg {
+    let word = |x: u32, y: u32| u128::from(x) | (u128::from(y) << 32);
+    rand_pcg::Pcg64Mcg::new(word(a, b) | (word(c, d) << 64))
 }
 
 /// The splitmix64 finalizer.
@@ -227,7 +260,7 @@ struct Incoming {
     /// others.
     lanes: [bool; 2 * PATHS],
     /// The query of element 0.
-    start: usize,
+    first: usize,
     /// The elements prepared.
     len: usize,
     /// The elements taken.
@@ -239,7 +272,7 @@ impl Incoming {
         wr: [[0.0; 2 * PATHS]; 3],
         rng: [[0; 2 * PATHS]; 4],
         lanes: [false; 2 * PATHS],
-        start: 0,
+        first: 0,
         len: 0,
         taken: 0,
     };
@@ -247,7 +280,7 @@ impl Incoming {
     /// Drops the first block once it is taken and prepares queries up to two blocks (fewer at
     /// the end of the batch).
     #[inline(always)]
-    fn top_up(&mut self, wi: &Directions<'_>, seed: u64) {
+    fn top_up(&mut self, wi: &Directions<'_>, keys: [u32; 4]) {
         if self.taken >= PATHS {
             for c in &mut self.wr {
                 c.copy_within(PATHS.., 0);
@@ -256,14 +289,17 @@ impl Incoming {
                 c.copy_within(PATHS.., 0);
             }
             self.lanes.copy_within(PATHS.., 0);
-            self.start += PATHS;
+            self.first += PATHS;
             self.len -= PATHS;
             self.taken -= PATHS;
         }
         let (x, y, z) = wi.slices();
-        let len = (x.len() - self.start).min(2 * PATHS);
+        let len = (x.len() - self.first).min(2 * PATHS);
         let from = self.len;
-        let (x, y, z) = (&x[self.start..][..len], &y[self.start..][..len], &z[self.start..][..len]);
+        let (x, y, z) = (&x[self.first..][..len], &y[self.first..][..len], &z[self.first..][..len]);
+        // the halves of query first + j in 32-bit words (j < 2³²: the high half carries at most
+        // one), so that the loop has no 64-bit lane
+        let (l0, u0) = (self.first as u32, ((self.first as u64) >> 32) as u32);
         for j in from..len {
             let w = Vec3::new(x[j], y[j], z[j]);
             // the lanes walk from above: a unit ωi with ωi.z > 0 (what `Microsurface::sample`
@@ -272,7 +308,8 @@ impl Incoming {
             self.wr[0][j] = -w.x;
             self.wr[1][j] = -w.y;
             self.wr[2][j] = -w.z;
-            let g = generator_of(stream(seed, self.start + j));
+            let l = l0.wrapping_add(j as u32);
+            let g = xoshiro_of(stream_of_halves(keys, l, u0.wrapping_add(u32::from(l < l0))));
             for (c, g) in g.into_iter().enumerate() {
                 self.rng[c][j] = g;
             }
@@ -286,8 +323,8 @@ impl Incoming {
     /// are off the lanes' domain.
     #[cold]
     #[inline(never)]
-    fn top_up_again(&mut self, wi: &Directions<'_>, seed: u64) {
-        self.top_up(wi, seed);
+    fn top_up_again(&mut self, wi: &Directions<'_>, keys: [u32; 4]) {
+        self.top_up(wi, keys);
     }
 }
 
@@ -298,7 +335,8 @@ struct WalkLoop<'s, 'a, 'b, H, S, M> {
     ay: f32,
     fresnel: Option<(Vec3A, Vec3A)>,
     wi: &'s Directions<'a>,
-    seed: u64,
+    /// The batch's stream keys ([`stream_keys`]).
+    keys: [u32; 4],
     out: &'s mut WalkOutputs<'b>,
 }
 
@@ -307,7 +345,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
     /// direction), from its own generator.
     #[inline(never)]
     fn scalar(&mut self, i: usize) {
-        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(stream(self.seed, i));
+        let mut rng = pcg_of(stream(self.keys, i));
         self.out.set(i, self.surface.sample(self.wi.get(i), &mut rng));
     }
 
@@ -317,7 +355,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
     fn refill(&mut self, p: &mut Paths, inc: &mut Incoming, k: usize) {
         loop {
             if inc.taken == inc.len {
-                if inc.start + inc.len == self.wi.len() {
+                if inc.first + inc.len == self.wi.len() {
                     // an idle slot walks a harmless ray whose results are dropped
                     p.query[k] = usize::MAX;
                     for (c, v) in [0.0, 0.0, -1.0].into_iter().enumerate() {
@@ -328,11 +366,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
                     p.bounces[k] = 0;
                     return;
                 }
-                inc.top_up_again(self.wi, self.seed);
+                inc.top_up_again(self.wi, self.keys);
             }
             let j = inc.taken;
             inc.taken += 1;
-            let i = inc.start + j;
+            let i = inc.first + j;
             if inc.lanes[j] {
                 p.query[k] = i;
                 for c in 0..4 {
@@ -473,7 +511,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             next_weight: [[0.0; PATHS]; 3],
         };
         let mut inc = Incoming::EMPTY;
-        inc.top_up(self.wi, self.seed);
+        inc.top_up(self.wi, self.keys);
         for k in 0..PATHS {
             self.refill(&mut p, &mut inc, k);
         }
@@ -483,7 +521,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             for k in 0..PATHS {
                 pending |= u64::from(p.status[k] != 0) << k;
             }
-            inc.top_up(self.wi, self.seed);
+            inc.top_up(self.wi, self.keys);
             self.finish_all(&mut p, &mut inc, pending);
         }
     }
@@ -522,13 +560,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             _ => None,
         };
         let Some((ax, ay, fresnel)) = lanes else {
+            let keys = stream_keys(seed);
             for i in 0..wi.len() {
-                let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(stream(seed, i));
+                let mut rng = pcg_of(stream(keys, i));
                 out.set(i, self.sample(wi.get(i), &mut rng));
             }
             return Ok(());
         };
-        dispatch(&mut WalkLoop { surface: self, ax, ay, fresnel, wi, seed, out });
+        dispatch(&mut WalkLoop { surface: self, ax, ay, fresnel, wi, keys: stream_keys(seed), out });
         Ok(())
     }
 }

@@ -1,5 +1,6 @@
-//! The random walk in lanes: many walks of [`Microsurface::sample`] at once, eight in flight,
-//! each lane refilled with the next query when its walk ends (supplement §3.1, Algorithm 3).
+//! The random walk in lanes: many walks of [`Microsurface::sample`] at once, 64 in flight and
+//! stepped eight at a time, each path's slot refilled with the next query when its walk ends
+//! (supplement §3.1, Algorithm 3).
 //!
 //! A lane carries one path: its ray, its height (ln C¹, or the undrawn rate of an opaque
 //! walk, `walk::Depth`), its weight, its bounce count, and its own generator. Every formula is
@@ -248,13 +249,13 @@ fn step(
 }
 
 /// The queries next in line for the lanes, prepared in a loop the compiler vectorizes (their
-/// directions read in full vectors, their generators seeded eight or four at a time): two
+/// directions read in full vectors, their generators seeded eight at a time with AVX2): two
 /// blocks of [`PATHS`], so that a finishing pass, which refills at most [`PATHS`] slots, finds
 /// them ready.
 struct Incoming {
     /// −ωi of each query.
     wr: [[f32; 2 * PATHS]; 3],
-    /// The four words of each query's generator ([`generator_of`]).
+    /// The four words of each query's generator ([`xoshiro_of`]).
     rng: [[u32; 2 * PATHS]; 4],
     /// Whether the lanes walk the query (a unit ωi from above); the scalar walk answers the
     /// others.
@@ -316,9 +317,7 @@ impl Incoming {
         }
         self.len = len;
     }
-}
 
-impl Incoming {
     /// [`Incoming::top_up`] within a finishing pass, compiled apart: only where many queries
     /// are off the lanes' domain.
     #[cold]
@@ -406,8 +405,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             }
             p.depth[k] = depth;
             p.status[k] = status;
-            for c in 0..4 {
-                p.rng[c][k] = rng[c];
+            for (c, v) in rng.into_iter().enumerate() {
+                p.rng[c][k] = v;
             }
             p.u[0][k] = u[0];
             p.u[1][k] = u[1];
@@ -451,7 +450,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             let (wo_x, wo_y, wo_z) = self.out.wo.slices();
             let (wt_r, wt_g, wt_b) = self.out.weight.slices();
             let n = wo_x.len();
-            let (wo_y, wo_z, wt_r, wt_g, wt_b) = (&mut wo_y[..n], &mut wo_z[..n], &mut wt_r[..n], &mut wt_g[..n], &mut wt_b[..n]);
+            let (wo_y, wo_z, wt_r, wt_g, wt_b) =
+                (&mut wo_y[..n], &mut wo_z[..n], &mut wt_r[..n], &mut wt_g[..n], &mut wt_b[..n]);
             let bounces = &mut self.out.bounces[..n];
             while pending != 0 {
                 let k = pending.trailing_zeros() as usize;

@@ -150,9 +150,15 @@ macro_rules! scalar_lanes {
             }
             #[inline(always)]
             fn quadrant(self) -> (Self, bool, bool) {
-                // x + ½ ≥ 0, so truncation is the floor
-                let q = (self + 0.5) as i32;
-                (q as $t, q & 1 != 0, q & 2 != 0)
+                // ⌊y⌋ of y = x + ½ ≥ 0: its nearest integer, less one where that rounded up; the
+                // low bits of q are those of the significand of q + 1.5·2ᵖ⁻¹ (exact). Float
+                // instructions only: a loop of them vectorizes, where the saturating `as i32`
+                // is a scalar conversion per lane.
+                let y = self + 0.5;
+                let r = y.nearest_int();
+                let q = if r > y { r - 1.0 } else { r };
+                let bits = (q + $magic).to_bits();
+                (q, bits & 1 != 0, bits & 2 != 0)
             }
             #[inline(always)]
             fn nearest_int(self) -> Self {

@@ -1,5 +1,6 @@
-//! The random walk in lanes: many walks of [`Microsurface::sample`] at once, eight in flight,
-//! each lane refilled with the next query when its walk ends (supplement §3.1, Algorithm 3).
+//! The random walk in lanes: many walks of [`Microsurface::sample`] at once, 64 in flight and
+//! stepped eight at a time, each path's slot refilled with the next query when its walk ends
+//! (supplement §3.1, Algorithm 3).
 //!
 //! A lane carries one path: its ray, its height (ln C¹, or the undrawn rate of an opaque
 //! walk, `walk::Depth`), its weight, its bounce count, and its own generator. Every formula is
@@ -26,7 +27,6 @@ use crate::slope::{MicrosurfaceSlope, lambda_and_area_of, sample_cap_of};
 use crate::soa::{Channels, Directions, check_len};
 use crate::special::ln_of;
 use glam::{Vec3, Vec3A};
-use rand::SeedableRng;
 
 /// The outputs of [`Microsurface::sample_batch`], one element per query: the exit direction,
 /// the weight f·|cos θo|/pdf and the number of bounces, 0 where [`Microsurface::sample`]
@@ -65,12 +65,54 @@ impl WalkOutputs<'_> {
     }
 }
 
-/// The splitmix64 state of query `i`'s stream from `seed` (a lane's generator is reseeded with
-/// each query, so that query i's walk depends on (seed, i) only, not on the lane or the order
-/// in which the lanes finish).
+/// The seed of query `i`'s generator under a batch's `keys` ([`stream_keys`]): four words
+/// w₀ = h(l ⊕ k₀), w₁ = h(l ⊕ k₁), w₂ = h(w₀ ⊕ u ⊕ k₂), w₃ = h(w₁ ⊕ u ⊕ k₃) of the low and high
+/// halves l, u of i, h MurmurHash3's bijective finalizer [`fmix32`]. (w₀, w₂) determine
+/// (l, u), so every query of a batch has its own state. 32-bit words, so that the lanes
+/// seed eight generators per AVX2 instruction. A lane's generator is reseeded with each query,
+/// so query i's walk depends on (seed, i) only, not on the lane or the order in which the
+/// lanes finish. The lanes make the words the state of their xoshiro128++ ([`xoshiro_of`]),
+/// the scalar walk the state of its PCG ([`pcg_of`]).
 #[inline(always)]
-fn stream(seed: u64, i: usize) -> u64 {
-    mix64(seed ^ mix64((i as u64).wrapping_add(0x632b_e59b_d9b4_e019)))
+fn stream(keys: [u32; 4], i: usize) -> [u32; 4] {
+    stream_of_halves(keys, i as u32, ((i as u64) >> 32) as u32)
+}
+
+/// [`stream`] of the query whose index has the low and high halves `l`, `u`.
+#[inline(always)]
+fn stream_of_halves(keys: [u32; 4], l: u32, u: u32) -> [u32; 4] {
+    let (w0, w1) = (fmix32(l ^ keys[0]), fmix32(l ^ keys[1]));
+    [w0, w1, fmix32(w0 ^ u ^ keys[2]), fmix32(w1 ^ u ^ keys[3])]
+}
+
+/// The keys of a batch's streams: the four words of two splitmix64 outputs of its seed.
+#[inline(always)]
+fn stream_keys(seed: u64) -> [u32; 4] {
+    let (a, b) = (mix64(seed), mix64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
+    [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32]
+}
+
+/// MurmurHash3's 32-bit finalizer (Appleby 2011): a bijection of `u32` whose output bits each
+/// depend on every input bit.
+#[inline(always)]
+fn fmix32(h: u32) -> u32 {
+    let h = (h ^ (h >> 16)).wrapping_mul(0x85eb_ca6b);
+    let h = (h ^ (h >> 13)).wrapping_mul(0xc2b2_ae35);
+    h ^ (h >> 16)
+}
+
+/// The xoshiro128++ state of the seed words `w` ([`stream`]; the last word odd, so that the
+/// state is never zero).
+#[inline(always)]
+fn xoshiro_of([a, b, c, d]: [u32; 4]) -> [u32; 4] {
+    [a, b, c, d | 1]
+}
+
+/// The scalar walk's generator of the seed words `w` ([`stream`]).
+#[inline(always)]
+fn pcg_of([a, b, c, d]: [u32; 4]) -> rand_pcg::Pcg64Mcg {
+    let word = |x: u32, y: u32| u128::from(x) | (u128::from(y) << 32);
+    rand_pcg::Pcg64Mcg::new(word(a, b) | (word(c, d) << 64))
 }
 
 /// The splitmix64 finalizer.
@@ -126,12 +168,13 @@ struct Paths {
     bounces: [u32; PATHS],
     /// The query of each path; `usize::MAX` for an idle slot.
     query: [usize; PATHS],
-    rng: [[u32; 4]; PATHS],
+    /// The four words of each path's generator.
+    rng: [[u32; PATHS]; 4],
     /// The step's verdict: 0 continues with the lanes' facet; otherwise the bits
     /// [`ESCAPED`], [`SCALAR_FACET`], [`ENDED`].
     status: [u8; PATHS],
     /// The uniforms of the last step's facet.
-    u: [[f32; 2]; PATHS],
+    u: [[f32; PATHS]; 2],
     /// The ray and weight after the lanes' facet of the last step.
     next_wr: [[f32; PATHS]; 3],
     next_weight: [[f32; PATHS]; 3],
@@ -205,6 +248,85 @@ fn step(
     (wo, next_depth, [weight[0] * f[0], weight[1] * f[1], weight[2] * f[2]], status, [u1, u2])
 }
 
+/// The queries next in line for the lanes, prepared in a loop the compiler vectorizes (their
+/// directions read in full vectors, their generators seeded eight at a time with AVX2): two
+/// blocks of [`PATHS`], so that a finishing pass, which refills at most [`PATHS`] slots, finds
+/// them ready.
+struct Incoming {
+    /// −ωi of each query.
+    wr: [[f32; 2 * PATHS]; 3],
+    /// The four words of each query's generator ([`xoshiro_of`]).
+    rng: [[u32; 2 * PATHS]; 4],
+    /// Whether the lanes walk the query (a unit ωi from above); the scalar walk answers the
+    /// others.
+    lanes: [bool; 2 * PATHS],
+    /// The query of element 0.
+    first: usize,
+    /// The elements prepared.
+    len: usize,
+    /// The elements taken.
+    taken: usize,
+}
+
+impl Incoming {
+    const EMPTY: Self = Self {
+        wr: [[0.0; 2 * PATHS]; 3],
+        rng: [[0; 2 * PATHS]; 4],
+        lanes: [false; 2 * PATHS],
+        first: 0,
+        len: 0,
+        taken: 0,
+    };
+
+    /// Drops the first block once it is taken and prepares queries up to two blocks (fewer at
+    /// the end of the batch).
+    #[inline(always)]
+    fn top_up(&mut self, wi: &Directions<'_>, keys: [u32; 4]) {
+        if self.taken >= PATHS {
+            for c in &mut self.wr {
+                c.copy_within(PATHS.., 0);
+            }
+            for c in &mut self.rng {
+                c.copy_within(PATHS.., 0);
+            }
+            self.lanes.copy_within(PATHS.., 0);
+            self.first += PATHS;
+            self.len -= PATHS;
+            self.taken -= PATHS;
+        }
+        let (x, y, z) = wi.slices();
+        let len = (x.len() - self.first).min(2 * PATHS);
+        let from = self.len;
+        let (x, y, z) = (&x[self.first..][..len], &y[self.first..][..len], &z[self.first..][..len]);
+        // the halves of query first + j in 32-bit words (j < 2³²: the high half carries at most
+        // one), so that the loop has no 64-bit lane
+        let (l0, u0) = (self.first as u32, ((self.first as u64) >> 32) as u32);
+        for j in from..len {
+            let w = Vec3::new(x[j], y[j], z[j]);
+            // the lanes walk from above: a unit ωi with ωi.z > 0 (what `Microsurface::sample`
+            // walks itself; a view from below is its `sample_from_below`)
+            self.lanes[j] = crate::contract::is_direction(w) & (w.z > 0.0);
+            self.wr[0][j] = -w.x;
+            self.wr[1][j] = -w.y;
+            self.wr[2][j] = -w.z;
+            let l = l0.wrapping_add(j as u32);
+            let g = xoshiro_of(stream_of_halves(keys, l, u0.wrapping_add(u32::from(l < l0))));
+            for (c, g) in g.into_iter().enumerate() {
+                self.rng[c][j] = g;
+            }
+        }
+        self.len = len;
+    }
+
+    /// [`Incoming::top_up`] within a finishing pass, compiled apart: only where many queries
+    /// are off the lanes' domain.
+    #[cold]
+    #[inline(never)]
+    fn top_up_again(&mut self, wi: &Directions<'_>, keys: [u32; 4]) {
+        self.top_up(wi, keys);
+    }
+}
+
 /// The walks of a GGX conductor in lanes.
 struct WalkLoop<'s, 'a, 'b, H, S, M> {
     surface: &'s Microsurface<H, S, M>,
@@ -212,7 +334,8 @@ struct WalkLoop<'s, 'a, 'b, H, S, M> {
     ay: f32,
     fresnel: Option<(Vec3A, Vec3A)>,
     wi: &'s Directions<'a>,
-    seed: u64,
+    /// The batch's stream keys ([`stream_keys`]).
+    keys: [u32; 4],
     out: &'s mut WalkOutputs<'b>,
 }
 
@@ -221,39 +344,47 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
     /// direction), from its own generator.
     #[inline(never)]
     fn scalar(&mut self, i: usize) {
-        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(stream(self.seed, i));
+        let mut rng = pcg_of(stream(self.keys, i));
         self.out.set(i, self.surface.sample(self.wi.get(i), &mut rng));
     }
 
     /// Fills slot `k` with the next query the lanes walk (answering the others with the scalar
     /// walk), or leaves it idle.
-    #[inline(never)]
-    fn refill(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
-        p.query[k] = usize::MAX;
-        // an idle slot walks a harmless ray whose results are dropped
-        let mut wi = Vec3::Z;
-        while *next < self.wi.len() {
-            let i = *next;
-            *next += 1;
-            let w = self.wi.get(i);
-            // the lanes walk from above: a unit ωi with ωi.z > 0 (what `Microsurface::sample`
-            // walks itself; a view from below is its `sample_from_below`)
-            if crate::contract::is_direction(w) && w.z > 0.0 {
+    #[inline(always)]
+    fn refill(&mut self, p: &mut Paths, inc: &mut Incoming, k: usize) {
+        loop {
+            if inc.taken == inc.len {
+                if inc.first + inc.len == self.wi.len() {
+                    // an idle slot walks a harmless ray whose results are dropped
+                    p.query[k] = usize::MAX;
+                    for (c, v) in [0.0, 0.0, -1.0].into_iter().enumerate() {
+                        p.wr[c][k] = v;
+                        p.weight[c][k] = 1.0;
+                    }
+                    p.depth[k] = 0.0;
+                    p.bounces[k] = 0;
+                    return;
+                }
+                inc.top_up_again(self.wi, self.keys);
+            }
+            let j = inc.taken;
+            inc.taken += 1;
+            let i = inc.first + j;
+            if inc.lanes[j] {
                 p.query[k] = i;
-                wi = w;
-                let s = stream(self.seed, i);
-                let (a, b) = (mix64(s), mix64(s ^ 0xd1b5_4a32_d192_ed03));
-                p.rng[k] = [a as u32, (a >> 32) as u32, b as u32, (b >> 32) as u32 | 1];
-                break;
+                for c in 0..4 {
+                    p.rng[c][k] = inc.rng[c][j];
+                }
+                for c in 0..3 {
+                    p.wr[c][k] = inc.wr[c][j];
+                    p.weight[c][k] = 1.0;
+                }
+                p.depth[k] = 0.0;
+                p.bounces[k] = 0;
+                return;
             }
             self.scalar(i);
         }
-        for (c, v) in [-wi.x, -wi.y, -wi.z].into_iter().enumerate() {
-            p.wr[c][k] = v;
-            p.weight[c][k] = 1.0;
-        }
-        p.depth[k] = 0.0;
-        p.bounces[k] = 0;
     }
 
     /// The step of every path (a loop the compiler vectorizes), then the commit of the paths
@@ -263,8 +394,9 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
         for k in 0..PATHS {
             let w = V3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
             let weight = [p.weight[0][k], p.weight[1][k], p.weight[2][k]];
+            let mut rng = [p.rng[0][k], p.rng[1][k], p.rng[2][k], p.rng[3][k]];
             let (wo, depth, weight, status, u) =
-                step(self.ax, self.ay, fresnel, w, p.depth[k], weight, &mut p.rng[k]);
+                step(self.ax, self.ay, fresnel, w, p.depth[k], weight, &mut rng);
             for (c, v) in [wo.x, wo.y, wo.z].into_iter().enumerate() {
                 p.next_wr[c][k] = v;
             }
@@ -273,7 +405,11 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             }
             p.depth[k] = depth;
             p.status[k] = status;
-            p.u[k] = u;
+            for (c, v) in rng.into_iter().enumerate() {
+                p.rng[c][k] = v;
+            }
+            p.u[0][k] = u[0];
+            p.u[1][k] = u[1];
         }
         for k in 0..PATHS {
             let go = p.status[k] == 0;
@@ -288,40 +424,73 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
         }
     }
 
-    /// The paths off the lanes' common path, one by one: the scalar facet, the exits, ends and
-    /// refills.
+    /// The facet of a path that continues, off the lanes' common path: the scalar sampler's.
     #[inline(never)]
-    fn finish(&mut self, p: &mut Paths, k: usize, next: &mut usize) {
-        let Some(i) = Some(p.query[k]).filter(|&i| i != usize::MAX) else { return };
-        let status = p.status[k];
-        if status & ESCAPED != 0 {
-            let s = WalkSample {
-                wo: Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]),
-                weight: Vec3::new(p.weight[0][k], p.weight[1][k], p.weight[2][k]),
-                bounces: p.bounces[k],
-            };
-            self.out.set(i, Some(s));
-            self.refill(p, k, next);
-            return;
+    fn scalar_facet(surface: &Microsurface<H, S, M>, p: &mut Paths, k: usize) {
+        let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
+        let (u1, u2) = (p.u[0][k], p.u[1][k]);
+        let wm = surface.slope().sample_d_wi_unchecked(wi, u1, u2);
+        let s = surface.material().mirror_reflection_unchecked(wi, wm);
+        for (c, (w, f)) in
+            [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
+        {
+            p.wr[c][k] = w;
+            p.weight[c][k] *= f;
         }
-        if status & SCALAR_FACET != 0 {
-            // the facet of a path that continues, off the lanes' common path: the scalar sampler's
-            let wi = -Vec3::new(p.wr[0][k], p.wr[1][k], p.wr[2][k]);
-            let [u1, u2] = p.u[k];
-            let wm = self.surface.slope().sample_d_wi_unchecked(wi, u1, u2);
-            let s = self.surface.material().mirror_reflection_unchecked(wi, wm);
-            for (c, (w, f)) in
-                [(s.wo.x, s.weight.x), (s.wo.y, s.weight.y), (s.wo.z, s.weight.z)].into_iter().enumerate()
-            {
-                p.wr[c][k] = w;
-                p.weight[c][k] *= f;
+        p.bounces[k] += 1;
+    }
+
+    /// The finishing pass over the paths whose step did not commit (the bits of `pending`): the
+    /// scalar facets, the outputs of the walks that exit or end, then the refill of their slots.
+    #[inline(never)]
+    fn finish_all(&mut self, p: &mut Paths, inc: &mut Incoming, mut pending: u64) {
+        let surface = self.surface;
+        let mut free = 0u64;
+        {
+            let (wo_x, wo_y, wo_z) = self.out.wo.slices();
+            let (wt_r, wt_g, wt_b) = self.out.weight.slices();
+            let n = wo_x.len();
+            let (wo_y, wo_z, wt_r, wt_g, wt_b) =
+                (&mut wo_y[..n], &mut wo_z[..n], &mut wt_r[..n], &mut wt_g[..n], &mut wt_b[..n]);
+            let bounces = &mut self.out.bounces[..n];
+            while pending != 0 {
+                let k = pending.trailing_zeros() as usize;
+                pending &= pending - 1;
+                let i = p.query[k];
+                if i >= n {
+                    // an idle slot
+                    continue;
+                }
+                let status = p.status[k];
+                if status & ESCAPED == 0 {
+                    if status & SCALAR_FACET != 0 {
+                        Self::scalar_facet(surface, p, k);
+                    }
+                    let absorbed = (0..3).all(|c| p.weight[c][k] == 0.0);
+                    if !(status & ENDED != 0 || absorbed || p.bounces[k] >= MAX_BOUNCES) {
+                        continue;
+                    }
+                    // no sample: a zero direction, weight and bounce count
+                    for c in 0..3 {
+                        p.wr[c][k] = 0.0;
+                        p.weight[c][k] = 0.0;
+                    }
+                    p.bounces[k] = 0;
+                }
+                wo_x[i] = p.wr[0][k];
+                wo_y[i] = p.wr[1][k];
+                wo_z[i] = p.wr[2][k];
+                wt_r[i] = p.weight[0][k];
+                wt_g[i] = p.weight[1][k];
+                wt_b[i] = p.weight[2][k];
+                bounces[i] = p.bounces[k];
+                free |= 1 << k;
             }
-            p.bounces[k] += 1;
         }
-        let absorbed = (0..3).all(|c| p.weight[c][k] == 0.0);
-        if status & ENDED != 0 || absorbed || p.bounces[k] >= MAX_BOUNCES {
-            self.out.set(i, None);
-            self.refill(p, k, next);
+        while free != 0 {
+            let k = free.trailing_zeros() as usize;
+            free &= free - 1;
+            self.refill(p, inc, k);
         }
     }
 
@@ -335,15 +504,16 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             weight: [[1.0; PATHS]; 3],
             bounces: [0; PATHS],
             query: [usize::MAX; PATHS],
-            rng: [[1; 4]; PATHS],
+            rng: [[1; PATHS]; 4],
             status: [0; PATHS],
-            u: [[0.0; 2]; PATHS],
+            u: [[0.0; PATHS]; 2],
             next_wr: [[0.0; PATHS]; 3],
             next_weight: [[0.0; PATHS]; 3],
         };
-        let mut next = 0;
+        let mut inc = Incoming::EMPTY;
+        inc.top_up(self.wi, self.keys);
         for k in 0..PATHS {
-            self.refill(&mut p, k, &mut next);
+            self.refill(&mut p, &mut inc, k);
         }
         while p.query.iter().any(|&q| q != usize::MAX) {
             self.step_all(&mut p, fresnel);
@@ -351,11 +521,8 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> WalkLoop<'_, '_, 
             for k in 0..PATHS {
                 pending |= u64::from(p.status[k] != 0) << k;
             }
-            while pending != 0 {
-                let k = pending.trailing_zeros() as usize;
-                pending &= pending - 1;
-                self.finish(&mut p, k, &mut next);
-            }
+            inc.top_up(self.wi, self.keys);
+            self.finish_all(&mut p, &mut inc, pending);
         }
     }
 }
@@ -393,13 +560,14 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             _ => None,
         };
         let Some((ax, ay, fresnel)) = lanes else {
+            let keys = stream_keys(seed);
             for i in 0..wi.len() {
-                let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(stream(seed, i));
+                let mut rng = pcg_of(stream(keys, i));
                 out.set(i, self.sample(wi.get(i), &mut rng));
             }
             return Ok(());
         };
-        dispatch(&mut WalkLoop { surface: self, ax, ay, fresnel, wi, seed, out });
+        dispatch(&mut WalkLoop { surface: self, ax, ay, fresnel, wi, keys: stream_keys(seed), out });
         Ok(())
     }
 }

@@ -24,6 +24,14 @@ pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec
     sample_stretched_cap(ggx, wi, CapBound::FULL, u1, u2)
 }
 
+/// [`sample_spherical_cap`]'s normal up to a positive scale, with its squared length
+/// ([`sample_stretched_cap_scaled`]).
+#[must_use]
+#[inline(always)]
+pub(crate) fn sample_spherical_cap_scaled(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+    sample_stretched_cap_scaled(ggx, wi, CapBound::FULL, u1, u2)
+}
+
 /// The lower end of the cap of [`sample_visible_cap`], c.z ≥ −k v̂.z, given by κ = 1 + k ∈ (0, 2]
 /// (κ = 2: the whole visible cap c.z ≥ −v̂.z of Dupuy and Benyoub; κ < 2: the bounded caps of
 /// [`GgxBoundedCap`](crate::vndf::GgxBoundedCap)). Only views above the horizon (v.z > 0) are
@@ -92,6 +100,24 @@ pub(crate) fn top_of<L: Lanes>(kappa: L, v: V3<L>, len: L) -> L {
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
+    let (m, len_sq) = sample_stretched_cap_scaled(ggx, wi, bound, u1, u2);
+    m * (1.0 / len_sq.sqrt())
+}
+
+/// The normal of [`sample_stretched_cap`] up to a positive scale: (m, |m|²) with m̂ the same
+/// unit normal (m normalized is it, bit for bit). On the common path m is the unstretched cap
+/// point itself (in the direct range and clearly visible, [`unstretch_of`]), so that a caller
+/// whose formulas are homogeneous in the normal needs neither its square root nor a division by
+/// it; elsewhere m is the unit normal of the robust path and |m|² = 1.
+#[must_use]
+#[inline(always)]
+pub(crate) fn sample_stretched_cap_scaled(
+    ggx: &Ggx,
+    wi: Vec3,
+    bound: CapBound,
+    u1: f32,
+    u2: f32,
+) -> (Vec3, f32) {
     let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
     let stretched = stretch_of(alpha_x, alpha_y, V3::of(wi)).vec3();
     let len_sq = stretched.length_squared();
@@ -101,7 +127,23 @@ pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32
         (normalize_scaled(stretched, Vec3::Z), 1.0)
     };
     let h = sample_visible_cap(v, len, bound, u1, u2);
-    ensure_visible(wi, normalize_fast(stretch_of(alpha_x, alpha_y, V3::of(h)).vec3(), Vec3::Z))
+    let (m, m_len_sq, common) = unstretch_of(alpha_x, alpha_y, V3::of(wi), V3::of(h));
+    if common { (m.vec3(), m_len_sq) } else { (ensure_visible(wi, normalize_fast(m.vec3(), Vec3::Z)), 1.0) }
+}
+
+/// The unstretched normal m of a cap point `h` (unnormalized), |m|², and the mask of the lanes
+/// on the common path: |m|² in the direct range and m clearly visible from ωi, ωi·m > 0 and
+/// (ωi·m)² > `VISIBLE_DOT_MARGIN`² |m|², the test ωi·m̂ > `VISIBLE_DOT_MARGIN` of
+/// [`ensure_visible`] without the square root. The others take the robust path
+/// ([`ensure_visible`] on the normalized m).
+#[inline(always)]
+pub(crate) fn unstretch_of<L: Lanes>(alpha_x: L, alpha_y: L, wi: V3<L>, h: V3<L>) -> (V3<L>, L, L::Mask) {
+    let m = stretch_of(alpha_x, alpha_y, h);
+    let len_sq = m.length_squared();
+    let k = wi.dot(m);
+    let margin = L::lit(VISIBLE_DOT_MARGIN);
+    let visible = k.gt(L::lit(0.0)) & (k * k).gt(margin * margin * len_sq);
+    (m, len_sq, in_direct_range(len_sq) & visible)
 }
 
 /// (αx x, αy y, z): the stretch of ωi to the α = 1 configuration, and the unstretch of a
@@ -131,16 +173,29 @@ pub(crate) fn sample_cap_of<L: Lanes>(
     u1: L,
     u2: L,
 ) -> (V3<L>, L::Mask) {
+    let (m, len_sq, common) = sample_cap_scaled_of(alpha_x, alpha_y, wi, kappa, u1, u2);
+    (m.scale(L::lit(1.0) / len_sq.sqrt()), common)
+}
+
+/// [`sample_cap_of`]'s normal up to its scale, as [`sample_stretched_cap_scaled`] returns it on
+/// the common path: the unstretched cap point m, |m|², and the mask of the lanes where they
+/// are the scalar sampler's, bit for bit.
+#[inline(always)]
+pub(crate) fn sample_cap_scaled_of<L: Lanes>(
+    alpha_x: L,
+    alpha_y: L,
+    wi: V3<L>,
+    kappa: L,
+    u1: L,
+    u2: L,
+) -> (V3<L>, L, L::Mask) {
     let v = stretch_of(alpha_x, alpha_y, wi);
     let len_sq = v.length_squared();
     let len = len_sq.sqrt();
     let lift = (L::lit(2.0) - kappa) * v.z;
     let (h, away) = cap_direct(v, len, top_of(kappa, v, len), lift, u1, u2);
-    let m = stretch_of(alpha_x, alpha_y, h);
-    let m_len_sq = m.length_squared();
-    let m = m.scale(L::lit(1.0) / m_len_sq.sqrt());
-    let visible = wi.dot(m).gt(L::lit(VISIBLE_DOT_MARGIN));
-    (m, in_direct_range(len_sq) & away & in_direct_range(m_len_sq) & visible)
+    let (m, m_len_sq, common) = unstretch_of(alpha_x, alpha_y, wi, h);
+    (m, m_len_sq, in_direct_range(len_sq) & away & common)
 }
 
 /// Samples the normals of the unit upper hemisphere visible from the direction `v` of length

@@ -35,11 +35,11 @@ use super::{Bsdf, MicrofacetBsdf, SpecularLimit, Technique};
 use crate::error::Error;
 use crate::fresnel::{fresnel_dielectric_cosines_of, reflectance_of, transmittance_dielectric_cosines_of};
 use crate::lanes::{LaneLoop, Lanes, V3, dispatch};
-use crate::material::{LaneMaterial, Material, g2_over_g1_of, reflectance_scaled_of};
+use crate::material::{LaneMaterial, Material, g2_over_g1_of, reflectance_scaled_of, refraction_scale};
 use crate::single_scattering::VISIBLE_SUM_MARGIN;
 use crate::slope::{
     F32_DENSITY_MIN_SUM, MicrosurfaceSlope, bounded_area_of, d_of_sum, kappa_of, lambda_and_area_of,
-    reflection_density_of, sample_cap_of,
+    reflection_density_of, sample_cap_of, sample_cap_scaled_of,
 };
 use crate::soa::{Channels, Directions, check_len};
 use crate::special::{beta_1p_of, ln_beta_1p_of};
@@ -568,9 +568,10 @@ fn primed_uniform(u: f32) -> f32 {
 
 /// The sample of a GGX dielectric seen from above (`Dielectric`'s `sample_at_facet` and
 /// `SingleScattering::sample`, renderer orientation; Heitz et al. 2016, supplement §3.4,
-/// Algorithm 7): ωm from the whole visible cap, reflection where uc < F(ωo·ωm), refraction
-/// otherwise. F and c − s = ωo·ωm − η cos θt are formed in f64 as the scalar sampler forms them
-/// ([`reflectance_scaled_of`], one formula), so that the event and the direction are the
+/// Algorithm 7): ωm from the whole visible cap, taken up to its scale m = l ωm, reflection
+/// where uc < F(ωo·ωm), refraction otherwise. F (from ωo·m and l²) and the refraction's
+/// (ωo·m − l η cos θt)/l² are formed in f64 as the scalar sampler forms them
+/// ([`reflectance_scaled_of`], [`refraction_scale`]), so that the event and the direction are the
 /// scalar's bit for bit; the weight G2/G1(ωo) (a reflection's from the projected areas, a
 /// transmission's the beta function of [`transmission_g2_over_g1`]) times the transport factor,
 /// and the density ([`front_reflection`], [`transmission_density`]), in f32. Returns ωi, the
@@ -587,15 +588,17 @@ fn sample_dielectric(
     let (ax, ay, eta) = (k.ax, k.ay, k.eta);
     let uniform = |u: f32| (0.0..1.0).contains(&u);
     let valid = is_direction(wo) & (wo.z > 0.0) & uniform(uc) & uniform(u1) & uniform(u2);
-    let (m, cap_ok) = sample_cap_of(ax, ay, wo, 2.0, primed_uniform(u1), primed_uniform(u2));
+    // the normal up to its scale, m = l ωm, as `sample_at_facet` takes it
+    let (m, m_len_sq, cap_ok) = sample_cap_scaled_of(ax, ay, wo, 2.0, primed_uniform(u1), primed_uniform(u2));
+    let inv_len_sq = 1.0 / m_len_sq;
     let dot = wo.dot(m);
-    let c = f64::from(dot.abs().min(1.0));
-    let (fresnel, s) = reflectance_scaled_of(f64::from(eta), c, 1.0);
+    let c = f64::from(dot.abs());
+    let (fresnel, s) = reflectance_scaled_of(f64::from(eta), c, f64::from(m_len_sq));
     let reflects = primed_uniform(uc) < fresnel as f32;
-    // `reflect` and `Dielectric::refract`, then the common path of `renormalize`
-    let two_dot = 2.0 * dot;
+    // `reflect_scaled` and `Dielectric::refract`, then the common path of `renormalize`
+    let two_dot = 2.0 * dot * inv_len_sq;
     let r = V3::new(two_dot * m.x - wo.x, two_dot * m.y - wo.y, two_dot * m.z - wo.z);
-    let cs = (c - s) as f32;
+    let cs = refraction_scale(c, s, inv_len_sq);
     let inv_eta = k.inv_eta;
     let t = V3::new((cs * m.x - wo.x) * inv_eta, (cs * m.y - wo.y) * inv_eta, (cs * m.z - wo.z) * inv_eta);
     let v = V3::select(reflects, r, t);

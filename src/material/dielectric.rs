@@ -2,7 +2,7 @@
 
 use super::{
     HalfSum, Interaction, LaneMaterial, Material, PhaseSample, Side, g2_reflection, phase_reflection,
-    reflect, reflection_half_vector,
+    reflect_scaled, reflection_half_vector,
 };
 use crate::contract::is_direction;
 use crate::error::Error;
@@ -242,21 +242,26 @@ impl Dielectric {
         reflectance_scaled_of(f64::from(self.eta), k, l_sq)
     }
 
-    /// The refraction of ωi through the facet ωm with c = ωi·ωm ≥ 0 and s = η cos θt
-    /// (no total internal reflection; s from [`Self::reflectance_scaled`] with l = 1):
-    /// ((c − s) ωm − ωi)/η. Unit in exact arithmetic (its squared length is
-    /// ((c − s)² − 2c(c − s) + 1)/η² = (s² − c² + 1)/η² = sin²θt + cos²θt), so the rounding is
-    /// corrected by one Newton step ([`renormalize`]: no square root or division on the walk's
-    /// critical path), with a full normalization where it is off by more than 2⁻¹². c − s is
-    /// formed in f64 (it cancels near η = 1).
+    /// The refraction of ωi through the facet of the normal m = l ωm of any length l, given
+    /// 1/l² = `inv_len_sq`, with k = ωi·m = l cos θi ≥ 0 and s = l η cos θt (no total internal
+    /// reflection; s from [`Self::reflectance_scaled`] with that l):
+    /// ((c − s/l) ωm − ωi)/η = ((k − s)/l² m − ωi)/η with c = cos θi. Unit in exact arithmetic
+    /// (its squared length is ((c − s/l)² − 2c(c − s/l) + 1)/η² = (s²/l² − c² + 1)/η² =
+    /// sin²θt + cos²θt), so the rounding is corrected by one Newton step ([`renormalize`]: no
+    /// square root or division on the walk's critical path), with a full normalization where it
+    /// is off by more than 2⁻¹². k − s is formed in f64 (it cancels near η = 1), and so is its
+    /// product with 1/l² (exact for a unit normal, l² = 1).
     #[inline(always)]
-    pub(crate) fn refract(&self, wi: Vec3, wm: Vec3, c: f64, s: f64) -> Vec3 {
-        renormalize(((c - s) as f32 * wm - wi) * self.inv_eta, -wm)
+    pub(crate) fn refract(&self, wi: Vec3, m: Vec3, k: f64, s: f64, inv_len_sq: f32) -> Vec3 {
+        renormalize((refraction_scale(k, s, inv_len_sq) * m - wi) * self.inv_eta, -m * inv_len_sq.sqrt())
     }
 
     /// A sample of the phase function from ωi on `side` with the visible normal drawn from
     /// the uniforms (u1, u2) (supplement §3.4, Algorithm 7): ωm ~ D_ωi, reflect with
-    /// probability F(ωi·ωm) (a third uniform), refract otherwise.
+    /// probability F(ωi·ωm) (a third uniform), refract otherwise. The normal is taken up to its
+    /// scale ([`MicrosurfaceSlope::sample_d_wi_scaled_unchecked`]: m = l ωm): the Fresnel term
+    /// from ωi·m and l² ([`Self::reflectance_scaled`]), the reflection and the refraction with
+    /// 1/l², whose division runs beside the Fresnel term's instead of a normalization ahead of it.
     #[inline(always)]
     fn sample_at_facet<S: MicrosurfaceSlope>(
         &self,
@@ -269,16 +274,25 @@ impl Dielectric {
     ) -> PhaseSample {
         let this = self.seen_from(side);
         let wi_local = side.frame(wi);
-        let wm = slope.sample_d_wi_unchecked(wi_local, u1, u2);
-        let c = f64::from(wi_local.dot(wm).abs().min(1.0));
-        let (f, s) = this.reflectance_scaled(c, 1.0);
+        let (m, len_sq) = slope.sample_d_wi_scaled_unchecked(wi_local, u1, u2);
+        let inv_len_sq = 1.0 / len_sq;
+        let k = f64::from(wi_local.dot(m).abs());
+        let (f, s) = this.reflectance_scaled(k, f64::from(len_sq));
         let (wo_local, wo_side) = if uniform(rng) < f as f32 {
-            (renormalize(reflect(wi_local, wm), wm), side)
+            (renormalize(reflect_scaled(wi_local, m, inv_len_sq), m * inv_len_sq.sqrt()), side)
         } else {
-            (this.refract(wi_local, wm, c, s), side.flipped())
+            (this.refract(wi_local, m, k, s, inv_len_sq), side.flipped())
         };
         PhaseSample { wo: side.frame(wo_local), weight: Vec3::ONE, side: wo_side }
     }
+}
+
+/// The factor (k − s)/l² of the normal m in [`Dielectric::refract`] (k = ωi·m, s = l η cos θt,
+/// `inv_len_sq` = 1/l²): the difference in f64 (it cancels near η = 1), times 1/l², rounded
+/// once to f32.
+#[inline(always)]
+pub(crate) fn refraction_scale(k: f64, s: f64, inv_len_sq: f32) -> f32 {
+    ((k - s) * f64::from(inv_len_sq)) as f32
 }
 
 /// [`Dielectric`]'s `reflectance_scaled` for every lane type, with η = `eta`: (F, s) for

@@ -9,7 +9,7 @@ mod side;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
-pub(crate) use dielectric::reflectance_scaled_of;
+pub(crate) use dielectric::{reflectance_scaled_of, refraction_scale};
 pub use diffuse::Diffuse;
 pub use interaction::{Event, Interaction};
 pub use side::Side;
@@ -408,7 +408,14 @@ impl HalfSum {
 /// The reflection of `wi` about the unit normal `wm`: 2(ωi·ωm)ωm − ωi.
 #[inline(always)]
 pub(crate) fn reflect(wi: Vec3, wm: Vec3) -> Vec3 {
-    2.0 * wi.dot(wm) * wm - wi
+    reflect_scaled(wi, wm, 1.0)
+}
+
+/// The reflection of `wi` about the normal `m` of any length, given 1/|m|² = `inv_len_sq`:
+/// 2(ωi·m)/|m|² m − ωi (the multiplication by 1 of a unit normal is exact: [`reflect`]).
+#[inline(always)]
+pub(crate) fn reflect_scaled(wi: Vec3, m: Vec3, inv_len_sq: f32) -> Vec3 {
+    2.0 * wi.dot(m) * inv_len_sq * m - wi
 }
 
 /// The Smith masking-shadowing G2 = 1/(1 + Λ(ωi) + Λ(ωo)) for ωi and ωo above the surface

@@ -132,7 +132,7 @@ impl NoncentralMaterial for Dielectric {
             }
             (wo, surface.g1_unchecked(wo))
         } else {
-            let wo = glass.refract(wi_local, wm, c, s);
+            let wo = glass.refract(wi_local, wm, c, s, 1.0);
             // a refraction that would leave above the base plane is masked by it
             if wo.z >= 0.0 || wo.z.is_nan() {
                 return None;

@@ -16,7 +16,7 @@ pub use ggx::Ggx;
 pub(crate) use beckmann::{gaussian_slope, visible_slope_x_above};
 pub(crate) use ggx::{
     F32_DENSITY_MIN_SUM, bounded_area_of, cap_bound, d_of_sum, kappa_of, lambda_and_area_of,
-    reflection_density_of, sample_bounded_cap, sample_cap_of,
+    reflection_density_of, sample_bounded_cap, sample_cap_of, sample_cap_scaled_of,
 };
 // the spherical-cap kernels, for the tabulated slopes' tail (feature `data-driven`).
 #[cfg(feature = "data-driven")]
@@ -303,6 +303,17 @@ pub trait MicrosurfaceSlope: Sealed + Copy + core::fmt::Debug + Send + Sync {
     /// The core of [`Self::sample_d_wi`]: no argument check.
     #[doc(hidden)]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3;
+
+    /// [`Self::sample_d_wi_unchecked`]'s normal up to a positive scale: (m, |m|²) with m/|m|
+    /// that normal, for callers whose formulas are homogeneous in the normal (the dielectric's
+    /// Fresnel term, reflection and refraction take ωi·m and |m|²). The default is the unit
+    /// normal and 1; [`Ggx`] returns its unstretched cap point, without the normalization's
+    /// square root and division. No argument check (crate-internal hot path).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn sample_d_wi_scaled_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        (self.sample_d_wi_unchecked(wi, u1, u2), 1.0)
+    }
 
     /// The density D(ωh)/(4 A(ωi)) of a reflection off mirror facets from ωi to ωo, both unit
     /// and strictly above the horizon, ωh = (ωi + ωo)/|ωi + ωo| (the single-scattering density

@@ -8,12 +8,13 @@ use crate::error::Error;
 use crate::lanes::{Lanes, V3};
 mod visible;
 
-pub(crate) use visible::{bounded_area_of, kappa_of, sample_cap_of};
+pub(crate) use visible::{bounded_area_of, kappa_of, sample_cap_of, sample_cap_scaled_of};
 
 use crate::albedo::AlbedoTable;
 use core::f32::consts::FRAC_1_PI;
 use glam::{DVec3, Vec2, Vec3};
 use visible::bounded_area;
+use visible::sample_spherical_cap_scaled;
 pub(crate) use visible::{cap_bound, sample_bounded_cap, sample_spherical_cap, sample_visible_hemisphere};
 
 /// 1/(4π), the constant of the reflection density D(ωh)/(4 A(ωi)).
@@ -336,6 +337,11 @@ impl MicrosurfaceSlope for Ggx {
     #[inline(always)]
     fn sample_d_wi_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> Vec3 {
         sample_spherical_cap(self, wi, u1, u2)
+    }
+
+    #[inline(always)]
+    fn sample_d_wi_scaled_unchecked(&self, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+        sample_spherical_cap_scaled(self, wi, u1, u2)
     }
 
     /// D(ωh)/(4 A(ωi)) in f32 from the unnormalized sum h = ωi + ωo: D is homogeneous of

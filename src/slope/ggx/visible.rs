@@ -24,6 +24,14 @@ pub(crate) fn sample_spherical_cap(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> Vec
     sample_stretched_cap(ggx, wi, CapBound::FULL, u1, u2)
 }
 
+/// [`sample_spherical_cap`]'s normal up to a positive scale, with its squared length
+/// ([`sample_stretched_cap_scaled`]).
+#[must_use]
+#[inline(always)]
+pub(crate) fn sample_spherical_cap_scaled(ggx: &Ggx, wi: Vec3, u1: f32, u2: f32) -> (Vec3, f32) {
+    sample_stretched_cap_scaled(ggx, wi, CapBound::FULL, u1, u2)
+}
+
 /// The lower end of the cap of [`sample_visible_cap`], c.z ≥ −k v̂.z, given by κ = 1 + k ∈ (0, 2]
 /// (κ = 2: the whole visible cap c.z ≥ −v̂.z of Dupuy and Benyoub; κ < 2: the bounded caps of
 /// [`GgxBoundedCap`](crate::vndf::GgxBoundedCap)). Only views above the horizon (v.z > 0) are
@@ -61,10 +69,13 @@ impl CapBound {
     }
 
     /// The height of the cap's bottom above the plane of −v, len (v̂.z − b) = (1 − k) v.z =
-    /// (2 − κ) v.z ≥ 0: 0 for the whole cap (also below the horizon, where κ = 2).
+    /// (2 − κ) v.z ≥ 0: 0 for the whole cap (also below the horizon, where κ = 2), written −0
+    /// there, the one addend the compiler drops: the cap's height (1 − u1) top + lift ≥ +0 is
+    /// the same with (2 − κ) v.z = ±0 and without it, and for [`CapBound::FULL`] the addition
+    /// folds away.
     #[inline(always)]
     fn lift(self, v: Vec3) -> f32 {
-        (2.0 - self.kappa) * v.z
+        if self.kappa == 2.0 { -0.0 } else { (2.0 - self.kappa) * v.z }
     }
 }
 
@@ -92,6 +103,33 @@ pub(crate) fn top_of<L: Lanes>(kappa: L, v: V3<L>, len: L) -> L {
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
+    ensure_visible(wi, normalize_fast(stretched_cap_point(ggx, wi, bound, u1, u2), Vec3::Z))
+}
+
+/// The normal of [`sample_stretched_cap`] up to a positive scale: (m, |m|²). On the common
+/// path m is the unstretched cap point itself (in the direct range and clearly visible,
+/// [`scaled_visible_of`]), so that a caller whose formulas are homogeneous in the normal needs
+/// neither its square root nor a division by it; elsewhere m is the unit normal of
+/// [`sample_stretched_cap`]'s robust path and |m|² = 1.
+#[must_use]
+#[inline(always)]
+pub(crate) fn sample_stretched_cap_scaled(
+    ggx: &Ggx,
+    wi: Vec3,
+    bound: CapBound,
+    u1: f32,
+    u2: f32,
+) -> (Vec3, f32) {
+    let m = stretched_cap_point(ggx, wi, bound, u1, u2);
+    let (len_sq, common) = scaled_visible_of(V3::of(wi), V3::of(m));
+    if common { (m, len_sq) } else { (ensure_visible(wi, normalize_fast(m, Vec3::Z)), 1.0) }
+}
+
+/// The unstretched cap point of [`sample_stretched_cap`], before its normalization: stretch
+/// ωi (normalized directly in the safe range, rescaled otherwise), sample the cap, unstretch.
+#[must_use]
+#[inline(always)]
+fn stretched_cap_point(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
     let (alpha_x, alpha_y) = (ggx.alpha_x(), ggx.alpha_y());
     let stretched = stretch_of(alpha_x, alpha_y, V3::of(wi)).vec3();
     let len_sq = stretched.length_squared();
@@ -101,7 +139,21 @@ pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32
         (normalize_scaled(stretched, Vec3::Z), 1.0)
     };
     let h = sample_visible_cap(v, len, bound, u1, u2);
-    ensure_visible(wi, normalize_fast(stretch_of(alpha_x, alpha_y, V3::of(h)).vec3(), Vec3::Z))
+    stretch_of(alpha_x, alpha_y, V3::of(h)).vec3()
+}
+
+/// |m|² of a normal m given up to its scale, and the mask of the lanes where m is used as it
+/// is: |m|² in the direct range and m clearly visible from ωi, ωi·m > 0 and
+/// (ωi·m)² > `VISIBLE_DOT_MARGIN`² |m|² (the test ωi·m̂ > `VISIBLE_DOT_MARGIN` of
+/// [`ensure_visible`] without the square root). The others take the robust path
+/// ([`ensure_visible`] on the normalized m).
+#[inline(always)]
+pub(crate) fn scaled_visible_of<L: Lanes>(wi: V3<L>, m: V3<L>) -> (L, L::Mask) {
+    let len_sq = m.length_squared();
+    let k = wi.dot(m);
+    let margin = L::lit(VISIBLE_DOT_MARGIN);
+    let visible = k.gt(L::lit(0.0)) & (k * k).gt(margin * margin * len_sq);
+    (len_sq, in_direct_range(len_sq) & visible)
 }
 
 /// (αx x, αy y, z): the stretch of ωi to the α = 1 configuration, and the unstretch of a
@@ -131,16 +183,40 @@ pub(crate) fn sample_cap_of<L: Lanes>(
     u1: L,
     u2: L,
 ) -> (V3<L>, L::Mask) {
+    let (m, common) = cap_point_of(alpha_x, alpha_y, wi, kappa, u1, u2);
+    let m_len_sq = m.length_squared();
+    let m = m.scale(L::lit(1.0) / m_len_sq.sqrt());
+    let visible = wi.dot(m).gt(L::lit(VISIBLE_DOT_MARGIN));
+    (m, common & in_direct_range(m_len_sq) & visible)
+}
+
+/// [`sample_stretched_cap_scaled`] for every lane type on its common path (the whole cap,
+/// κ = 2, or bounded as in [`sample_cap_of`]): the unstretched cap point m, |m|², and the mask
+/// of the lanes where they are the scalar sampler's, bit for bit ([`scaled_visible_of`]).
+#[inline(always)]
+pub(crate) fn sample_cap_scaled_of<L: Lanes>(
+    alpha_x: L,
+    alpha_y: L,
+    wi: V3<L>,
+    kappa: L,
+    u1: L,
+    u2: L,
+) -> (V3<L>, L, L::Mask) {
+    let (m, common) = cap_point_of(alpha_x, alpha_y, wi, kappa, u1, u2);
+    let (len_sq, scaled_common) = scaled_visible_of(wi, m);
+    (m, len_sq, common & scaled_common)
+}
+
+/// [`stretched_cap_point`] for every lane type, with the mask of the lanes on its common path
+/// (the stretched ωi normalized directly, the cap point away from −v̂).
+#[inline(always)]
+fn cap_point_of<L: Lanes>(alpha_x: L, alpha_y: L, wi: V3<L>, kappa: L, u1: L, u2: L) -> (V3<L>, L::Mask) {
     let v = stretch_of(alpha_x, alpha_y, wi);
     let len_sq = v.length_squared();
     let len = len_sq.sqrt();
     let lift = (L::lit(2.0) - kappa) * v.z;
     let (h, away) = cap_direct(v, len, top_of(kappa, v, len), lift, u1, u2);
-    let m = stretch_of(alpha_x, alpha_y, h);
-    let m_len_sq = m.length_squared();
-    let m = m.scale(L::lit(1.0) / m_len_sq.sqrt());
-    let visible = wi.dot(m).gt(L::lit(VISIBLE_DOT_MARGIN));
-    (m, in_direct_range(len_sq) & away & in_direct_range(m_len_sq) & visible)
+    (stretch_of(alpha_x, alpha_y, h), in_direct_range(len_sq) & away)
 }
 
 /// Samples the normals of the unit upper hemisphere visible from the direction `v` of length

@@ -103,7 +103,14 @@ pub(crate) fn top_of<L: Lanes>(kappa: L, v: V3<L>, len: L) -> L {
 #[must_use]
 #[inline(always)]
 pub(crate) fn sample_stretched_cap(ggx: &Ggx, wi: Vec3, bound: CapBound, u1: f32, u2: f32) -> Vec3 {
-    ensure_visible(wi, normalize_fast(stretched_cap_point(ggx, wi, bound, u1, u2), Vec3::Z))
+    unit_visible(wi, stretched_cap_point(ggx, wi, bound, u1, u2))
+}
+
+/// The robust finish of an unstretched cap point m: normalized ([`normalize_fast`]) and made
+/// visible from ωi ([`ensure_visible`]).
+#[inline(always)]
+fn unit_visible(wi: Vec3, m: Vec3) -> Vec3 {
+    ensure_visible(wi, normalize_fast(m, Vec3::Z))
 }
 
 /// The normal of [`sample_stretched_cap`] up to a positive scale: (m, |m|²). On the common
@@ -122,7 +129,7 @@ pub(crate) fn sample_stretched_cap_scaled(
 ) -> (Vec3, f32) {
     let m = stretched_cap_point(ggx, wi, bound, u1, u2);
     let (len_sq, common) = scaled_visible_of(V3::of(wi), V3::of(m));
-    if common { (m, len_sq) } else { (ensure_visible(wi, normalize_fast(m, Vec3::Z)), 1.0) }
+    if common { (m, len_sq) } else { (unit_visible(wi, m), 1.0) }
 }
 
 /// The unstretched cap point of [`sample_stretched_cap`], before its normalization: stretch

@@ -528,6 +528,22 @@ fn compensated_conductor_batches_are_the_scalar_calls() {
     }
 }
 
+/// Compensated conductors in batches too small to tabulate their direction factors (1, 63 and
+/// 127 queries; every scheme): on Beckmann slopes, whose single scattering is its scalar calls
+/// in a batch, equal to the scalar calls bit for bit (the same three steps of f).
+#[test]
+fn small_compensated_conductor_batches_are_the_scalar_calls() {
+    let beckmann = Beckmann::isotropic(0.4).expect("valid roughness");
+    let (wo, wi) = queries(620, false);
+    for scheme in SCHEMES {
+        let bsdf =
+            Compensated::with_scheme(beckmann, Conductor::new(ComplexIor::GOLD), scheme).expect("tabulated");
+        for n in [1, 63, 127] {
+            check_exact(&format!("gold {scheme:?} Beckmann 0.4, {n} queries"), &bsdf, &wo[..n], &wi[..n]);
+        }
+    }
+}
+
 /// Compensated glass (η = 1.5 and 1/1.5; every scheme): within the single-scattering
 /// dielectric's bounds ([`GLASS`], carried through the added lobes, the mixture and Turquin's
 /// factor); Turquin's samples with single scattering's batch direction, event and η bit for bit

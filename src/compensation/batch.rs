@@ -12,17 +12,19 @@
 //! renormalized directions, or the contract's *nothing*.
 
 use super::compensated::{Compensated, Compensation};
-use super::conductor::{Column, ConductorLobes, DirectionFactors};
+use super::conductor::DirectionFactors;
 use crate::bsdf::{BatchBsdf, Bsdf, BsdfSample, MicrofacetBsdf, SampleOutputs, sample_each};
 use crate::contract::is_direction;
 use crate::error::Error;
+use crate::lanes::{LaneLoop, dispatch};
 use crate::material::{Conductor, Dielectric};
 use crate::slope::MicrosurfaceSlope;
 use crate::soa::{Channels, Directions};
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec2, Vec3};
 
 /// What a compensated lobe's scalar calls compute after single scattering, at valid
-/// directions (the material's own functions, which the scalar calls end with).
+/// directions (the material's own functions, which the scalar calls end with), and the passes
+/// of a batch that compose them.
 trait Composition: Bsdf {
     /// The single-scattering BSDF inside.
     type Single: BatchBsdf;
@@ -30,24 +32,20 @@ trait Composition: Bsdf {
     /// A Dirac lobe: single scattering's answers, uncompensated.
     fn dirac(&self) -> bool;
     fn scheme(&self) -> Compensation;
-    /// What f's compensation reads, prepared for a batch of `n` queries.
-    type Factors<'a>
-    where
-        Self: 'a;
-    fn factors(&self, n: usize) -> Self::Factors<'_>;
-    fn compensated_f(&self, factors: &Self::Factors<'_>, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3;
     fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32;
-    /// Both of the above (a material whose two read the same cells reads them once).
-    fn compensated(
-        &self,
-        factors: &Self::Factors<'_>,
-        wo: Vec3,
-        wi: Vec3,
-        f_ss: Vec3,
-        pdf_ss: f32,
-    ) -> (Vec3, f32);
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3>;
+    /// f of every query whose directions are unit as given, from single scattering's f in `f`;
+    /// every other query is marked with a NaN in f's first channel.
+    fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>);
+    /// [`Composition::compose_f`] and the density of the same queries from single
+    /// scattering's in `pdf`.
+    fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]);
 }
+
+/// Three coordinate slices of equal length.
+type Slices<'a> = (&'a [f32], &'a [f32], &'a [f32]);
+/// Three mutable channel slices of equal length.
+type SlicesMut<'a> = (&'a mut [f32], &'a mut [f32], &'a mut [f32]);
 
 impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
     type Single = MicrofacetBsdf<S, Conductor>;
@@ -63,40 +61,96 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
     fn scheme(&self) -> Compensation {
         self.scheme
     }
-    type Factors<'a>
-        = ConductorFactors<'a>
-    where
-        Self: 'a;
-    #[inline]
-    fn factors(&self, n: usize) -> ConductorFactors<'_> {
-        if n >= COLUMN_QUERIES && self.scheme != Compensation::Turquin {
-            ConductorFactors::Column(self.lobes.column())
-        } else {
-            ConductorFactors::Lobes(&self.lobes)
-        }
-    }
-    #[inline(always)]
-    fn compensated_f(&self, factors: &ConductorFactors<'_>, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
-        Compensated::<S, Conductor>::compensated_f(self, factors, wo, wi, f_ss)
-    }
     #[inline(always)]
     fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         Compensated::<S, Conductor>::compensated_pdf(self, wo, wi, pdf_ss)
     }
     #[inline(always)]
-    fn compensated(
-        &self,
-        factors: &ConductorFactors<'_>,
-        wo: Vec3,
-        wi: Vec3,
-        f_ss: Vec3,
-        pdf_ss: f32,
-    ) -> (Vec3, f32) {
-        (self.compensated_f(factors, wo, wi, f_ss), self.compensated_pdf(wo, wi, pdf_ss))
-    }
-    #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Conductor>::turquin_weight(self, wo, weight)
+    }
+    /// In three stages per block of queries: the coordinates and weights in vectorized lanes,
+    /// the lookups query by query, f in vectorized lanes; the lookups from the lobes' [`Column`](super::conductor::Column) in a batch of at least
+    /// [`COLUMN_QUERIES`] queries, else from the lobes' tables.
+    fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>) {
+        if f.0.len() >= COLUMN_QUERIES {
+            let column = self.lobes.column();
+            dispatch(&mut ConductorStages { bsdf: self, factors: &column, wo, wi, f });
+        } else {
+            dispatch(&mut ConductorStages { bsdf: self, factors: &self.lobes, wo, wi, f });
+        }
+    }
+    fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]) {
+        let pdf = &mut pdf[..f.0.len()];
+        self.compose_f(wo, wi, (&mut *f.0, &mut *f.1, &mut *f.2));
+        let marks = &*f.0;
+        for (i, p) in pdf.iter_mut().enumerate() {
+            if !marks[i].is_nan() {
+                *p = self.compensated_pdf(at(wo, i), at(wi, i), *p);
+            }
+        }
+    }
+}
+
+/// The three stages of a compensated conductor's f over a batch (see
+/// [`Composition::compose_f`]), compiled by [`dispatch`] for the CPU's vector instructions.
+struct ConductorStages<'s, 'a, 'b, S, F> {
+    bsdf: &'s Compensated<S, Conductor>,
+    factors: &'s F,
+    wo: Slices<'a>,
+    wi: Slices<'a>,
+    f: SlicesMut<'b>,
+}
+
+/// Queries per block of [`ConductorStages`] (the first stage's outputs, on the stack).
+const BLOCK: usize = 64;
+
+impl<S: MicrosurfaceSlope, F: DirectionFactors> LaneLoop for ConductorStages<'_, '_, '_, S, F> {
+    #[inline(always)]
+    fn run(&mut self) {
+        // (one copy of the stages per scheme: loops without a branch on it)
+        match self.bsdf.scheme {
+            Compensation::Walk => self.stages(Compensation::Walk),
+            Compensation::KullaConty => self.stages(Compensation::KullaConty),
+            Compensation::Turquin => self.stages(Compensation::Turquin),
+        }
+    }
+}
+
+impl<S: MicrosurfaceSlope, F: DirectionFactors> ConductorStages<'_, '_, '_, S, F> {
+    #[inline(always)]
+    fn stages(&mut self, scheme: Compensation) {
+        let bsdf = self.bsdf;
+        let (fa, fb, fc) = (&mut *self.f.0, &mut *self.f.1, &mut *self.f.2);
+        let n = fa.len();
+        let (fb, fc) = (&mut fb[..n], &mut fc[..n]);
+        let (wo, wi) = (cut(self.wo, n), cut(self.wi, n));
+        let mut start = 0;
+        while start < n {
+            let m = BLOCK.min(n - start);
+            let (mut xo, mut xi, mut weight) = ([0.0f32; BLOCK], [0.0f32; BLOCK], [0.0f32; BLOCK]);
+            // the coordinates and weights (a NaN weight marks a query the pass does not compose)
+            for k in 0..m {
+                let (o, w) = (at(wo, start + k), at(wi, start + k));
+                let (a, b, c) = bsdf.coordinates_of(scheme, o.z, w.z);
+                (xo[k], xi[k], weight[k]) = (a, b, if as_given(o, w) { c } else { f32::NAN });
+            }
+            // the lookups
+            let mut lookups = [[0.0f32; BLOCK]; 3];
+            for k in 0..m {
+                let v = bsdf.lookups_at(scheme, self.factors, xo[k], xi[k]);
+                (lookups[0][k], lookups[1][k], lookups[2][k]) = (v.x, v.y, v.z);
+            }
+            // f
+            let (fa, fb, fc) =
+                (&mut fa[start..start + m], &mut fb[start..start + m], &mut fc[start..start + m]);
+            for k in 0..m {
+                let v = Vec3::new(lookups[0][k], lookups[1][k], lookups[2][k]);
+                let f = bsdf.compose(scheme, Vec3::new(fa[k], fb[k], fc[k]), v, weight[k]);
+                (fa[k], fb[k], fc[k]) = (f.x, f.y, f.z);
+            }
+            start += m;
+        }
     }
 }
 
@@ -114,60 +168,44 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
     fn scheme(&self) -> Compensation {
         self.scheme
     }
-    type Factors<'a>
-        = ()
-    where
-        Self: 'a;
-    #[inline(always)]
-    fn factors(&self, _n: usize) {}
-    #[inline(always)]
-    fn compensated_f(&self, _factors: &(), wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
-        Compensated::<S, Dielectric>::compensated_f(self, wo, wi, f_ss)
-    }
     #[inline(always)]
     fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         Compensated::<S, Dielectric>::compensated_pdf(self, wo, wi, pdf_ss)
     }
     #[inline(always)]
-    fn compensated(&self, _factors: &(), wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
-        Compensated::<S, Dielectric>::compensated(self, wo, wi, f_ss, pdf_ss)
-    }
-    #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Dielectric>::turquin_weight(self, wo, weight)
     }
+    /// Query by query.
+    fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, (fa, fb, fc): SlicesMut<'_>) {
+        for i in 0..fa.len() {
+            let (o, w) = (at(wo, i), at(wi, i));
+            let v =
+                if as_given(o, w) { self.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i])) } else { MARK };
+            (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        }
+    }
+    /// Query by query, the lobes read at the view once for both.
+    fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, (fa, fb, fc): SlicesMut<'_>, pdf: &mut [f32]) {
+        let pdf = &mut pdf[..fa.len()];
+        for i in 0..fa.len() {
+            let (o, w) = (at(wo, i), at(wi, i));
+            if as_given(o, w) {
+                let (v, p) = self.compensated(o, w, Vec3::new(fa[i], fb[i], fc[i]), pdf[i]);
+                (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
+            } else {
+                fa[i] = f32::NAN;
+            }
+        }
+    }
 }
+
+/// The mark of a query a composing pass leaves to the scalar call.
+const MARK: Vec3 = Vec3::splat(f32::NAN);
 
 /// The batch size from which a compensated conductor tabulates its direction factors at its
-/// roughness ([`Column`]: about 4500 instructions, which save about 150 per query).
-const COLUMN_QUERIES: usize = 64;
-
-/// Where a compensated conductor's batch reads its direction factors: the lobes' tables, or
-/// their [`Column`] for a batch of at least [`COLUMN_QUERIES`] queries (of an additive scheme:
-/// Turquin's reads one factor per query).
-// (on the stack for one batch call: boxing the column would allocate on the hot path)
-#[allow(clippy::large_enum_variant)]
-enum ConductorFactors<'a> {
-    Lobes(&'a ConductorLobes),
-    Column(Column),
-}
-
-impl DirectionFactors for ConductorFactors<'_> {
-    #[inline(always)]
-    fn complement_at(&self, x: f32) -> f32 {
-        match self {
-            Self::Lobes(lobes) => lobes.complement_at(x),
-            Self::Column(column) => column.complement_at(x),
-        }
-    }
-    #[inline(always)]
-    fn walk_factor_at(&self, x: f32) -> Vec3A {
-        match self {
-            Self::Lobes(lobes) => lobes.walk_factor_at(x),
-            Self::Column(column) => column.walk_factor_at(x),
-        }
-    }
-}
+/// roughness ([`Column`](super::conductor::Column): about 4500 instructions, which save about 40 per query).
+const COLUMN_QUERIES: usize = 128;
 
 /// Whether the scalar calls take a query's directions as given (no renormalization).
 #[inline(always)]
@@ -175,12 +213,11 @@ fn as_given(wo: Vec3, wi: Vec3) -> bool {
     is_direction(wo) & is_direction(wi)
 }
 
-/// The first `n` queries of structure-of-arrays slices (one bounds check for the loop's
+/// The first `n` queries of structure-of-arrays slices (one bounds check for a loop's
 /// reads).
 #[inline(always)]
-fn first<'a>(w: &Directions<'a>, n: usize) -> (&'a [f32], &'a [f32], &'a [f32]) {
-    let (x, y, z) = w.slices();
-    (&x[..n], &y[..n], &z[..n])
+fn cut(w: Slices<'_>, n: usize) -> Slices<'_> {
+    (&w.0[..n], &w.1[..n], &w.2[..n])
 }
 
 /// Query i of structure-of-arrays slices.
@@ -227,16 +264,13 @@ fn eval_batch<B: Composition>(
         return Ok(());
     }
     let (fa, fb, fc) = f.slices();
-    let (wo, wi) = (first(wo, fa.len()), first(wi, fa.len()));
-    let factors = bsdf.factors(fa.len());
+    let (wo, wi) = (cut(wo.slices(), fa.len()), cut(wi.slices(), fa.len()));
+    bsdf.compose_f(wo, wi, (&mut *fa, &mut *fb, &mut *fc));
     for i in 0..fa.len() {
-        let (o, w) = (at(wo, i), at(wi, i));
-        let v = if as_given(o, w) {
-            bsdf.compensated_f(&factors, o, w, Vec3::new(fa[i], fb[i], fc[i]))
-        } else {
-            scalar_eval(bsdf, o, w)
-        };
-        (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        if fa[i].is_nan() {
+            let v = scalar_eval(bsdf, at(wo, i), at(wi, i));
+            (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        }
     }
     Ok(())
 }
@@ -252,7 +286,7 @@ fn pdf_batch<B: Composition>(
     if bsdf.dirac() || bsdf.scheme() == Compensation::Turquin {
         return Ok(());
     }
-    let (wo, wi) = (first(wo, pdf.len()), first(wi, pdf.len()));
+    let (wo, wi) = (cut(wo.slices(), pdf.len()), cut(wi.slices(), pdf.len()));
     for (i, p) in pdf.iter_mut().enumerate() {
         let (o, w) = (at(wo, i), at(wi, i));
         *p = if as_given(o, w) { bsdf.compensated_pdf(o, w, *p) } else { scalar_pdf(bsdf, o, w) };
@@ -273,16 +307,13 @@ fn eval_with_pdf_batch<B: Composition>(
     }
     let (fa, fb, fc) = f.slices();
     let pdf = &mut pdf[..fa.len()];
-    let (wo, wi) = (first(wo, fa.len()), first(wi, fa.len()));
-    let factors = bsdf.factors(fa.len());
+    let (wo, wi) = (cut(wo.slices(), fa.len()), cut(wi.slices(), fa.len()));
+    bsdf.compose_f_pdf(wo, wi, (&mut *fa, &mut *fb, &mut *fc), pdf);
     for i in 0..fa.len() {
-        let (o, w) = (at(wo, i), at(wi, i));
-        let (v, p) = if as_given(o, w) {
-            bsdf.compensated(&factors, o, w, Vec3::new(fa[i], fb[i], fc[i]), pdf[i])
-        } else {
-            scalar_eval_with_pdf(bsdf, o, w)
-        };
-        (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
+        if fa[i].is_nan() {
+            let (v, p) = scalar_eval_with_pdf(bsdf, at(wo, i), at(wi, i));
+            (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
+        }
     }
     Ok(())
 }

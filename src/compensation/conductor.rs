@@ -87,13 +87,13 @@ impl ConductorLobes {
 
     /// The direction coordinates x of two cosines in [0, 1] from one division.
     #[inline(always)]
-    fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
+    pub(super) fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
         self.axis.coordinates(mu_o, mu_i)
     }
 
     /// The direction coordinate x of one cosine in [0, 1].
     #[inline(always)]
-    fn coordinate(&self, mu: f32) -> f32 {
+    pub(super) fn coordinate(&self, mu: f32) -> f32 {
         self.axis.coordinate(mu)
     }
 
@@ -120,21 +120,6 @@ impl ConductorLobes {
             Compensation::Walk => c * self.order_series(x),
             _ => Vec3A::splat(c),
         }
-    }
-
-    /// The additive lobe g(μo) g(μi) scale of directions above the horizon (both coordinates
-    /// from one division; symmetric in its arguments), 0 unless both are above it, with the
-    /// direction factors read from `factors` (these lobes' tables, or their [`Column`]).
-    #[inline(always)]
-    fn added<F: DirectionFactors>(&self, factors: &F, scheme: Compensation, mu_o: f32, mu_i: f32) -> Vec3 {
-        if !(mu_o > 0.0 && mu_i > 0.0) {
-            return Vec3::ZERO;
-        }
-        let (xo, xi) = self.coordinates(mu_o, mu_i);
-        Vec3::from(match scheme {
-            Compensation::Walk => self.scale * factors.walk_factor_at(xo) * factors.walk_factor_at(xi),
-            _ => self.scale * (factors.complement_at(xo) * factors.complement_at(xi)),
-        })
     }
 
     /// The mixture's probability p of single scattering for a view at cos θo = `mu_o`.
@@ -175,15 +160,14 @@ impl ConductorLobes {
 
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
     #[inline(always)]
-    fn turquin_factor(&self, c_o: f32) -> Vec3 {
-        Vec3::from(Vec3A::ONE + self.scale * (c_o / (1.0 - c_o)))
+    pub(super) fn turquin_factor(&self, c_o: f32) -> Vec3 {
+        Vec3::ONE + Vec3::from(self.scale) * (c_o / (1.0 - c_o))
     }
 
-    /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation), read
-    /// from `factors`.
+    /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
     #[inline(always)]
-    fn view_complement<F: DirectionFactors>(&self, factors: &F, wo: Vec3) -> f32 {
-        if wo.z > 0.0 { factors.complement_at(self.coordinate(wo.z)) } else { 0.0 }
+    fn view_complement(&self, wo: Vec3) -> f32 {
+        if wo.z > 0.0 { self.complement(self.coordinate(wo.z)) } else { 0.0 }
     }
 
     /// The direction factors at every node of the albedo table's direction axis, for a batch
@@ -452,19 +436,66 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// f of a rough surface at valid directions from single scattering's `f_ss` at the same
     /// directions: f_ss plus the additive lobe (Kulla–Conty, the walk's orders) or f_ss times
     /// Turquin's factor of the view. Every evaluation of the BSDF (`eval`, `eval_with_pdf`, the
-    /// batch calls) ends with this expression.
+    /// batch calls) is this expression in three steps: [`Self::coordinates_of`],
+    /// [`Self::lookups_at`] and [`Self::compose`].
     #[inline(always)]
-    pub(super) fn compensated_f<F: DirectionFactors>(
-        &self,
-        factors: &F,
-        wo: Vec3,
-        wi: Vec3,
-        f_ss: Vec3,
-    ) -> Vec3 {
+    pub(super) fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
+        let scheme = self.scheme;
+        let (xo, xi, weight) = self.coordinates_of(scheme, wo.z, wi.z);
+        if weight > 0.0 {
+            self.compose(scheme, f_ss, self.lookups_at(scheme, &self.lobes, xo, xi), weight)
+        } else {
+            f_ss
+        }
+    }
+
+    /// The direction coordinates that f's compensation reads at cosines μo and μi (the
+    /// lobes' `scheme`, an argument so that a batch's loops see it as a constant), and its
+    /// weight: 1 where the scheme compensates (both directions above the horizon for the
+    /// additive lobes, the view for Turquin's factor), 0 elsewhere. Branch-free (a batch runs
+    /// it in vectorized lanes).
+    #[inline(always)]
+    pub(super) fn coordinates_of(&self, scheme: Compensation, mu_o: f32, mu_i: f32) -> (f32, f32, f32) {
         let lobes = &self.lobes;
-        match self.scheme {
-            Compensation::Turquin => f_ss * lobes.turquin_factor(lobes.view_complement(factors, wo)),
-            scheme => f_ss + lobes.added(factors, scheme, wo.z, wi.z),
+        let one = |above: bool| if above { 1.0 } else { 0.0 };
+        match scheme {
+            Compensation::Turquin => (lobes.coordinate(mu_o.max(0.0)), 0.0, one(mu_o > 0.0)),
+            _ => {
+                let (xo, xi) = lobes.coordinates(mu_o.max(0.0), mu_i.max(0.0));
+                (xo, xi, one(mu_o > 0.0 && mu_i > 0.0))
+            }
+        }
+    }
+
+    /// What the scheme reads at the direction coordinates of [`Self::coordinates_of`]:
+    /// g(μo) g(μi) per channel for the walk's orders, (1 − E(μo)) (1 − E(μi)) for
+    /// Kulla–Conty, 1 − E(μo) for Turquin; from `factors` (the lobes' tables, or a batch's
+    /// [`Column`]).
+    #[inline(always)]
+    pub(super) fn lookups_at<F: DirectionFactors>(
+        &self,
+        scheme: Compensation,
+        factors: &F,
+        xo: f32,
+        xi: f32,
+    ) -> Vec3 {
+        match scheme {
+            Compensation::Walk => Vec3::from(factors.walk_factor_at(xo) * factors.walk_factor_at(xi)),
+            Compensation::KullaConty => Vec3::splat(factors.complement_at(xo) * factors.complement_at(xi)),
+            Compensation::Turquin => Vec3::splat(factors.complement_at(xo)),
+        }
+    }
+
+    /// f from single scattering's `f_ss`, the scheme's `lookups` and the weight of
+    /// [`Self::coordinates_of`]: f_ss + scale · lookups · weight for the additive lobes, f_ss
+    /// times Turquin's factor of the view's 1 − E · weight (a weight of 0 gives f_ss, a NaN
+    /// gives NaN). Branch-free (a batch runs it in vectorized lanes).
+    #[inline(always)]
+    pub(super) fn compose(&self, scheme: Compensation, f_ss: Vec3, lookups: Vec3, weight: f32) -> Vec3 {
+        let lobes = &self.lobes;
+        match scheme {
+            Compensation::Turquin => f_ss * lobes.turquin_factor(lookups.x * weight),
+            _ => f_ss + Vec3::from(lobes.scale) * lookups * weight,
         }
     }
 
@@ -477,7 +508,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
         let weight = if self.single.is_specular() {
             weight
         } else {
-            weight * lobes.turquin_factor(lobes.view_complement(lobes, wo))
+            weight * lobes.turquin_factor(lobes.view_complement(wo))
         };
         weight.is_finite().then_some(weight)
     }
@@ -539,7 +570,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         if self.single.is_specular() {
             return v;
         }
-        BsdfValue { f: self.compensated_f(&self.lobes, wo, wi, v.f), exact: true }
+        BsdfValue { f: self.compensated_f(wo, wi, v.f), exact: true }
     }
 
     #[inline]
@@ -601,7 +632,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         if self.single.is_specular() {
             return (v, pdf_ss);
         }
-        let f = self.compensated_f(&self.lobes, wo, wi, v.f);
+        let f = self.compensated_f(wo, wi, v.f);
         (BsdfValue { f, exact: true }, self.compensated_pdf(wo, wi, pdf_ss))
     }
 }

@@ -12,7 +12,7 @@
 //! renormalized directions, or the contract's *nothing*.
 
 use super::compensated::{Compensated, Compensation};
-use super::conductor::DirectionFactors;
+use super::conductor::{DirectionFactors, mixture_of};
 use crate::bsdf::{BatchBsdf, Bsdf, BsdfSample, MicrofacetBsdf, SampleOutputs, sample_each};
 use crate::contract::is_direction;
 use crate::error::Error;
@@ -32,11 +32,13 @@ trait Composition: Bsdf {
     /// A Dirac lobe: single scattering's answers, uncompensated.
     fn dirac(&self) -> bool;
     fn scheme(&self) -> Compensation;
-    fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32;
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3>;
     /// f of every query whose directions are unit as given, from single scattering's f in `f`;
     /// every other query is marked with a NaN in f's first channel.
     fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>);
+    /// The density of every query whose directions are unit as given, from single
+    /// scattering's in `pdf`; every other query is marked with a NaN.
+    fn compose_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, pdf: &mut [f32]);
     /// [`Composition::compose_f`] and the density of the same queries from single
     /// scattering's in `pdf`.
     fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]);
@@ -62,10 +64,6 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
         self.scheme
     }
     #[inline(always)]
-    fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        Compensated::<S, Conductor>::compensated_pdf(self, wo, wi, pdf_ss)
-    }
-    #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Conductor>::turquin_weight(self, wo, weight)
     }
@@ -80,14 +78,60 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
             dispatch(&mut ConductorStages { bsdf: self, factors: &self.lobes, wo, wi, f });
         }
     }
+    /// In three stages per block of queries, as f's: which queries mix, in vectorized lanes;
+    /// the mixture's parts query by query; the density in vectorized lanes.
+    fn compose_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, pdf: &mut [f32]) {
+        dispatch(&mut DensityStages { bsdf: self, wo, wi, pdf });
+    }
     fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]) {
-        let pdf = &mut pdf[..f.0.len()];
-        self.compose_f(wo, wi, (&mut *f.0, &mut *f.1, &mut *f.2));
-        let marks = &*f.0;
-        for (i, p) in pdf.iter_mut().enumerate() {
-            if !marks[i].is_nan() {
-                *p = self.compensated_pdf(at(wo, i), at(wi, i), *p);
+        self.compose_f(wo, wi, f);
+        // (the queries f's pass leaves to the scalar call take its density too)
+        if self.lobes.mixing {
+            self.compose_pdf(wo, wi, pdf);
+        }
+    }
+}
+
+/// The three stages of a compensated conductor's density over a batch (see
+/// [`Composition::compose_pdf`]).
+struct DensityStages<'s, 'a, 'b, S> {
+    bsdf: &'s Compensated<S, Conductor>,
+    wo: Slices<'a>,
+    wi: Slices<'a>,
+    pdf: &'b mut [f32],
+}
+
+impl<S: MicrosurfaceSlope> LaneLoop for DensityStages<'_, '_, '_, S> {
+    #[inline(always)]
+    fn run(&mut self) {
+        // (a copy, as in the stages of f)
+        let bsdf = &{ *self.bsdf };
+        let pdf = &mut *self.pdf;
+        let n = pdf.len();
+        let (wo, wi) = (cut(self.wo, n), cut(self.wi, n));
+        let mut start = 0;
+        while start < n {
+            let m = BLOCK.min(n - start);
+            // which queries mix: 1 or 0, NaN marking a query the pass does not compose
+            let mut weight = [0.0f32; BLOCK];
+            for k in 0..m {
+                let (o, w) = (at(wo, start + k), at(wi, start + k));
+                let mixes = if bsdf.mixes_at(o.z, w.z) { 1.0 } else { 0.0 };
+                weight[k] = if as_given(o, w) { mixes } else { f32::NAN };
             }
+            // the mixture's parts (at any cosine: a cell's index is clamped to the table)
+            let (mut share, mut added) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
+            for k in 0..m {
+                (share[k], added[k]) = bsdf.lobes.mixture_parts(wo.2[start + k], wi.2[start + k]);
+            }
+            // the density
+            let pdf = &mut pdf[start..start + m];
+            for k in 0..m {
+                let mixed = mixture_of((share[k], added[k]), pdf[k]);
+                let v = if weight[k] > 0.0 { mixed } else { pdf[k] };
+                pdf[k] = if weight[k].is_nan() { f32::NAN } else { v };
+            }
+            start += m;
         }
     }
 }
@@ -120,7 +164,9 @@ impl<S: MicrosurfaceSlope, F: DirectionFactors> LaneLoop for ConductorStages<'_,
 impl<S: MicrosurfaceSlope, F: DirectionFactors> ConductorStages<'_, '_, '_, S, F> {
     #[inline(always)]
     fn stages(&mut self, scheme: Compensation) {
-        let bsdf = self.bsdf;
+        // (a copy: the loops' reads of it cannot alias the outputs, which lets the compiler
+        // vectorize them)
+        let bsdf = &{ *self.bsdf };
         let (fa, fb, fc) = (&mut *self.f.0, &mut *self.f.1, &mut *self.f.2);
         let n = fa.len();
         let (fb, fc) = (&mut fb[..n], &mut fc[..n]);
@@ -169,10 +215,6 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
         self.scheme
     }
     #[inline(always)]
-    fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        Compensated::<S, Dielectric>::compensated_pdf(self, wo, wi, pdf_ss)
-    }
-    #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Dielectric>::turquin_weight(self, wo, weight)
     }
@@ -183,6 +225,13 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
             let v =
                 if as_given(o, w) { self.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i])) } else { MARK };
             (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        }
+    }
+    /// Query by query.
+    fn compose_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, pdf: &mut [f32]) {
+        for (i, p) in pdf.iter_mut().enumerate() {
+            let (o, w) = (at(wo, i), at(wi, i));
+            *p = if as_given(o, w) { self.compensated_pdf(o, w, *p) } else { f32::NAN };
         }
     }
     /// Query by query, the lobes read at the view once for both.
@@ -287,9 +336,11 @@ fn pdf_batch<B: Composition>(
         return Ok(());
     }
     let (wo, wi) = (cut(wo.slices(), pdf.len()), cut(wi.slices(), pdf.len()));
-    for (i, p) in pdf.iter_mut().enumerate() {
-        let (o, w) = (at(wo, i), at(wi, i));
-        *p = if as_given(o, w) { bsdf.compensated_pdf(o, w, *p) } else { scalar_pdf(bsdf, o, w) };
+    bsdf.compose_pdf(wo, wi, pdf);
+    for i in 0..pdf.len() {
+        if pdf[i].is_nan() {
+            pdf[i] = scalar_pdf(bsdf, at(wo, i), at(wi, i));
+        }
     }
     Ok(())
 }

@@ -57,7 +57,7 @@ pub struct ConductorLobes {
     upper: f32,
     /// Whether the sampler mixes in the added lobe (an additive scheme with energy on a rough
     /// surface).
-    mixing: bool,
+    pub(super) mixing: bool,
     /// F̄ = F_avg per channel (Kulla–Conty and the walk's orders).
     fresnel_average: Vec3A,
     /// Kulla–Conty: F_ms/(π C); the walk's orders: 1/(π ḡ) per channel; Turquin: F0.
@@ -144,7 +144,7 @@ impl ConductorLobes {
 
     /// The mixture's weight p of single scattering and its added term (1 − p) d(μi) μi/π.
     #[inline(always)]
-    fn mixture_parts(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
+    pub(super) fn mixture_parts(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
         let p = self.single_share(mu_o);
         (p, (1.0 - p) * self.profile_pdf(mu_i))
     }
@@ -154,8 +154,7 @@ impl ConductorLobes {
     /// expression: pdf, eval_with_pdf and both branches of sample agree bit for bit.
     #[inline(always)]
     fn mixture_pdf(&self, mu_o: f32, pdf_ss: f32, mu_i: f32) -> f32 {
-        let (p, added) = self.mixture_parts(mu_o, mu_i.max(0.0));
-        p * pdf_ss + added
+        mixture_of(self.mixture_parts(mu_o, mu_i.max(0.0)), pdf_ss)
     }
 
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
@@ -242,6 +241,13 @@ impl DirectionFactors for Column {
         let v = a + t * (b - a);
         v.x * Vec3A::new(v.y, v.z, v.w)
     }
+}
+
+/// The mixture density p pdf_ss + added from the parts (p, added) of
+/// [`ConductorLobes::mixture_parts`].
+#[inline(always)]
+pub(super) fn mixture_of((p, added): (f32, f32), pdf_ss: f32) -> f32 {
+    p * pdf_ss + added
 }
 
 /// A table cell (index, fraction) as stored in [`ConductorLobes`] (a u32 index: 8 bytes).
@@ -517,10 +523,22 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// directions: the sampling mixture's p pdf_ss + (1 − p) d(μi) μi/π where the sampler mixes
     /// and the light is above the horizon, else `pdf_ss` (a light below the horizon of a view
     /// from above has density 0 in both lobes). Every density of the BSDF but the sample's
-    /// (`pdf`, `eval_with_pdf`, the batch calls) ends with this expression.
+    /// (`pdf`, `eval_with_pdf`, the batch calls) is this expression: [`Self::mixes_at`], then
+    /// [`ConductorLobes::mixture_parts`] and [`mixture_of`] where it mixes.
     #[inline(always)]
     pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        if self.mixes(wo) && wi.z > 0.0 { self.lobes.mixture_pdf(wo.z, pdf_ss, wi.z) } else { pdf_ss }
+        if self.mixes_at(wo.z, wi.z) {
+            mixture_of(self.lobes.mixture_parts(wo.z, wi.z), pdf_ss)
+        } else {
+            pdf_ss
+        }
+    }
+
+    /// Whether the density at directions of cosines μo and μi is the sampling mixture's: the
+    /// sampler mixes for the view ([`Self::mixes`]) and the light is above the horizon.
+    #[inline(always)]
+    pub(super) fn mixes_at(&self, mu_o: f32, mu_i: f32) -> bool {
+        self.lobes.mixing && mu_o > 0.0 && mu_i > 0.0
     }
 
     /// Single scattering's density at a pair of valid directions with `wo` above the horizon:

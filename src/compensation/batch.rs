@@ -19,7 +19,7 @@ use crate::error::Error;
 use crate::lanes::{LaneLoop, dispatch};
 use crate::material::{Conductor, Dielectric};
 use crate::slope::MicrosurfaceSlope;
-use crate::soa::{Channels, Directions};
+use crate::soa::{Channels, Directions, next_marked};
 use glam::{Vec2, Vec3};
 
 /// What a compensated lobe's scalar calls compute after single scattering, at valid
@@ -114,10 +114,10 @@ impl<S: MicrosurfaceSlope> LaneLoop for DensityStages<'_, '_, '_, S> {
             let m = BLOCK.min(n - start);
             // which queries mix: 1 or 0, NaN marking a query the pass does not compose
             let mut weight = [0.0f32; BLOCK];
-            for k in 0..m {
+            for (k, slot) in weight[..m].iter_mut().enumerate() {
                 let (o, w) = (at(wo, start + k), at(wi, start + k));
                 let mixes = if bsdf.mixes_at(o.z, w.z) { 1.0 } else { 0.0 };
-                weight[k] = if as_given(o, w) { mixes } else { f32::NAN };
+                *slot = if as_given(o, w) { mixes } else { f32::NAN };
             }
             // the mixture's parts (at any cosine: a cell's index is clamped to the table)
             let (mut share, mut added) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
@@ -315,11 +315,11 @@ fn eval_batch<B: Composition>(
     let (fa, fb, fc) = f.slices();
     let (wo, wi) = (cut(wo.slices(), fa.len()), cut(wi.slices(), fa.len()));
     bsdf.compose_f(wo, wi, (&mut *fa, &mut *fb, &mut *fc));
-    for i in 0..fa.len() {
-        if fa[i].is_nan() {
-            let v = scalar_eval(bsdf, at(wo, i), at(wi, i));
-            (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
-        }
+    let mut from = 0;
+    while let Some(i) = next_marked(fa, from) {
+        let v = scalar_eval(bsdf, at(wo, i), at(wi, i));
+        (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        from = i + 1;
     }
     Ok(())
 }
@@ -337,10 +337,10 @@ fn pdf_batch<B: Composition>(
     }
     let (wo, wi) = (cut(wo.slices(), pdf.len()), cut(wi.slices(), pdf.len()));
     bsdf.compose_pdf(wo, wi, pdf);
-    for i in 0..pdf.len() {
-        if pdf[i].is_nan() {
-            pdf[i] = scalar_pdf(bsdf, at(wo, i), at(wi, i));
-        }
+    let mut from = 0;
+    while let Some(i) = next_marked(pdf, from) {
+        pdf[i] = scalar_pdf(bsdf, at(wo, i), at(wi, i));
+        from = i + 1;
     }
     Ok(())
 }
@@ -360,11 +360,11 @@ fn eval_with_pdf_batch<B: Composition>(
     let pdf = &mut pdf[..fa.len()];
     let (wo, wi) = (cut(wo.slices(), fa.len()), cut(wi.slices(), fa.len()));
     bsdf.compose_f_pdf(wo, wi, (&mut *fa, &mut *fb, &mut *fc), pdf);
-    for i in 0..fa.len() {
-        if fa[i].is_nan() {
-            let (v, p) = scalar_eval_with_pdf(bsdf, at(wo, i), at(wi, i));
-            (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
-        }
+    let mut from = 0;
+    while let Some(i) = next_marked(fa, from) {
+        let (v, p) = scalar_eval_with_pdf(bsdf, at(wo, i), at(wi, i));
+        (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
+        from = i + 1;
     }
     Ok(())
 }

@@ -172,7 +172,7 @@ impl ConductorLobes {
     /// The direction factors at every node of the albedo table's direction axis, for a batch
     /// (see [`Column`]).
     #[inline]
-    pub(super) fn column(&self) -> Column {
+    pub(super) fn column(&self, scheme: Compensation) -> Column {
         let tables = self.tables.0;
         let (j, fr) = self.row();
         let order_row = cell(self.order_row);
@@ -181,13 +181,18 @@ impl ConductorLobes {
         Column {
             corners: core::array::from_fn(|i| [lower[i], upper[i], lower[i + 1], upper[i + 1]]),
             fraction: fr,
-            series: core::array::from_fn(|i| {
-                // the per-order axis's node below i and the fraction of its cell (a whole
-                // number of the albedo axis's cells, COARSE per cell)
-                let k = (i / COARSE).min(ORDER_TABLE_SIZE - 2);
-                let [a, b] = tables.fractions_at((k, (i - k * COARSE) as f32 / COARSE as f32), order_row);
-                series(self.fresnel_average, a, b)
-            }),
+            // (the walk's orders alone read the series)
+            series: if scheme == Compensation::Walk {
+                core::array::from_fn(|i| {
+                    // the per-order axis's node below i and the fraction of its cell (a whole
+                    // number of the albedo axis's cells, COARSE per cell)
+                    let k = (i / COARSE).min(ORDER_TABLE_SIZE - 2);
+                    let [a, b] = tables.fractions_at((k, (i - k * COARSE) as f32 / COARSE as f32), order_row);
+                    series(self.fresnel_average, a, b)
+                })
+            } else {
+                [Vec3A::ZERO; ALBEDO_DIRECTIONS]
+            },
         }
     }
 }
@@ -685,7 +690,7 @@ mod tests {
     fn column_reads_the_lobes_within_rounding() {
         fn check<S: AlbedoTabulated>(slope: S, conductor: Conductor, worst: &mut f32) {
             let b = Compensated::with_scheme(slope, conductor, Compensation::Walk).unwrap();
-            let column = b.lobes.column();
+            let column = b.lobes.column(Compensation::Walk);
             let mut state = 0x2545_f491_4f6c_dd1du64;
             let mut next = || {
                 state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);

@@ -110,3 +110,44 @@ impl<'a> Channels<'a> {
 pub(crate) fn check_len(name: &'static str, expected: usize, found: usize) -> Result<(), Error> {
     if expected == found { Ok(()) } else { Err(Error::LengthMismatch { name, expected, found }) }
 }
+
+/// The first index i ≥ `from` whose value is NaN (the mark of a query left to a scalar call),
+/// if any: blocks of eight values tested at once (vectorized), the marked block searched.
+#[inline(always)]
+pub(crate) fn next_marked(values: &[f32], from: usize) -> Option<usize> {
+    let rest = values.get(from..)?;
+    let blocks = rest.chunks_exact(8);
+    let tail = blocks.remainder();
+    for (b, block) in blocks.enumerate() {
+        if block.iter().fold(false, |any, x| any | x.is_nan()) {
+            return block.iter().position(|x| x.is_nan()).map(|k| from + 8 * b + k);
+        }
+    }
+    tail.iter().position(|x| x.is_nan()).map(|k| values.len() - tail.len() + k)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `next_marked` finds every NaN in order, from any start, in and across blocks of eight
+    /// and in the remainder (lengths 0 to 27, marks at every third, fifth or ninth index).
+    #[test]
+    fn next_marked_finds_every_mark_in_order() {
+        for n in 0..28 {
+            for every in [3, 5, 9] {
+                let values: Vec<f32> =
+                    (0..n).map(|i| if i % every == 1 { f32::NAN } else { i as f32 }).collect();
+                let expected: Vec<usize> = (0..n).filter(|i| i % every == 1).collect();
+                let mut found = Vec::new();
+                let mut from = 0;
+                while let Some(i) = next_marked(&values, from) {
+                    found.push(i);
+                    from = i + 1;
+                }
+                assert_eq!(found, expected, "n = {n}, every {every}");
+                assert_eq!(next_marked(&values, n + 3), None);
+            }
+        }
+    }
+}

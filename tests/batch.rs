@@ -491,10 +491,12 @@ fn check_exact<B: BatchBsdf>(label: &str, bsdf: &B, wo: &[Vec3], wi: &[Vec3]) {
 }
 
 /// Compensated conductors (gold, copper; every scheme): the batch is single scattering's batch
-/// with the scalar calls' added lobe, Turquin factor and mixture density: densities bit for
-/// bit, f within single scattering's bounds (a compensated f is at least single scattering's,
-/// Turquin's scales it), samples bit for bit (Turquin's are single scattering's batch samples);
-/// Beckmann (the scalar fallback) and the Dirac mirror bit for bit.
+/// with the scalar calls' added lobe (its direction factors tabulated at the lobe's roughness,
+/// within rounding of the scalar lookups), Turquin factor and mixture density: densities bit
+/// for bit, f within single scattering's bounds (a compensated f is at least single
+/// scattering's, Turquin's scales it), samples bit for bit (Turquin's are single scattering's
+/// batch samples); on Beckmann (single scattering's scalar fallback) the same bounds; the Dirac
+/// mirror bit for bit.
 #[test]
 fn compensated_conductor_batches_are_the_scalar_calls() {
     let bounds = Bounds { rel: 4e-6, transmit_rel: 4e-6, abs: 1e-6, ..Bounds::EXACT };
@@ -515,13 +517,29 @@ fn compensated_conductor_batches_are_the_scalar_calls() {
             let beckmann = Beckmann::isotropic(0.4).expect("valid roughness");
             let bsdf = Compensated::with_scheme(beckmann, metal, scheme).expect("tabulated");
             let label = format!("{name} {scheme:?} Beckmann 0.4");
-            check_eval(&label, &bsdf, seed, Bounds::EXACT);
+            check_eval(&label, &bsdf, seed, bounds);
             check_sample(&label, &bsdf, seed, 0.0, 0.0, 0.0);
             let dirac = Compensated::with_scheme(Ggx::isotropic(DIRAC).expect("valid"), metal, scheme);
             let (dirac, label) = (dirac.expect("tabulated"), format!("{name} {scheme:?} Dirac"));
             let (wo, wi) = queries(seed, false);
             check_exact(&label, &dirac, &wo, &wi);
             check_sample(&label, &dirac, seed, 0.0, 0.0, 0.0);
+        }
+    }
+}
+
+/// Compensated conductors in batches too small to tabulate their direction factors (1, 63 and
+/// 127 queries; every scheme): on Beckmann slopes, whose single scattering is its scalar calls
+/// in a batch, equal to the scalar calls bit for bit (the same three steps of f).
+#[test]
+fn small_compensated_conductor_batches_are_the_scalar_calls() {
+    let beckmann = Beckmann::isotropic(0.4).expect("valid roughness");
+    let (wo, wi) = queries(620, false);
+    for scheme in SCHEMES {
+        let bsdf =
+            Compensated::with_scheme(beckmann, Conductor::new(ComplexIor::GOLD), scheme).expect("tabulated");
+        for n in [1, 63, 127] {
+            check_exact(&format!("gold {scheme:?} Beckmann 0.4, {n} queries"), &bsdf, &wo[..n], &wi[..n]);
         }
     }
 }

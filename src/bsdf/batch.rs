@@ -41,7 +41,7 @@ use crate::slope::{
     F32_DENSITY_MIN_SUM, MicrosurfaceSlope, bounded_area_of, d_of_sum, kappa_of, lambda_and_area_of,
     reflection_density_of, sample_cap_of, sample_cap_scaled_of,
 };
-use crate::soa::{Channels, Directions, check_len};
+use crate::soa::{Channels, Directions, check_len, next_marked};
 use crate::special::{beta_1p_of, ln_beta_1p_of};
 use glam::{Vec2, Vec3, Vec3A};
 
@@ -638,6 +638,17 @@ struct EvalLoop<'s, 'a, 'b, B, const WANT: u8> {
 }
 
 impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
+    /// The output that marks the queries left to the scalar call: the density, or f's first
+    /// channel.
+    #[inline(always)]
+    fn marks(&self) -> &[f32] {
+        match (&self.f, &self.pdf) {
+            (_, Some(pdf)) => pdf,
+            (Some(f), None) => f.a,
+            (None, None) => &[],
+        }
+    }
+
     /// The scalar call for query `i`.
     #[inline(never)]
     fn scalar(&mut self, i: usize) {
@@ -691,15 +702,10 @@ impl<B: Bsdf, const WANT: u8> EvalLoop<'_, '_, '_, B, WANT> {
             }
             (None, None) => {}
         }
-        for i in 0..n {
-            let marked = match (&self.f, &self.pdf) {
-                (_, Some(pdf)) => pdf[i].is_nan(),
-                (Some(f), None) => f.a[i].is_nan(),
-                (None, None) => false,
-            };
-            if marked {
-                self.scalar(i);
-            }
+        let mut from = 0;
+        while let Some(i) = next_marked(self.marks(), from) {
+            self.scalar(i);
+            from = i + 1;
         }
     }
 }
@@ -847,11 +853,11 @@ impl<B: Bsdf> SampleLoop<'_, '_, '_, B> {
                 eta[i] = ratio;
             }
         }
-        for i in 0..n {
-            if self.out.pdf[i].is_nan() {
-                let s = self.bsdf.sample(self.wo.get(i), uc[i], Vec2::new(u1[i], u2[i]));
-                self.out.set(i, s);
-            }
+        let mut from = 0;
+        while let Some(i) = next_marked(self.out.pdf, from) {
+            let s = self.bsdf.sample(self.wo.get(i), uc[i], Vec2::new(u1[i], u2[i]));
+            self.out.set(i, s);
+            from = i + 1;
         }
     }
 }

@@ -1,8 +1,9 @@
 //! The batch calls of the compensated lobes ([`BatchBsdf`]): single scattering's batch (in
 //! eight lanes where [`MicrofacetBsdf`] has them, by its scalar calls elsewhere), then one pass
-//! over the queries that ends each as the scalar call ends it, with the same expression: the
+//! over the queries that ends each as the scalar call ends it, with the same functions: the
 //! added lobe or Turquin's factor on f, the sampling mixture on the density, Turquin's factor
-//! on a sample's weight.
+//! on a sample's weight. A conductor's pass runs those functions in three stages per block of
+//! queries (vectorized, the table reads, vectorized); a dielectric's, query by query.
 //!
 //! The scalar calls renormalize directions that drifted from unit length on entry
 //! (`unit_directions!`), and single scattering's batch answers such a query with its own
@@ -12,16 +13,19 @@
 //! renormalized directions, or the contract's *nothing*.
 
 use super::compensated::{Compensated, Compensation};
+use super::conductor::{DirectionFactors, mixture_of};
 use crate::bsdf::{BatchBsdf, Bsdf, BsdfSample, MicrofacetBsdf, SampleOutputs, sample_each};
 use crate::contract::is_direction;
 use crate::error::Error;
+use crate::lanes::{LaneLoop, dispatch};
 use crate::material::{Conductor, Dielectric};
 use crate::slope::MicrosurfaceSlope;
-use crate::soa::{Channels, Directions};
+use crate::soa::{Channels, Directions, next_marked};
 use glam::{Vec2, Vec3};
 
 /// What a compensated lobe's scalar calls compute after single scattering, at valid
-/// directions (the material's own functions, which the scalar calls end with).
+/// directions (the material's own functions, which the scalar calls end with), and the passes
+/// of a batch that compose them.
 trait Composition: Bsdf {
     /// The single-scattering BSDF inside.
     type Single: BatchBsdf;
@@ -29,12 +33,22 @@ trait Composition: Bsdf {
     /// A Dirac lobe: single scattering's answers, uncompensated.
     fn dirac(&self) -> bool;
     fn scheme(&self) -> Compensation;
-    fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3;
-    fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32;
-    /// Both of the above (a material whose two read the same cells reads them once).
-    fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32);
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3>;
+    /// f of every query whose directions are unit as given, from single scattering's f in `f`;
+    /// every other query is marked with a NaN in f's first channel.
+    fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>);
+    /// The density of every query whose directions are unit as given, from single
+    /// scattering's in `pdf`; every other query is marked with a NaN.
+    fn compose_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, pdf: &mut [f32]);
+    /// [`Composition::compose_f`] and the density of the same queries from single
+    /// scattering's in `pdf`.
+    fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]);
 }
+
+/// Three coordinate slices of equal length.
+type Slices<'a> = (&'a [f32], &'a [f32], &'a [f32]);
+/// Three mutable channel slices of equal length.
+type SlicesMut<'a> = (&'a mut [f32], &'a mut [f32], &'a mut [f32]);
 
 impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
     type Single = MicrofacetBsdf<S, Conductor>;
@@ -51,20 +65,139 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
         self.scheme
     }
     #[inline(always)]
-    fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
-        Compensated::<S, Conductor>::compensated_f(self, wo, wi, f_ss)
-    }
-    #[inline(always)]
-    fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        Compensated::<S, Conductor>::compensated_pdf(self, wo, wi, pdf_ss)
-    }
-    #[inline(always)]
-    fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
-        (self.compensated_f(wo, wi, f_ss), self.compensated_pdf(wo, wi, pdf_ss))
-    }
-    #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Conductor>::turquin_weight(self, wo, weight)
+    }
+    /// In three stages per block of queries: the coordinates and weights in vectorized lanes,
+    /// the lookups query by query, f in vectorized lanes; the lookups from the lobes' [`Column`](super::conductor::Column) in a batch of at least
+    /// [`COLUMN_QUERIES`] queries, else from the lobes' tables.
+    fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>) {
+        if f.0.len() >= COLUMN_QUERIES {
+            let column = self.lobes.column(self.scheme);
+            dispatch(&mut ConductorStages { bsdf: self, factors: &column, wo, wi, f });
+        } else {
+            dispatch(&mut ConductorStages { bsdf: self, factors: &self.lobes, wo, wi, f });
+        }
+    }
+    /// In three stages per block of queries, as f's: which queries mix, in vectorized lanes;
+    /// the mixture's parts query by query; the density in vectorized lanes.
+    fn compose_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, pdf: &mut [f32]) {
+        dispatch(&mut DensityStages { bsdf: self, wo, wi, pdf });
+    }
+    fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]) {
+        self.compose_f(wo, wi, f);
+        // (the queries f's pass leaves to the scalar call take its density too)
+        if self.lobes.mixing {
+            self.compose_pdf(wo, wi, pdf);
+        }
+    }
+}
+
+/// The three stages of a compensated conductor's density over a batch (see
+/// [`Composition::compose_pdf`]).
+struct DensityStages<'s, 'a, 'b, S> {
+    bsdf: &'s Compensated<S, Conductor>,
+    wo: Slices<'a>,
+    wi: Slices<'a>,
+    pdf: &'b mut [f32],
+}
+
+impl<S: MicrosurfaceSlope> LaneLoop for DensityStages<'_, '_, '_, S> {
+    #[inline(always)]
+    fn run(&mut self) {
+        // (a copy, as in the stages of f)
+        let bsdf = &{ *self.bsdf };
+        let pdf = &mut *self.pdf;
+        let n = pdf.len();
+        let (wo, wi) = (cut(self.wo, n), cut(self.wi, n));
+        let mut start = 0;
+        while start < n {
+            let m = BLOCK.min(n - start);
+            // which queries mix: 1 or 0, NaN marking a query the pass does not compose
+            let mut weight = [0.0f32; BLOCK];
+            for (k, slot) in weight[..m].iter_mut().enumerate() {
+                let (o, w) = (at(wo, start + k), at(wi, start + k));
+                let mixes = if bsdf.mixes_at(o.z, w.z) { 1.0 } else { 0.0 };
+                *slot = if as_given(o, w) { mixes } else { f32::NAN };
+            }
+            // the mixture's parts (at any cosine: a cell's index is clamped to the table)
+            let (mut share, mut added) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
+            for k in 0..m {
+                (share[k], added[k]) = bsdf.lobes.mixture_parts(wo.2[start + k], wi.2[start + k]);
+            }
+            // the density
+            let pdf = &mut pdf[start..start + m];
+            for k in 0..m {
+                let mixed = mixture_of((share[k], added[k]), pdf[k]);
+                let v = if weight[k] > 0.0 { mixed } else { pdf[k] };
+                pdf[k] = if weight[k].is_nan() { f32::NAN } else { v };
+            }
+            start += m;
+        }
+    }
+}
+
+/// The three stages of a compensated conductor's f over a batch (see
+/// [`Composition::compose_f`]), compiled by [`dispatch`] for the CPU's vector instructions.
+struct ConductorStages<'s, 'a, 'b, S, F> {
+    bsdf: &'s Compensated<S, Conductor>,
+    factors: &'s F,
+    wo: Slices<'a>,
+    wi: Slices<'a>,
+    f: SlicesMut<'b>,
+}
+
+/// Queries per block of [`ConductorStages`] (the first stage's outputs, on the stack).
+const BLOCK: usize = 64;
+
+impl<S: MicrosurfaceSlope, F: DirectionFactors> LaneLoop for ConductorStages<'_, '_, '_, S, F> {
+    #[inline(always)]
+    fn run(&mut self) {
+        // (one copy of the stages per scheme: loops without a branch on it)
+        match self.bsdf.scheme {
+            Compensation::Walk => self.stages(Compensation::Walk),
+            Compensation::KullaConty => self.stages(Compensation::KullaConty),
+            Compensation::Turquin => self.stages(Compensation::Turquin),
+        }
+    }
+}
+
+impl<S: MicrosurfaceSlope, F: DirectionFactors> ConductorStages<'_, '_, '_, S, F> {
+    #[inline(always)]
+    fn stages(&mut self, scheme: Compensation) {
+        // (a copy: the loops' reads of it cannot alias the outputs, which lets the compiler
+        // vectorize them)
+        let bsdf = &{ *self.bsdf };
+        let (fa, fb, fc) = (&mut *self.f.0, &mut *self.f.1, &mut *self.f.2);
+        let n = fa.len();
+        let (fb, fc) = (&mut fb[..n], &mut fc[..n]);
+        let (wo, wi) = (cut(self.wo, n), cut(self.wi, n));
+        let mut start = 0;
+        while start < n {
+            let m = BLOCK.min(n - start);
+            let (mut xo, mut xi, mut weight) = ([0.0f32; BLOCK], [0.0f32; BLOCK], [0.0f32; BLOCK]);
+            // the coordinates and weights (a NaN weight marks a query the pass does not compose)
+            for k in 0..m {
+                let (o, w) = (at(wo, start + k), at(wi, start + k));
+                let (a, b, c) = bsdf.coordinates_of(scheme, o.z, w.z);
+                (xo[k], xi[k], weight[k]) = (a, b, if as_given(o, w) { c } else { f32::NAN });
+            }
+            // the lookups
+            let mut lookups = [[0.0f32; BLOCK]; 3];
+            for k in 0..m {
+                let v = bsdf.lookups_at(scheme, self.factors, xo[k], xi[k]);
+                (lookups[0][k], lookups[1][k], lookups[2][k]) = (v.x, v.y, v.z);
+            }
+            // f
+            let (fa, fb, fc) =
+                (&mut fa[start..start + m], &mut fb[start..start + m], &mut fc[start..start + m]);
+            for k in 0..m {
+                let v = Vec3::new(lookups[0][k], lookups[1][k], lookups[2][k]);
+                let f = bsdf.compose(scheme, Vec3::new(fa[k], fb[k], fc[k]), v, weight[k]);
+                (fa[k], fb[k], fc[k]) = (f.x, f.y, f.z);
+            }
+            start += m;
+        }
     }
 }
 
@@ -83,27 +216,60 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
         self.scheme
     }
     #[inline(always)]
-    fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
-        Compensated::<S, Dielectric>::compensated_f(self, wo, wi, f_ss)
-    }
-    #[inline(always)]
-    fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        Compensated::<S, Dielectric>::compensated_pdf(self, wo, wi, pdf_ss)
-    }
-    #[inline(always)]
-    fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
-        Compensated::<S, Dielectric>::compensated(self, wo, wi, f_ss, pdf_ss)
-    }
-    #[inline(always)]
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Dielectric>::turquin_weight(self, wo, weight)
     }
+    /// Query by query.
+    fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, (fa, fb, fc): SlicesMut<'_>) {
+        for i in 0..fa.len() {
+            let (o, w) = (at(wo, i), at(wi, i));
+            let v =
+                if as_given(o, w) { self.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i])) } else { MARK };
+            (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        }
+    }
+    /// Query by query.
+    fn compose_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, pdf: &mut [f32]) {
+        for (i, p) in pdf.iter_mut().enumerate() {
+            let (o, w) = (at(wo, i), at(wi, i));
+            *p = if as_given(o, w) { self.compensated_pdf(o, w, *p) } else { f32::NAN };
+        }
+    }
+    /// Query by query, the lobes read at the view once for both.
+    fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, (fa, fb, fc): SlicesMut<'_>, pdf: &mut [f32]) {
+        let pdf = &mut pdf[..fa.len()];
+        for i in 0..fa.len() {
+            let (o, w) = (at(wo, i), at(wi, i));
+            if as_given(o, w) {
+                let (v, p) = self.compensated(o, w, Vec3::new(fa[i], fb[i], fc[i]), pdf[i]);
+                (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
+            } else {
+                fa[i] = f32::NAN;
+            }
+        }
+    }
 }
+
+/// The mark of a query a composing pass leaves to the scalar call.
+const MARK: Vec3 = Vec3::splat(f32::NAN);
+
+/// The batch size from which a compensated conductor lays out its direction factors at its
+/// roughness ([`Column`](super::conductor::Column)): in a batch of 1024 queries it saves 24
+/// (Turquin) to 146 (the walk's orders) instructions per query of f, its construction
+/// included (about 9000 instructions with the walk's series, a few hundred without).
+const COLUMN_QUERIES: usize = 128;
 
 /// Whether the scalar calls take a query's directions as given (no renormalization).
 #[inline(always)]
 fn as_given(wo: Vec3, wi: Vec3) -> bool {
     is_direction(wo) & is_direction(wi)
+}
+
+/// The first `n` queries of structure-of-arrays slices (one bounds check for a loop's
+/// reads).
+#[inline(always)]
+fn cut(w: Slices<'_>, n: usize) -> Slices<'_> {
+    (&w.0[..n], &w.1[..n], &w.2[..n])
 }
 
 /// Query i of structure-of-arrays slices.
@@ -149,16 +315,14 @@ fn eval_batch<B: Composition>(
     if bsdf.dirac() {
         return Ok(());
     }
-    let (wo, wi) = (wo.slices(), wi.slices());
     let (fa, fb, fc) = f.slices();
-    for i in 0..fa.len() {
-        let (o, w) = (at(wo, i), at(wi, i));
-        let v = if as_given(o, w) {
-            bsdf.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i]))
-        } else {
-            scalar_eval(bsdf, o, w)
-        };
+    let (wo, wi) = (cut(wo.slices(), fa.len()), cut(wi.slices(), fa.len()));
+    bsdf.compose_f(wo, wi, (&mut *fa, &mut *fb, &mut *fc));
+    let mut from = 0;
+    while let Some(i) = next_marked(fa, from) {
+        let v = scalar_eval(bsdf, at(wo, i), at(wi, i));
         (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+        from = i + 1;
     }
     Ok(())
 }
@@ -174,10 +338,12 @@ fn pdf_batch<B: Composition>(
     if bsdf.dirac() || bsdf.scheme() == Compensation::Turquin {
         return Ok(());
     }
-    let (wo, wi) = (wo.slices(), wi.slices());
-    for (i, p) in pdf.iter_mut().enumerate() {
-        let (o, w) = (at(wo, i), at(wi, i));
-        *p = if as_given(o, w) { bsdf.compensated_pdf(o, w, *p) } else { scalar_pdf(bsdf, o, w) };
+    let (wo, wi) = (cut(wo.slices(), pdf.len()), cut(wi.slices(), pdf.len()));
+    bsdf.compose_pdf(wo, wi, pdf);
+    let mut from = 0;
+    while let Some(i) = next_marked(pdf, from) {
+        pdf[i] = scalar_pdf(bsdf, at(wo, i), at(wi, i));
+        from = i + 1;
     }
     Ok(())
 }
@@ -193,17 +359,15 @@ fn eval_with_pdf_batch<B: Composition>(
     if bsdf.dirac() {
         return Ok(());
     }
-    let (wo, wi) = (wo.slices(), wi.slices());
     let (fa, fb, fc) = f.slices();
     let pdf = &mut pdf[..fa.len()];
-    for i in 0..fa.len() {
-        let (o, w) = (at(wo, i), at(wi, i));
-        let (v, p) = if as_given(o, w) {
-            bsdf.compensated(o, w, Vec3::new(fa[i], fb[i], fc[i]), pdf[i])
-        } else {
-            scalar_eval_with_pdf(bsdf, o, w)
-        };
+    let (wo, wi) = (cut(wo.slices(), fa.len()), cut(wi.slices(), fa.len()));
+    bsdf.compose_f_pdf(wo, wi, (&mut *fa, &mut *fb, &mut *fc), pdf);
+    let mut from = 0;
+    while let Some(i) = next_marked(fa, from) {
+        let (v, p) = scalar_eval_with_pdf(bsdf, at(wo, i), at(wi, i));
         (fa[i], fb[i], fc[i], pdf[i]) = (v.x, v.y, v.z, p);
+        from = i + 1;
     }
     Ok(())
 }
@@ -240,12 +404,13 @@ fn sample_batch<B: Composition>(
 }
 
 /// The batch calls of the compensated conductor: single scattering's batch (eight lanes on GGX),
-/// then each query's compensation by the scalar calls' own expression (see the bounds on
-/// [`BatchBsdf`] for [`MicrofacetBsdf`], which carry over: the added lobe and the mixture
-/// density are the scalar call's bits, so densities are equal bit for bit and f errs by single
-/// scattering's error alone, scaled by Turquin's factor for that scheme). Turquin's samples are
-/// single scattering's batch samples with the scalar call's weight factor (bit for bit); the
-/// additive schemes sample by the scalar call, query by query.
+/// then each query's compensation by the scalar calls' own functions (see the bounds on
+/// [`BatchBsdf`] for [`MicrofacetBsdf`], which carry over: 1 − E and the mixture density are
+/// the scalar call's bits, so densities are equal bit for bit and f errs by single scattering's
+/// error, scaled by Turquin's factor for that scheme, and for the walk's orders by the series'
+/// rounding, within 1e-6 of its cell's largest value). Turquin's samples are single
+/// scattering's batch samples with the scalar call's weight factor (bit for bit); the additive
+/// schemes sample by the scalar call, query by query.
 impl<S: MicrosurfaceSlope> BatchBsdf for Compensated<S, Conductor> {
     fn eval_batch(
         &self,

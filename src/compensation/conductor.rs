@@ -57,7 +57,7 @@ pub struct ConductorLobes {
     upper: f32,
     /// Whether the sampler mixes in the added lobe (an additive scheme with energy on a rough
     /// surface).
-    mixing: bool,
+    pub(super) mixing: bool,
     /// F̄ = F_avg per channel (Kulla–Conty and the walk's orders).
     fresnel_average: Vec3A,
     /// Kulla–Conty: F_ms/(π C); the walk's orders: 1/(π ḡ) per channel; Turquin: F0.
@@ -87,13 +87,13 @@ impl ConductorLobes {
 
     /// The direction coordinates x of two cosines in [0, 1] from one division.
     #[inline(always)]
-    fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
+    pub(super) fn coordinates(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
         self.axis.coordinates(mu_o, mu_i)
     }
 
     /// The direction coordinate x of one cosine in [0, 1].
     #[inline(always)]
-    fn coordinate(&self, mu: f32) -> f32 {
+    pub(super) fn coordinate(&self, mu: f32) -> f32 {
         self.axis.coordinate(mu)
     }
 
@@ -122,21 +122,6 @@ impl ConductorLobes {
         }
     }
 
-    /// The additive lobe g(μo) g(μi) scale of directions above the horizon (both coordinates
-    /// from one division; symmetric in its arguments), 0 unless both are above it.
-    #[inline(always)]
-    fn added(&self, scheme: Compensation, mu_o: f32, mu_i: f32) -> Vec3 {
-        if !(mu_o > 0.0 && mu_i > 0.0) {
-            return Vec3::ZERO;
-        }
-        let (xo, xi) = self.coordinates(mu_o, mu_i);
-        let (co, ci) = (self.complement(xo), self.complement(xi));
-        Vec3::from(match scheme {
-            Compensation::Walk => self.scale * self.factor(scheme, xo, co) * self.factor(scheme, xi, ci),
-            _ => self.scale * (co * ci),
-        })
-    }
-
     /// The mixture's probability p of single scattering for a view at cos θo = `mu_o`.
     #[inline(always)]
     fn single_share(&self, mu_o: f32) -> f32 {
@@ -159,7 +144,7 @@ impl ConductorLobes {
 
     /// The mixture's weight p of single scattering and its added term (1 − p) d(μi) μi/π.
     #[inline(always)]
-    fn mixture_parts(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
+    pub(super) fn mixture_parts(&self, mu_o: f32, mu_i: f32) -> (f32, f32) {
         let p = self.single_share(mu_o);
         (p, (1.0 - p) * self.profile_pdf(mu_i))
     }
@@ -169,14 +154,13 @@ impl ConductorLobes {
     /// expression: pdf, eval_with_pdf and both branches of sample agree bit for bit.
     #[inline(always)]
     fn mixture_pdf(&self, mu_o: f32, pdf_ss: f32, mu_i: f32) -> f32 {
-        let (p, added) = self.mixture_parts(mu_o, mu_i.max(0.0));
-        p * pdf_ss + added
+        mixture_of(self.mixture_parts(mu_o, mu_i.max(0.0)), pdf_ss)
     }
 
     /// Turquin's factor 1 + F0 (1 − E)/E for a view complement `c_o`.
     #[inline(always)]
-    fn turquin_factor(&self, c_o: f32) -> Vec3 {
-        Vec3::from(Vec3A::ONE + self.scale * (c_o / (1.0 - c_o)))
+    pub(super) fn turquin_factor(&self, c_o: f32) -> Vec3 {
+        Vec3::ONE + Vec3::from(self.scale) * (c_o / (1.0 - c_o))
     }
 
     /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
@@ -184,6 +168,106 @@ impl ConductorLobes {
     fn view_complement(&self, wo: Vec3) -> f32 {
         if wo.z > 0.0 { self.complement(self.coordinate(wo.z)) } else { 0.0 }
     }
+
+    /// The direction factors at every node of the albedo table's direction axis, for a batch
+    /// (see [`Column`]).
+    #[inline]
+    pub(super) fn column(&self, scheme: Compensation) -> Column {
+        let tables = self.tables.0;
+        let (j, fr) = self.row();
+        let order_row = cell(self.order_row);
+        let (lower, upper) =
+            (&tables.complement[j * ALBEDO_DIRECTIONS..], &tables.complement[(j + 1) * ALBEDO_DIRECTIONS..]);
+        Column {
+            corners: core::array::from_fn(|i| [lower[i], upper[i], lower[i + 1], upper[i + 1]]),
+            fraction: fr,
+            // (the walk's orders alone read the series)
+            series: if scheme == Compensation::Walk {
+                core::array::from_fn(|i| {
+                    // the per-order axis's node below i and the fraction of its cell (a whole
+                    // number of the albedo axis's cells, COARSE per cell)
+                    let k = (i / COARSE).min(ORDER_TABLE_SIZE - 2);
+                    let [a, b] = tables.fractions_at((k, (i - k * COARSE) as f32 / COARSE as f32), order_row);
+                    series(self.fresnel_average, a, b)
+                })
+            } else {
+                [Vec3A::ZERO; ALBEDO_DIRECTIONS]
+            },
+        }
+    }
+}
+
+/// The albedo table's direction cells per cell of the per-order tables (the same axis x, the
+/// per-order nodes every `COARSE`-th albedo node).
+const COARSE: usize = (ALBEDO_DIRECTIONS - 1) / (ORDER_TABLE_SIZE - 1);
+const _: () = assert!(COARSE * (ORDER_TABLE_SIZE - 1) == ALBEDO_DIRECTIONS - 1);
+
+/// What the added lobe reads at a direction coordinate x ∈ [0, 1].
+pub(super) trait DirectionFactors {
+    /// 1 − E.
+    fn complement_at(&self, x: f32) -> f32;
+    /// The walk's orders' factor g = (1 − E) Σ_k F̄ᵏ φ_k per channel.
+    fn walk_factor_at(&self, x: f32) -> Vec3A;
+}
+
+/// The tables' bilinear lookups at the lobe's roughness.
+impl DirectionFactors for ConductorLobes {
+    #[inline(always)]
+    fn complement_at(&self, x: f32) -> f32 {
+        self.complement(x)
+    }
+    #[inline(always)]
+    fn walk_factor_at(&self, x: f32) -> Vec3A {
+        self.factor(Compensation::Walk, x, self.complement(x))
+    }
+}
+
+/// The direction factors of a [`ConductorLobes`] at its roughness, laid out for a batch, where
+/// they are read at many directions: 1 − E as the four corners of each direction cell of the
+/// lobe's two roughness rows (one 16-byte read per lookup, interpolated as the lobes
+/// interpolate them: the same bits), and Σ_k F̄ᵏ φ_k per channel at the albedo table's
+/// direction nodes. The per-order tables' nodes are every third node of the same axis, so
+/// that the series, linear in the fractions, interpolates between the albedo nodes as the
+/// lobes interpolate it between theirs: the walk's factor is the lobes' within rounding, 1e-6
+/// of the largest value at the ends of the cell (the unit test
+/// `column_reads_the_lobes_within_rounding`).
+pub(super) struct Column {
+    /// 1 − E at the corners of direction cell i: (lower row, upper row) at node i, then at
+    /// node i + 1.
+    corners: [[f32; 4]; ALBEDO_DIRECTIONS - 1],
+    /// The fraction of the lobe's roughness in its cell of the rows.
+    fraction: f32,
+    series: [Vec3A; ALBEDO_DIRECTIONS],
+}
+
+impl Column {
+    /// 1 − E in direction cell `(i, t)`: the lobes' bilinear interpolation, in their order.
+    #[inline(always)]
+    fn complement_in(&self, (i, t): (usize, f32)) -> f32 {
+        let [a, b, c, d] = self.corners[i];
+        let (lower, upper) = (a + t * (c - a), b + t * (d - b));
+        lower + self.fraction * (upper - lower)
+    }
+}
+
+impl DirectionFactors for Column {
+    #[inline(always)]
+    fn complement_at(&self, x: f32) -> f32 {
+        self.complement_in(node_cell(x * LAST_X, ALBEDO_DIRECTIONS))
+    }
+    #[inline(always)]
+    fn walk_factor_at(&self, x: f32) -> Vec3A {
+        let (i, t) = node_cell(x * LAST_X, ALBEDO_DIRECTIONS);
+        let (a, b) = (self.series[i], self.series[i + 1]);
+        self.complement_in((i, t)) * (a + t * (b - a))
+    }
+}
+
+/// The mixture density p pdf_ss + added from the parts (p, added) of
+/// [`ConductorLobes::mixture_parts`].
+#[inline(always)]
+pub(super) fn mixture_of((p, added): (f32, f32), pdf_ss: f32) -> f32 {
+    p * pdf_ss + added
 }
 
 /// A table cell (index, fraction) as stored in [`ConductorLobes`] (a u32 index: 8 bytes).
@@ -378,12 +462,66 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// f of a rough surface at valid directions from single scattering's `f_ss` at the same
     /// directions: f_ss plus the additive lobe (Kulla–Conty, the walk's orders) or f_ss times
     /// Turquin's factor of the view. Every evaluation of the BSDF (`eval`, `eval_with_pdf`, the
-    /// batch calls) ends with this expression.
+    /// batch calls) is this expression in three steps: [`Self::coordinates_of`],
+    /// [`Self::lookups_at`] and [`Self::compose`].
     #[inline(always)]
     pub(super) fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
-        match self.scheme {
-            Compensation::Turquin => f_ss * self.lobes.turquin_factor(self.lobes.view_complement(wo)),
-            scheme => f_ss + self.lobes.added(scheme, wo.z, wi.z),
+        let scheme = self.scheme;
+        let (xo, xi, weight) = self.coordinates_of(scheme, wo.z, wi.z);
+        if weight > 0.0 {
+            self.compose(scheme, f_ss, self.lookups_at(scheme, &self.lobes, xo, xi), weight)
+        } else {
+            f_ss
+        }
+    }
+
+    /// The direction coordinates that f's compensation reads at cosines μo and μi (the
+    /// lobes' `scheme`, an argument so that a batch's loops see it as a constant), and its
+    /// weight: 1 where the scheme compensates (both directions above the horizon for the
+    /// additive lobes, the view for Turquin's factor), 0 elsewhere. Branch-free (a batch runs
+    /// it in vectorized lanes).
+    #[inline(always)]
+    pub(super) fn coordinates_of(&self, scheme: Compensation, mu_o: f32, mu_i: f32) -> (f32, f32, f32) {
+        let lobes = &self.lobes;
+        let one = |above: bool| if above { 1.0 } else { 0.0 };
+        match scheme {
+            Compensation::Turquin => (lobes.coordinate(mu_o.max(0.0)), 0.0, one(mu_o > 0.0)),
+            _ => {
+                let (xo, xi) = lobes.coordinates(mu_o.max(0.0), mu_i.max(0.0));
+                (xo, xi, one(mu_o > 0.0 && mu_i > 0.0))
+            }
+        }
+    }
+
+    /// What the scheme reads at the direction coordinates of [`Self::coordinates_of`]:
+    /// g(μo) g(μi) per channel for the walk's orders, (1 − E(μo)) (1 − E(μi)) for
+    /// Kulla–Conty, 1 − E(μo) for Turquin; from `factors` (the lobes' tables, or a batch's
+    /// [`Column`]).
+    #[inline(always)]
+    pub(super) fn lookups_at<F: DirectionFactors>(
+        &self,
+        scheme: Compensation,
+        factors: &F,
+        xo: f32,
+        xi: f32,
+    ) -> Vec3 {
+        match scheme {
+            Compensation::Walk => Vec3::from(factors.walk_factor_at(xo) * factors.walk_factor_at(xi)),
+            Compensation::KullaConty => Vec3::splat(factors.complement_at(xo) * factors.complement_at(xi)),
+            Compensation::Turquin => Vec3::splat(factors.complement_at(xo)),
+        }
+    }
+
+    /// f from single scattering's `f_ss`, the scheme's `lookups` and the weight of
+    /// [`Self::coordinates_of`]: f_ss + scale · lookups · weight for the additive lobes, f_ss
+    /// times Turquin's factor of the view's 1 − E · weight (a weight of 0 gives f_ss, a NaN
+    /// gives NaN). Branch-free (a batch runs it in vectorized lanes).
+    #[inline(always)]
+    pub(super) fn compose(&self, scheme: Compensation, f_ss: Vec3, lookups: Vec3, weight: f32) -> Vec3 {
+        let lobes = &self.lobes;
+        match scheme {
+            Compensation::Turquin => f_ss * lobes.turquin_factor(lookups.x * weight),
+            _ => f_ss + Vec3::from(lobes.scale) * lookups * weight,
         }
     }
 
@@ -405,10 +543,22 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     /// directions: the sampling mixture's p pdf_ss + (1 − p) d(μi) μi/π where the sampler mixes
     /// and the light is above the horizon, else `pdf_ss` (a light below the horizon of a view
     /// from above has density 0 in both lobes). Every density of the BSDF but the sample's
-    /// (`pdf`, `eval_with_pdf`, the batch calls) ends with this expression.
+    /// (`pdf`, `eval_with_pdf`, the batch calls) is this expression: [`Self::mixes_at`], then
+    /// [`ConductorLobes::mixture_parts`] and [`mixture_of`] where it mixes.
     #[inline(always)]
     pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        if self.mixes(wo) && wi.z > 0.0 { self.lobes.mixture_pdf(wo.z, pdf_ss, wi.z) } else { pdf_ss }
+        if self.mixes_at(wo.z, wi.z) {
+            mixture_of(self.lobes.mixture_parts(wo.z, wi.z), pdf_ss)
+        } else {
+            pdf_ss
+        }
+    }
+
+    /// Whether the density at directions of cosines μo and μi is the sampling mixture's: the
+    /// sampler mixes for the view ([`Self::mixes`]) and the light is above the horizon.
+    #[inline(always)]
+    pub(super) fn mixes_at(&self, mu_o: f32, mu_i: f32) -> bool {
+        self.lobes.mixing && mu_o > 0.0 && mu_i > 0.0
     }
 
     /// Single scattering's density at a pair of valid directions with `wo` above the horizon:
@@ -520,7 +670,8 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
         if self.single.is_specular() {
             return (v, pdf_ss);
         }
-        (BsdfValue { f: self.compensated_f(wo, wi, v.f), exact: true }, self.compensated_pdf(wo, wi, pdf_ss))
+        let f = self.compensated_f(wo, wi, v.f);
+        (BsdfValue { f, exact: true }, self.compensated_pdf(wo, wi, pdf_ss))
     }
 }
 
@@ -529,6 +680,53 @@ mod tests {
     use super::*;
     use crate::fresnel::ComplexIor;
     use crate::slope::{Beckmann, Ggx};
+
+    /// A batch's [`Column`] reads the lobes' direction factors: 1 − E bit for bit, each channel
+    /// of the walk's factor g within 1e-6 of the largest value at the ends of the coordinate's
+    /// cell (the series interpolated after the roughness rows, not before; every direction node
+    /// and cell midpoint, and 4096 random coordinates per case: GGX and Beckmann, α from 1e-3
+    /// to 1 across the roughness cells, gold, copper and F = 1).
+    #[test]
+    fn column_reads_the_lobes_within_rounding() {
+        fn check<S: AlbedoTabulated>(slope: S, conductor: Conductor, worst: &mut f32) {
+            let b = Compensated::with_scheme(slope, conductor, Compensation::Walk).unwrap();
+            let column = b.lobes.column(Compensation::Walk);
+            let mut state = 0x2545_f491_4f6c_dd1du64;
+            let mut next = || {
+                state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                ((state >> 40) as f32 + 0.5) / (1u64 << 24) as f32
+            };
+            let nodes = (0..2 * ALBEDO_DIRECTIONS - 1).map(|k| k as f32 / (2.0 * LAST_X));
+            let xs: Vec<f32> = nodes.chain((0..4096).map(|_| next())).collect();
+            for x in xs {
+                let (c, g) = (b.lobes.complement_at(x), b.lobes.walk_factor_at(x));
+                let (cc, gc) = (column.complement_at(x), column.walk_factor_at(x));
+                // the largest value at the ends of x's cell (the interpolations' rounding scale)
+                let i = node_cell(x * LAST_X, ALBEDO_DIRECTIONS).0 as f32;
+                let ends = [i / LAST_X, (i + 1.0) / LAST_X]
+                    .map(|e| b.lobes.complement_at(e).max(b.lobes.walk_factor_at(e).max_element()));
+                let scale = g.max_element().max(ends[0]).max(ends[1]).max(f32::MIN_POSITIVE);
+                assert_eq!(
+                    cc.to_bits(),
+                    c.to_bits(),
+                    "x = {x}: 1 − E = {c} by the lobes, {cc} by the column"
+                );
+                let err = (gc - g).abs().max_element() / scale;
+                assert!(err <= 1e-6, "x = {x}: g = {g} by the lobes, {gc} by the column");
+                *worst = worst.max(err);
+            }
+        }
+        let mut worst = 0.0f32;
+        for alpha in [1e-3f32, 0.013, 0.05, 0.21, 0.5, 0.77, 1.0] {
+            for conductor in
+                [Conductor::new(ComplexIor::GOLD), Conductor::new(ComplexIor::COPPER), Conductor::perfect()]
+            {
+                check(Ggx::isotropic(alpha).unwrap(), conductor, &mut worst);
+                check(Beckmann::isotropic(alpha).unwrap(), conductor, &mut worst);
+            }
+        }
+        println!("column against the lobes: g within {worst:.2e} of the cell's largest value");
+    }
 
     /// The added lobe's branch of the sampler takes single scattering's f·cos θi and density
     /// in its sampler's form (`single_at`): the density is `pdf`'s, bit for bit, and f is

@@ -130,7 +130,7 @@ pub(crate) fn next_marked(values: &[f32], from: usize) -> Option<usize> {
 mod tests {
     use super::*;
 
-    /// `next_marked` finds every NaN in order, from any start, in and across blocks of eight
+    /// `next_marked` finds every NaN in order, from every start, in and across blocks of eight
     /// and in the remainder (lengths 0 to 27, marks at every third, fifth or ninth index).
     #[test]
     fn next_marked_finds_every_mark_in_order() {
@@ -146,7 +146,10 @@ mod tests {
                     from = i + 1;
                 }
                 assert_eq!(found, expected, "n = {n}, every {every}");
-                assert_eq!(next_marked(&values, n + 3), None);
+                for from in 0..=n + 3 {
+                    let first = expected.iter().copied().find(|&i| i >= from);
+                    assert_eq!(next_marked(&values, from), first, "n = {n}, every {every}, from {from}");
+                }
             }
         }
     }

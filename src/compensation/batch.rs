@@ -69,10 +69,11 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Conductor> {
         Compensated::<S, Conductor>::turquin_weight(self, wo, weight)
     }
     /// In three stages per block of queries: the coordinates and weights in vectorized lanes,
-    /// the lookups query by query, f in vectorized lanes; the lookups from the lobes' [`Column`](super::conductor::Column) in a batch of at least
-    /// [`COLUMN_QUERIES`] queries, else from the lobes' tables.
+    /// the lookups query by query, f in vectorized lanes; the lookups from the lobes'
+    /// [`Column`](super::conductor::Column) in a batch of at least [`column_queries`] queries,
+    /// else from the lobes' tables.
     fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>) {
-        if f.0.len() >= COLUMN_QUERIES {
+        if f.0.len() >= column_queries(self.scheme) {
             let column = self.lobes.column(self.scheme);
             dispatch(&mut ConductorStages { bsdf: self, factors: &column, wo, wi, f });
         } else {
@@ -254,10 +255,13 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
 const MARK: Vec3 = Vec3::splat(f32::NAN);
 
 /// The batch size from which a compensated conductor lays out its direction factors at its
-/// roughness ([`Column`](super::conductor::Column)): in a batch of 1024 queries it saves 24
-/// (Turquin) to 146 (the walk's orders) instructions per query of f, its construction
-/// included (about 9000 instructions with the walk's series, a few hundred without).
-const COLUMN_QUERIES: usize = 128;
+/// roughness ([`Column`](super::conductor::Column)), per scheme. In a batch of 1024 queries it
+/// saves 24 (Turquin) to 146 (the walk's orders) instructions per query of f, its construction
+/// included; it costs about 9000 instructions with the walk's series and a few hundred without,
+/// so that it pays from about 60 and 15 queries.
+fn column_queries(scheme: Compensation) -> usize {
+    if scheme == Compensation::Walk { 64 } else { 16 }
+}
 
 /// Whether the scalar calls take a query's directions as given (no renormalization).
 #[inline(always)]
@@ -408,7 +412,7 @@ fn sample_batch<B: Composition>(
 /// [`BatchBsdf`] for [`MicrofacetBsdf`], which carry over: 1 − E and the mixture density are
 /// the scalar call's bits, so densities are equal bit for bit and f errs by single scattering's
 /// error, scaled by Turquin's factor for that scheme, and for the walk's orders by the series'
-/// rounding, within 1e-6 of its cell's largest value). Turquin's samples are single
+/// rounding, within 1e-6 per channel of its cell's largest value). Turquin's samples are single
 /// scattering's batch samples with the scalar call's weight factor (bit for bit); the additive
 /// schemes sample by the scalar call, query by query.
 impl<S: MicrosurfaceSlope> BatchBsdf for Compensated<S, Conductor> {

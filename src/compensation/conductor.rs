@@ -229,7 +229,7 @@ impl DirectionFactors for ConductorLobes {
 /// direction nodes. The per-order tables' nodes are every third node of the same axis, so
 /// that the series, linear in the fractions, interpolates between the albedo nodes as the
 /// lobes interpolate it between theirs: the walk's factor is the lobes' within rounding, 1e-6
-/// of the largest value at the ends of the cell (the unit test
+/// per channel of its largest value at the ends of the cell (the unit test
 /// `column_reads_the_lobes_within_rounding`).
 pub(super) struct Column {
     /// 1 − E at the corners of direction cell i: (lower row, upper row) at node i, then at
@@ -682,10 +682,10 @@ mod tests {
     use crate::slope::{Beckmann, Ggx};
 
     /// A batch's [`Column`] reads the lobes' direction factors: 1 − E bit for bit, each channel
-    /// of the walk's factor g within 1e-6 of the largest value at the ends of the coordinate's
-    /// cell (the series interpolated after the roughness rows, not before; every direction node
-    /// and cell midpoint, and 4096 random coordinates per case: GGX and Beckmann, α from 1e-3
-    /// to 1 across the roughness cells, gold, copper and F = 1).
+    /// of the walk's factor g within 1e-6 of that channel's largest value at the coordinate and
+    /// the ends of its cell (the series interpolated after the roughness rows, not before; every
+    /// direction node and cell midpoint, and 4096 random coordinates per case: GGX and
+    /// Beckmann, α from 1e-3 to 1 across the roughness cells, gold, copper and F = 1).
     #[test]
     fn column_reads_the_lobes_within_rounding() {
         fn check<S: AlbedoTabulated>(slope: S, conductor: Conductor, worst: &mut f32) {
@@ -703,15 +703,14 @@ mod tests {
                 let (cc, gc) = (column.complement_at(x), column.walk_factor_at(x));
                 // the largest value at the ends of x's cell (the interpolations' rounding scale)
                 let i = node_cell(x * LAST_X, ALBEDO_DIRECTIONS).0 as f32;
-                let ends = [i / LAST_X, (i + 1.0) / LAST_X]
-                    .map(|e| b.lobes.complement_at(e).max(b.lobes.walk_factor_at(e).max_element()));
-                let scale = g.max_element().max(ends[0]).max(ends[1]).max(f32::MIN_POSITIVE);
+                let ends = [i / LAST_X, (i + 1.0) / LAST_X].map(|e| b.lobes.walk_factor_at(e));
+                let scale = g.max(ends[0]).max(ends[1]).max(Vec3A::splat(f32::MIN_POSITIVE));
                 assert_eq!(
                     cc.to_bits(),
                     c.to_bits(),
                     "x = {x}: 1 − E = {c} by the lobes, {cc} by the column"
                 );
-                let err = (gc - g).abs().max_element() / scale;
+                let err = ((gc - g).abs() / scale).max_element();
                 assert!(err <= 1e-6, "x = {x}: g = {g} by the lobes, {gc} by the column");
                 *worst = worst.max(err);
             }
@@ -725,7 +724,7 @@ mod tests {
                 check(Beckmann::isotropic(alpha).unwrap(), conductor, &mut worst);
             }
         }
-        println!("column against the lobes: g within {worst:.2e} of the cell's largest value");
+        println!("column against the lobes: g within {worst:.2e} of its channel's largest value");
     }
 
     /// The added lobe's branch of the sampler takes single scattering's f·cos θi and density

@@ -111,8 +111,7 @@ impl<S: MicrosurfaceSlope> LaneLoop for DensityStages<'_, '_, '_, S> {
         let pdf = &mut *self.pdf;
         let n = pdf.len();
         let (wo, wi) = (cut(self.wo, n), cut(self.wi, n));
-        let mut start = 0;
-        while start < n {
+        for start in (0..n).step_by(BLOCK) {
             let m = BLOCK.min(n - start);
             // which queries mix: 1 or 0, NaN marking a query the pass does not compose
             let mut weight = [0.0f32; BLOCK];
@@ -133,7 +132,6 @@ impl<S: MicrosurfaceSlope> LaneLoop for DensityStages<'_, '_, '_, S> {
                 let v = if weight[k] > 0.0 { mixed } else { pdf[k] };
                 pdf[k] = if weight[k].is_nan() { f32::NAN } else { v };
             }
-            start += m;
         }
     }
 }
@@ -173,8 +171,7 @@ impl<S: MicrosurfaceSlope, F: DirectionFactors> ConductorStages<'_, '_, '_, S, F
         let n = fa.len();
         let (fb, fc) = (&mut fb[..n], &mut fc[..n]);
         let (wo, wi) = (cut(self.wo, n), cut(self.wi, n));
-        let mut start = 0;
-        while start < n {
+        for start in (0..n).step_by(BLOCK) {
             let m = BLOCK.min(n - start);
             let (mut xo, mut xi, mut weight) = ([0.0f32; BLOCK], [0.0f32; BLOCK], [0.0f32; BLOCK]);
             // the coordinates and weights (a NaN weight marks a query the pass does not compose)
@@ -197,7 +194,6 @@ impl<S: MicrosurfaceSlope, F: DirectionFactors> ConductorStages<'_, '_, '_, S, F
                 let f = bsdf.compose(scheme, Vec3::new(fa[k], fb[k], fc[k]), v, weight[k]);
                 (fa[k], fb[k], fc[k]) = (f.x, f.y, f.z);
             }
-            start += m;
         }
     }
 }
@@ -224,9 +220,12 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
     fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, (fa, fb, fc): SlicesMut<'_>) {
         for i in 0..fa.len() {
             let (o, w) = (at(wo, i), at(wi, i));
-            let v =
-                if as_given(o, w) { self.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i])) } else { MARK };
-            (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+            if as_given(o, w) {
+                let v = self.compensated_f(o, w, Vec3::new(fa[i], fb[i], fc[i]));
+                (fa[i], fb[i], fc[i]) = (v.x, v.y, v.z);
+            } else {
+                fa[i] = f32::NAN;
+            }
         }
     }
     /// Query by query.
@@ -250,9 +249,6 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
         }
     }
 }
-
-/// The mark of a query a composing pass leaves to the scalar call.
-const MARK: Vec3 = Vec3::splat(f32::NAN);
 
 /// The batch size from which a compensated conductor lays out its direction factors at its
 /// roughness ([`Column`](super::conductor::Column)), per scheme. In a batch of 1024 queries it

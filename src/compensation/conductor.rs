@@ -24,7 +24,7 @@
 //! the single-scattering lobe.
 
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
-use super::conductor_tables::{ConductorTables, RoughnessCells};
+use super::conductor_tables::{ConductorTables, RoughnessCells, bilinear};
 use super::fresnel_average::fresnel_average;
 use super::shared::{NOTHING, Shared, mixture_sample};
 use crate::albedo::{ALBEDO_DIRECTIONS, DirectionAxis, ORDER_TABLE_SIZE, node_cell};
@@ -241,12 +241,10 @@ pub(super) struct Column {
 }
 
 impl Column {
-    /// 1 − E in direction cell `(i, t)`: the lobes' bilinear interpolation, in their order.
+    /// 1 − E in direction cell `(i, t)`: the lobes' bilinear interpolation ([`bilinear`]).
     #[inline(always)]
     fn complement_in(&self, (i, t): (usize, f32)) -> f32 {
-        let [a, b, c, d] = self.corners[i];
-        let (lower, upper) = (a + t * (c - a), b + t * (d - b));
-        lower + self.fraction * (upper - lower)
+        bilinear(self.corners[i], t, self.fraction)
     }
 }
 
@@ -653,14 +651,15 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Conductor> {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         unit_directions!(wo, wi, 0.0, self.pdf(wo, wi));
         // Turquin (and a mirror, or no energy to restore) samples the single-scattering lobe
-        if !self.mixes(wo) || wi.z <= 0.0 {
+        if !self.mixes_at(wo.z, wi.z) {
             // (a light below the horizon: single scattering's density, 0 for a view from above
             // — the mixture's p·0 + q·0)
             return self.single.pdf(wo, wi);
         }
-        // `single_pdf` of a light above the horizon, without its test
+        // `single_pdf` of a light above the horizon, without its test; `compensated_pdf`'s
+        // mixture without its test
         let pdf_ss = SingleScattering::<S, Conductor>::mirror_density(self.single.surface().slope(), wo, wi);
-        self.compensated_pdf(wo, wi, if pdf_ss.is_finite() { pdf_ss } else { 0.0 })
+        mixture_of(self.lobes.mixture_parts(wo.z, wi.z), if pdf_ss.is_finite() { pdf_ss } else { 0.0 })
     }
 
     #[inline]

@@ -208,9 +208,8 @@ impl ConductorTables {
     pub(crate) fn complement_at(&self, (i, fx): (usize, f32), (j, fr): (usize, f32)) -> f32 {
         let n = j * ALBEDO_DIRECTIONS + i;
         let c = &self.complement;
-        let lower = c[n] + fx * (c[n + 1] - c[n]);
-        let upper = c[n + ALBEDO_DIRECTIONS] + fx * (c[n + ALBEDO_DIRECTIONS + 1] - c[n + ALBEDO_DIRECTIONS]);
-        lower + fr * (upper - lower)
+        let upper = n + ALBEDO_DIRECTIONS;
+        bilinear([c[n], c[upper], c[n + 1], c[upper + 1]], fx, fr)
     }
 
     /// The order fractions at the direction cell `(i, fx)` of the per-order roughness cell
@@ -226,6 +225,16 @@ impl ConductorTables {
         };
         [at(0), at(1)]
     }
+}
+
+/// 1 − E in a cell from its corners (lower row, upper row) at the lower direction node, then at
+/// the upper one: linear in the direction fraction `fx`, then in the roughness fraction `fr`
+/// (the one order in which the compensated conductor interpolates it, so that every reader
+/// gets the same bits).
+#[inline(always)]
+pub(crate) fn bilinear([a, b, c, d]: [f32; 4], fx: f32, fr: f32) -> f32 {
+    let (lower, upper) = (a + fx * (c - a), b + fx * (d - b));
+    lower + fr * (upper - lower)
 }
 
 #[cfg(test)]

@@ -60,6 +60,7 @@
 
 use super::compensated::{Compensated, CompensatedMaterial, Compensation};
 use super::glass_tables::{GlassSide, GlassTables};
+use super::lobe_profile::{MU_CELLS, line_pdf, mu_cell};
 use super::shared::{NOTHING, ONE_MINUS_ULP, Shared, eta_error, mixture_sample};
 use crate::albedo::{
     DIELECTRIC_TABLE_SIZE, DielectricAlbedoTable, DielectricDirection, DielectricLossTable,
@@ -174,18 +175,25 @@ impl DielectricLobes {
         a * x + b * mu
     }
 
-    /// The lobes' node values (D, ΔT') of view side `view` at the loss grid's fractional
-    /// direction node t: trilinear at this hit's (roughness, index) cell.
+    /// The lobes' values (D, ΔT') of view side `view` at the loss grid's direction node i,
+    /// bilinear at this hit's (roughness, index) cell.
     #[inline(always)]
-    fn lobe_values(&self, view: usize, t: f32) -> Vec2 {
+    fn lobe_node(&self, view: usize, i: usize) -> Vec2 {
         let grid = &self.side(view).lobes;
-        let (i, fx) = node_cell(t, NX);
         let base = self.loss_corner * NX + i;
         let (fr, fu) = self.loss_f;
-        let at = |k: usize| grid[k].lerp(grid[k + 1], fx);
-        let near = at(base).lerp(at(base + NX), fr);
-        let far = at(base + PLANE).lerp(at(base + PLANE + NX), fr);
+        let near = grid[base].lerp(grid[base + NX], fr);
+        let far = grid[base + PLANE].lerp(grid[base + PLANE + NX], fr);
         near.lerp(far, fu)
+    }
+
+    /// The lobes' values (D, ΔT') of view side `view` at the loss grid's fractional direction
+    /// node t: trilinear at this hit's (roughness, index) cell, the nodes from `factors`.
+    #[inline(always)]
+    fn lobe_values<F: GlassFactors>(factors: &F, view: usize, t: f32) -> Vec2 {
+        let (i, fx) = node_cell(t, NX);
+        let (low, high) = factors.lobe_nodes(view, i);
+        low.lerp(high, fx)
     }
 
     /// The weights of (D, ΔT') in the μ profile of the lobe of a view on side `a` and a light
@@ -200,16 +208,16 @@ impl DielectricLobes {
     /// the side its lobe is read at): what the added lobe and the mixture read at the view,
     /// read once per call.
     #[inline(always)]
-    fn values_at(&self, a: usize, mu: f32) -> Vec2 {
-        self.lobe_values(a, self.loss_node(a, self.axis.coordinate(mu), mu))
+    fn values_at<F: GlassFactors>(&self, factors: &F, a: usize, mu: f32) -> Vec2 {
+        Self::lobe_values(factors, a, self.loss_node(a, self.axis.coordinate(mu), mu))
     }
 
     /// The added lobe f_R or f_T for a view on side `a` with lobe values `vo`
     /// ([`Self::values_at`]) and a light crossing (`c` = 1) or not at |cos θi| = `mu_i`, both
     /// off the horizon.
     #[inline(always)]
-    fn added(&self, a: usize, c: usize, vo: Vec2, mu_i: f32) -> f32 {
-        let vi = self.values_at(a ^ c, mu_i);
+    fn added<F: GlassFactors>(&self, factors: &F, a: usize, c: usize, vo: Vec2, mu_i: f32) -> f32 {
+        let vi = self.values_at(factors, a ^ c, mu_i);
         let w = self.profile_weights(a, c);
         // (both profiles are ≥ 0 at every node; rounding may leave −1e-9)
         vo.dot(w).max(0.0) * vi.dot(w).max(0.0) * self.scales[a][c]
@@ -227,43 +235,147 @@ impl DielectricLobes {
         Vec4::new(single * scale, (d - t) * scale, t * scale, 0.0)
     }
 
-    /// The density of the light's profile for a view on side `a` and a light crossing (`c`)
-    /// or not, at |cos θi| = `mu_i`.
+    /// The line ([`MuProfile::line`](super::lobe_profile::MuProfile::line)) in μ cell k of
+    /// the light's profile for a view on side `a` and a light crossing (`c`) or not: the four
+    /// rows' lines mixed by the rows' probabilities (the profile's density is the mixture of
+    /// theirs).
     #[inline(always)]
-    fn profile_pdf(&self, a: usize, c: usize, mu_i: f32) -> f32 {
+    fn profile_line(&self, a: usize, c: usize, k: usize) -> Vec2 {
         let rows = &self.side(a ^ c).rows;
         let n = self.corner;
         let cum = self.corners[a][c];
-        let w = Vec4::new(cum.x, cum.y - cum.x, cum.z - cum.y, cum.w - cum.z);
-        let p = Vec4::new(
-            rows[n].profiles[c].pdf(mu_i),
-            rows[n + 1].profiles[c].pdf(mu_i),
-            rows[n + N].profiles[c].pdf(mu_i),
-            rows[n + N + 1].profiles[c].pdf(mu_i),
-        );
-        w.dot(p)
+        let line = |row: usize| rows[row].profiles[c].line(k);
+        line(n) * cum.x
+            + line(n + 1) * (cum.y - cum.x)
+            + line(n + N) * (cum.z - cum.y)
+            + line(n + N + 1) * (cum.w - cum.z)
+    }
+
+    /// The density of the light's profile for a view on side `a` and a light crossing (`c`)
+    /// or not, at |cos θi| = `mu_i`, its line from `factors`.
+    #[inline(always)]
+    fn profile_pdf<F: GlassFactors>(factors: &F, a: usize, c: usize, mu_i: f32) -> f32 {
+        line_pdf(factors.profile_line(a, c, mu_cell(mu_i)), mu_i)
     }
 
     /// The mixture density at wi (off the horizon) for a view on side `a` with probabilities
     /// `p` and single scattering's density `pdf_ss`.
     #[inline(always)]
-    fn mixture_pdf(&self, a: usize, p: Vec4, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
+    fn mixture_pdf<F: GlassFactors>(factors: &F, a: usize, p: Vec4, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
         let c = crossing(wo, wi);
-        p.x * pdf_ss + p[1 + c] * self.profile_pdf(a, c, wi.z.abs())
+        p.x * pdf_ss + p[1 + c] * Self::profile_pdf(factors, a, c, wi.z.abs())
     }
 
-    /// E = R + T of the single-scattering tables for a view on side `a` at |cos θo| = `mu`.
+    /// E = R + T of the single-scattering tables for a view on side `a` at the tables'
+    /// direction node i, bilinear at this hit's (roughness, index) cell.
     #[inline(always)]
-    fn single_albedo(&self, a: usize, mu: f32) -> f32 {
+    fn single_node(&self, a: usize, i: usize) -> f32 {
         let grid = &self.side(a).single;
-        let x = self.single_axis[a].coordinate(mu);
-        let (i, fx) = node_cell(x * LAST, N);
         let base = self.single_base + i;
         let (fr, fu) = self.single_f;
-        let at = |k: usize| grid[k] + fx * (grid[k + 1] - grid[k]);
-        let near = at(base) + fr * (at(base + N) - at(base));
-        let far = at(base + N * N) + fr * (at(base + N * N + N) - at(base + N * N));
+        let near = grid[base] + fr * (grid[base + N] - grid[base]);
+        let far = grid[base + N * N] + fr * (grid[base + N * N + N] - grid[base + N * N]);
         near + fu * (far - near)
+    }
+
+    /// E = R + T of the single-scattering tables for a view on side `a` at |cos θo| = `mu`,
+    /// the nodes from `factors`.
+    #[inline(always)]
+    fn single_albedo<F: GlassFactors>(&self, factors: &F, a: usize, mu: f32) -> f32 {
+        let x = self.single_axis[a].coordinate(mu);
+        let (i, fx) = node_cell(x * LAST, N);
+        let (low, high) = factors.single_nodes(a, i);
+        low + fx * (high - low)
+    }
+
+    /// The values the queries of a batch read at this hit's (roughness, index), for every node
+    /// of the direction axes ([`GlassColumn`]): E's for Turquin's scheme, the lobes' and the
+    /// light profiles' lines for the others.
+    pub(super) fn column(&self, scheme: Compensation) -> GlassColumn {
+        let mut column = GlassColumn {
+            lobes: [[Vec2::ZERO; NX]; 2],
+            lines: [[[Vec2::ZERO; MU_CELLS]; 2]; 2],
+            single: [[0.0; N]; 2],
+        };
+        if !self.active {
+            return column;
+        }
+        for view in 0..2 {
+            if scheme == Compensation::Turquin {
+                for (i, e) in column.single[view].iter_mut().enumerate() {
+                    *e = self.single_node(view, i);
+                }
+                continue;
+            }
+            for (i, v) in column.lobes[view].iter_mut().enumerate() {
+                *v = self.lobe_node(view, i);
+            }
+            for (c, lines) in column.lines[view].iter_mut().enumerate() {
+                for (k, line) in lines.iter_mut().enumerate() {
+                    *line = self.profile_line(view, c, k);
+                }
+            }
+        }
+        column
+    }
+}
+
+/// Where a compensated dielectric's queries read the tables' values at the hit's (roughness,
+/// index): blended from the shared tables query by query ([`DielectricLobes`]), or read from a
+/// batch's [`GlassColumn`], which holds the same blends, computed by the same functions, at
+/// every node (the same bits).
+pub(super) trait GlassFactors {
+    /// The lobes' values (D, ΔT') of view side `view` at the loss grid's direction nodes i and
+    /// i + 1 (i ≤ 22).
+    fn lobe_nodes(&self, view: usize, i: usize) -> (Vec2, Vec2);
+    /// The light profile's line in μ cell k for a view on side `a` and a crossing `c`
+    /// ([`DielectricLobes::profile_line`]).
+    fn profile_line(&self, a: usize, c: usize, k: usize) -> Vec2;
+    /// E of view side `view` at the single-scattering tables' direction nodes i and i + 1
+    /// (Turquin's scheme).
+    fn single_nodes(&self, view: usize, i: usize) -> (f32, f32);
+}
+
+impl GlassFactors for DielectricLobes {
+    #[inline(always)]
+    fn lobe_nodes(&self, view: usize, i: usize) -> (Vec2, Vec2) {
+        (self.lobe_node(view, i), self.lobe_node(view, i + 1))
+    }
+    #[inline(always)]
+    fn profile_line(&self, a: usize, c: usize, k: usize) -> Vec2 {
+        DielectricLobes::profile_line(self, a, c, k)
+    }
+    #[inline(always)]
+    fn single_nodes(&self, view: usize, i: usize) -> (f32, f32) {
+        (self.single_node(view, i), self.single_node(view, i + 1))
+    }
+}
+
+/// A compensated dielectric's values at its (roughness, index) for every node of the
+/// direction axes, laid out for a batch ([`DielectricLobes::column`]; 1.6 KB): each query then
+/// reads two nodes per lobe value (where the lobes blend eight table entries) and one line per
+/// profile density (where they read four rows).
+pub(super) struct GlassColumn {
+    /// (D, ΔT') per view side and loss grid direction node.
+    lobes: [[Vec2; NX]; 2],
+    /// The light profiles' lines per view side, crossing and μ cell.
+    lines: [[[Vec2; MU_CELLS]; 2]; 2],
+    /// E per view side and single-scattering direction node.
+    single: [[f32; N]; 2],
+}
+
+impl GlassFactors for GlassColumn {
+    #[inline(always)]
+    fn lobe_nodes(&self, view: usize, i: usize) -> (Vec2, Vec2) {
+        (self.lobes[view][i], self.lobes[view][i + 1])
+    }
+    #[inline(always)]
+    fn profile_line(&self, a: usize, c: usize, k: usize) -> Vec2 {
+        self.lines[a][c][k]
+    }
+    #[inline(always)]
+    fn single_nodes(&self, view: usize, i: usize) -> (f32, f32) {
+        (self.single[view][i], self.single[view][i + 1])
     }
 }
 
@@ -427,7 +539,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
             return Some((0.0, 0.0));
         }
         let a = usize::from(side == Side::Inside);
-        let v = l.values_at(a, mu);
+        let v = l.values_at(l, a, mu);
         Some(((v.x - l.c[a] * v.y).max(0.0), l.c[a] * v.y))
     }
 
@@ -442,7 +554,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
         if !self.lobes.active {
             return Some(1.0);
         }
-        Some(self.lobes.single_albedo(usize::from(side == Side::Inside), mu))
+        Some(self.lobes.single_albedo(&self.lobes, usize::from(side == Side::Inside), mu))
     }
 
     /// Whether the added lobes answer for (wo, wi): a rough surface, valid directions off the
@@ -452,13 +564,14 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
         self.lobes.active && wo.z != 0.0 && wi.z != 0.0
     }
 
-    /// Turquin's factor 1/E(μo) for the view `wo` (1 on the horizon, where f_ss = 0).
+    /// Turquin's factor 1/E(μo) for the view `wo` (1 on the horizon, where f_ss = 0), E's
+    /// nodes from `factors`.
     #[inline(always)]
-    fn turquin_factor(&self, wo: Vec3) -> f32 {
+    fn turquin_factor<F: GlassFactors>(&self, factors: &F, wo: Vec3) -> f32 {
         if wo.z == 0.0 || !self.lobes.active {
             return 1.0;
         }
-        1.0 / self.lobes.single_albedo(side_of(wo), wo.z.abs())
+        1.0 / self.lobes.single_albedo(factors, side_of(wo), wo.z.abs())
     }
 
     /// f·factor, or 0 where it is not a finite f32 (see Turquin's special cases).
@@ -472,37 +585,52 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
     /// lobes answer (an additive scheme on a rough surface, valid directions off the horizon):
     /// what f and the density read at the view.
     #[inline(always)]
-    fn view_values(&self, wo: Vec3, wi: Vec3) -> Option<(usize, Vec2)> {
+    fn view_values<F: GlassFactors>(&self, factors: &F, wo: Vec3, wi: Vec3) -> Option<(usize, Vec2)> {
         (self.scheme != Compensation::Turquin && self.compensates(wo, wi)).then(|| {
             let a = side_of(wo);
-            (a, self.lobes.values_at(a, wo.z.abs()))
+            (a, self.lobes.values_at(factors, a, wo.z.abs()))
         })
     }
 
     /// f_ss plus the added lobe of the light's side, for a view `(a, vo)` of
     /// [`Self::view_values`].
     #[inline(always)]
-    fn added_f(&self, (a, vo): (usize, Vec2), wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
-        f_ss + Vec3::splat(self.lobes.added(a, crossing(wo, wi), vo, wi.z.abs()))
+    fn added_f<F: GlassFactors>(
+        &self,
+        factors: &F,
+        (a, vo): (usize, Vec2),
+        wo: Vec3,
+        wi: Vec3,
+        f_ss: Vec3,
+    ) -> Vec3 {
+        f_ss + Vec3::splat(self.lobes.added(factors, a, crossing(wo, wi), vo, wi.z.abs()))
     }
 
     /// The sampling mixture's density from single scattering's `pdf_ss`, for a view `(a, vo)`
     /// of [`Self::view_values`].
     #[inline(always)]
-    fn mixture_density(&self, (a, vo): (usize, Vec2), wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        self.lobes.mixture_pdf(a, self.lobes.mixture(a, vo), wo, wi, pdf_ss)
+    fn mixture_density<F: GlassFactors>(
+        &self,
+        factors: &F,
+        (a, vo): (usize, Vec2),
+        wo: Vec3,
+        wi: Vec3,
+        pdf_ss: f32,
+    ) -> f32 {
+        DielectricLobes::mixture_pdf(factors, a, self.lobes.mixture(a, vo), wo, wi, pdf_ss)
     }
 
     /// f at valid directions from single scattering's `f_ss` at the same directions: f_ss
     /// scaled by Turquin's factor, or f_ss plus the added lobe of the light's side where the
     /// lobes answer. Every evaluation of the BSDF (`eval`, the batch calls; `eval_with_pdf`
-    /// through [`Self::compensated`]) ends with this expression.
+    /// through [`Self::compensated`]) ends with this expression; the tables' values at the
+    /// hit from `factors` (the lobes, or a batch's [`GlassColumn`]).
     #[inline(always)]
-    pub(super) fn compensated_f(&self, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
+    pub(super) fn compensated_f<F: GlassFactors>(&self, factors: &F, wo: Vec3, wi: Vec3, f_ss: Vec3) -> Vec3 {
         if self.scheme == Compensation::Turquin {
-            return Self::scaled(f_ss, self.turquin_factor(wo));
+            return Self::scaled(f_ss, self.turquin_factor(factors, wo));
         }
-        self.view_values(wo, wi).map_or(f_ss, |v| self.added_f(v, wo, wi, f_ss))
+        self.view_values(factors, wo, wi).map_or(f_ss, |v| self.added_f(factors, v, wo, wi, f_ss))
     }
 
     /// The density at valid directions from single scattering's `pdf_ss` at the same
@@ -510,19 +638,34 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
     /// `pdf_ss`. Every density of the BSDF but the sample's (`pdf`, the batch calls;
     /// `eval_with_pdf` through [`Self::compensated`]) ends with this expression.
     #[inline(always)]
-    pub(super) fn compensated_pdf(&self, wo: Vec3, wi: Vec3, pdf_ss: f32) -> f32 {
-        self.view_values(wo, wi).map_or(pdf_ss, |v| self.mixture_density(v, wo, wi, pdf_ss))
+    pub(super) fn compensated_pdf<F: GlassFactors>(
+        &self,
+        factors: &F,
+        wo: Vec3,
+        wi: Vec3,
+        pdf_ss: f32,
+    ) -> f32 {
+        self.view_values(factors, wo, wi).map_or(pdf_ss, |v| self.mixture_density(factors, v, wo, wi, pdf_ss))
     }
 
     /// [`Self::compensated_f`] and [`Self::compensated_pdf`] with the lobes read at the view
     /// once (`eval_with_pdf`, scalar and batch).
     #[inline(always)]
-    pub(super) fn compensated(&self, wo: Vec3, wi: Vec3, f_ss: Vec3, pdf_ss: f32) -> (Vec3, f32) {
+    pub(super) fn compensated<F: GlassFactors>(
+        &self,
+        factors: &F,
+        wo: Vec3,
+        wi: Vec3,
+        f_ss: Vec3,
+        pdf_ss: f32,
+    ) -> (Vec3, f32) {
         if self.scheme == Compensation::Turquin {
-            return (Self::scaled(f_ss, self.turquin_factor(wo)), pdf_ss);
+            return (Self::scaled(f_ss, self.turquin_factor(factors, wo)), pdf_ss);
         }
-        match self.view_values(wo, wi) {
-            Some(v) => (self.added_f(v, wo, wi, f_ss), self.mixture_density(v, wo, wi, pdf_ss)),
+        match self.view_values(factors, wo, wi) {
+            Some(v) => {
+                (self.added_f(factors, v, wo, wi, f_ss), self.mixture_density(factors, v, wo, wi, pdf_ss))
+            }
             None => (f_ss, pdf_ss),
         }
     }
@@ -532,7 +675,7 @@ impl<S: MicrosurfaceSlope> Compensated<S, Dielectric> {
     /// (`sample`, the batch call) ends with this expression.
     #[inline(always)]
     pub(super) fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
-        let weight = weight * self.turquin_factor(wo);
+        let weight = weight * self.turquin_factor(&self.lobes, wo);
         weight.is_finite().then_some(weight)
     }
 
@@ -557,7 +700,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
     fn eval_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> BsdfValue {
         unit_directions!(wo, wi, NOTHING, self.eval_keyed(wo, wi, key));
         let v = self.single.eval_valid(wo, wi, key);
-        BsdfValue { f: self.compensated_f(wo, wi, v.f), ..v }
+        BsdfValue { f: self.compensated_f(&self.lobes, wo, wi, v.f), ..v }
     }
 
     #[inline]
@@ -575,7 +718,7 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
             return self.single.sample_keyed(wo, uc, u, key);
         }
         let a = side_of(wo);
-        let vo = lobes.values_at(a, wo.z.abs());
+        let vo = lobes.values_at(lobes, a, wo.z.abs());
         let p = lobes.mixture(a, vo);
         let (wi, f_cos_ss, pdf_ss) = if uc < p.x {
             // the single-scattering lobe: its sample carries f·|cos θi| (weight × pdf) and its
@@ -602,9 +745,9 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
             return None;
         }
         let c = crossing(wo, wi);
-        let f_cos = f_cos_ss + Vec3::splat(lobes.added(a, c, vo, wi.z.abs()) * wi.z.abs());
+        let f_cos = f_cos_ss + Vec3::splat(lobes.added(lobes, a, c, vo, wi.z.abs()) * wi.z.abs());
         let eta = lobes.transmitted_eta[a];
-        mixture_sample(wo, wi, f_cos, lobes.mixture_pdf(a, p, wo, wi, pdf_ss), eta)
+        mixture_sample(wo, wi, f_cos, DielectricLobes::mixture_pdf(lobes, a, p, wo, wi, pdf_ss), eta)
     }
 
     #[inline]
@@ -613,14 +756,14 @@ impl<S: MicrosurfaceSlope> Bsdf for Compensated<S, Dielectric> {
         if self.scheme == Compensation::Turquin || !self.compensates(wo, wi) {
             return self.single.pdf(wo, wi);
         }
-        self.compensated_pdf(wo, wi, self.single_pdf(wo, wi))
+        self.compensated_pdf(&self.lobes, wo, wi, self.single_pdf(wo, wi))
     }
 
     #[inline]
     fn eval_with_pdf_keyed(&self, wo: Vec3, wi: Vec3, key: u64) -> (BsdfValue, f32) {
         unit_directions!(wo, wi, (NOTHING, 0.0), self.eval_with_pdf_keyed(wo, wi, key));
         let (v, pdf_ss) = self.single.eval_with_pdf_keyed(wo, wi, key);
-        let (f, pdf) = self.compensated(wo, wi, v.f, pdf_ss);
+        let (f, pdf) = self.compensated(&self.lobes, wo, wi, v.f, pdf_ss);
         (BsdfValue { f, ..v }, pdf)
     }
 }

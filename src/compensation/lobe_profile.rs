@@ -206,6 +206,14 @@ pub(crate) fn mu_cell(mu: f32) -> usize {
     floor_index(mu * MU_CELLS as f32, MU_CELLS - 1)
 }
 
+/// The density (intercept + slope μ²) μ ≥ 0 of a [`MuProfile::line`] (or of a mixture of
+/// lines) at |cos θ| = μ in its cell.
+#[inline(always)]
+pub(crate) fn line_pdf(line: Vec2, mu: f32) -> f32 {
+    // (the line is ≥ 0 on its cell; rounding may leave −1e-12 at a node of value 0)
+    ((line.x + line.y * (mu * mu)) * mu).max(0.0)
+}
+
 /// The cosine at the centre of cell k of the uniform μ axis.
 pub(crate) fn mu_cell_centre(k: usize) -> f32 {
     (k as f32 + 0.5) / MU_CELLS as f32
@@ -364,9 +372,16 @@ impl MuProfile {
     /// sampled on: one multiply and one truncation to find the cell, a line in μ².
     #[inline(always)]
     pub(crate) fn pdf(&self, mu: f32) -> f32 {
-        let c = &self.cells[mu_cell(mu)];
-        // (the line is ≥ 0 on its cell; rounding may leave −1e-12 at a node of value 0)
-        ((c.intercept + c.slope * (mu * mu)) * mu).max(0.0)
+        line_pdf(self.line(mu_cell(mu)), mu)
+    }
+
+    /// The line of cell k ([`mu_cell`]) in μ²: (intercept, slope), the density
+    /// ([`line_pdf`]) (intercept + slope μ²) μ. A mixture of profiles has the mixture of their
+    /// lines on every cell.
+    #[inline(always)]
+    pub(crate) fn line(&self, k: usize) -> Vec2 {
+        let c = &self.cells[k];
+        Vec2::new(c.intercept, c.slope)
     }
 
     /// A direction in the upper hemisphere from u ∈ [0, 1)²: u.x picks a column and, with what

@@ -3,8 +3,8 @@
 //! over the queries that ends each as the scalar call ends it, with the same functions: the
 //! added lobe or Turquin's factor on f, the sampling mixture on the density, Turquin's factor
 //! on a sample's weight. A conductor's pass runs those functions in three stages per block of
-//! queries (vectorized, the table reads, vectorized); a dielectric's, query by query, from its tables'
-//! values at the hit laid out for the batch.
+//! queries (vectorized, the table reads, vectorized); a dielectric's, query by query, from its
+//! tables' values at the hit laid out for the batch.
 //!
 //! The scalar calls renormalize directions that drifted from unit length on entry
 //! (`unit_directions!`), and single scattering's batch answers such a query with its own
@@ -218,8 +218,9 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
     fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
         Compensated::<S, Dielectric>::turquin_weight(self, wo, weight)
     }
-    /// Query by query, the tables' values from the lobes' [`GlassColumn`](super::dielectric::GlassColumn) in a batch of at
-    /// least [`GLASS_COLUMN_QUERIES`] queries, else from the lobes' tables.
+    /// Query by query, the tables' values from the lobes'
+    /// [`GlassColumn`](super::dielectric::GlassColumn) in a batch of at least
+    /// [`GLASS_COLUMN_QUERIES`] queries, else from the lobes' tables.
     fn compose_f(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>) {
         if f.0.len() >= GLASS_COLUMN_QUERIES {
             glass_f(self, &self.lobes.column(self.scheme), wo, wi, f);

@@ -204,7 +204,16 @@ fn load() -> String {
 
 fn main() -> Result<(), microsurface::Error> {
     #[cfg(target_arch = "x86_64")]
-    let isa = if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+    let avx2 = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+    #[cfg(target_arch = "x86_64")]
+    let isa = if avx2
+        && std::is_x86_feature_detected!("avx512f")
+        && std::is_x86_feature_detected!("avx512vl")
+        && std::is_x86_feature_detected!("avx512dq")
+        && std::is_x86_feature_detected!("avx512bw")
+    {
+        "AVX-512 (16 f32 lanes)"
+    } else if avx2 {
         "AVX2 + FMA (8 f32 lanes)"
     } else {
         "SSE2 (8 f32 lanes as two 4-lane halves)"

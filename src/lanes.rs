@@ -4,9 +4,9 @@
 //!
 //! Every operation of a lane type is the same IEEE operation applied to each lane, in the same
 //! order (no fused multiply-add, no reassociation). The batch calls run the f32 instances in
-//! loops over their queries, which LLVM vectorizes (eight queries per AVX2 instruction inside
-//! [`dispatch`]'s AVX2 build, four per SSE2 instruction otherwise), so a batch answer is, query
-//! by query, the very bits of the f32 kernel. Branches of a formula are [`Lanes::choose`] (a
+//! loops over their queries, which LLVM vectorizes (sixteen queries per AVX-512 instruction or
+//! eight per AVX2 instruction inside [`dispatch`]'s builds for them, four per SSE2 instruction
+//! otherwise), so a batch answer is, query by query, the very bits of the f32 kernel. Branches of a formula are [`Lanes::choose`] (a
 //! branch for one lane, both sides blended for several) or [`Lanes::select`] (both sides
 //! computed: what a vectorized loop does with a branch anyway).
 
@@ -325,20 +325,46 @@ impl V3<f32> {
     }
 }
 
-/// Whether this CPU runs the AVX2 + FMA build of the batch loops (checked once).
+/// The instruction sets [`dispatch`] compiles the batch loops for, best first.
+#[cfg(target_arch = "x86_64")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum InstructionSet {
+    /// AVX-512 (F, VL, DQ, BW) with AVX2 and FMA: sixteen f32 lanes per instruction.
+    Avx512,
+    /// AVX2 and FMA: eight f32 lanes per instruction.
+    Avx2,
+    /// The build's baseline (SSE2 on x86-64): four lanes.
+    Baseline,
+}
+
+/// The best instruction set of this CPU for the batch loops (checked once per process).
 #[cfg(target_arch = "x86_64")]
 #[inline]
-pub(crate) fn has_avx2() -> bool {
+fn instruction_set() -> InstructionSet {
     use std::sync::atomic::{AtomicU8, Ordering};
+    const SETS: [InstructionSet; 3] =
+        [InstructionSet::Avx512, InstructionSet::Avx2, InstructionSet::Baseline];
+    // 0: not checked yet; k + 1: SETS[k]
     static STATE: AtomicU8 = AtomicU8::new(0);
     match STATE.load(Ordering::Relaxed) {
-        1 => true,
-        2 => false,
-        _ => {
-            let yes = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
-            STATE.store(if yes { 1 } else { 2 }, Ordering::Relaxed);
-            yes
+        0 => {
+            let avx2 = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+            let avx512 = avx2
+                && std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512vl")
+                && std::is_x86_feature_detected!("avx512dq")
+                && std::is_x86_feature_detected!("avx512bw");
+            let k = if avx512 {
+                0
+            } else if avx2 {
+                1
+            } else {
+                2
+            };
+            STATE.store(k as u8 + 1, Ordering::Relaxed);
+            SETS[k]
         }
+        k => SETS[usize::from(k - 1).min(2)],
     }
 }
 
@@ -348,20 +374,28 @@ pub(crate) trait LaneLoop {
     fn run(&mut self);
 }
 
-/// Runs `op` compiled with AVX2 and FMA where the CPU has them (checked once per process), and
-/// compiled for the build's baseline (SSE2 on x86-64) otherwise. The arithmetic is the same
-/// IEEE operations either way (no fused multiply-adds are formed), so both give the same bits.
+/// Runs `op` compiled for the CPU's best instruction set (checked once per process): AVX-512
+/// (sixteen lanes), AVX2 with FMA (eight), or the build's baseline (SSE2 on x86-64: four). The
+/// arithmetic is the same IEEE operations in every build (no fused multiply-adds are formed),
+/// so all give the same bits.
 #[inline]
 #[allow(unsafe_code)]
 pub(crate) fn dispatch<Op: LaneLoop>(op: &mut Op) {
     #[cfg(target_arch = "x86_64")]
-    {
-        if has_avx2() {
-            // SAFETY: the CPU supports AVX2 and FMA (checked above).
-            unsafe { run_avx2(op) };
-            return;
-        }
+    match instruction_set() {
+        // SAFETY: the CPU supports AVX-512 F, VL, DQ and BW, AVX2 and FMA (checked above).
+        InstructionSet::Avx512 => return unsafe { run_avx512(op) },
+        // SAFETY: the CPU supports AVX2 and FMA (checked above).
+        InstructionSet::Avx2 => return unsafe { run_avx2(op) },
+        InstructionSet::Baseline => {}
     }
+    op.run();
+}
+
+/// [`LaneLoop::run`] compiled with AVX-512 (F, VL, DQ, BW), AVX2 and FMA enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
+fn run_avx512<Op: LaneLoop>(op: &mut Op) {
     op.run();
 }
 

@@ -112,7 +112,7 @@
 //! `data-driven` ([`tabulated`]). A renderer that needs only this page's types, the compensated
 //! lobes and the walk builds with `default-features = false`.
 
-// No unsafe code, except the runtime dispatch of the batch loops to their AVX2 build
+// No unsafe code, except the runtime dispatch of the batch loops to their AVX-512 and AVX2 builds
 // (`lanes::dispatch`: a call of a `#[target_feature]` function after the CPU check).
 #![deny(unsafe_code)]
 #![deny(missing_docs)]

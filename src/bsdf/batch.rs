@@ -102,7 +102,7 @@ impl SampleOutputs<'_> {
 /// The provided methods call the scalar methods query by query. The crate's lobes override
 /// them:
 ///
-/// * [`MicrofacetBsdf`]: eight-lane loops for single scattering on GGX conductors and
+/// * [`MicrofacetBsdf`]: vectorized loops for single scattering on GGX conductors and
 ///   dielectrics (η at least 0.05 from 1), the scalar calls for every other configuration;
 ///   the bounds against the scalar calls are stated on its implementation.
 /// * [`Compensated`](crate::Compensated) of a conductor or a dielectric, every scheme: the

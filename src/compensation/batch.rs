@@ -1,5 +1,5 @@
 //! The batch calls of the compensated lobes ([`BatchBsdf`]): single scattering's batch (in
-//! eight lanes where [`MicrofacetBsdf`] has them, by its scalar calls elsewhere), then one pass
+//! vector lanes where [`MicrofacetBsdf`] has them, by its scalar calls elsewhere), then one pass
 //! over the queries that ends each as the scalar call ends it, with the same functions: the
 //! added lobe or Turquin's factor on f, the sampling mixture on the density, Turquin's factor
 //! on a sample's weight. A conductor's pass runs those functions in three stages per block of
@@ -467,7 +467,7 @@ fn sample_batch<B: Composition>(
     Ok(())
 }
 
-/// The batch calls of the compensated conductor: single scattering's batch (eight lanes on GGX),
+/// The batch calls of the compensated conductor: single scattering's batch (vector lanes on GGX),
 /// then each query's compensation by the scalar calls' own functions (see the bounds on
 /// [`BatchBsdf`] for [`MicrofacetBsdf`], which carry over: 1 − E and the mixture density are
 /// the scalar call's bits, so densities are equal bit for bit and f errs by single scattering's
@@ -512,7 +512,7 @@ impl<S: MicrosurfaceSlope> BatchBsdf for Compensated<S, Conductor> {
 }
 
 /// The batch calls of the compensated dielectric, as the conductor's: single scattering's
-/// batch (eight lanes on GGX, η at least 0.05 from 1), then each query's compensation by the
+/// batch (vector lanes on GGX, η at least 0.05 from 1), then each query's compensation by the
 /// scalar calls' own expression. f and the density err by single scattering's batch bounds
 /// ([`MicrofacetBsdf`]'s), carried through the added lobe, the mixture's weight of
 /// single scattering and Turquin's factor; Turquin's samples are single scattering's batch

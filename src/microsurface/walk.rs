@@ -534,6 +534,15 @@ impl Heights for Depth {
                 }
                 self
             }
+            // a dielectric's first hit held as C¹ ([`Depth::two_sided`]), seen from either
+            // side, and a ray going up: most escape without the logarithm
+            None if !lazy && self.0 > 0.0 && w.z >= 0.0 => {
+                let u = uniform(rng);
+                if escapes_from_held_c1(lambda, self.0, u) {
+                    return None;
+                }
+                Depth::at(next_ln_c1(w.z, lambda, self.ln_c1(), u)?)
+            }
             _ => {
                 let ln_c1 = Microsurface::<H, S, M>::drawn(self, rng);
                 Depth::at(next_ln_c1(w.z, lambda, ln_c1, uniform(rng))?)
@@ -542,9 +551,9 @@ impl Heights for Depth {
         Some(Vertex { depth, lambda, incident_area: incident_area(w.z, lambda) })
     }
 
-    /// ln(1 − C¹) ([`flip_ln_c1`]), the depth drawn first if it was not; ln(1 − C¹) of C¹
-    /// itself where the depth holds it ([`Depth::two_sided`]: one logarithm of the exact
-    /// 1 − C¹).
+    /// ln(1 − C¹) ([`flip_ln_c1`]), the depth drawn first if it was not; 1 − C¹ itself (exact)
+    /// where the depth holds C¹ ([`Depth::two_sided`]: the point seen from the other side,
+    /// held alike, its logarithm taken where it is needed).
     #[inline(always)]
     fn other_side<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         at: &Vertex<Self>,
@@ -552,7 +561,7 @@ impl Heights for Depth {
         rng: &mut impl Rng,
     ) -> Self {
         if !Microsurface::<H, S, M>::LAZY && at.depth.0 > 0.0 {
-            return Depth::at(ln_f32(1.0 - at.depth.0));
+            return Depth::two_sided(1.0 - at.depth.0);
         }
         Depth::at(flip_ln_c1(Microsurface::<H, S, M>::drawn(at.depth, rng)))
     }
@@ -573,9 +582,10 @@ impl Heights for Depth {
             None if !Microsurface::<H, S, M>::LAZY => (bounce == 1 && same_side).then_some(-at.lambda),
             None => None,
         };
-        // a depth holding C¹ ([`Depth::two_sided`]) is the first hit's, whose masking on its
-        // own side is closed
-        debug_assert!(closed.is_some() || seen.0 <= 0.0, "C¹ {} where ln C¹ is needed", seen.0);
+        // ln C¹ of a point held as C¹ ([`Depth::two_sided`]): the first hit's seen from ωo
+        // across the interface (on its own side, its masking is closed)
+        let seen =
+            if Microsurface::<H, S, M>::LAZY || closed.is_some() { seen } else { Depth::at(seen.ln_c1()) };
         masking(closed, seen, lambda_o)
     }
 }
@@ -668,13 +678,14 @@ impl Depth {
 
     /// A dielectric's first hit (from above, with Λ(ωi) ≤ [`TWO_SIDED_UP_TO`]) drawn as
     /// max(C, W) by [`first_hit_two_sided`]: ln C¹ ≤ 0 where W is the maximum, and where the
-    /// uniform C is, C¹ = C ∈ (0, 1) itself. Its point is then known on both sides of the
-    /// interface with one logarithm each and no exponential: ln C¹ ([`Depth::ln_c1`]) on its
-    /// side, ln(1 − C¹) of the exact 1 − C on the other (`Heights::other_side`, where
+    /// uniform C is, C¹ = C ∈ (0, 1) itself. Its point is then held on both sides of the
+    /// interface: C¹ on its side, the exact 1 − C¹ on the other (`Heights::other_side`, where
     /// [`flip_ln_c1`] would take an exponential and a logarithm after the logarithm of the
-    /// draw). The walk takes only the one it needs: the refracted ray's (nine in ten at
-    /// the listing's glass), and ωo's across the interface in `eval` (its masking on the
-    /// first hit's own side is closed, see [`masking`]).
+    /// draw), each logarithm ([`Depth::ln_c1`]) taken only where the walk needs it: for the
+    /// masking of ωo across the interface in `eval` (on the first hit's own side it is closed,
+    /// see [`masking`]), and for the step of a ray leaving the point that the escape bound
+    /// [`escapes_from_held_c1`] does not send out (the refracted ray escapes without any
+    /// logarithm nine times in ten at the listing's glass).
     #[inline(always)]
     fn two_sided(depth: f32) -> Self {
         Self(depth)
@@ -733,6 +744,18 @@ impl Depth {
             self.0
         }
     }
+}
+
+/// Whether a ray going up with Λ = `lambda` ≥ 0 from a point held as C¹ = `c1`
+/// ([`Depth::two_sided`]: a multiple of 2⁻²⁴ in (0, 1), 1 − C¹ exact) escapes for the uniform
+/// `u`, decided without a logarithm: where u C¹ ≥ Λ (1 − C¹) (products of f32, exact in f64),
+/// ln(1 − u) ≤ −u ≤ −Λ (1 − C¹)/C¹ ≤ Λ ln C¹, the escape of [`next_ln_c1`] (whose cut only
+/// raises u) in exact arithmetic. Decides most escapes of the rays leaving a dielectric's
+/// first hit (Λ small): the refracted ray's, nine in ten at the listing's glass, then needs
+/// no logarithm at all.
+#[inline(always)]
+fn escapes_from_held_c1(lambda: f32, c1: f32, u: f32) -> bool {
+    f64::from(u) * f64::from(c1) >= f64::from(lambda) * f64::from(1.0 - c1)
 }
 
 /// The masking factor of the next-event estimate at a hit at `depth`, seen from ωo's side
@@ -795,7 +818,7 @@ pub(crate) fn incident_area(z: f32, lambda: f32) -> Option<f32> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Depth, Heights, TWO_SIDED_UP_TO, Vertex, incident_area};
+    use super::{Depth, Heights, TWO_SIDED_UP_TO, Vertex, escapes_from_held_c1, incident_area};
     use crate::height::UniformHeight;
     use crate::material::{Conductor, Dielectric};
     use crate::microsurface::geometry::{MIN_HIT_DEPTH, first_hit_two_sided, flip_ln_c1, next_ln_c1};
@@ -858,8 +881,9 @@ mod tests {
     /// ([`first_hit_two_sided`]) has the CDF c^a, a = 1 + Λ(ωi), as Algorithm 1 from above
     /// the surface draws it: N = 200 000 draws per Λ(ωi) (0, the listing's 0.018, 0.3 and
     /// [`TWO_SIDED_UP_TO`]), χ² of C¹^a on 20 equal bins at α = 1e-4 each (family-wise 4e-4).
-    /// Both sides of a point drawn as C¹ itself are within 0.51 f32 ulp of ln C¹ and
-    /// ln(1 − C¹) (1 − C¹ exact) in f64; a point drawn as ln C¹ is flipped by [`flip_ln_c1`].
+    /// A point drawn as C¹ itself is held as 1 − C¹ (exact) on the other side, and the
+    /// logarithms of both are within 0.51 f32 ulp of ln C¹ and ln(1 − C¹) in f64; a point
+    /// drawn as ln C¹ is flipped by [`flip_ln_c1`].
     #[test]
     fn two_sided_first_hit_law_is_algorithm_1s() {
         const N: usize = 200_000;
@@ -881,16 +905,18 @@ mod tests {
                 let ln_c1 = depth.ln_c1();
                 assert!(ln_c1 <= -MIN_HIT_DEPTH, "Λ(ωi) = {lambda_i}: ln C¹ = {ln_c1}");
                 let vertex = Vertex { depth, lambda: -1.0 - lambda_i, incident_area: None };
-                let other = <Depth as Heights>::other_side(&vertex, &surface, &mut rng).0;
+                let other = <Depth as Heights>::other_side(&vertex, &surface, &mut rng);
                 if depth.0 > 0.0 {
                     uniform_wins += 1;
                     let c1 = f64::from(depth.0);
+                    assert_eq!(f64::from(other.0), 1.0 - c1, "the other side holds 1 − C¹ exactly");
+                    let ln_other = other.ln_c1();
                     assert!(
-                        ulps(-ln_c1, -c1.ln()) <= 0.51 && ulps(-other, -(1.0 - c1).ln()) <= 0.51,
-                        "C¹ = {c1}: ln C¹ {ln_c1}, ln(1 − C¹) {other}"
+                        ulps(-ln_c1, -c1.ln()) <= 0.51 && ulps(-ln_other, -(1.0 - c1).ln()) <= 0.51,
+                        "C¹ = {c1}: ln C¹ {ln_c1}, ln(1 − C¹) {ln_other}"
                     );
                 } else {
-                    assert_eq!(other, flip_ln_c1(ln_c1));
+                    assert_eq!(other.0, flip_ln_c1(ln_c1));
                 }
                 let v = (a * f64::from(ln_c1)).exp();
                 counts[((v * BINS as f64) as usize).min(BINS - 1)] += 1;
@@ -901,6 +927,28 @@ mod tests {
             // the uniform is the maximum with probability 1/a
             assert!(uniform_wins > N / 2, "Λ(ωi) = {lambda_i}: the uniform won {uniform_wins} of {N}");
         }
+    }
+
+    /// The escape bound of a point held as C¹ ([`escapes_from_held_c1`]) decides only
+    /// escapes, and those of [`next_ln_c1`]: 10⁶ draws of C¹ (multiples of 2⁻²⁴), u and
+    /// Λ ∈ {0, 0.008, 0.3, 4}, with both outcomes of the bound seen often.
+    #[test]
+    fn held_c1_escape_bound_is_next_ln_c1s() {
+        let mut rng = Pcg64Mcg::seed_from_u64(89);
+        let (mut decided, mut left) = (0usize, 0usize);
+        for k in 0..1_000_000 {
+            let lambda = [0.0f32, 0.008, 0.3, 4.0][k % 4];
+            let c1 = (1.0 - uniform(&mut rng)).min(1.0 - 1.0 / 16_777_216.0);
+            let u = uniform(&mut rng);
+            if escapes_from_held_c1(lambda, c1, u) {
+                decided += 1;
+                let ln_c1 = Depth::two_sided(c1).ln_c1();
+                assert_eq!(next_ln_c1(0.5, lambda, ln_c1, u), None, "Λ = {lambda}, C¹ = {c1}, u = {u}");
+            } else {
+                left += 1;
+            }
+        }
+        assert!(decided > 300_000 && left > 100_000, "decided {decided}, left {left}");
     }
 
     /// The f32 ulps between `a` and the exact `b`, relative to b.

@@ -313,7 +313,6 @@ pub(crate) fn reflectance_scaled_of<L: Lanes>(eta: L, k: L, l_sq: L) -> (L, L) {
 impl Material for Dielectric {
     const TRANSMITS: bool = true;
     const EXACT_PHASE_PDF: bool = true;
-    const UNIT_WEIGHT: bool = true;
 
     #[inline]
     fn lane_material(&self) -> LaneMaterial {

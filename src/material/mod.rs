@@ -103,13 +103,6 @@ pub trait Material: crate::sealed::Sealed + Copy + core::fmt::Debug + Send + Syn
     #[doc(hidden)]
     const VERTEX_HAS_INCIDENT_AREA: bool = false;
 
-    /// Whether every phase sample's weight is exactly 1 (dielectrics: the Fresnel term chooses
-    /// the event instead of weighting it), so that the walks carry no path throughput: the
-    /// weight comes back from a sampler that is not inlined, and multiplying it in and testing
-    /// the product for absorption cost a dielectric walk 10 instructions per bounce.
-    #[doc(hidden)]
-    const UNIT_WEIGHT: bool = false;
-
     /// The phase function p(ωi, ωo) times the per-channel weight (Fresnel, albedo), for the
     /// interaction's sides. Stochastic (unbiased) for the diffuse material, exact otherwise
     /// (the formulas are on each material's type).

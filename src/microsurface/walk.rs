@@ -275,8 +275,7 @@ impl<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material> Microsurface<H, S
             };
             wr = s.wo;
             side = next_side;
-            // a unit weight leaves the path's weight at 1 (`Material::UNIT_WEIGHT`)
-            if !M::UNIT_WEIGHT && !estimator.carry(s.weight) {
+            if !estimator.carry(s.weight) {
                 return estimator.end();
             }
             let Some(next) = depth.hit(self, wr, side, rng) else {

@@ -25,7 +25,7 @@ pub(crate) use exp::{EXP_NONPOSITIVE_FROM, ROUNDING_MAGIC, exp_nonpositive};
 pub use gamma::{beta, ln_beta, ln_gamma};
 pub(crate) use gauss_legendre::{GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_16};
 pub(crate) use gaussian::gaussian_integral_and_half;
-pub(crate) use ln::{exp_f32, ln_1m_exp_f32, ln_f32, ln_of};
+pub(crate) use ln::{exp_f32, ln, ln_1m_exp_f32, ln_f32, ln_of};
 pub(crate) use stirling::{beta_1p_of, ln_beta_1p_of};
 pub(crate) use tail_ratio::tail_ratio;
 pub use trig::sin_cos_turns;

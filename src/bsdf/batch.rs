@@ -356,15 +356,16 @@ fn transmission_density<L: Lanes>(ax: L, ay: L, eta: L, wo: V3<L>, wi: V3<L>) ->
     let h = V3::select(up, sum, V3::new(-sum.x, -sum.y, -sum.z));
     let len_sq = h.length_squared();
     let len = len_sq.sqrt();
-    let (cos_ih, cos_oh) = (wo.dot(h) / len, wi.dot(h) / len);
+    let inv_len = L::lit(1.0) / len;
+    let (cos_ih, cos_oh) = (wo.dot(h) * inv_len, wi.dot(h) * inv_len);
     let margin = L::lit(REFRACTION_MARGIN);
     let valid = h.z.gt(margin * len) & cos_ih.gt(margin) & cos_oh.lt(-margin);
     let invalid = h.z.lt(-margin * len) | cos_ih.lt(-margin) | cos_oh.gt(margin);
     let d = d_of_sum(ax, ay, h, L::lit(core::f32::consts::FRAC_1_PI));
     let (lambda, area) = lambda_and_area_of(ax, ay, wo);
     let transmittance = transmittance_dielectric_cosines_of(cos_ih, -cos_oh, eta);
-    let d_wi = cos_ih * d / area;
-    let pdf = eta * eta * transmittance * d_wi * (-cos_oh) / len_sq;
+    // D_ωo(ωh) = cos_ih D/A(ωo) and the Jacobian's 1/|h|² under one division
+    let pdf = eta * eta * transmittance * (cos_ih * d) * (-cos_oh) / (area * len_sq);
     let sane = len.gt(L::lit(DIELECTRIC_LANES_MIN_CONTRAST)) & len_sq.ge(L::lit(F32_DENSITY_MIN_SUM));
     (L::select(valid, pdf, zero), lambda, valid, sane & (valid | invalid))
 }

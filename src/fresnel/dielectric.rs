@@ -54,7 +54,9 @@ pub(crate) fn fresnel_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) -> L {
     let (num_s, den_s) = (c - eta * t, c + eta * t);
     let (num_p, den_p) = (eta * c - t, eta * c + t);
     let zero = L::lit(0.0);
-    let (rs, rp) = (num_s / den_s, num_p / den_p);
+    // (one division for both ratios)
+    let inv = L::lit(1.0) / (den_s * den_p);
+    let (rs, rp) = (num_s * den_p * inv, num_p * den_s * inv);
     L::select(den_s.le(zero) | den_p.le(zero), L::lit(1.0), L::lit(0.5) * (rs * rs + rp * rp))
 }
 
@@ -71,6 +73,8 @@ pub(crate) fn transmittance_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) 
     let (den_s, den_p) = (c + eta * t, eta * c + t);
     let zero = L::lit(0.0);
     let two_eta_ct = L::lit(2.0) * eta * c * t;
-    let value = two_eta_ct / (den_s * den_s) + two_eta_ct / (den_p * den_p);
+    // (one division for both terms)
+    let (den_s2, den_p2) = (den_s * den_s, den_p * den_p);
+    let value = two_eta_ct * (den_s2 + den_p2) / (den_s2 * den_p2);
     L::select(den_s.le(zero) | den_p.le(zero), zero, value)
 }

@@ -151,8 +151,8 @@ impl Dielectric {
     /// 1 − F = [`transmittance_dielectric_cosines_of`](kᵢ, kₒ, η) (homogeneous in the cosines)
     /// and D(ωh)/(|h|⁴ A) from h directly
     /// ([`MicrosurfaceSlope::d64_over_len4_area_unchecked`]): no square root, no normalization
-    /// and, for GGX, three divisions independent of one another (the transmittance's two and
-    /// D's). In f64, rounded once.
+    /// and, for GGX, two divisions independent of one another (the transmittance's and D's).
+    /// In f64, rounded once.
     #[inline(always)]
     fn transmission_density_of_sum<S: MicrosurfaceSlope>(
         &self,

@@ -120,10 +120,12 @@ pub(crate) fn d_of<L: Lanes>(ax: L, ay: L, m: V3<L>, frac_1_pi: L) -> L {
 
 /// |h|²/t with t = h.x²/αx² + h.y²/αy² + h.z², and |h|² and t themselves: D of the direction of
 /// an unnormalized h is (|h|²/t)²/(π αx αy) (D is homogeneous of degree 0). Sums of squares
-/// only: a few ulps of the lane type for every h.
+/// only: a few ulps of the lane type for every h. The coordinates are scaled by 1/αx and 1/αy,
+/// which a loop over queries of one roughness forms once (one division per query, not three).
 #[inline(always)]
 pub(crate) fn sum_ratio<L: Lanes>(ax: L, ay: L, h: V3<L>) -> (L, L, L) {
-    let (x, y) = (h.x / ax, h.y / ay);
+    let one = L::lit(1.0);
+    let (x, y) = (h.x * (one / ax), h.y * (one / ay));
     let t = x * x + y * y + h.z * h.z;
     let len_sq = h.length_squared();
     (len_sq / t, len_sq, t)
@@ -133,7 +135,8 @@ pub(crate) fn sum_ratio<L: Lanes>(ax: L, ay: L, h: V3<L>) -> (L, L, L) {
 #[inline(always)]
 pub(crate) fn d_of_sum<L: Lanes>(ax: L, ay: L, h: V3<L>, frac_1_pi: L) -> L {
     let (ratio, _, _) = sum_ratio(ax, ay, h);
-    frac_1_pi * (ratio * ratio) / (ax * ay)
+    // (1/(π αx αy) formed once per roughness in a loop over queries)
+    (ratio * ratio) * (frac_1_pi / (ax * ay))
 }
 
 /// Λ(ω) on the whole sphere (saturated at ±`f32::MAX` in f32 lanes) and the projected area
@@ -150,7 +153,8 @@ pub(crate) fn lambda_and_area_of<L: Lanes>(ax: L, ay: L, w: V3<L>) -> (L, L) {
 #[inline(always)]
 pub(crate) fn reflection_density_of<L: Lanes>(ax: L, ay: L, h: V3<L>, area: L) -> (L, L, L) {
     let (ratio, len_sq, t) = sum_ratio(ax, ay, h);
-    (L::lit(FRAC_1_4PI) * (ratio * ratio) / (ax * ay * area), len_sq, t)
+    // (1/(4π αx αy) formed once per roughness in a loop over queries)
+    ((ratio * ratio) * (L::lit(FRAC_1_4PI) / (ax * ay)) / area, len_sq, t)
 }
 
 impl Ggx {

@@ -216,7 +216,7 @@ fn main() -> Result<(), microsurface::Error> {
     } else if avx2 {
         "AVX2 + FMA (8 f32 lanes)"
     } else {
-        "SSE2 (8 f32 lanes as two 4-lane halves)"
+        "SSE2 (4 f32 lanes)"
     };
     #[cfg(not(target_arch = "x86_64"))]
     let isa = "the build's baseline";

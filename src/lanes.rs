@@ -6,9 +6,10 @@
 //! order (no fused multiply-add, no reassociation). The batch calls run the f32 instances in
 //! loops over their queries, which LLVM vectorizes (sixteen queries per AVX-512 instruction or
 //! eight per AVX2 instruction inside [`dispatch`]'s builds for them, four per SSE2 instruction
-//! otherwise), so a batch answer is, query by query, the very bits of the f32 kernel. Branches of a formula are [`Lanes::choose`] (a
-//! branch for one lane, both sides blended for several) or [`Lanes::select`] (both sides
-//! computed: what a vectorized loop does with a branch anyway).
+//! otherwise), so a batch answer is, query by query, the very bits of the f32 kernel. Branches
+//! of a formula are [`Lanes::choose`] (a branch for one lane, both sides blended for several)
+//! or [`Lanes::select`] (both sides computed: what a vectorized loop does with a branch
+//! anyway).
 
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 use glam::{BVec3A, Vec3, Vec3A};

@@ -534,8 +534,9 @@ fn compensated_conductor_batches_are_the_scalar_calls() {
     }
 }
 
-/// Compensated gold and glass in small batches (1, 15, 31 and 63 queries, on both sides of the
-/// sizes from which the lobes lay out their tables' values for the batch; every scheme), invalid
+/// Compensated gold and glass in small batches (1, 15, 31 and 63 queries: on both sides of the
+/// sizes from which glass and gold's Kulla–Conty and Turquin lobes lay out their tables' values
+/// for the batch, and below gold's walk's; every scheme), invalid
 /// and drifted directions among them: on Beckmann slopes, whose single scattering is its scalar
 /// calls in a batch, equal to the scalar calls bit for bit (the same functions of f and the
 /// density; the odd queries, the scalar calls themselves).

@@ -1,14 +1,14 @@
 //! The batch interface: eval, pdf, eval_with_pdf and sample over many queries at once, in
 //! structure-of-arrays slices, with the single-scattering GGX conductor and dielectric run in
-//! eight f32 lanes.
+//! vector lanes (sixteen f32 with AVX-512, eight with AVX2, four otherwise).
 //!
 //! # Layout
 //!
 //! Directions are three `&[f32]` slices (x, y, z), colours three, and every output is a slice
-//! the caller provides (nothing is allocated). Eight consecutive queries form one chunk: each
-//! coordinate of a chunk is one 256-bit load, the layout a wavefront renderer already keeps its
-//! rays in (Mitsuba 3 and Dr.Jit, pbrt-v4's GPU wavefront queues) and the one SIMD code needs
-//! without transposes. The last `len % 8` queries take the scalar calls.
+//! the caller provides (nothing is allocated). Consecutive queries fill a vector's lanes: each
+//! coordinate of sixteen (or eight) queries is one 512-bit (or 256-bit) load, the layout a
+//! wavefront renderer already keeps its rays in (Mitsuba 3 and Dr.Jit, pbrt-v4's GPU wavefront
+//! queues) and the one SIMD code needs without transposes.
 //!
 //! # One formula, two control flows
 //!
@@ -254,6 +254,9 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             return None;
         }
         let (ax, ay) = self.surface().slope().ggx_roughness()?;
+        if !(ax.min(ay) >= LANES_MIN_ALPHA) {
+            return None;
+        }
         match self.surface().material().lane_material() {
             LaneMaterial::Conductor(fresnel) => Some(Kernel::Conductor { ax, ay, fresnel }),
             // near η = 1 the refraction half vector cancels: the f64 scalar path serves
@@ -266,6 +269,11 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
         }
     }
 }
+
+/// The smallest αx and αy of a GGX lobe whose batch calls run in lanes: the kernels scale by
+/// 1/αx, 1/αy and 1/(π αx αy), at most 3.2e29 from here on. Below it (a lobe sharp along one
+/// axis, or a Dirac-like one) the scalar calls serve.
+const LANES_MIN_ALPHA: f32 = 1e-15;
 
 /// The smallest |η − 1| of a dielectric whose batch calls run in lanes: |ωo + η ωi| ≥ |η − 1|,
 /// so the f32 refraction half vector keeps 2⁻²⁴/0.05 of relative precision.

@@ -238,7 +238,7 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
     }
     /// Query by query, as f's, the lobes read at the view once for both.
     fn compose_f_pdf(&self, wo: Slices<'_>, wi: Slices<'_>, f: SlicesMut<'_>, pdf: &mut [f32]) {
-        if pdf.len() >= GLASS_COLUMN_QUERIES {
+        if f.0.len() >= GLASS_COLUMN_QUERIES {
             glass_f_pdf(self, &self.lobes.column(self.scheme), wo, wi, f, pdf);
         } else {
             glass_f_pdf(self, &self.lobes, wo, wi, f, pdf);
@@ -248,9 +248,9 @@ impl<S: MicrosurfaceSlope> Composition for Compensated<S, Dielectric> {
 
 /// The batch size from which a compensated dielectric lays out its tables' values at its
 /// (roughness, index) ([`GlassColumn`](super::dielectric::GlassColumn)). Its construction
-/// costs about 4300 instructions (Turquin's 1300); in a batch of 1024 queries it saves 160
-/// (f of the walk's split) to 60 (Turquin's f) instructions per query, so that it pays from
-/// about 30 queries.
+/// costs about 4300 instructions (Turquin's 1300); in a batch of 1024 queries it saves 56
+/// (Turquin's f) to 205 (`eval_with_pdf` of the additive schemes) instructions per query
+/// against the lobes' own tables, so that it pays from about 30 queries.
 const GLASS_COLUMN_QUERIES: usize = 32;
 
 /// [`Composition::compose_f`] of a compensated dielectric with the tables' values from

@@ -326,7 +326,7 @@ impl DielectricLobes {
 /// every node (the same bits).
 pub(super) trait GlassFactors {
     /// The lobes' values (D, ΔT') of view side `view` at the loss grid's direction nodes i and
-    /// i + 1 (i ≤ 22).
+    /// i + 1 (i ≤ 22, the loss grid's last cell).
     fn lobe_nodes(&self, view: usize, i: usize) -> (Vec2, Vec2);
     /// The light profile's line in μ cell k for a view on side `a` and a crossing `c`
     /// ([`DielectricLobes::profile_line`]).
@@ -352,7 +352,7 @@ impl GlassFactors for DielectricLobes {
 }
 
 /// A compensated dielectric's values at its (roughness, index) for every node of the
-/// direction axes, laid out for a batch ([`DielectricLobes::column`]; 1.6 KB): each query then
+/// direction axes, laid out for a batch ([`DielectricLobes::column`]; 1.5 KiB): each query then
 /// reads two nodes per lobe value (where the lobes blend eight table entries) and one line per
 /// profile density (where they read four rows).
 pub(super) struct GlassColumn {

@@ -63,7 +63,8 @@ pub(crate) fn fresnel_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) -> L {
 /// The unpolarized dielectric transmittance 1 − F of [`fresnel_dielectric_cosines_of`] for
 /// every lane type, without its cancellation where F is close to 1 (grazing incidence):
 /// 1 − Rs² = 4ηct/(c + ηt)² and 1 − Rp² = 4ηct/(ηc + t)², so
-/// 1 − F = 2ηct (1/(c + ηt)² + 1/(ηc + t)²): a few ulps relative to the transmittance itself
+/// 1 − F = 2ηct (1/(c + ηt)² + 1/(ηc + t)²), formed as 2ηct ((c + ηt)² + (ηc + t)²) q² with
+/// q = 1/((c + ηt)(ηc + t)): a few ulps relative to the transmittance itself
 /// (1 − F formed by subtraction is a few ulps of 1). Homogeneous of degree 0 in (c, t), so
 /// cosines given with a common positive scale serve as well. 0 where a denominator is not
 /// positive (F = 1 there).
@@ -73,8 +74,9 @@ pub(crate) fn transmittance_dielectric_cosines_of<L: Lanes>(c: L, t: L, eta: L) 
     let (den_s, den_p) = (c + eta * t, eta * c + t);
     let zero = L::lit(0.0);
     let two_eta_ct = L::lit(2.0) * eta * c * t;
-    // (one division for both terms)
-    let (den_s2, den_p2) = (den_s * den_s, den_p * den_p);
-    let value = two_eta_ct * (den_s2 + den_p2) / (den_s2 * den_p2);
+    // 2ηct (den_s² + den_p²)/(den_s den_p)²: one division, its reciprocal squared as two
+    // factors (no fourth power of the denominators, which would overflow f32 from η ≈ 6e9)
+    let q = L::lit(1.0) / (den_s * den_p);
+    let value = (two_eta_ct * q) * ((den_s * den_s + den_p * den_p) * q);
     L::select(den_s.le(zero) | den_p.le(zero), zero, value)
 }

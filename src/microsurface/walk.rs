@@ -352,7 +352,9 @@ impl<D: Heights> Estimator<D> for Evaluation<D> {
     /// The next-event term (where `order` counts the bounce) and the next direction in one
     /// material call; at the last bounce the term alone. Where ωo lies across the interface
     /// (a dielectric), the masking takes the vertex's point seen from ωo's side, which is
-    /// returned for a crossing of the sampled direction: one ln(1 − C¹) per vertex.
+    /// returned for a crossing of the sampled direction: at most one ln(1 − C¹) per vertex
+    /// (none for a first hit held as C¹, whose masking across takes the logarithm of 1 − C¹,
+    /// and whose crossing ray takes it again where its escape bound does not decide).
     #[inline(always)]
     fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         &mut self,
@@ -655,8 +657,8 @@ struct Depth(f32);
 /// The largest Λ(ωi) for which a dielectric's first hit is drawn as max(C, W)
 /// ([`Depth::two_sided`]); beyond, W is the maximum too often (with probability
 /// Λ(ωi)/(1 + Λ(ωi))) for the logarithm it saves where C is. Measured per `eval` of GGX glass
-/// (η = 1.5, θi = 0.5, ωo inside) against the draw of [`next_ln_c1`]: −44 instructions at
-/// α = 0.5 (Λ(ωi) = 0.018), −16 at α = 2 (0.24), even at α = 3 (0.46).
+/// (η = 1.5, θi = 0.5, ωo inside) against the draw of [`next_ln_c1`]: fewer instructions at
+/// α = 0.5 (Λ(ωi) = 0.018) and α = 2 (0.24), even at α = 3 (0.46).
 const TWO_SIDED_UP_TO: f32 = 0.5;
 
 impl Depth {
@@ -726,7 +728,8 @@ impl Depth {
         if self.0 > 0.0 { ln_f32(self.0) } else { self.0 }
     }
 
-    /// The rate a of an undrawn depth, `None` for a drawn one.
+    /// The rate a of an undrawn depth, `None` for a drawn one (opaque walks only: a
+    /// dielectric's positive depth is a first hit held as C¹, [`Depth::two_sided`]).
     #[inline(always)]
     fn rate(self) -> Option<f32> {
         (self.0 > 0.0).then_some(self.0)

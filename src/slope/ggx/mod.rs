@@ -153,8 +153,7 @@ pub(crate) fn lambda_and_area_of<L: Lanes>(ax: L, ay: L, w: V3<L>) -> (L, L) {
 #[inline(always)]
 pub(crate) fn reflection_density_of<L: Lanes>(ax: L, ay: L, h: V3<L>, area: L) -> (L, L, L) {
     let (ratio, len_sq, t) = sum_ratio(ax, ay, h);
-    // (1/(4π αx αy) formed once per roughness in a loop over queries)
-    ((ratio * ratio) * (L::lit(FRAC_1_4PI) / (ax * ay)) / area, len_sq, t)
+    (L::lit(FRAC_1_4PI) * (ratio * ratio) / (ax * ay * area), len_sq, t)
 }
 
 impl Ggx {

@@ -254,7 +254,7 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
             return None;
         }
         let (ax, ay) = self.surface().slope().ggx_roughness()?;
-        if !(ax.min(ay) >= LANES_MIN_ALPHA) {
+        if ax.min(ay) < LANES_MIN_ALPHA {
             return None;
         }
         match self.surface().material().lane_material() {

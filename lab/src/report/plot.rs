@@ -351,10 +351,8 @@ fn lobe_panel(area: &Area, panel: &LobePanel, r_max: f64, full_circle: bool) -> 
     series.push(Curve { label: total_label, color: BLACK, points: total_pts });
     for Curve { color, points, .. } in &series {
         let mut pts = points.clone();
-        if full_circle {
-            if let Some(&p) = pts.first() {
-                pts.push(p);
-            }
+        if full_circle && let Some(&p) = pts.first() {
+            pts.push(p);
         }
         chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))?;
     }

@@ -110,7 +110,7 @@ fn par_map<T: Send>(n: usize, label: &str, f: impl Fn(usize) -> T + Sync) -> Vec
                         }
                         out.push((k, f(k)));
                         let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                        if show && (d % 8 == 0 || d == n) {
+                        if show && (d.is_multiple_of(8) || d == n) {
                             let bar = "#".repeat(40 * d / n);
                             eprint!("\r{label:>24} [{bar:<40}] {d}/{n}");
                         }

@@ -98,13 +98,13 @@ fn walk_counts(family: Family, side: Side, mu: f64, alpha: f64, eta: f64, n: u32
         let (mut r, mut t) = (0, 0);
         for _ in 0..n {
             // a walk that reached the bounce cap (`None`) lost its energy: counts as neither
-            if let Some((wo, bounces)) = sample(&mut rng) {
-                if bounces >= 2 {
-                    if (wo.z > 0.0) == (wi.z > 0.0) {
-                        r += 1;
-                    } else {
-                        t += 1;
-                    }
+            if let Some((wo, bounces)) = sample(&mut rng)
+                && bounces >= 2
+            {
+                if (wo.z > 0.0) == (wi.z > 0.0) {
+                    r += 1;
+                } else {
+                    t += 1;
                 }
             }
         }

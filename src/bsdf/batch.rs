@@ -270,10 +270,14 @@ impl<S: MicrosurfaceSlope, M: Material + SpecularLimit> MicrofacetBsdf<S, M> {
     }
 }
 
-/// The smallest αx and αy of a GGX lobe whose batch calls run in lanes: the kernels scale by
-/// 1/αx, 1/αy and 1/(π αx αy), at most 3.2e29 from here on. Below it (a lobe sharp along one
-/// axis, or a Dirac-like one) the scalar calls serve.
-const LANES_MIN_ALPHA: f32 = 1e-15;
+/// The smallest αx and αy of a GGX lobe whose batch calls run in lanes; a lobe sharper along
+/// one axis takes the scalar calls. Toward α = 0 the f32 kernels' intermediate terms leave the
+/// normal range: the squared ratio of D's unnormalized form underflows off the sharp axis
+/// (about α⁴/h.x⁴, from α ≈ 1e-10), D overflows f32 on it (below αx αy ≈ 1e-39), and at
+/// α = 1e-6 the density of an in-plane refraction was already 1.06e-4 from the scalar call's
+/// (the batch bound is 1e-4; within it at 1e-5). `tests/batch.rs`
+/// (`extreme_anisotropy_batches_are_the_scalar_calls`) checks both sides.
+const LANES_MIN_ALPHA: f32 = 1e-4;
 
 /// The smallest |η − 1| of a dielectric whose batch calls run in lanes: |ωo + η ωi| ≥ |η − 1|,
 /// so the f32 refraction half vector keeps 2⁻²⁴/0.05 of relative precision.

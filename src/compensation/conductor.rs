@@ -163,12 +163,6 @@ impl ConductorLobes {
         Vec3::ONE + Vec3::from(self.scale) * (c_o / (1.0 - c_o))
     }
 
-    /// 1 − E(μo) of a view direction above the horizon, 0 otherwise (no compensation).
-    #[inline(always)]
-    fn view_complement(&self, wo: Vec3) -> f32 {
-        if wo.z > 0.0 { self.complement(self.coordinate(wo.z)) } else { 0.0 }
-    }
-
     /// The direction factors at every node of the albedo table's direction axis, for a batch
     /// (see [`Column`]).
     #[inline]
@@ -524,15 +518,17 @@ impl<S: MicrosurfaceSlope> Compensated<S, Conductor> {
     }
 
     /// Turquin's sample weight from single scattering's sample `weight` for the view `wo`
-    /// (valid): scaled by the view's factor on a rough surface; `None` where not finite. Every
-    /// sample of Turquin's scheme (`sample`, the batch call) ends with this expression.
+    /// (valid): scaled by the view's factor on a rough surface, as f is ([`Self::compose`]);
+    /// `None` where not finite. Every sample of Turquin's scheme (`sample`, the batch call) ends
+    /// with this expression.
     #[inline(always)]
     pub(super) fn turquin_weight(&self, wo: Vec3, weight: Vec3) -> Option<Vec3> {
-        let lobes = &self.lobes;
         let weight = if self.single.is_specular() {
             weight
         } else {
-            weight * lobes.turquin_factor(lobes.view_complement(wo))
+            let turquin = Compensation::Turquin;
+            let (xo, _, w) = self.coordinates_of(turquin, wo.z, 0.0);
+            self.compose(turquin, weight, self.lookups_at(turquin, &self.lobes, xo, 0.0), w)
         };
         weight.is_finite().then_some(weight)
     }

@@ -352,9 +352,10 @@ impl<D: Heights> Estimator<D> for Evaluation<D> {
     /// The next-event term (where `order` counts the bounce) and the next direction in one
     /// material call; at the last bounce the term alone. Where ωo lies across the interface
     /// (a dielectric), the masking takes the vertex's point seen from ωo's side, which is
-    /// returned for a crossing of the sampled direction: at most one ln(1 − C¹) per vertex
-    /// (none for a first hit held as C¹, whose masking across takes the logarithm of 1 − C¹,
-    /// and whose crossing ray takes it again where its escape bound does not decide).
+    /// returned for a crossing of the sampled direction: one ln(1 − C¹) per vertex. A first
+    /// hit held as C¹ returns the exact 1 − C¹ instead; its masking takes the logarithm of
+    /// that, and so does the crossing ray where its escape bound does not decide (rare: passing
+    /// the masking's logarithm on measured 2–5 instructions more per `eval`).
     #[inline(always)]
     fn vertex<H: MicrosurfaceHeight, S: MicrosurfaceSlope, M: Material>(
         &mut self,
